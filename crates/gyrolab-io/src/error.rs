@@ -1,0 +1,86 @@
+//! The error every reader returns: which file, which line and column, what was wrong and what
+//! was expected.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// A column of a delimited file: its 1-based position and, when known, its header name.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ColumnRef {
+    /// 1-based column position.
+    pub index: usize,
+    /// Header name, when the file has one.
+    pub name: Option<String>,
+}
+
+/// A problem with input data, located as precisely as the reader could.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DataError {
+    /// The file (or `<stdin>`, `<built-in ...>`).
+    pub file: PathBuf,
+    /// 1-based line, when the problem is on one line.
+    pub line: Option<u64>,
+    /// Column, when the problem is in one column.
+    pub column: Option<ColumnRef>,
+    /// What was wrong and what was expected.
+    pub message: String,
+}
+
+impl DataError {
+    /// A problem with a file as a whole.
+    pub fn new(file: impl AsRef<Path>, message: impl Into<String>) -> Self {
+        DataError { file: file.as_ref().to_path_buf(), line: None, column: None, message: message.into() }
+    }
+
+    /// Locates the problem on a line.
+    pub fn at_line(mut self, line: u64) -> Self {
+        self.line = Some(line);
+        self
+    }
+
+    /// Locates the problem in a column (1-based index and optional header name).
+    pub fn at_column(mut self, index: usize, name: Option<&str>) -> Self {
+        self.column = Some(ColumnRef { index, name: name.map(str::to_string) });
+        self
+    }
+
+    /// An I/O failure while opening or reading a file.
+    pub fn io(file: impl AsRef<Path>, err: &std::io::Error) -> Self {
+        DataError::new(file, format!("cannot read the file: {err}"))
+    }
+}
+
+impl fmt::Display for DataError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.file.display())?;
+        if let Some(l) = self.line {
+            write!(f, ":{l}")?;
+            if let Some(c) = &self.column {
+                write!(f, ":{}", c.index)?;
+            }
+        }
+        write!(f, ": ")?;
+        if let Some(ColumnRef { name: Some(n), index }) = &self.column {
+            if self.line.is_some() {
+                write!(f, "column '{n}': ")?;
+            } else {
+                write!(f, "column {index} '{n}': ")?;
+            }
+        }
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for DataError {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn display_names_file_line_column() {
+        let e = DataError::new("x.csv", "found 'abc', expected a number").at_line(12).at_column(4, Some("output_v"));
+        assert_eq!(e.to_string(), "x.csv:12:4: column 'output_v': found 'abc', expected a number");
+        assert_eq!(DataError::new("x.csv", "the file is empty").to_string(), "x.csv: the file is empty");
+    }
+}

@@ -1,0 +1,9 @@
+//! gyrolab-io: readers and writers for gyrolab, with errors that name the file, line and column.
+//!
+//! - [`error`]: the [`DataError`] every reader returns;
+//! - [`atomic`]: outputs written to a temporary file and renamed into place.
+
+pub mod atomic;
+pub mod error;
+
+pub use error::DataError;
