@@ -1,1 +1,40 @@
-fn main() {}
+//! The `gyrolab` command-line program: parses arguments, calls the library crates, prints.
+
+mod cmd;
+mod error;
+mod output;
+mod paper_data;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// gyrolab: gyroscope test evaluation (rate-table calibration, bias, Allan variance).
+#[derive(Debug, Parser)]
+#[command(name = "gyrolab", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Evaluate rate-table records: scale factor, nonlinearity, linearity, hysteresis, repeatability...
+    Rate(Box<cmd::rate::RateArgs>),
+    /// Run the paper's worked example on its data (built in) and compare with its printed tables.
+    Demo(cmd::demo::DemoArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Rate(a) => cmd::rate::run(a),
+        Command::Demo(a) => cmd::demo::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            e.exit_code()
+        }
+    }
+}

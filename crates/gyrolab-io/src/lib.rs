@@ -1,9 +1,15 @@
 //! gyrolab-io: readers and writers for gyrolab, with errors that name the file, line and column.
 //!
 //! - [`error`]: the [`DataError`] every reader returns;
-//! - [`atomic`]: outputs written to a temporary file and renamed into place.
+//! - [`atomic`]: outputs written to a temporary file and renamed into place;
+//! - [`text`]: a small delimited-text parser with line numbers;
+//! - [`rate_table`]: rate-table records in the long and wide layouts;
+//! - [`calibration`]: calibration files (TOML) written by `gyrolab rate --cal-out`.
 
 pub mod atomic;
+pub mod calibration;
 pub mod error;
 
 pub use error::DataError;
+pub mod rate_table;
+pub mod text;

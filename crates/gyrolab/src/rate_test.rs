@@ -494,7 +494,8 @@ fn side_fit(rates: &[f64], means: &[f64], keep: impl Fn(f64) -> bool) -> Option<
 }
 
 /// Widest symmetric range |rate| <= R whose nonlinearity (refitted on that range) is within
-/// `limit`; candidate R are the distinct |rates| of the table.
+/// `limit`; candidate R are the distinct |rates| of the table; a range needs three or more rates
+/// (two points always fit a line exactly).
 fn linear_range(rates: &[f64], means: &[f64], rest_reference: f64, limit: f64) -> LinearRange {
     let mut bounds: Vec<f64> = rates.iter().map(|w| w.abs()).collect();
     bounds.sort_by(|a, b| b.total_cmp(a));
@@ -502,6 +503,11 @@ fn linear_range(rates: &[f64], means: &[f64], rest_reference: f64, limit: f64) -
     for r in bounds {
         let (x, y): (Vec<f64>, Vec<f64>) =
             rates.iter().zip(means).filter(|(w, _)| w.abs() <= r * (1.0 + 1e-12)).map(|(w, y)| (*w, *y)).unzip();
+        let mut distinct = x.clone();
+        distinct.dedup();
+        if distinct.len() < 3 {
+            break;
+        }
         if let Ok((_, _, _, ka)) = nonlinearity_of(&x, &y, rest_reference) {
             if ka <= limit {
                 return LinearRange { limit, max_rate_dps: Some(r), nonlinearity: Some(ka), points: x.len() };

@@ -1,0 +1,28 @@
+//! Writing results: to standard output (a closed pipe is not an error) or atomically to a file.
+
+use crate::error::{CliError, CliResult};
+use std::io::Write;
+use std::path::Path;
+
+/// Prints text to standard output; a closed pipe (`| head`) ends quietly.
+pub fn print(text: &str) -> CliResult {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => Err(CliError::Output(format!("cannot write to standard output: {e}"))),
+    }
+}
+
+/// Writes a file whole or not at all.
+pub fn write_file(path: &Path, bytes: &[u8]) -> CliResult {
+    gyrolab_io::atomic::write_atomic(path, bytes)
+        .map_err(|e| CliError::Output(format!("{}: cannot write the file: {e}", path.display())))
+}
+
+/// Serialises a value as pretty JSON with a final newline.
+pub fn to_json<T: serde::Serialize>(value: &T) -> CliResult<String> {
+    serde_json::to_string_pretty(value)
+        .map(|s| s + "\n")
+        .map_err(|e| CliError::Output(format!("cannot serialise JSON: {e}")))
+}
