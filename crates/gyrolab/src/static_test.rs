@@ -473,6 +473,65 @@ impl Moments {
         Moments { n, mean_t, mean_d, ctt, cdd, ctd }
     }
 
+    fn of_shifted(t: &[f64], t0: f64, x: &[f64], x0: f64) -> Moments {
+        let n = x.len() as f64;
+        if x.is_empty() {
+            return Moments::default();
+        }
+        let mean_t = lane_sum(t, t0) / n;
+        let mean_d = lane_sum(x, x0) / n;
+        let (mut ctt, mut cdd, mut ctd) = ([0.0; 4], [0.0; 4], [0.0; 4]);
+        let (tc, xc) = (t.chunks_exact(4), x.chunks_exact(4));
+        let (tr, xr) = (tc.remainder(), xc.remainder());
+        for (tq, xq) in tc.zip(xc) {
+            for l in 0..4 {
+                let (a, b) = (tq[l] - t0 - mean_t, xq[l] - x0 - mean_d);
+                ctt[l] += a * a;
+                cdd[l] += b * b;
+                ctd[l] += a * b;
+            }
+        }
+        for (&ti, &xi) in tr.iter().zip(xr) {
+            let (a, b) = (ti - t0 - mean_t, xi - x0 - mean_d);
+            ctt[0] += a * a;
+            cdd[0] += b * b;
+            ctd[0] += a * b;
+        }
+        let s = |v: [f64; 4]| (v[0] + v[1]) + (v[2] + v[3]);
+        Moments { n, mean_t, mean_d, ctt: s(ctt), cdd: s(cdd), ctd: s(ctd) }
+    }
+
+    fn of_indexed(i0: u64, fs: f64, t0: f64, x: &[f64], x0: f64) -> Moments {
+        // Times i / fs; their centred sums are exact closed forms of the index.
+        let n = x.len() as f64;
+        if x.is_empty() {
+            return Moments::default();
+        }
+        let mean_i = (n - 1.0) / 2.0;
+        let mean_t = (i0 as f64 + mean_i) / fs - t0;
+        let mean_d = lane_sum(x, x0) / n;
+        let (mut cdd, mut cid) = ([0.0; 4], [0.0; 4]);
+        let xc = x.chunks_exact(4);
+        let rest = xc.remainder();
+        for (q, xq) in xc.enumerate() {
+            for l in 0..4 {
+                let a = (q * 4 + l) as f64 - mean_i;
+                let b = xq[l] - x0 - mean_d;
+                cdd[l] += b * b;
+                cid[l] += a * b;
+            }
+        }
+        let base = x.len() - rest.len();
+        for (j, &xi) in rest.iter().enumerate() {
+            let (a, b) = ((base + j) as f64 - mean_i, xi - x0 - mean_d);
+            cdd[0] += b * b;
+            cid[0] += a * b;
+        }
+        let s = |v: [f64; 4]| (v[0] + v[1]) + (v[2] + v[3]);
+        let cii = n * (n * n - 1.0) / 12.0;
+        Moments { n, mean_t, mean_d, ctt: cii / (fs * fs), cdd: s(cdd), ctd: s(cid) / fs }
+    }
+
     fn merge(&mut self, o: &Moments) {
         if o.n == 0.0 {
             return;
@@ -491,6 +550,20 @@ impl Moments {
         self.mean_d += dd * o.n / n;
         self.n = n;
     }
+}
+
+/// Sum of (v - shift) over a slice, in four lanes (vectorisable).
+fn lane_sum(v: &[f64], shift: f64) -> f64 {
+    let mut acc = [0.0; 4];
+    let c = v.chunks_exact(4);
+    let rest = c.remainder();
+    for q in c {
+        for l in 0..4 {
+            acc[l] += q[l] - shift;
+        }
+    }
+    let tail: f64 = rest.iter().map(|x| x - shift).sum();
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
 /// Welford accumulation of window means.
@@ -528,6 +601,35 @@ struct Windows {
 }
 
 impl Windows {
+    /// Adds a slice of valid samples (deviations x - shift).
+    fn add_slice(&mut self, x: &[f64], shift: f64) {
+        let mut i = 0;
+        while i < x.len() {
+            let take = ((self.m - self.filled) as usize).min(x.len() - i);
+            self.sum += lane_sum(&x[i..i + take], shift);
+            self.filled += take as u64;
+            self.valid += take as u64;
+            i += take;
+            if self.filled == self.m {
+                self.close();
+            }
+        }
+    }
+
+    fn close(&mut self) {
+        if self.valid == 0 {
+            self.empty += 1;
+        } else {
+            if self.valid < self.m {
+                self.with_missing += 1;
+            }
+            self.means.add(self.sum / self.valid as f64);
+        }
+        self.filled = 0;
+        self.valid = 0;
+        self.sum = 0.0;
+    }
+
     #[inline]
     fn add(&mut self, d: Option<f64>) {
         self.filled += 1;
@@ -536,17 +638,7 @@ impl Windows {
             self.valid += 1;
         }
         if self.filled == self.m {
-            if self.valid == 0 {
-                self.empty += 1;
-            } else {
-                if self.valid < self.m {
-                    self.with_missing += 1;
-                }
-                self.means.add(self.sum / self.valid as f64);
-            }
-            self.filled = 0;
-            self.valid = 0;
-            self.sum = 0.0;
+            self.close();
         }
     }
 }
@@ -760,6 +852,114 @@ impl StaticTestAccumulator {
     }
 
     fn process(&mut self, b: &SampleBlock) {
+        if self.block_is_clean(b) {
+            self.process_clean(b);
+        } else {
+            self.process_each(b);
+        }
+    }
+
+    /// Whether every sample is finite and inside the outlier rule (then the slice loops apply).
+    fn block_is_clean(&self, b: &SampleBlock) -> bool {
+        if b.output.is_empty() {
+            return false;
+        }
+        let finite = |v: &[f64]| v.iter().fold(true, |a, x| a & x.is_finite());
+        if !finite(b.output) || !b.time_s.map_or(true, finite) {
+            return false;
+        }
+        match (self.rule, b.time_s) {
+            (None, _) => true,
+            (Some(r), Some(ts)) => {
+                b.output.iter().zip(ts).fold(true, |a, (&x, &t)| a & ((x - r.line.eval(t)).abs() <= r.limit))
+            }
+            (Some(r), None) => {
+                let fs = self.fs.unwrap_or(1.0); // ok: set before processing
+                let i0 = self.samples;
+                b.output
+                    .iter()
+                    .enumerate()
+                    .fold(true, |a, (i, &x)| a & ((x - r.line.eval((i0 + i as u64) as f64 / fs)).abs() <= r.limit))
+            }
+        }
+    }
+
+    /// The fast path: a block of finite samples, processed slice by slice.
+    fn process_clean(&mut self, b: &SampleBlock) {
+        let fs = self.fs.unwrap_or(1.0); // ok: process runs only once the rate is set
+        let x = b.output;
+        let n = x.len();
+        let i0 = self.samples;
+        let pos = |i: usize| Position { sample: i0 + i as u64, line: b.lines.map(|l| l[i]) };
+        let t_first = b.time_s.map_or(i0 as f64 / fs, |t| t[0]);
+        let (x0, t0) = *self.reference.get_or_insert((x[0], t_first));
+        // Time checks.
+        if let Some(ts) = b.time_s {
+            let gap_limit = self.config.gap_factor / fs;
+            let mut prev = self.prev_time.unwrap_or(ts[0]);
+            let mut largest = self.quality.largest_interval_s.unwrap_or(f64::NEG_INFINITY);
+            let start = usize::from(self.prev_time.is_none());
+            for (i, &t) in ts.iter().enumerate().skip(start) {
+                let dt = t - prev;
+                if dt <= 0.0 || dt > gap_limit {
+                    if dt == 0.0 {
+                        self.quality.repeated_time.note(pos(i));
+                    } else if dt < 0.0 {
+                        self.quality.decreasing_time.note(pos(i));
+                    } else {
+                        self.quality.time_gaps.note(pos(i));
+                    }
+                }
+                largest = largest.max(dt);
+                prev = t;
+            }
+            if n > start {
+                self.quality.largest_interval_s = Some(largest);
+            }
+            self.prev_time = Some(prev);
+            self.last_time = prev;
+        } else {
+            self.last_time = (i0 + n as u64 - 1) as f64 / fs;
+        }
+        // Min, max and rail runs.
+        let (lo, hi) = x.iter().fold((self.min, self.max), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        for (i, &v) in x.iter().enumerate() {
+            if self.rail.run_len > 0 && v == self.rail.run_value {
+                self.rail.run_len += 1;
+            } else {
+                // The running min/max as of this sample decide whether the ending run is at a rail.
+                self.min = self.min.min(v);
+                self.max = self.max.max(v);
+                self.end_run();
+                self.rail.run_value = v;
+                self.rail.run_len = 1;
+                self.rail.run_start = Some(pos(i));
+            }
+        }
+        self.min = lo;
+        self.max = hi;
+        // Moments of (t - t0, x - x0).
+        let m = match b.time_s {
+            Some(ts) => Moments::of_shifted(ts, t0, x, x0),
+            None => Moments::of_indexed(i0, fs, t0, x, x0),
+        };
+        self.moments.merge(&m);
+        self.samples += n as u64;
+        // Windows.
+        for w in &mut self.windows {
+            if w.m > 1 {
+                w.add_slice(x, x0);
+            }
+        }
+        if let Some(c) = b.temperature_c {
+            for (i, &v) in x.iter().enumerate() {
+                self.add_temp(Some(v - x0), Some(c[i]));
+            }
+        }
+    }
+
+    /// The general path: sample by sample, with missing samples and the outlier rule.
+    fn process_each(&mut self, b: &SampleBlock) {
         let fs = self.fs.unwrap_or(1.0); // ok: process runs only once the rate is set
         let gap_limit = self.config.gap_factor / fs;
         self.scratch_t.clear();
@@ -773,6 +973,23 @@ impl StaticTestAccumulator {
                 Some(ts) => ts[i],
                 None => idx as f64 / fs,
             };
+            // Time stamps are checked whenever they are finite, even if the output is missing.
+            if b.time_s.is_some() && t.is_finite() {
+                if let Some(prev) = self.prev_time {
+                    let dt = t - prev;
+                    if dt == 0.0 {
+                        self.quality.repeated_time.note(pos);
+                    } else if dt < 0.0 {
+                        self.quality.decreasing_time.note(pos);
+                    } else if dt > gap_limit {
+                        self.quality.time_gaps.note(pos);
+                    }
+                    if self.quality.largest_interval_s.map_or(true, |m| dt > m) {
+                        self.quality.largest_interval_s = Some(dt);
+                    }
+                }
+                self.prev_time = Some(t);
+            }
             let mut ok = x.is_finite() && t.is_finite();
             if !ok {
                 self.quality.missing.note(pos);
@@ -790,22 +1007,6 @@ impl StaticTestAccumulator {
                 }
                 self.add_temp(None, None);
                 continue;
-            }
-            if b.time_s.is_some() {
-                if let Some(prev) = self.prev_time {
-                    let dt = t - prev;
-                    if dt == 0.0 {
-                        self.quality.repeated_time.note(pos);
-                    } else if dt < 0.0 {
-                        self.quality.decreasing_time.note(pos);
-                    } else if dt > gap_limit {
-                        self.quality.time_gaps.note(pos);
-                    }
-                    if self.quality.largest_interval_s.map_or(true, |m| dt > m) {
-                        self.quality.largest_interval_s = Some(dt);
-                    }
-                }
-                self.prev_time = Some(t);
             }
             let (x0, t0) = *self.reference.get_or_insert((x, t));
             let d = x - x0;
