@@ -297,7 +297,10 @@ impl<R: Read> SeriesReader<R> {
         let mut first = true;
         let header_text = loop {
             if r.pos >= r.complete && !r.fill()? {
-                return Err(DataError::new(&file, "the file is empty: expected a header row such as 'time_s,output_v'"));
+                return Err(DataError::new(
+                    &file,
+                    "the file is empty: expected a header row such as 'time_s,output_v'",
+                ));
             }
             let start = r.pos;
             let end = memchr::memchr(b'\n', &r.buf[start..r.complete]).map_or(r.complete, |i| start + i);
@@ -341,7 +344,7 @@ impl<R: Read> SeriesReader<R> {
                 );
             }
         }
-        let selected = |n: &str| options.channels.as_ref().map_or(true, |l| l.iter().any(|c| c.eq_ignore_ascii_case(n)));
+        let selected = |n: &str| options.channels.as_ref().is_none_or(|l| l.iter().any(|c| c.eq_ignore_ascii_case(n)));
         let accepted = OutputUnit::accepted_suffixes();
         let mut columns = Vec::with_capacity(names.len());
         let mut channels: Vec<ChannelInfo> = Vec::new();
@@ -360,7 +363,11 @@ impl<R: Read> SeriesReader<R> {
                 ColumnRole::Time
             } else if matches!(base.as_str(), "temp" | "temperature") && unit_override.is_none() {
                 if !matches!(sfx, Some("c") | Some("degc")) {
-                    return err(i + 1, Some(name), format!("temperature column '{name}': expected degC, named 'temp_c'"));
+                    return err(
+                        i + 1,
+                        Some(name),
+                        format!("temperature column '{name}': expected degC, named 'temp_c'"),
+                    );
                 }
                 if let Some(c) = self.header.temperature_column {
                     return err(i + 1, Some(name), format!("a second temperature column: column {c} is already one"));
@@ -660,12 +667,9 @@ impl<R: Read> SeriesReader<R> {
         let expected = self.targets.len();
         let col = found.min(expected) + 1;
         let name = self.header.columns.get(found).map(|c| c.name.as_str());
-        DataError::new(
-            &self.header.file,
-            format!("found {found} fields, expected {expected} (one per header column)"),
-        )
-        .at_line(line)
-        .at_column(col, name)
+        DataError::new(&self.header.file, format!("found {found} fields, expected {expected} (one per header column)"))
+            .at_line(line)
+            .at_column(col, name)
     }
 }
 
@@ -783,9 +787,8 @@ pub fn evaluate_static_file(
             cfg
         })
         .collect();
-    let wrap = |ch: &str, e: gyrolab::static_test::StaticTestError| {
-        DataError::new(path, format!("channel '{ch}': {e}"))
-    };
+    let wrap =
+        |ch: &str, e: gyrolab::static_test::StaticTestError| DataError::new(path, format!("channel '{ch}': {e}"));
     let mut accs = Vec::with_capacity(configs.len());
     for cfg in &configs {
         accs.push(StaticTestAccumulator::new(cfg.clone()).map_err(|e| wrap(&cfg.channel, e))?);

@@ -830,8 +830,7 @@ impl StaticTestAccumulator {
         if p.output.is_empty() {
             return Ok(());
         }
-        let mut dts: Vec<f64> =
-            p.time.windows(2).map(|w| w[1] - w[0]).filter(|d| d.is_finite() && *d > 0.0).collect();
+        let mut dts: Vec<f64> = p.time.windows(2).map(|w| w[1] - w[0]).filter(|d| d.is_finite() && *d > 0.0).collect();
         if dts.is_empty() {
             return Err(StaticTestError::SampleRateUnknown(format!(
                 "no increasing time stamps among the first {} samples; give sample_rate_hz",
@@ -865,7 +864,7 @@ impl StaticTestAccumulator {
             return false;
         }
         let finite = |v: &[f64]| v.iter().fold(true, |a, x| a & x.is_finite());
-        if !finite(b.output) || !b.time_s.map_or(true, finite) {
+        if !finite(b.output) || !b.time_s.is_none_or(finite) {
             return false;
         }
         match (self.rule, b.time_s) {
@@ -984,7 +983,7 @@ impl StaticTestAccumulator {
                     } else if dt > gap_limit {
                         self.quality.time_gaps.note(pos);
                     }
-                    if self.quality.largest_interval_s.map_or(true, |m| dt > m) {
+                    if self.quality.largest_interval_s.is_none_or(|m| dt > m) {
                         self.quality.largest_interval_s = Some(dt);
                     }
                 }
@@ -1134,10 +1133,7 @@ impl StaticTestAccumulator {
                 skipped.push(SkippedSmoothing {
                     smoothing_s: w.smoothing_s,
                     windows: n,
-                    reason: format!(
-                        "{n} whole windows of {} samples fit, at least {} needed",
-                        w.m, cfg.min_windows
-                    ),
+                    reason: format!("{n} whole windows of {} samples fit, at least {} needed", w.m, cfg.min_windows),
                 });
                 continue;
             }
@@ -1171,11 +1167,7 @@ impl StaticTestAccumulator {
                 slope_output_per_s: slope,
                 residual_std_output: resid,
             };
-            (
-                Some(units::per_s_to_per_h(slope)),
-                k.map(|k| units::dps_per_s_to_dph_per_h(slope / k)),
-                Some(line),
-            )
+            (Some(units::per_s_to_per_h(slope)), k.map(|k| units::dps_per_s_to_dph_per_h(slope / k)), Some(line))
         } else {
             notes.push("drift not computed: all time stamps are equal".into());
             (None, None, None)
@@ -1194,24 +1186,17 @@ impl StaticTestAccumulator {
         };
 
         let mut quality = self.quality;
-        quality.stuck_at_min = if self.rail.at_min.value == Some(self.min) { self.rail.at_min } else { RailRuns::default() };
-        quality.stuck_at_max = if self.rail.at_max.value == Some(self.max) { self.rail.at_max } else { RailRuns::default() };
-        if let Some(rule) = self.rule {
-            quality.outliers = Some(OutlierReport {
-                k_sigma: self.config.outlier_k_sigma,
-                residual_std_output: rule.line.residual_std_output,
-                outliers: self.outliers,
-                dropped: true,
-            });
-        }
+        quality.stuck_at_min =
+            if self.rail.at_min.value == Some(self.min) { self.rail.at_min } else { RailRuns::default() };
+        quality.stuck_at_max =
+            if self.rail.at_max.value == Some(self.max) { self.rail.at_max } else { RailRuns::default() };
         Ok(StaticTestResult {
             channel: self.config.channel.clone(),
             output_unit: self.config.output_unit,
             samples: self.samples,
             valid_samples: valid,
             sample_rate_hz: fs,
-            sample_rate_source: if self.fs_given { "given" } else { "estimated from the median time interval" }
-                .into(),
+            sample_rate_source: if self.fs_given { "given" } else { "estimated from the median time interval" }.into(),
             duration_s: self.last_time - t0,
             mean_output,
             std_output,
@@ -1288,6 +1273,7 @@ fn temperature_fit(
 #[derive(Debug, Clone)]
 pub struct OutlierScan {
     inner: StaticTestAccumulator,
+    line: DriftLine,
 }
 
 impl OutlierScan {
@@ -1304,8 +1290,11 @@ impl OutlierScan {
             slope_output_per_s: 0.0,
             residual_std_output: first.std_output,
         });
-        inner.rule = Some(OutlierRule { line, limit: config.outlier_k_sigma * line.residual_std_output });
-        Ok(OutlierScan { inner })
+        // A record that lies exactly on its drift line has sigma 0: no sample is an outlier by this rule.
+        if line.residual_std_output > 0.0 {
+            inner.rule = Some(OutlierRule { line, limit: config.outlier_k_sigma * line.residual_std_output });
+        }
+        Ok(OutlierScan { inner, line })
     }
 
     /// Adds a block of the same record, in the same order as the first pass.
@@ -1315,22 +1304,17 @@ impl OutlierScan {
 
     /// The final result: the first pass's figures with the outlier report, or, with
     /// `drop_outliers`, the figures recomputed without the outliers.
-    pub fn finish(self, first: StaticTestResult) -> Result<StaticTestResult, StaticTestError> {
+    pub fn finish(mut self, first: StaticTestResult) -> Result<StaticTestResult, StaticTestError> {
         let drop = self.inner.config.drop_outliers;
-        let second = self.inner.finish()?;
-        let mut report = second.quality.outliers.clone();
-        if let Some(r) = report.as_mut() {
-            r.dropped = drop;
-        }
-        if drop {
-            let mut out = second;
-            out.quality.outliers = report;
-            Ok(out)
-        } else {
-            let mut out = first;
-            out.quality.outliers = report;
-            Ok(out)
-        }
+        let report = OutlierReport {
+            k_sigma: self.inner.config.outlier_k_sigma,
+            residual_std_output: self.line.residual_std_output,
+            outliers: std::mem::take(&mut self.inner.outliers),
+            dropped: drop,
+        };
+        let mut out = if drop && report.outliers.count > 0 { self.inner.finish()? } else { first };
+        out.quality.outliers = Some(report);
+        Ok(out)
     }
 }
 
