@@ -6,7 +6,7 @@ use crate::DataError;
 use std::path::Path;
 
 /// Field separator of a text file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Delimiter {
     /// `,`
     Comma,
@@ -19,6 +19,16 @@ pub enum Delimiter {
 }
 
 impl Delimiter {
+    /// The separator byte (a space for whitespace, which also matches tabs).
+    pub(crate) fn byte(self) -> u8 {
+        match self {
+            Delimiter::Comma => b',',
+            Delimiter::Tab => b'\t',
+            Delimiter::Semicolon => b';',
+            Delimiter::Whitespace => b' ',
+        }
+    }
+
     /// Guesses the separator from a header line: tab, then comma, then semicolon, else whitespace.
     pub fn sniff(header: &str) -> Delimiter {
         if header.contains('\t') {

@@ -5,6 +5,7 @@
 //! - [`units`]: units of rates, outputs and noise coefficients, and every conversion;
 //! - [`fit`]: least-squares lines and polynomials;
 //! - [`rate_test`]: rate-table (scale-factor) test figures;
+//! - [`static_test`]: static (bias) test figures, accumulated block by block;
 //! - [`published`]: comparison with figures printed in a publication.
 //!
 //! Formulas and their sources are listed in `docs/METHODS.md`.
@@ -12,4 +13,5 @@
 pub mod fit;
 pub mod published;
 pub mod rate_test;
+pub mod static_test;
 pub mod units;

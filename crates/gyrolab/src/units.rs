@@ -63,6 +63,27 @@ pub fn ratio_to_ppm(v: f64) -> f64 {
     v * 1e6
 }
 
+/// Converts a quantity per second (such as a drift slope in V/s) to the same quantity per hour.
+pub fn per_s_to_per_h(v: f64) -> f64 {
+    v * SECONDS_PER_HOUR
+}
+
+/// Converts a rate change in (deg/s)/s to (deg/h)/h (factor 3600 * 3600).
+pub fn dps_per_s_to_dph_per_h(v: f64) -> f64 {
+    v * SECONDS_PER_HOUR * SECONDS_PER_HOUR
+}
+
+/// Converts a temperature sensitivity in (deg/s)/degC to (deg/h)/degC.
+pub fn dps_per_c_to_dph_per_c(v: f64) -> f64 {
+    v * SECONDS_PER_HOUR
+}
+
+/// Earth-rate component along a vertical (upward) input axis at a latitude in degrees:
+/// Omega_e * sin(latitude), in deg/h. For a downward axis pass the negated latitude.
+pub fn earth_rate_vertical_dph(latitude_deg: f64) -> f64 {
+    EARTH_RATE_DPH * deg_to_rad(latitude_deg).sin()
+}
+
 /// Unit of an input (table) rate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum RateUnit {
@@ -193,6 +214,21 @@ impl OutputUnit {
         }
     }
 
+    /// The scale factor, in this unit per deg/s, of an output that is already a rate
+    /// (1 for deg/s, pi/180 for rad/s); `None` for V, mV and LSB, which need a calibration.
+    pub fn native_scale_factor_per_dps(self) -> Option<f64> {
+        match self {
+            OutputUnit::DegPerSec => Some(1.0),
+            OutputUnit::RadPerSec => Some(deg_to_rad(1.0)),
+            _ => None,
+        }
+    }
+
+    /// The accepted column-name suffixes, for messages: `v, mv, lsb, dps, rad_s`.
+    pub fn accepted_suffixes() -> String {
+        OutputUnit::ALL.iter().map(|u| u.suffix()).collect::<Vec<_>>().join(", ")
+    }
+
     /// The unit in which people usually quote a scale factor for this output, with the factor
     /// that converts a value in this unit to it (volts are quoted in mV per deg/s).
     pub fn scale_factor_display(self) -> (OutputUnit, f64) {
@@ -252,6 +288,10 @@ mod tests {
         assert_relative_eq!(rrw_dph_rt_h_to_dps_rt_s(216_000.0), 1.0);
         assert_relative_eq!(dps_to_dph(1.0), 3600.0);
         assert_relative_eq!(EARTH_RATE_DPH, 15.041_07, epsilon = 1e-4);
+        // 1 (deg/s)/s = 3600 (deg/h)/s = 12 960 000 (deg/h)/h; sin(30 deg) = 1/2.
+        assert_relative_eq!(dps_per_s_to_dph_per_h(1.0), 12_960_000.0);
+        assert_relative_eq!(earth_rate_vertical_dph(30.0), 0.5 * EARTH_RATE_DPH, epsilon = 1e-12);
+        assert_relative_eq!(OutputUnit::RadPerSec.native_scale_factor_per_dps().unwrap(), 0.017_453_292_519_943_295);
     }
 
     #[test]

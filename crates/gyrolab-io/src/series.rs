@@ -1,0 +1,785 @@
+//! Streaming reader of time-series text files (CSV, TSV, semicolon or whitespace separated).
+//!
+//! The file is read in large chunks (default 2 MiB); lines are found with `memchr`, a partial
+//! last line is carried into the next chunk, and numbers are parsed with `fast-float2` straight
+//! from the bytes (no allocation per line or field). Parsed values are handed out column by
+//! column in blocks of at most `block_rows` rows, so memory stays constant whatever the length.
+//!
+//! Layout: optional UTF-8 BOM; `#` comment lines and blank lines anywhere; one header row whose
+//! names carry unit suffixes (`time_s`, `temp_c`, `output_v`, `gyro_x_mv`, `rate_dps`,
+//! `rate_rad_s`, `counts_lsb`); then one row of numbers per sample. The delimiter is sniffed
+//! from the header (comma, else tab, else semicolon, else runs of whitespace).
+//! Bad input is never repaired: every problem is a [`DataError`] with line and column, except
+//! NaN and empty cells in tolerant mode, which are passed on as NaN and listed in
+//! [`ReaderQuality`].
+
+use crate::error::DataError;
+use gyrolab::static_test::{OutlierScan, SampleBlock, StaticTestAccumulator, StaticTestConfig, StaticTestResult};
+use gyrolab::units::{split_unit_suffix, OutputUnit};
+use serde::{Deserialize, Serialize};
+use std::fs::File;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+/// Default chunk size read from the file at once.
+pub const DEFAULT_CHUNK_BYTES: usize = 2 << 20;
+/// Default number of rows per block handed to the caller.
+pub const DEFAULT_BLOCK_ROWS: usize = 1 << 16;
+/// Longest line accepted (a guard against binary files read as text).
+pub const MAX_LINE_BYTES: usize = 64 << 20;
+/// How many missing cells the reader lists individually (all are counted).
+pub const FIRST_MISSING: usize = 100;
+
+pub use crate::text::Delimiter;
+
+/// Options of the time-series reader.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeriesOptions {
+    /// Field separator; `None` sniffs it from the header.
+    pub delimiter: Option<Delimiter>,
+    /// Sample rate in Hz; required when the file has no time column.
+    pub sample_rate_hz: Option<f64>,
+    /// Units for named columns, overriding (or supplying) the header suffix.
+    pub column_units: Vec<(String, OutputUnit)>,
+    /// Output channels to read by header name; `None` reads every non-time, non-temperature column.
+    pub channels: Option<Vec<String>>,
+    /// Tolerant mode: NaN and empty cells become NaN and are listed, instead of being errors.
+    pub tolerant: bool,
+    /// Bytes read from the file at once.
+    pub chunk_bytes: usize,
+    /// Rows per block handed to the caller.
+    pub block_rows: usize,
+}
+
+impl Default for SeriesOptions {
+    fn default() -> Self {
+        SeriesOptions {
+            delimiter: None,
+            sample_rate_hz: None,
+            column_units: Vec::new(),
+            channels: None,
+            tolerant: false,
+            chunk_bytes: DEFAULT_CHUNK_BYTES,
+            block_rows: DEFAULT_BLOCK_ROWS,
+        }
+    }
+}
+
+/// What a column of the file holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ColumnRole {
+    /// Time stamps in seconds.
+    Time,
+    /// Temperature in degC.
+    Temperature,
+    /// Output channel (index into [`SeriesHeader::channels`]).
+    Channel(usize),
+    /// Not read (not among the selected channels).
+    Ignored,
+}
+
+/// A column of the file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ColumnInfo {
+    /// 1-based position.
+    pub index: usize,
+    /// Header name as written.
+    pub name: String,
+    /// What it holds.
+    pub role: ColumnRole,
+}
+
+/// An output channel of the file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ChannelInfo {
+    /// Header name as written.
+    pub name: String,
+    /// 1-based column position.
+    pub column: usize,
+    /// Output unit.
+    pub unit: OutputUnit,
+}
+
+/// The parsed header of a time-series file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SeriesHeader {
+    /// The file.
+    pub file: PathBuf,
+    /// 1-based line of the header row.
+    pub header_line: u64,
+    /// Field separator in use.
+    pub delimiter: Delimiter,
+    /// Every column.
+    pub columns: Vec<ColumnInfo>,
+    /// 1-based column of the time stamps.
+    pub time_column: Option<usize>,
+    /// 1-based column of the temperature.
+    pub temperature_column: Option<usize>,
+    /// Output channels read, in file order.
+    pub channels: Vec<ChannelInfo>,
+    /// Sample rate given by the caller, Hz.
+    pub sample_rate_hz: Option<f64>,
+}
+
+/// A NaN or empty cell accepted in tolerant mode.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MissingCell {
+    /// 1-based line.
+    pub line: u64,
+    /// 1-based column.
+    pub column: usize,
+    /// Column name.
+    pub name: String,
+    /// The cell's text (empty for an empty cell).
+    pub text: String,
+}
+
+/// Cells the reader passed on as NaN (tolerant mode only).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ReaderQuality {
+    /// Count of NaN or empty cells.
+    pub missing_cells: u64,
+    /// The first of them (at most [`FIRST_MISSING`]).
+    pub first_missing: Vec<MissingCell>,
+}
+
+/// A block of parsed rows, column by column (all slices have the same length).
+#[derive(Debug, Clone, Copy)]
+pub struct SeriesBlock<'a> {
+    /// Source line of the first row.
+    pub first_line: u64,
+    /// Source line of each row.
+    pub lines: &'a [u64],
+    /// Time stamps, seconds.
+    pub time: Option<&'a [f64]>,
+    /// Temperature, degC.
+    pub temp: Option<&'a [f64]>,
+    /// One column per output channel, in the order of [`SeriesHeader::channels`].
+    pub channels: &'a [Vec<f64>],
+}
+
+impl<'a> SeriesBlock<'a> {
+    /// Rows in the block.
+    pub fn len(&self) -> usize {
+        self.lines.len()
+    }
+
+    /// Whether the block has no rows.
+    pub fn is_empty(&self) -> bool {
+        self.lines.is_empty()
+    }
+
+    /// The samples of one channel as a core [`SampleBlock`] (with time, temperature, lines).
+    pub fn samples(&self, channel: usize) -> SampleBlock<'a> {
+        SampleBlock {
+            output: self.channels.get(channel).map_or(&[][..], |c| &c[..]),
+            time_s: self.time,
+            temperature_c: self.temp,
+            lines: Some(self.lines),
+        }
+    }
+}
+
+const SKIP: u32 = u32::MAX;
+
+/// Streaming reader: parse the header with [`SeriesReader::open`], then call
+/// [`SeriesReader::next_block`] until it returns `None`. After an error the reader is spent.
+pub struct SeriesReader<R: Read> {
+    src: R,
+    header: SeriesHeader,
+    tolerant: bool,
+    block_rows: usize,
+    chunk_bytes: usize,
+    buf: Vec<u8>,
+    pos: usize,
+    filled: usize,
+    complete: usize,
+    eof: bool,
+    line_no: u64,
+    rows: u64,
+    targets: Vec<u32>,
+    time_slot: Option<usize>,
+    temp_slot: Option<usize>,
+    cols: Vec<Vec<f64>>,
+    lines: Vec<u64>,
+    quality: ReaderQuality,
+}
+
+impl SeriesReader<File> {
+    /// Opens a file and reads its header.
+    pub fn open(path: impl AsRef<Path>, options: &SeriesOptions) -> Result<Self, DataError> {
+        let path = path.as_ref();
+        let f = File::open(path).map_err(|e| DataError::io(path, &e))?;
+        SeriesReader::from_reader(path, f, options)
+    }
+}
+
+fn is_blank_or_comment(line: &[u8]) -> bool {
+    let t = line.trim_ascii();
+    t.is_empty() || t[0] == b'#'
+}
+
+impl<R: Read> SeriesReader<R> {
+    /// Reads the header from any byte source; `name` names it in errors.
+    pub fn from_reader(name: impl AsRef<Path>, src: R, options: &SeriesOptions) -> Result<Self, DataError> {
+        let file = name.as_ref().to_path_buf();
+        let chunk_bytes = options.chunk_bytes.max(16);
+        let mut r = SeriesReader {
+            src,
+            header: SeriesHeader {
+                file: file.clone(),
+                header_line: 0,
+                delimiter: Delimiter::Comma,
+                columns: Vec::new(),
+                time_column: None,
+                temperature_column: None,
+                channels: Vec::new(),
+                sample_rate_hz: options.sample_rate_hz,
+            },
+            tolerant: options.tolerant,
+            block_rows: options.block_rows.max(1),
+            chunk_bytes,
+            buf: vec![0; chunk_bytes],
+            pos: 0,
+            filled: 0,
+            complete: 0,
+            eof: false,
+            line_no: 0,
+            rows: 0,
+            targets: Vec::new(),
+            time_slot: None,
+            temp_slot: None,
+            cols: Vec::new(),
+            lines: Vec::new(),
+            quality: ReaderQuality::default(),
+        };
+        if let Some(f) = options.sample_rate_hz {
+            if !(f.is_finite() && f > 0.0) {
+                return Err(DataError::new(&file, format!("sample rate {f} Hz: expected a positive number")));
+            }
+        }
+        // Header: the first line that is neither blank nor a comment.
+        let mut first = true;
+        let header_text = loop {
+            if r.pos >= r.complete && !r.fill()? {
+                return Err(DataError::new(
+                    &file,
+                    "the file is empty: expected a header row such as 'time_s,output_v'",
+                ));
+            }
+            let start = r.pos;
+            let end = memchr::memchr(b'\n', &r.buf[start..r.complete]).map_or(r.complete, |i| start + i);
+            r.pos = (end + 1).min(r.complete);
+            r.line_no += 1;
+            let mut line = &r.buf[start..end];
+            if first {
+                line = line.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(line);
+                first = false;
+            }
+            if !is_blank_or_comment(line) {
+                break String::from_utf8_lossy(line).trim().to_string();
+            }
+        };
+        r.header.header_line = r.line_no;
+        r.parse_header(&header_text, options)?;
+        Ok(r)
+    }
+
+    fn parse_header(&mut self, text: &str, options: &SeriesOptions) -> Result<(), DataError> {
+        let file = self.header.file.clone();
+        let line = self.header.header_line;
+        let delim = options.delimiter.unwrap_or_else(|| Delimiter::sniff(text));
+        self.header.delimiter = delim;
+        let names: Vec<String> = match delim {
+            Delimiter::Whitespace => text.split_ascii_whitespace().map(str::to_string).collect(),
+            d => text.split(d.byte() as char).map(|s| s.trim().trim_matches('"').trim().to_string()).collect(),
+        };
+        let err = |col: usize, name: Option<&str>, msg: String| {
+            Err(DataError::new(&file, msg).at_line(line).at_column(col, name))
+        };
+        for (i, n) in names.iter().enumerate() {
+            if n.is_empty() {
+                return err(i + 1, None, "empty column name in the header: expected a name such as 'output_v'".into());
+            }
+            if let Some(j) = names[..i].iter().position(|m| m.eq_ignore_ascii_case(n)) {
+                return err(
+                    i + 1,
+                    Some(n),
+                    format!("duplicate column name: column {} '{}' and column {} '{}'", j + 1, names[j], i + 1, n),
+                );
+            }
+        }
+        let selected = |n: &str| options.channels.as_ref().is_none_or(|l| l.iter().any(|c| c.eq_ignore_ascii_case(n)));
+        let accepted = OutputUnit::accepted_suffixes();
+        let mut columns = Vec::with_capacity(names.len());
+        let mut channels: Vec<ChannelInfo> = Vec::new();
+        for (i, name) in names.iter().enumerate() {
+            let (base, suffix) = split_unit_suffix(name);
+            let sfx = suffix.as_deref();
+            let unit_override = options.column_units.iter().find(|(c, _)| c.eq_ignore_ascii_case(name)).map(|p| p.1);
+            let role = if matches!(base.as_str(), "time" | "t" | "timestamp") {
+                if sfx != Some("s") {
+                    return err(i + 1, Some(name), format!("time column '{name}': expected seconds, named 'time_s'"));
+                }
+                if let Some(c) = self.header.time_column {
+                    return err(i + 1, Some(name), format!("a second time column: column {c} is already the time"));
+                }
+                self.header.time_column = Some(i + 1);
+                ColumnRole::Time
+            } else if matches!(base.as_str(), "temp" | "temperature") && unit_override.is_none() {
+                if !matches!(sfx, Some("c") | Some("degc")) {
+                    return err(
+                        i + 1,
+                        Some(name),
+                        format!("temperature column '{name}': expected degC, named 'temp_c'"),
+                    );
+                }
+                if let Some(c) = self.header.temperature_column {
+                    return err(i + 1, Some(name), format!("a second temperature column: column {c} is already one"));
+                }
+                self.header.temperature_column = Some(i + 1);
+                ColumnRole::Temperature
+            } else if !selected(name) {
+                ColumnRole::Ignored
+            } else {
+                let unit = match unit_override.or_else(|| sfx.and_then(OutputUnit::parse)) {
+                    Some(u) => u,
+                    None => {
+                        let what = match sfx {
+                            Some(s) => format!("unknown unit suffix '{s}'"),
+                            None => "no unit suffix".to_string(),
+                        };
+                        return err(
+                            i + 1,
+                            Some(name),
+                            format!(
+                                "{what} in column '{name}': expected one of the suffixes {accepted} \
+                                 (as in 'output_v'), a unit named for the column, or a channel selection without it"
+                            ),
+                        );
+                    }
+                };
+                channels.push(ChannelInfo { name: name.clone(), column: i + 1, unit });
+                ColumnRole::Channel(channels.len() - 1)
+            };
+            columns.push(ColumnInfo { index: i + 1, name: name.clone(), role });
+        }
+        if let Some(list) = &options.channels {
+            if let Some(missing) = list.iter().find(|c| !names.iter().any(|n| n.eq_ignore_ascii_case(c))) {
+                return Err(DataError::new(
+                    &file,
+                    format!("selected channel '{missing}' is not in the header: found {}", names.join(", ")),
+                )
+                .at_line(line));
+            }
+        }
+        if channels.is_empty() {
+            return Err(DataError::new(&file, "no output channel in the header: expected a column such as 'output_v'")
+                .at_line(line));
+        }
+        if self.header.time_column.is_none() && self.header.sample_rate_hz.is_none() {
+            return Err(DataError::new(
+                &file,
+                "no time column ('time_s') and no sample rate given: expected one of them",
+            )
+            .at_line(line));
+        }
+        let nch = channels.len();
+        self.time_slot = self.header.time_column.map(|_| nch);
+        self.temp_slot = self.header.temperature_column.map(|_| nch + usize::from(self.time_slot.is_some()));
+        let nslots = nch + usize::from(self.time_slot.is_some()) + usize::from(self.temp_slot.is_some());
+        self.targets = columns
+            .iter()
+            .map(|c| match c.role {
+                ColumnRole::Channel(k) => k as u32,
+                ColumnRole::Time => self.time_slot.map_or(SKIP, |s| s as u32),
+                ColumnRole::Temperature => self.temp_slot.map_or(SKIP, |s| s as u32),
+                ColumnRole::Ignored => SKIP,
+            })
+            .collect();
+        self.cols = (0..nslots).map(|_| Vec::with_capacity(self.block_rows)).collect();
+        self.lines = Vec::with_capacity(self.block_rows);
+        self.header.columns = columns;
+        self.header.channels = channels;
+        Ok(())
+    }
+
+    /// The parsed header.
+    pub fn header(&self) -> &SeriesHeader {
+        &self.header
+    }
+
+    /// NaN and empty cells passed on so far (tolerant mode).
+    pub fn quality(&self) -> &ReaderQuality {
+        &self.quality
+    }
+
+    /// Data rows read so far.
+    pub fn rows(&self) -> u64 {
+        self.rows
+    }
+
+    /// Reads more bytes; returns false when nothing is left to parse.
+    fn fill(&mut self) -> Result<bool, DataError> {
+        // Move the unparsed tail to the front.
+        if self.pos > 0 {
+            self.buf.copy_within(self.pos..self.filled, 0);
+            self.filled -= self.pos;
+            self.complete = self.complete.saturating_sub(self.pos);
+            self.pos = 0;
+        }
+        loop {
+            if let Some(i) = memchr::memrchr(b'\n', &self.buf[self.complete..self.filled]) {
+                // Keep reading to fill the chunk unless the buffer is full or the file ended.
+                if self.filled == self.buf.len() || self.eof {
+                    self.complete += i + 1;
+                    return Ok(true);
+                }
+            } else if self.eof {
+                if self.filled > self.complete {
+                    // A last line without a line end.
+                    if self.filled == self.buf.len() {
+                        self.buf.push(b'\n');
+                    } else {
+                        self.buf[self.filled] = b'\n';
+                    }
+                    self.filled += 1;
+                    self.complete = self.filled;
+                    return Ok(true);
+                }
+                return Ok(false);
+            }
+            if self.filled == self.buf.len() {
+                if self.buf.len() >= MAX_LINE_BYTES {
+                    return Err(DataError::new(
+                        &self.header.file,
+                        format!("a line longer than {MAX_LINE_BYTES} bytes: expected a text file of numbers"),
+                    )
+                    .at_line(self.line_no + 1));
+                }
+                let n = (self.buf.len() * 2).max(self.chunk_bytes);
+                self.buf.resize(n, 0);
+            }
+            match self.src.read(&mut self.buf[self.filled..]) {
+                Ok(0) => self.eof = true,
+                Ok(n) => self.filled += n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(DataError::io(&self.header.file, &e)),
+            }
+        }
+    }
+
+    /// The next block of rows, or `None` at the end of the file.
+    pub fn next_block(&mut self) -> Result<Option<SeriesBlock<'_>>, DataError> {
+        for c in &mut self.cols {
+            c.clear();
+        }
+        self.lines.clear();
+        while self.lines.len() < self.block_rows {
+            if self.pos >= self.complete && !self.fill()? {
+                break;
+            }
+            self.parse_rows()?;
+        }
+        if self.lines.is_empty() {
+            if self.rows == 0 {
+                return Err(DataError::new(
+                    &self.header.file,
+                    "the file has a header but no data rows: expected at least one row of numbers",
+                )
+                .at_line(self.header.header_line));
+            }
+            return Ok(None);
+        }
+        let nch = self.header.channels.len();
+        Ok(Some(SeriesBlock {
+            first_line: self.lines[0],
+            lines: &self.lines,
+            time: self.time_slot.map(|s| &self.cols[s][..]),
+            temp: self.temp_slot.map(|s| &self.cols[s][..]),
+            channels: &self.cols[..nch],
+        }))
+    }
+
+    /// Parses complete lines from `pos` until the block is full or the chunk is used up.
+    fn parse_rows(&mut self) -> Result<(), DataError> {
+        let bytes = &self.buf[..self.complete];
+        let end = self.complete;
+        let ws = self.header.delimiter == Delimiter::Whitespace;
+        let delim = self.header.delimiter.byte();
+        let ncols = self.targets.len();
+        let mut p = self.pos;
+        let mut line_no = self.line_no;
+        let result = 'rows: loop {
+            if p >= end || self.lines.len() >= self.block_rows {
+                break 'rows Ok(());
+            }
+            line_no += 1;
+            let line_start = p;
+            let c0 = bytes[p];
+            if c0 == b'#' || c0 == b'\n' || c0 == b'\r' || c0 == b' ' || c0 == b'\t' {
+                let le = memchr::memchr(b'\n', &bytes[p..end]).map_or(end, |i| p + i);
+                if is_blank_or_comment(&bytes[p..le]) {
+                    p = le + 1;
+                    continue 'rows;
+                }
+            }
+            for (ci, &slot) in self.targets.iter().enumerate() {
+                while bytes[p] == b' ' || (bytes[p] == b'\t' && delim != b'\t') {
+                    p += 1;
+                }
+                let field_start = p;
+                if slot == SKIP {
+                    while !is_field_end(bytes[p], delim, ws) {
+                        p += 1;
+                    }
+                } else {
+                    let value = match fast_float2::parse_partial::<f64, _>(&bytes[p..end]) {
+                        Ok((v, n)) => {
+                            p += n;
+                            v
+                        }
+                        Err(_) if ws && is_field_end(bytes[p], delim, ws) => {
+                            break 'rows Err(self.wrong_count(bytes, line_start, line_no, delim, ws));
+                        }
+                        Err(_) if is_field_end(bytes[p], delim, ws) => f64::NAN,
+                        Err(_) => {
+                            break 'rows Err(self.bad_number(bytes, field_start, line_no, ci, delim, ws));
+                        }
+                    };
+                    if !value.is_finite() && !is_field_end_after_spaces(bytes, p, delim, ws) {
+                        break 'rows Err(self.bad_number(bytes, field_start, line_no, ci, delim, ws));
+                    }
+                    if value.is_finite() {
+                        self.cols[slot as usize].push(value);
+                    } else {
+                        let text = field_text(bytes, field_start, delim, ws);
+                        if !self.tolerant || value == f64::INFINITY || value == f64::NEG_INFINITY {
+                            let what = if text.is_empty() { "an empty cell".to_string() } else { format!("'{text}'") };
+                            let hint = if value.is_nan() { " (tolerant mode reports NaN and empty cells)" } else { "" };
+                            break 'rows Err(self.err_at(
+                                line_no,
+                                ci,
+                                format!("found {what}, expected a finite number{hint}"),
+                            ));
+                        }
+                        self.quality.missing_cells += 1;
+                        if self.quality.first_missing.len() < FIRST_MISSING {
+                            self.quality.first_missing.push(MissingCell {
+                                line: line_no,
+                                column: ci + 1,
+                                name: self.header.columns[ci].name.clone(),
+                                text: text.to_string(),
+                            });
+                        }
+                        self.cols[slot as usize].push(f64::NAN);
+                    }
+                }
+                // After the field: spaces, then a delimiter or the line end.
+                let before = p;
+                while bytes[p] == b' ' || (bytes[p] == b'\t' && delim != b'\t') {
+                    p += 1;
+                }
+                let b = bytes[p];
+                let at_eol = b == b'\n' || (b == b'\r' && bytes.get(p + 1) == Some(&b'\n'));
+                if ci + 1 < ncols {
+                    if at_eol {
+                        break 'rows Err(self.wrong_count(bytes, line_start, line_no, delim, ws));
+                    }
+                    if ws {
+                        if p == before {
+                            break 'rows Err(self.bad_number(bytes, field_start, line_no, ci, delim, ws));
+                        }
+                    } else if b == delim {
+                        p += 1;
+                    } else {
+                        break 'rows Err(self.bad_number(bytes, field_start, line_no, ci, delim, ws));
+                    }
+                } else if at_eol {
+                    p += if b == b'\r' { 2 } else { 1 };
+                } else if b == delim || (ws && p > before) {
+                    break 'rows Err(self.wrong_count(bytes, line_start, line_no, delim, ws));
+                } else {
+                    break 'rows Err(self.bad_number(bytes, field_start, line_no, ci, delim, ws));
+                }
+            }
+            self.lines.push(line_no);
+            self.rows += 1;
+        };
+        self.pos = p;
+        self.line_no = line_no;
+        result
+    }
+
+    fn err_at(&self, line: u64, ci: usize, msg: String) -> DataError {
+        let name = self.header.columns.get(ci).map(|c| c.name.as_str());
+        DataError::new(&self.header.file, msg).at_line(line).at_column(ci + 1, name)
+    }
+
+    fn bad_number(&self, bytes: &[u8], field_start: usize, line: u64, ci: usize, delim: u8, ws: bool) -> DataError {
+        let text = field_text(bytes, field_start, delim, ws);
+        self.err_at(line, ci, format!("found '{text}', expected a number"))
+    }
+
+    fn wrong_count(&self, bytes: &[u8], line_start: usize, line: u64, delim: u8, ws: bool) -> DataError {
+        let le = memchr::memchr(b'\n', &bytes[line_start..]).map_or(bytes.len(), |i| line_start + i);
+        let text = bytes[line_start..le].trim_ascii();
+        let found = if ws {
+            text.split(|b| b.is_ascii_whitespace()).filter(|f| !f.is_empty()).count()
+        } else {
+            text.split(|&b| b == delim).count()
+        };
+        let expected = self.targets.len();
+        let col = found.min(expected) + 1;
+        let name = self.header.columns.get(found).map(|c| c.name.as_str());
+        DataError::new(&self.header.file, format!("found {found} fields, expected {expected} (one per header column)"))
+            .at_line(line)
+            .at_column(col, name)
+    }
+}
+
+#[inline(always)]
+fn is_field_end(b: u8, delim: u8, ws: bool) -> bool {
+    b == b'\n' || b == b'\r' || b == delim || (ws && (b == b' ' || b == b'\t'))
+}
+
+fn is_field_end_after_spaces(bytes: &[u8], mut p: usize, delim: u8, ws: bool) -> bool {
+    while bytes[p] == b' ' || (bytes[p] == b'\t' && delim != b'\t') {
+        p += 1;
+    }
+    is_field_end(bytes[p], delim, ws)
+}
+
+fn field_text(bytes: &[u8], start: usize, delim: u8, ws: bool) -> String {
+    let mut e = start;
+    while e < bytes.len() && !is_field_end(bytes[e], delim, ws) {
+        e += 1;
+    }
+    String::from_utf8_lossy(bytes[start..e].trim_ascii()).into_owned()
+}
+
+/// Row count and findings of a streamed read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeriesSummary {
+    /// The header.
+    pub header: SeriesHeader,
+    /// Data rows read.
+    pub rows: u64,
+    /// NaN and empty cells passed on (tolerant mode).
+    pub quality: ReaderQuality,
+}
+
+/// Streams a file block by block into `on_block`; stops at the first error (the reader's or the callback's).
+pub fn read_series(
+    path: impl AsRef<Path>,
+    options: &SeriesOptions,
+    mut on_block: impl FnMut(&SeriesHeader, &SeriesBlock) -> Result<(), DataError>,
+) -> Result<SeriesSummary, DataError> {
+    let mut r = SeriesReader::open(path, options)?;
+    let header = r.header.clone();
+    while let Some(b) = r.next_block()? {
+        on_block(&header, &b)?;
+    }
+    Ok(SeriesSummary { header, rows: r.rows, quality: r.quality.clone() })
+}
+
+/// A whole time series in memory, column by column.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeriesData {
+    /// The header.
+    pub header: SeriesHeader,
+    /// Source line of each row.
+    pub lines: Vec<u64>,
+    /// Time stamps, seconds.
+    pub time: Option<Vec<f64>>,
+    /// Temperature, degC.
+    pub temperature: Option<Vec<f64>>,
+    /// One column per output channel, in the order of `header.channels`.
+    pub channels: Vec<Vec<f64>>,
+    /// NaN and empty cells passed on (tolerant mode).
+    pub quality: ReaderQuality,
+}
+
+/// Reads a whole file into memory (for analyses that need the whole record, such as Allan variance).
+pub fn read_series_all(path: impl AsRef<Path>, options: &SeriesOptions) -> Result<SeriesData, DataError> {
+    let r = SeriesReader::open(path, options)?;
+    collect_series(r)
+}
+
+/// Reads every block of an open reader into memory.
+pub fn collect_series<R: Read>(mut r: SeriesReader<R>) -> Result<SeriesData, DataError> {
+    let header = r.header.clone();
+    let mut lines = Vec::new();
+    let mut time = header.time_column.map(|_| Vec::new());
+    let mut temperature = header.temperature_column.map(|_| Vec::new());
+    let mut channels = vec![Vec::new(); header.channels.len()];
+    while let Some(b) = r.next_block()? {
+        lines.extend_from_slice(b.lines);
+        if let (Some(t), Some(bt)) = (time.as_mut(), b.time) {
+            t.extend_from_slice(bt);
+        }
+        if let (Some(t), Some(bt)) = (temperature.as_mut(), b.temp) {
+            t.extend_from_slice(bt);
+        }
+        for (c, bc) in channels.iter_mut().zip(b.channels) {
+            c.extend_from_slice(bc);
+        }
+    }
+    let quality = r.quality.clone();
+    Ok(SeriesData { header, lines, time, temperature, channels, quality })
+}
+
+/// Evaluates the static (bias) test of every channel of a file, streaming it twice (figures,
+/// then outliers); `config_for` gives each channel's options (scale factor, null, latitude ...).
+pub fn evaluate_static_file(
+    path: impl AsRef<Path>,
+    options: &SeriesOptions,
+    config_for: impl Fn(&ChannelInfo) -> StaticTestConfig,
+) -> Result<(Vec<StaticTestResult>, SeriesSummary), DataError> {
+    let path = path.as_ref();
+    let mut r = SeriesReader::open(path, options)?;
+    let header = r.header.clone();
+    let configs: Vec<StaticTestConfig> = header
+        .channels
+        .iter()
+        .map(|c| {
+            let mut cfg = config_for(c);
+            cfg.channel = c.name.clone();
+            cfg.output_unit = c.unit;
+            if cfg.sample_rate_hz.is_none() {
+                cfg.sample_rate_hz = header.sample_rate_hz;
+            }
+            cfg
+        })
+        .collect();
+    let wrap =
+        |ch: &str, e: gyrolab::static_test::StaticTestError| DataError::new(path, format!("channel '{ch}': {e}"));
+    let mut accs = Vec::with_capacity(configs.len());
+    for cfg in &configs {
+        accs.push(StaticTestAccumulator::new(cfg.clone()).map_err(|e| wrap(&cfg.channel, e))?);
+    }
+    while let Some(b) = r.next_block()? {
+        for (k, acc) in accs.iter_mut().enumerate() {
+            acc.push(&b.samples(k)).map_err(|e| wrap(&configs[k].channel, e))?;
+        }
+    }
+    let summary = SeriesSummary { header: header.clone(), rows: r.rows, quality: r.quality.clone() };
+    let mut firsts = Vec::with_capacity(accs.len());
+    let mut scans = Vec::with_capacity(accs.len());
+    for (acc, cfg) in accs.into_iter().zip(&configs) {
+        let first = acc.finish().map_err(|e| wrap(&cfg.channel, e))?;
+        scans.push(OutlierScan::new(&first, cfg).map_err(|e| wrap(&cfg.channel, e))?);
+        firsts.push(first);
+    }
+    let mut r = SeriesReader::open(path, options)?;
+    while let Some(b) = r.next_block()? {
+        for (k, scan) in scans.iter_mut().enumerate() {
+            scan.push(&b.samples(k)).map_err(|e| wrap(&configs[k].channel, e))?;
+        }
+    }
+    let mut results = Vec::with_capacity(scans.len());
+    for ((scan, first), cfg) in scans.into_iter().zip(firsts).zip(&configs) {
+        results.push(scan.finish(first).map_err(|e| wrap(&cfg.channel, e))?);
+    }
+    Ok((results, summary))
+}

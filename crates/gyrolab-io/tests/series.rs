@@ -1,0 +1,252 @@
+//! The time-series reader: good layouts, every bad input (with line and column), block and chunk
+//! boundaries, and the static test of a file.
+
+use gyrolab::static_test::{Position, StaticTestConfig};
+use gyrolab::units::OutputUnit;
+use gyrolab_io::series::*;
+use gyrolab_io::DataError;
+use proptest::prelude::*;
+
+fn read_str(text: &str, opts: &SeriesOptions) -> Result<SeriesData, DataError> {
+    collect_series(SeriesReader::from_reader("t.csv", text.as_bytes(), opts)?)
+}
+
+fn err(text: &str, opts: &SeriesOptions) -> DataError {
+    read_str(text, opts).expect_err("expected an error")
+}
+
+fn at(e: &DataError) -> (Option<u64>, Option<usize>) {
+    (e.line, e.column.as_ref().map(|c| c.index))
+}
+
+fn tolerant() -> SeriesOptions {
+    SeriesOptions { tolerant: true, ..SeriesOptions::default() }
+}
+
+#[test]
+fn csv_with_bom_comments_blank_lines_crlf() {
+    let text = "\u{feff}# comment\r\n\r\ntime_s, temp_c ,gyro_x_mv,rate_rad_s\r\n0,20.5,+1.5e3,-2\r\n# mid comment\r\n  \r\n0.01,20.6,1500.25,3E-2\r\n";
+    let d = read_str(text, &SeriesOptions::default()).unwrap();
+    assert_eq!(d.header.header_line, 3);
+    assert_eq!(d.header.delimiter, Delimiter::Comma);
+    assert_eq!(d.header.time_column, Some(1));
+    assert_eq!(d.header.temperature_column, Some(2));
+    let units: Vec<OutputUnit> = d.header.channels.iter().map(|c| c.unit).collect();
+    assert_eq!(units, vec![OutputUnit::Millivolt, OutputUnit::RadPerSec]);
+    assert_eq!(d.lines, vec![4, 7]);
+    assert_eq!(d.time.unwrap(), vec![0.0, 0.01]);
+    assert_eq!(d.temperature.unwrap(), vec![20.5, 20.6]);
+    assert_eq!(d.channels, vec![vec![1500.0, 1500.25], vec![-2.0, 0.03]]);
+}
+
+#[test]
+fn tsv_whitespace_and_sample_rate_without_time() {
+    let d = read_str("time_s\toutput_v\n1\t2.5\n2\t2.6", &SeriesOptions::default()).unwrap();
+    assert_eq!(d.header.delimiter, Delimiter::Tab);
+    assert_eq!(d.channels[0], vec![2.5, 2.6], "a last line without a line end is read");
+    let o = SeriesOptions { sample_rate_hz: Some(100.0), ..SeriesOptions::default() };
+    let d = read_str("  output_v   counts_lsb\n  2.5   12\n2.6 \t 13  \n", &o).unwrap();
+    assert_eq!(d.header.delimiter, Delimiter::Whitespace);
+    assert!(d.time.is_none());
+    assert_eq!(d.channels, vec![vec![2.5, 2.6], vec![12.0, 13.0]]);
+    assert_eq!(d.header.sample_rate_hz, Some(100.0));
+}
+
+#[test]
+fn unit_override_and_channel_selection() {
+    let o = SeriesOptions { column_units: vec![("sensor".into(), OutputUnit::Volt)], ..SeriesOptions::default() };
+    let d = read_str("time_s,sensor\n0,1\n", &o).unwrap();
+    assert_eq!(d.header.channels[0].unit, OutputUnit::Volt);
+    let o = SeriesOptions { channels: Some(vec!["output_v".into()]), ..SeriesOptions::default() };
+    let d = read_str("time_s,status_flag,output_v\n0,abc,1\n", &o).unwrap();
+    assert_eq!(d.header.columns[1].role, ColumnRole::Ignored);
+    assert_eq!(d.channels, vec![vec![1.0]]);
+    let o = SeriesOptions { channels: Some(vec!["output_mv".into()]), ..SeriesOptions::default() };
+    let e = err("time_s,output_v\n0,1\n", &o);
+    assert!(e.message.contains("'output_mv' is not in the header"), "{e}");
+}
+
+#[test]
+fn text_in_a_number_names_line_column_and_text() {
+    let e = err("time_s,output_v\n0,1\n1,abc\n", &SeriesOptions::default());
+    assert_eq!(at(&e), (Some(3), Some(2)));
+    assert_eq!(e.column.as_ref().unwrap().name.as_deref(), Some("output_v"));
+    assert!(e.message.contains("found 'abc', expected a number"), "{e}");
+    let e = err("time_s,output_v\n0,1\n1.5x,2\n", &SeriesOptions::default());
+    assert_eq!(at(&e), (Some(3), Some(1)));
+    assert!(e.message.contains("'1.5x'"), "{e}");
+    assert_eq!(e.to_string(), "t.csv:3:1: column 'time_s': found '1.5x', expected a number");
+}
+
+#[test]
+fn wrong_field_counts() {
+    let e = err("time_s,output_v,temp_c\n0,1,2\n1,2\n", &SeriesOptions::default());
+    assert_eq!(at(&e), (Some(3), Some(3)));
+    assert!(e.message.contains("found 2 fields, expected 3"), "{e}");
+    let e = err("time_s,output_v\n0,1\n\n1,2,3\n", &SeriesOptions::default());
+    assert_eq!(at(&e), (Some(4), Some(3)));
+    assert!(e.message.contains("found 3 fields, expected 2"), "{e}");
+    let o = SeriesOptions { sample_rate_hz: Some(1.0), ..SeriesOptions::default() };
+    let e = err("output_v gyro_y_v\n1 2\n3\n", &o);
+    assert_eq!(at(&e), (Some(3), Some(2)));
+    assert!(e.message.contains("found 1 fields, expected 2"), "{e}");
+}
+
+#[test]
+fn nan_and_empty_cells_are_errors_or_listed_when_tolerant() {
+    let e = err("time_s,output_v\n0,1\n1,NaN\n", &SeriesOptions::default());
+    assert_eq!(at(&e), (Some(3), Some(2)));
+    assert!(e.message.contains("found 'NaN', expected a finite number"), "{e}");
+    let e = err("time_s,output_v\n0,\n", &SeriesOptions::default());
+    assert_eq!(at(&e), (Some(2), Some(2)));
+    assert!(e.message.contains("found an empty cell"), "{e}");
+    let e = err("time_s,output_v\n0,inf\n", &tolerant());
+    assert_eq!(at(&e), (Some(2), Some(2)));
+    let d = read_str("time_s,output_v\n0,1\n1,nan\n2,\n3,4\n", &tolerant()).unwrap();
+    assert!(d.channels[0][1].is_nan() && d.channels[0][2].is_nan());
+    assert_eq!(d.quality.missing_cells, 2);
+    let first: Vec<(u64, usize, &str)> =
+        d.quality.first_missing.iter().map(|m| (m.line, m.column, m.text.as_str())).collect();
+    assert_eq!(first, vec![(3, 2, "nan"), (4, 2, "")]);
+}
+
+#[test]
+fn empty_header_only_and_comment_only_files() {
+    for text in ["", "\n\n", "# only a comment\n"] {
+        let e = err(text, &SeriesOptions::default());
+        assert!(e.message.contains("the file is empty"), "{e}");
+        assert_eq!(at(&e), (None, None));
+    }
+    let e = err("# c\ntime_s,output_v\n# no data\n", &SeriesOptions::default());
+    assert_eq!(at(&e), (Some(2), None));
+    assert!(e.message.contains("no data rows"), "{e}");
+}
+
+#[test]
+fn header_errors() {
+    let e = err("time_s,output_v,Output_V\n0,1,2\n", &SeriesOptions::default());
+    assert_eq!(at(&e), (Some(1), Some(3)));
+    assert!(e.message.contains("column 2 'output_v' and column 3 'Output_V'"), "{e}");
+    let e = err("# x\ntime_s,output_furlong\n0,1\n", &SeriesOptions::default());
+    assert_eq!(at(&e), (Some(2), Some(2)));
+    assert!(e.message.contains("unknown unit suffix 'furlong'"), "{e}");
+    assert!(e.message.contains("v, mv, lsb, dps, rad_s"), "{e}");
+    let e = err("time_s,sensor\n0,1\n", &SeriesOptions::default());
+    assert_eq!(at(&e), (Some(1), Some(2)));
+    assert!(e.message.contains("no unit suffix"), "{e}");
+    let e = err("time_ms,output_v\n0,1\n", &SeriesOptions::default());
+    assert_eq!(at(&e), (Some(1), Some(1)));
+    let e = err("temp_k,output_v\n0,1\n", &SeriesOptions { sample_rate_hz: Some(1.0), ..SeriesOptions::default() });
+    assert_eq!(at(&e), (Some(1), Some(1)));
+    let e = err("output_v\n1\n", &SeriesOptions::default());
+    assert!(e.message.contains("no time column"), "{e}");
+    let e = err("time_s,temp_c\n0,1\n", &SeriesOptions::default());
+    assert!(e.message.contains("no output channel"), "{e}");
+}
+
+fn write_temp(text: &str) -> (tempfile::TempDir, std::path::PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("rec.csv");
+    std::fs::write(&p, text).unwrap();
+    (dir, p)
+}
+
+#[test]
+fn static_test_of_a_file_reports_gaps_and_unsorted_time_with_lines() {
+    // 1 Hz; line 2 is the header, sample i on line 3 + i. Gap before sample 5 (t 4 -> 7),
+    // t repeats at sample 8, decreases at sample 9.
+    let times = [0.0, 1.0, 2.0, 3.0, 4.0, 7.0, 8.0, 9.0, 9.0, 8.5, 10.0, 11.0];
+    let mut text = String::from("# rec\ntime_s,output_v\n");
+    for (i, t) in times.iter().enumerate() {
+        text.push_str(&format!("{t},{}\n", 2.5 + 0.001 * (i % 3) as f64));
+    }
+    let (_d, p) = write_temp(&text);
+    let (res, summary) = evaluate_static_file(&p, &SeriesOptions::default(), |_| StaticTestConfig {
+        sample_rate_hz: Some(1.0),
+        ..StaticTestConfig::default()
+    })
+    .unwrap();
+    assert_eq!(summary.rows, 12);
+    let q = &res[0].quality;
+    let pos = |s: u64| Position { sample: s, line: Some(3 + s) };
+    // Sample 10 follows 8.5 by 1.5 s: not above 1.5 x 1 s, so not a gap.
+    assert_eq!(q.time_gaps.first, vec![pos(5)]);
+    assert_eq!(q.repeated_time.first, vec![pos(8)]);
+    assert_eq!(q.decreasing_time.first, vec![pos(9)]);
+    // Short record: 12 samples fit 1 window of 10 s, none of 100 s: both skipped with reasons.
+    let skipped: Vec<f64> = res[0].bias_stability_skipped.iter().map(|s| s.smoothing_s).collect();
+    assert_eq!(skipped, vec![10.0, 100.0]);
+    assert!(res[0].bias_stability_skipped[0].reason.contains("1 whole windows"));
+    assert_eq!(res[0].channel, "output_v");
+}
+
+#[test]
+fn tolerant_missing_cells_reach_the_static_test_with_lines() {
+    let (_d, p) = write_temp("time_s,output_v,gyro_y_v\n0,1,1\n1,nan,2\n2,3,\n3,4,4\n");
+    let (res, summary) = evaluate_static_file(&p, &tolerant(), |_| StaticTestConfig::default()).unwrap();
+    assert_eq!(summary.quality.missing_cells, 2);
+    assert_eq!(res[0].quality.missing.first, vec![Position { sample: 1, line: Some(3) }]);
+    assert_eq!(res[1].quality.missing.first, vec![Position { sample: 2, line: Some(4) }]);
+    assert_eq!(res[0].valid_samples, 3);
+    assert!((res[0].mean_output - 8.0 / 3.0).abs() < 1e-15);
+}
+
+#[test]
+fn chunk_and_block_sizes_do_not_change_static_results() {
+    let mut text = String::from("time_s,temp_c,output_v\n");
+    for i in 0..3000 {
+        let x = 2.5 + 1e-3 * (((i * 7919) % 101) as f64 / 101.0 - 0.5) + 1e-7 * i as f64;
+        text.push_str(&format!("{:.2},{:.3},{x:.9}\n", i as f64 * 0.1, 20.0 + i as f64 * 0.001));
+    }
+    let (_d, p) = write_temp(&text);
+    let base = evaluate_static_file(&p, &SeriesOptions::default(), |_| StaticTestConfig::default()).unwrap().0;
+    for (chunk, rows) in [(16, 1), (64, 7), (1000, 333), (5000, 4096)] {
+        let o = SeriesOptions { chunk_bytes: chunk, block_rows: rows, ..SeriesOptions::default() };
+        let r = evaluate_static_file(&p, &o, |_| StaticTestConfig::default()).unwrap().0;
+        let (a, b) = (&base[0], &r[0]);
+        assert_eq!(a.samples, b.samples);
+        assert!((a.mean_output - b.mean_output).abs() < 1e-14);
+        for (k, v) in &a.bias_stability_output {
+            assert!((b.bias_stability_output[k] - v).abs() < 1e-12 * v.abs(), "{k}");
+        }
+        assert!((a.drift_output_per_h.unwrap() - b.drift_output_per_h.unwrap()).abs() < 1e-10);
+        let (ta, tb) = (a.temperature.as_ref().unwrap(), b.temperature.as_ref().unwrap());
+        assert!((ta.slope_output_per_c - tb.slope_output_per_c).abs() < 1e-9 * ta.slope_output_per_c.abs());
+    }
+}
+
+proptest! {
+    #[test]
+    fn values_round_trip_exactly_for_any_chunk_size(
+        rows in prop::collection::vec((any::<f64>(), any::<f64>()), 1..60),
+        chunk in 16usize..200,
+        block_rows in 1usize..20,
+        sep in prop::sample::select(vec![",", "\t", " ", ";"]),
+        comments in any::<bool>(),
+    ) {
+        let rows: Vec<(f64, f64)> = rows.into_iter().filter(|(a, b)| a.is_finite() && b.is_finite()).collect();
+        prop_assume!(!rows.is_empty());
+        let mut text = format!("time_s{sep}output_v\n");
+        let mut lines = Vec::new();
+        let mut line = 1u64;
+        for (i, (t, x)) in rows.iter().enumerate() {
+            if comments && i % 3 == 0 {
+                text.push_str("# c\n\n");
+                line += 2;
+            }
+            // Rust's Display gives the shortest text that parses back to the same f64; '+' and exponents too.
+            let tt = if i % 2 == 0 { format!("{t:e}") } else { format!("{t}") };
+            let xt = if x.is_sign_positive() && i % 4 == 1 { format!("+{x}") } else { format!("{x}") };
+            text.push_str(&format!("{tt}{sep}{xt}\n"));
+            line += 1;
+            lines.push(line);
+        }
+        let o = SeriesOptions { chunk_bytes: chunk, block_rows, ..SeriesOptions::default() };
+        let d = read_str(&text, &o).unwrap();
+        let t: Vec<f64> = rows.iter().map(|r| r.0).collect();
+        let x: Vec<f64> = rows.iter().map(|r| r.1).collect();
+        prop_assert_eq!(d.time.unwrap(), t);
+        prop_assert_eq!(&d.channels[0], &x);
+        prop_assert_eq!(d.lines, lines);
+    }
+}
