@@ -5,11 +5,13 @@
 //! - [`units`]: units of rates, outputs and noise coefficients, and every conversion;
 //! - [`fit`]: least-squares lines and polynomials;
 //! - [`rate_test`]: rate-table (scale-factor) test figures;
-//! - [`published`]: comparison with figures printed in a publication.
+//! - [`published`]: comparison with figures printed in a publication;
+//! - [`sim`]: gyro simulator with known truth (static records, rate-table tests).
 //!
 //! Formulas and their sources are listed in `docs/METHODS.md`.
 
 pub mod fit;
 pub mod published;
 pub mod rate_test;
+pub mod sim;
 pub mod units;
