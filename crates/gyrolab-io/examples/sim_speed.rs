@@ -1,9 +1,10 @@
 //! Speed of simulating and writing a static record.
 //!
-//! Usage: `cargo run --release -p gyrolab-io --example sim_speed -- [SAMPLES] [PRESET] [MODE] > /dev/null`
+//! Usage: `cargo run --release -p gyrolab-io --example sim_speed -- [SAMPLES] [PRESET] [MODE] [pipelined] > /dev/null`
 //! SAMPLES defaults to 10 000 000, PRESET to adxrs646; MODE is `shortest` (default), `fixed9`
-//! (9 decimals) or `generate` (simulate only, write nothing). The record (100 Hz) goes to stdout;
-//! the timing goes to stderr.
+//! (9 decimals) or `generate` (simulate only, write nothing); a 4th argument `pipelined` simulates
+//! on a second thread while the first formats. The record (100 Hz) goes to stdout; the timing goes
+//! to stderr.
 
 use std::io::Write;
 use std::time::Instant;
@@ -34,7 +35,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "fixed9" => NumberFormat::Fixed { decimals: 9 },
             _ => NumberFormat::Shortest,
         };
-        let options = SimCsvOptions { number_format, comments: vec![format!("preset = {preset_name}")] };
+        let pipelined = args.get(3).is_some_and(|s| s == "pipelined");
+        let options = SimCsvOptions { number_format, comments: vec![format!("preset = {preset_name}")], pipelined };
         let stdout = std::io::stdout().lock();
         let sum = write_static_csv(stdout, &model, &spec, 1, &options)?;
         (sum.rows, sum.bytes)

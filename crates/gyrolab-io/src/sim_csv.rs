@@ -14,7 +14,7 @@
 use std::io::Write;
 
 use gyrolab::sim::{
-    FlickerDesign, RateTableGenerator, RateTableSpec, SensorModel, SimError, StaticGenerator, StaticSpec,
+    FlickerDesign, RateTableGenerator, RateTableSpec, SensorModel, SimError, StaticGenerator, StaticSample, StaticSpec,
     FLICKER_BAND,
 };
 use gyrolab::units::OutputUnit;
@@ -34,13 +34,26 @@ pub enum NumberFormat {
 }
 
 /// Options of the simulated-record writers.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct SimCsvOptions {
     /// Number formatting of the value columns.
     pub number_format: NumberFormat,
     /// Extra comment lines written after the title (such as the preset name or the command line).
     pub comments: Vec<String>,
+    /// Simulate static records on a second thread while this one formats (same bytes either way;
+    /// helps only when a second core is free).
+    pub pipelined: bool,
 }
+
+impl Default for SimCsvOptions {
+    /// Shortest number form, no extra comments, one thread.
+    fn default() -> Self {
+        SimCsvOptions { number_format: NumberFormat::Shortest, comments: Vec::new(), pipelined: false }
+    }
+}
+
+/// Samples per block handed from the simulating thread to the formatting thread.
+const BLOCK_SAMPLES: usize = 8192;
 
 /// Why a simulated record could not be written.
 #[derive(Debug, Error)]
@@ -72,6 +85,67 @@ const EXACT_INT_LIMIT: f64 = 9_007_199_254_740_992.0;
 /// Buffer size at which rows are handed to the writer.
 const FLUSH_AT: usize = 1 << 16;
 
+/// Two-digit groups "00".."99", for writing integers two digits at a time.
+const DIGIT_PAIRS: [u8; 200] = {
+    let mut t = [0u8; 200];
+    let mut i = 0;
+    while i < 100 {
+        t[2 * i] = b'0' + (i / 10) as u8;
+        t[2 * i + 1] = b'0' + (i % 10) as u8;
+        i += 1;
+    }
+    t
+};
+
+/// Writes `v` in exactly `width` decimal digits (zero-padded on the left) ending before `end`;
+/// returns the start index. `v` must be below 10^width.
+#[inline]
+fn write_padded(out: &mut [u8], end: usize, mut v: u64, width: usize) -> usize {
+    let start = end - width;
+    let mut i = end;
+    while i >= start + 2 {
+        let pair = (v % 100) as usize * 2;
+        v /= 100;
+        out[i - 2..i].copy_from_slice(&DIGIT_PAIRS[pair..pair + 2]);
+        i -= 2;
+    }
+    if i > start {
+        out[i - 1] = b'0' + (v % 10) as u8;
+    }
+    start
+}
+
+/// Writes `v` as decimal digits ending at the end of `out`, with a decimal point before the last
+/// `decimals` digits (zero-padded: 5 with 3 decimals is `0.005`); returns the start index.
+/// `out` must hold 20 + 1 + decimals bytes.
+#[inline]
+fn write_digits(out: &mut [u8], v: u64, decimals: usize) -> usize {
+    let mut end = out.len();
+    let mut int = v;
+    if decimals > 0 {
+        let unit = POW10_INT[decimals];
+        end = write_padded(out, end, v % unit, decimals) - 1;
+        out[end] = b'.';
+        int = v / unit;
+    }
+    let mut width = 1;
+    while width < 20 && int >= POW10_INT[width] {
+        width += 1;
+    }
+    write_padded(out, end, int, width)
+}
+
+/// Exact integer powers of ten 10^0 ..= 10^19.
+const POW10_INT: [u64; 20] = {
+    let mut t = [1u64; 20];
+    let mut i = 1;
+    while i < 20 {
+        t[i] = t[i - 1] * 10;
+        i += 1;
+    }
+    t
+};
+
 /// Row formatter over a block buffer.
 struct RowWriter<W: Write> {
     out: W,
@@ -85,9 +159,7 @@ impl<W: Write> RowWriter<W> {
     fn new(out: W, format: NumberFormat) -> Result<Self, SimCsvError> {
         if let NumberFormat::Fixed { decimals } = format {
             if decimals > 15 {
-                return Err(SimCsvError::InvalidOption(format!(
-                    "fixed decimals = {decimals}: must be within 0..=15"
-                )));
+                return Err(SimCsvError::InvalidOption(format!("fixed decimals = {decimals}: must be within 0..=15")));
             }
         }
         Ok(RowWriter { out, buf: Vec::with_capacity(FLUSH_AT + 1024), ryu: ryu::Buffer::new(), format, bytes: 0 })
@@ -106,17 +178,9 @@ impl<W: Write> RowWriter<W> {
         }
     }
 
-    fn unsigned(&mut self, mut v: u64) {
-        let mut digits = [0u8; 20];
-        let mut i = digits.len();
-        loop {
-            i -= 1;
-            digits[i] = b'0' + (v % 10) as u8;
-            v /= 10;
-            if v == 0 {
-                break;
-            }
-        }
+    fn unsigned(&mut self, v: u64) {
+        let mut digits = [0u8; 21];
+        let i = write_digits(&mut digits, v, 0);
         self.buf.extend_from_slice(&digits[i..]);
     }
 
@@ -137,21 +201,16 @@ impl<W: Write> RowWriter<W> {
                     self.shortest(v);
                     return;
                 }
-                if scaled < 0.0 {
-                    self.buf.push(b'-');
-                }
                 // ok: |scaled| < 2^53, so the conversion to u64 is exact.
                 let int = scaled.abs() as u64;
-                let unit = 10u64.pow(u32::from(decimals));
-                self.unsigned(int / unit);
-                if d > 0 {
-                    self.buf.push(b'.');
-                    let frac = int % unit;
-                    let start = self.buf.len();
-                    self.unsigned(frac + unit);
-                    // Drop the leading 1 of (frac + 10^d), which kept the zero padding.
-                    self.buf.remove(start);
+                // Sign, up to 16 integer digits, point, up to 15 decimals.
+                let mut text = [0u8; 40];
+                let mut i = write_digits(&mut text, int, d);
+                if scaled < 0.0 {
+                    i -= 1;
+                    text[i] = b'-';
                 }
+                self.buf.extend_from_slice(&text[i..]);
             }
         }
     }
@@ -261,19 +320,53 @@ pub fn write_static_csv<W: Write>(
     w.text(&static_header(model.output_unit, with_temp));
     w.end_row()?;
     let mut rows = 0u64;
-    for s in generator {
-        w.number(s.time_s);
-        w.buf.push(b',');
-        w.number(s.output);
-        if let Some(t) = s.temp_c {
-            w.buf.push(b',');
-            w.number(t);
+    if options.pipelined {
+        let (to_writer, from_generator) = std::sync::mpsc::sync_channel::<Vec<StaticSample>>(4);
+        let (to_generator, from_writer) = std::sync::mpsc::channel::<Vec<StaticSample>>();
+        let written = std::thread::scope(|scope| {
+            scope.spawn(move || {
+                let mut generator = generator;
+                loop {
+                    let mut block = from_writer.try_recv().unwrap_or_else(|_| Vec::with_capacity(BLOCK_SAMPLES));
+                    block.clear();
+                    block.extend(generator.by_ref().take(BLOCK_SAMPLES));
+                    // A send error means the writer stopped (an I/O error): stop too.
+                    if block.is_empty() || to_writer.send(block).is_err() {
+                        break;
+                    }
+                }
+            });
+            for block in from_generator {
+                for s in &block {
+                    write_static_row(&mut w, s)?;
+                }
+                rows += block.len() as u64;
+                // The generator may have finished: a failed return of the buffer is harmless.
+                let _ = to_generator.send(block);
+            }
+            Ok::<(), std::io::Error>(())
+        });
+        written?;
+    } else {
+        for s in generator {
+            write_static_row(&mut w, &s)?;
+            rows += 1;
         }
-        w.end_row()?;
-        rows += 1;
     }
     let bytes = w.finish()?;
     Ok(WriteSummary { rows, bytes })
+}
+
+#[inline]
+fn write_static_row<W: Write>(w: &mut RowWriter<W>, s: &StaticSample) -> std::io::Result<()> {
+    w.number(s.time_s);
+    w.buf.push(b',');
+    w.number(s.output);
+    if let Some(t) = s.temp_c {
+        w.buf.push(b',');
+        w.number(t);
+    }
+    w.end_row()
 }
 
 /// Simulates a rate-table test and writes it in the long layout; returns rows and bytes written.
@@ -320,7 +413,8 @@ mod tests {
 
     fn static_bytes(seed: u64, options: &SimCsvOptions) -> Vec<u8> {
         let model = SensorModel { rrw_deg_h_rt_h: 3.0, ..SensorModel::preset(Preset::Adxrs646) };
-        let spec = StaticSpec { sample_rate_hz: 100.0, duration_s: 30.0, record_temperature: true, ..StaticSpec::default() };
+        let spec =
+            StaticSpec { sample_rate_hz: 100.0, duration_s: 30.0, record_temperature: true, ..StaticSpec::default() };
         let mut out = Vec::new();
         let sum = write_static_csv(&mut out, &model, &spec, seed, options).unwrap();
         assert_eq!(sum.rows, 3000);
@@ -332,6 +426,8 @@ mod tests {
     fn same_seed_same_bytes_different_seed_different_bytes() {
         let o = SimCsvOptions::default();
         assert_eq!(static_bytes(42, &o), static_bytes(42, &o));
+        let pipelined = SimCsvOptions { pipelined: true, ..SimCsvOptions::default() };
+        assert_eq!(static_bytes(42, &o), static_bytes(42, &pipelined));
         assert_ne!(static_bytes(42, &o), static_bytes(43, &o));
         let spec = RateTableSpec { runs: 2, samples_per_plateau: 10, ..RateTableSpec::default() };
         let model = SensorModel::preset(Preset::Adxrs646);
@@ -375,6 +471,17 @@ mod tests {
         // A negative value that rounds to zero is written without its sign.
         assert_eq!(String::from_utf8(out).unwrap(), "2.5000 0.0000 -0.0001 1.2346 0.0000 12345.2500 1e300 ");
         assert!(RowWriter::new(Vec::new(), NumberFormat::Fixed { decimals: 16 }).is_err());
+        let mut out = Vec::new();
+        let mut w = RowWriter::new(&mut out, NumberFormat::Fixed { decimals: 3 }).unwrap();
+        for v in [0.005, -0.005, 9.9996, 1234567.0, 99.0] {
+            w.number(v);
+            w.buf.push(b' ');
+        }
+        w.unsigned(0);
+        w.buf.push(b' ');
+        w.unsigned(18_446_744_073_709_551_615);
+        w.finish().unwrap();
+        assert_eq!(String::from_utf8(out).unwrap(), "0.005 -0.005 10.000 1234567.000 99.000 0 18446744073709551615");
     }
 
     #[test]
@@ -388,7 +495,12 @@ mod tests {
             rest_samples: 1,
             ..RateTableSpec::default()
         };
-        let model = SensorModel { output_unit: OutputUnit::Volt, scale_factor_per_dps: 0.01, null: 2.5, ..SensorModel::default() };
+        let model = SensorModel {
+            output_unit: OutputUnit::Volt,
+            scale_factor_per_dps: 0.01,
+            null: 2.5,
+            ..SensorModel::default()
+        };
         let o = SimCsvOptions { number_format: NumberFormat::Fixed { decimals: 6 }, ..SimCsvOptions::default() };
         let mut out = Vec::new();
         let sum = write_rate_table_csv(&mut out, &model, &spec, 0, &o).unwrap();
@@ -434,6 +546,9 @@ mod tests {
         assert_eq!(cfg.static_record.samples(), 1200);
         assert_eq!(cfg.rate_table.runs, 4);
         assert!(toml::from_str::<SimConfig>("seed = 1\n[sensor]\narw = 0.5\n").is_err());
-        assert!(toml::from_str::<SimConfig>("[static_record]\ntemperature = { kind = \"constant\", temp_c = 1.0, x = 2 }\n").is_err());
+        assert!(toml::from_str::<SimConfig>(
+            "[static_record]\ntemperature = { kind = \"constant\", temp_c = 1.0, x = 2 }\n"
+        )
+        .is_err());
     }
 }

@@ -98,8 +98,8 @@ impl Engine {
         } else {
             (None, Vec::new())
         };
-        let earth_dps = latitude_deg
-            .map_or(0.0, |lat| units::dph_to_dps(units::EARTH_RATE_DPH) * portable::sin_deg(lat));
+        let earth_dps =
+            latitude_deg.map_or(0.0, |lat| units::dph_to_dps(units::EARTH_RATE_DPH) * portable::sin_deg(lat));
         Ok(Engine {
             dt_s,
             scale_factor: model.scale_factor_per_dps,
@@ -477,7 +477,7 @@ pub fn collect_rate_test(samples: impl IntoIterator<Item = RateTableSample>) -> 
             _ => observations.extend(s.observation()),
         }
     }
-    let rest = (start.1 > 0 && end.1 > 0)
-        .then(|| RestRecord { start: start.0 / start.1 as f64, end: end.0 / end.1 as f64 });
+    let rest =
+        (start.1 > 0 && end.1 > 0).then(|| RestRecord { start: start.0 / start.1 as f64, end: end.0 / end.1 as f64 });
     SimulatedRateTest { observations, rest }
 }

@@ -36,10 +36,9 @@ mod tests;
 
 pub use flicker::{FlickerDesign, FLICKER_ADEV_FACTOR, FLICKER_BAND, FLICKER_MIN_TAU_SAMPLES};
 pub use generate::{
-    collect_rate_test, RateTableGenerator, RateTableSample, SimStroke, SimulatedRateTest, StaticGenerator,
-    StaticSample,
+    collect_rate_test, RateTableGenerator, RateTableSample, SimStroke, SimulatedRateTest, StaticGenerator, StaticSample,
 };
 pub use model::{
-    ParameterText, Preset, RateTableSpec, SensorModel, SensorOverrides, SettlingRows, SimConfig, SimError,
-    StaticSpec, TemperatureProfile, TemperatureStep, PAPER_RATES_DPS,
+    ParameterText, Preset, RateTableSpec, SensorModel, SensorOverrides, SettlingRows, SimConfig, SimError, StaticSpec,
+    TemperatureProfile, TemperatureStep, PAPER_RATES_DPS,
 };

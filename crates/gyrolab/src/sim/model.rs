@@ -302,7 +302,12 @@ impl SensorModel {
 
     /// Checks every parameter; the error names the parameter and its valid range.
     pub fn validate(&self) -> Result<(), SimError> {
-        check("scale_factor_per_dps", self.scale_factor_per_dps, self.scale_factor_per_dps != 0.0, "finite and non-zero")?;
+        check(
+            "scale_factor_per_dps",
+            self.scale_factor_per_dps,
+            self.scale_factor_per_dps != 0.0,
+            "finite and non-zero",
+        )?;
         finite("null", self.null)?;
         let e = self.scale_factor_error_ppm;
         check("scale_factor_error_ppm", e, e > -1e6, "finite and > -1e6 (the scale factor keeps its sign)")?;
@@ -438,7 +443,12 @@ impl TemperatureProfile {
                 finite("temperature.start_c", *start_c)?;
                 let mut last = f64::NEG_INFINITY;
                 for s in steps {
-                    check("temperature.steps.at_s", s.at_s, s.at_s >= 0.0 && s.at_s > last, "finite, >= 0 and increasing")?;
+                    check(
+                        "temperature.steps.at_s",
+                        s.at_s,
+                        s.at_s >= 0.0 && s.at_s > last,
+                        "finite, >= 0 and increasing",
+                    )?;
                     finite("temperature.steps.temp_c", s.temp_c)?;
                     last = s.at_s;
                 }
@@ -609,7 +619,12 @@ impl RateTableSpec {
         self.sorted_rates()?;
         check("runs", self.runs as f64, self.runs >= 1, "an integer >= 1")?;
         positive("sample_rate_hz", self.sample_rate_hz)?;
-        check("samples_per_plateau", self.samples_per_plateau as f64, self.samples_per_plateau >= 1, "an integer >= 1")?;
+        check(
+            "samples_per_plateau",
+            self.samples_per_plateau as f64,
+            self.samples_per_plateau >= 1,
+            "an integer >= 1",
+        )?;
         non_negative("settling_s", self.settling_s)?;
         check("settling_s", self.settling_s, self.settling_s * self.sample_rate_hz < 4e9, "shorter than 4e9 samples")?;
         self.temperature.validate()?;

@@ -49,7 +49,8 @@ fn same_seed_same_samples_different_seed_different() {
     assert_eq!(bits(7), bits(7));
     assert_ne!(bits(7), bits(8));
     let rt = RateTableSpec { runs: 1, samples_per_plateau: 5, rest_samples: 5, ..RateTableSpec::default() };
-    let rows = |seed| RateTableGenerator::new(&model, &rt, seed).unwrap().map(|s| s.output.to_bits()).collect::<Vec<_>>();
+    let rows =
+        |seed| RateTableGenerator::new(&model, &rt, seed).unwrap().map(|s| s.output.to_bits()).collect::<Vec<_>>();
     assert_eq!(rows(1), rows(1));
     assert_ne!(rows(1), rows(2));
 }
@@ -163,12 +164,7 @@ fn flicker_allan_deviation_is_flat_within_band() {
     // B = 10 deg/h, flat range 1..100 s at 10 Hz (tau_min = 10 dt, the shortest allowed: the worst
     // case for point sampling). 1e6 samples (1e5 s).
     let b_dps = 10.0 / 3600.0;
-    let model = SensorModel {
-        bias_instability_dph: 10.0,
-        flicker_tau_min_s: 1.0,
-        flicker_tau_max_s: 100.0,
-        ..ideal()
-    };
+    let model = SensorModel { bias_instability_dph: 10.0, flicker_tau_min_s: 1.0, flicker_tau_max_s: 100.0, ..ideal() };
     let dt = 0.1;
     let v = outputs(&model, &static_spec(10.0, 100_000.0), 21);
     let n_phase = (v.len() + 1) as f64;
@@ -218,7 +214,8 @@ fn nonlinearity_asymmetry_and_scale_factor_error_follow_their_definitions() {
         nonlinearity_cubic_per_dps2: 1e-7,
         ..ideal()
     };
-    let spec = RateTableSpec { rates_dps: vec![-100.0, 100.0], runs: 1, samples_per_plateau: 1, ..RateTableSpec::default() };
+    let spec =
+        RateTableSpec { rates_dps: vec![-100.0, 100.0], runs: 1, samples_per_plateau: 1, ..RateTableSpec::default() };
     let (table, _) = rate_table(&model, &spec, 1);
     // w = +-100: w + k2 w^2 + k3 w^3 = 100 + 0.1 + 0.1 = 100.2 and -100 + 0.1 - 0.1 = -100.
     // K+ = 2 * 1.001 * 1.001, K- = 2 * 1.001 * 0.999.
@@ -276,7 +273,8 @@ fn settling_rows_are_dropped_or_flagged_and_rest_records_frame_the_test() {
     assert_eq!(dropped.len(), 3 + 2 * 2 * 3 * 4 + 3);
     assert_eq!(dropped[0].stroke.label(), "rest_start");
     assert_eq!(dropped.last().unwrap().stroke.label(), "rest_end");
-    let fwd: Vec<f64> = dropped.iter().filter(|s| s.run == 1 && s.stroke == SimStroke::Forward).map(|s| s.rate_dps).collect();
+    let fwd: Vec<f64> =
+        dropped.iter().filter(|s| s.run == 1 && s.stroke == SimStroke::Forward).map(|s| s.rate_dps).collect();
     assert_eq!(fwd, [-10.0, -10.0, -10.0, -10.0, 0.0, 0.0, 0.0, 0.0, 10.0, 10.0, 10.0, 10.0]);
     let flagged = RateTableSpec { settling: SettlingRows::Flag, ..base };
     let all: Vec<RateTableSample> = RateTableGenerator::new(&ideal(), &flagged, 1).unwrap().collect();
@@ -332,7 +330,8 @@ fn presets_validate_and_overrides_replace_fields() {
         let v = outputs(&m, &static_spec(100.0, 2.0), 1);
         assert!(v.iter().all(|x| x.is_finite()));
     }
-    let o = SensorOverrides { arw_deg_rt_h: Some(1.5), output_rail_high: Some(Some(5.0)), ..SensorOverrides::default() };
+    let o =
+        SensorOverrides { arw_deg_rt_h: Some(1.5), output_rail_high: Some(Some(5.0)), ..SensorOverrides::default() };
     let m = SensorModel::preset(Preset::Adxrs646).with_overrides(&o);
     assert_eq!((m.arw_deg_rt_h, m.output_rail_high, m.bias_instability_dph), (1.5, Some(5.0), 12.0));
     let cfg = SimConfig { preset: Some(Preset::Stim300), sensor: o, ..SimConfig::default() };
