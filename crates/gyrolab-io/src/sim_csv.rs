@@ -196,7 +196,7 @@ impl<W: Write> RowWriter<W> {
             NumberFormat::Fixed { decimals } => {
                 let d = usize::from(decimals);
                 let scaled = (v * POW10[d]).round();
-                if !(scaled.abs() < EXACT_INT_LIMIT) {
+                if scaled.is_nan() || scaled.abs() >= EXACT_INT_LIMIT {
                     // Too large for the integer path (or not finite).
                     self.shortest(v);
                     return;

@@ -522,7 +522,7 @@ impl StaticSpec {
         positive("sample_rate_hz", self.sample_rate_hz)?;
         positive("duration_s", self.duration_s)?;
         let n = self.duration_s * self.sample_rate_hz;
-        check("duration_s", self.duration_s, n >= 0.5 && n < 9e18, "at least one sample interval long")?;
+        check("duration_s", self.duration_s, (0.5..9e18).contains(&n), "at least one sample interval long")?;
         self.temperature.validate()?;
         validate_latitude(self.latitude_deg)
     }

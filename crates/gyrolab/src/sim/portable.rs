@@ -7,9 +7,9 @@
 //! series evaluated by Horner's rule.
 
 /// ln 2, high part (its last 11 bits are zero, so `k * LN2_HI` is exact for |k| < 2^11).
-const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-01;
+const LN2_HI: f64 = 6.931_471_803_691_238e-1;
 /// ln 2, low part: ln 2 - LN2_HI.
-const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
+const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
 
 /// 2^k for an integer k in [-1022, 1023], built from its bit pattern.
 fn pow2(k: i64) -> f64 {
