@@ -58,6 +58,33 @@ pub fn ratio_to_pct(v: f64) -> f64 {
     v * 100.0
 }
 
+/// Converts parts per million to a dimensionless ratio.
+pub fn ppm_to_ratio(v: f64) -> f64 {
+    v * 1e-6
+}
+
+/// Converts a rate ramp from deg/h per hour (deg/h^2) to deg/s per second (deg/s^2).
+pub fn rate_ramp_dph_per_h_to_dps_per_s(v: f64) -> f64 {
+    v / (SECONDS_PER_HOUR * SECONDS_PER_HOUR)
+}
+
+/// Converts a temperature rate from degC per hour to degC per second.
+pub fn per_hour_to_per_second(v: f64) -> f64 {
+    v / SECONDS_PER_HOUR
+}
+
+/// Per-sample standard deviation (deg/s) of white rate noise from an angle random walk N in
+/// deg/sqrt(h) at sample interval dt in s: sigma = N[deg/sqrt(s)] / sqrt(dt) (IEEE Std 952 annex C).
+pub fn arw_deg_rt_h_to_sample_sigma_dps(arw_deg_rt_h: f64, dt_s: f64) -> f64 {
+    arw_deg_rt_h_to_deg_rt_s(arw_deg_rt_h) / dt_s.sqrt()
+}
+
+/// Standard deviation (deg/s) of one rate-random-walk increment over dt in s from K in
+/// deg/h/sqrt(h): sigma = K[deg/s/sqrt(s)] * sqrt(dt) (IEEE Std 952 annex C).
+pub fn rrw_dph_rt_h_to_increment_sigma_dps(rrw_deg_h_rt_h: f64, dt_s: f64) -> f64 {
+    rrw_dph_rt_h_to_dps_rt_s(rrw_deg_h_rt_h) * dt_s.sqrt()
+}
+
 /// Converts a dimensionless ratio to parts per million.
 pub fn ratio_to_ppm(v: f64) -> f64 {
     v * 1e6

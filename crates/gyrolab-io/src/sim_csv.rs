@@ -1,0 +1,554 @@
+//! Fast CSV writer for simulated records: the static layout (`time_s,output_<unit>` or
+//! `time_s,rate_<unit>`, optional `temp_c`) and the rate-table long layout
+//! (`rate_dps,run,stroke,output_<unit>`, optional `settling`), each after `# ` comment lines that
+//! record the simulator's parameters and seed.
+//!
+//! Numbers are written either in the shortest form that reads back to the same f64 (Ryu
+//! algorithm, `ryu` crate) or with a fixed number of decimals (one correctly rounded multiply by an
+//! exact power of ten, round half away from zero, then integer digits: a value within half an ulp
+//! of a rounding tie may round up where exact decimal rounding would round down); both are
+//! byte-identical on every platform. Rows are
+//! formatted into a 64 KiB buffer and handed to the writer in large blocks, so the caller need not
+//! wrap it in a `BufWriter`.
+
+use std::io::Write;
+
+use gyrolab::sim::{
+    FlickerDesign, RateTableGenerator, RateTableSpec, SensorModel, SimError, StaticGenerator, StaticSample, StaticSpec,
+    FLICKER_BAND,
+};
+use gyrolab::units::OutputUnit;
+use thiserror::Error;
+
+/// How numbers are written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum NumberFormat {
+    /// Shortest text that reads back to the same f64 (Ryu); exact, up to 17 significant digits.
+    #[default]
+    Shortest,
+    /// A fixed number of decimals (0..=15); values too large for it fall back to `Shortest`.
+    Fixed {
+        /// Digits after the decimal point.
+        decimals: u8,
+    },
+}
+
+/// Options of the simulated-record writers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimCsvOptions {
+    /// Number formatting of the value columns.
+    pub number_format: NumberFormat,
+    /// Extra comment lines written after the title (such as the preset name or the command line).
+    pub comments: Vec<String>,
+    /// Simulate static records on a second thread while this one formats (same bytes either way;
+    /// helps only when a second core is free).
+    pub pipelined: bool,
+}
+
+impl Default for SimCsvOptions {
+    /// Shortest number form, no extra comments, one thread.
+    fn default() -> Self {
+        SimCsvOptions { number_format: NumberFormat::Shortest, comments: Vec::new(), pipelined: false }
+    }
+}
+
+/// Samples per block handed from the simulating thread to the formatting thread.
+const BLOCK_SAMPLES: usize = 8192;
+
+/// Why a simulated record could not be written.
+#[derive(Debug, Error)]
+pub enum SimCsvError {
+    /// The simulation parameters are invalid.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    /// Writing failed.
+    #[error("cannot write the simulated record: {0}")]
+    Io(#[from] std::io::Error),
+    /// A writer option is out of range.
+    #[error("invalid option: {0}")]
+    InvalidOption(String),
+}
+
+/// What a writer wrote.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct WriteSummary {
+    /// Data rows written (comment and header lines not counted).
+    pub rows: u64,
+    /// Bytes written in all.
+    pub bytes: u64,
+}
+
+/// Exact powers of ten 10^0 ..= 10^15 (all exactly representable in f64).
+const POW10: [f64; 16] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15];
+/// Largest magnitude written through the integer path (2^53).
+const EXACT_INT_LIMIT: f64 = 9_007_199_254_740_992.0;
+/// Buffer size at which rows are handed to the writer.
+const FLUSH_AT: usize = 1 << 16;
+
+/// Two-digit groups "00".."99", for writing integers two digits at a time.
+const DIGIT_PAIRS: [u8; 200] = {
+    let mut t = [0u8; 200];
+    let mut i = 0;
+    while i < 100 {
+        t[2 * i] = b'0' + (i / 10) as u8;
+        t[2 * i + 1] = b'0' + (i % 10) as u8;
+        i += 1;
+    }
+    t
+};
+
+/// Writes `v` in exactly `width` decimal digits (zero-padded on the left) ending before `end`;
+/// returns the start index. `v` must be below 10^width.
+#[inline]
+fn write_padded(out: &mut [u8], end: usize, mut v: u64, width: usize) -> usize {
+    let start = end - width;
+    let mut i = end;
+    while i >= start + 2 {
+        let pair = (v % 100) as usize * 2;
+        v /= 100;
+        out[i - 2..i].copy_from_slice(&DIGIT_PAIRS[pair..pair + 2]);
+        i -= 2;
+    }
+    if i > start {
+        out[i - 1] = b'0' + (v % 10) as u8;
+    }
+    start
+}
+
+/// Writes `v` as decimal digits ending at the end of `out`, with a decimal point before the last
+/// `decimals` digits (zero-padded: 5 with 3 decimals is `0.005`); returns the start index.
+/// `out` must hold 20 + 1 + decimals bytes.
+#[inline]
+fn write_digits(out: &mut [u8], v: u64, decimals: usize) -> usize {
+    let mut end = out.len();
+    let mut int = v;
+    if decimals > 0 {
+        let unit = POW10_INT[decimals];
+        end = write_padded(out, end, v % unit, decimals) - 1;
+        out[end] = b'.';
+        int = v / unit;
+    }
+    let mut width = 1;
+    while width < 20 && int >= POW10_INT[width] {
+        width += 1;
+    }
+    write_padded(out, end, int, width)
+}
+
+/// Exact integer powers of ten 10^0 ..= 10^19.
+const POW10_INT: [u64; 20] = {
+    let mut t = [1u64; 20];
+    let mut i = 1;
+    while i < 20 {
+        t[i] = t[i - 1] * 10;
+        i += 1;
+    }
+    t
+};
+
+/// Row formatter over a block buffer.
+struct RowWriter<W: Write> {
+    out: W,
+    buf: Vec<u8>,
+    ryu: ryu::Buffer,
+    format: NumberFormat,
+    bytes: u64,
+}
+
+impl<W: Write> RowWriter<W> {
+    fn new(out: W, format: NumberFormat) -> Result<Self, SimCsvError> {
+        if let NumberFormat::Fixed { decimals } = format {
+            if decimals > 15 {
+                return Err(SimCsvError::InvalidOption(format!("fixed decimals = {decimals}: must be within 0..=15")));
+            }
+        }
+        Ok(RowWriter { out, buf: Vec::with_capacity(FLUSH_AT + 1024), ryu: ryu::Buffer::new(), format, bytes: 0 })
+    }
+
+    fn text(&mut self, s: &str) {
+        self.buf.extend_from_slice(s.as_bytes());
+    }
+
+    fn comment(&mut self, line: &str) {
+        // One comment line per text line, so that no text can end the comment block early.
+        for part in line.split('\n') {
+            self.buf.extend_from_slice(b"# ");
+            self.buf.extend_from_slice(part.trim_end_matches('\r').as_bytes());
+            self.buf.push(b'\n');
+        }
+    }
+
+    fn unsigned(&mut self, v: u64) {
+        let mut digits = [0u8; 21];
+        let i = write_digits(&mut digits, v, 0);
+        self.buf.extend_from_slice(&digits[i..]);
+    }
+
+    fn shortest(&mut self, v: f64) {
+        let s = self.ryu.format(v);
+        self.buf.extend_from_slice(s.as_bytes());
+    }
+
+    #[inline]
+    fn number(&mut self, v: f64) {
+        match self.format {
+            NumberFormat::Shortest => self.shortest(v),
+            NumberFormat::Fixed { decimals } => {
+                let d = usize::from(decimals);
+                let scaled = (v * POW10[d]).round();
+                if scaled.is_nan() || scaled.abs() >= EXACT_INT_LIMIT {
+                    // Too large for the integer path (or not finite).
+                    self.shortest(v);
+                    return;
+                }
+                // ok: |scaled| < 2^53, so the conversion to u64 is exact.
+                let int = scaled.abs() as u64;
+                // Sign, up to 16 integer digits, point, up to 15 decimals.
+                let mut text = [0u8; 40];
+                let mut i = write_digits(&mut text, int, d);
+                if scaled < 0.0 {
+                    i -= 1;
+                    text[i] = b'-';
+                }
+                self.buf.extend_from_slice(&text[i..]);
+            }
+        }
+    }
+
+    #[inline]
+    fn end_row(&mut self) -> std::io::Result<()> {
+        self.buf.push(b'\n');
+        if self.buf.len() >= FLUSH_AT {
+            self.flush_buffer()?;
+        }
+        Ok(())
+    }
+
+    fn flush_buffer(&mut self) -> std::io::Result<()> {
+        self.out.write_all(&self.buf)?;
+        self.bytes += self.buf.len() as u64;
+        self.buf.clear();
+        Ok(())
+    }
+
+    fn finish(mut self) -> std::io::Result<u64> {
+        self.flush_buffer()?;
+        self.out.flush()?;
+        Ok(self.bytes)
+    }
+}
+
+/// Column name of a static record's output: `rate_<suffix>` for rate units, else `output_<suffix>`.
+pub fn static_output_column(unit: OutputUnit) -> String {
+    match unit {
+        OutputUnit::DegPerSec | OutputUnit::RadPerSec => format!("rate_{}", unit.suffix()),
+        _ => format!("output_{}", unit.suffix()),
+    }
+}
+
+/// Header line of the static layout, such as `time_s,output_v,temp_c`.
+pub fn static_header(unit: OutputUnit, with_temperature: bool) -> String {
+    let mut h = format!("time_s,{}", static_output_column(unit));
+    if with_temperature {
+        h.push_str(",temp_c");
+    }
+    h
+}
+
+/// Header line of the rate-table long layout, such as `rate_dps,run,stroke,output_v[,settling]`.
+pub fn rate_table_header(unit: OutputUnit, with_settling_flag: bool) -> String {
+    let mut h = format!("rate_dps,run,stroke,output_{}", unit.suffix());
+    if with_settling_flag {
+        h.push_str(",settling");
+    }
+    h
+}
+
+fn flicker_comment(d: &FlickerDesign) -> String {
+    let times: Vec<String> = d.correlation_times_s.iter().map(|t| format!("{t:?}")).collect();
+    format!(
+        "truth.flicker = sum of {} Gauss-Markov processes, correlation times {} s, sigma each {:?} deg/s; \
+         Allan deviation within +-{:?} % of 0.6643 B for tau in [{:?}, {:?}] s",
+        times.len(),
+        times.join(" "),
+        d.sigma_each_dps,
+        FLICKER_BAND * 100.0,
+        d.tau_min_s,
+        d.tau_max_s
+    )
+}
+
+fn write_preamble<W: Write>(
+    w: &mut RowWriter<W>,
+    title: &str,
+    seed: u64,
+    options: &SimCsvOptions,
+    model: &SensorModel,
+    record: Vec<(&'static str, String)>,
+    truth: Vec<String>,
+) {
+    w.comment(title);
+    w.comment(&format!("seed = {seed}"));
+    for c in &options.comments {
+        w.comment(c);
+    }
+    for (k, v) in model.parameter_lines() {
+        w.comment(&format!("sensor.{k} = {v}"));
+    }
+    for (k, v) in record {
+        w.comment(&format!("record.{k} = {v}"));
+    }
+    for t in truth {
+        w.comment(&t);
+    }
+}
+
+/// Simulates a static record and writes it in the static layout; returns rows and bytes written.
+pub fn write_static_csv<W: Write>(
+    out: W,
+    model: &SensorModel,
+    spec: &StaticSpec,
+    seed: u64,
+    options: &SimCsvOptions,
+) -> Result<WriteSummary, SimCsvError> {
+    let generator = StaticGenerator::new(model, spec, seed)?;
+    let mut w = RowWriter::new(out, options.number_format)?;
+    let mut truth = vec![format!("truth.earth_rate_dps = {:?}", generator.earth_rate_dps())];
+    truth.extend(generator.flicker_design().map(flicker_comment));
+    write_preamble(&mut w, "gyrolab simulated static record", seed, options, model, spec.parameter_lines(), truth);
+    let with_temp = generator.records_temperature();
+    w.text(&static_header(model.output_unit, with_temp));
+    w.end_row()?;
+    let mut rows = 0u64;
+    if options.pipelined {
+        let (to_writer, from_generator) = std::sync::mpsc::sync_channel::<Vec<StaticSample>>(4);
+        let (to_generator, from_writer) = std::sync::mpsc::channel::<Vec<StaticSample>>();
+        let written = std::thread::scope(|scope| {
+            scope.spawn(move || {
+                let mut generator = generator;
+                loop {
+                    let mut block = from_writer.try_recv().unwrap_or_else(|_| Vec::with_capacity(BLOCK_SAMPLES));
+                    block.clear();
+                    block.extend(generator.by_ref().take(BLOCK_SAMPLES));
+                    // A send error means the writer stopped (an I/O error): stop too.
+                    if block.is_empty() || to_writer.send(block).is_err() {
+                        break;
+                    }
+                }
+            });
+            for block in from_generator {
+                for s in &block {
+                    write_static_row(&mut w, s)?;
+                }
+                rows += block.len() as u64;
+                // The generator may have finished: a failed return of the buffer is harmless.
+                let _ = to_generator.send(block);
+            }
+            Ok::<(), std::io::Error>(())
+        });
+        written?;
+    } else {
+        for s in generator {
+            write_static_row(&mut w, &s)?;
+            rows += 1;
+        }
+    }
+    let bytes = w.finish()?;
+    Ok(WriteSummary { rows, bytes })
+}
+
+#[inline]
+fn write_static_row<W: Write>(w: &mut RowWriter<W>, s: &StaticSample) -> std::io::Result<()> {
+    w.number(s.time_s);
+    w.buf.push(b',');
+    w.number(s.output);
+    if let Some(t) = s.temp_c {
+        w.buf.push(b',');
+        w.number(t);
+    }
+    w.end_row()
+}
+
+/// Simulates a rate-table test and writes it in the long layout; returns rows and bytes written.
+pub fn write_rate_table_csv<W: Write>(
+    out: W,
+    model: &SensorModel,
+    spec: &RateTableSpec,
+    seed: u64,
+    options: &SimCsvOptions,
+) -> Result<WriteSummary, SimCsvError> {
+    let generator = RateTableGenerator::new(model, spec, seed)?;
+    let mut w = RowWriter::new(out, options.number_format)?;
+    let mut truth = vec![format!("truth.earth_rate_dps = {:?}", generator.earth_rate_dps())];
+    truth.extend(generator.flicker_design().map(flicker_comment));
+    let title = "gyrolab simulated rate-table test: runs of a forward stroke (rates rising) then a reverse \
+                 stroke (rates falling)";
+    write_preamble(&mut w, title, seed, options, model, spec.parameter_lines(), truth);
+    let flagged = generator.flags_settling();
+    w.text(&rate_table_header(model.output_unit, flagged));
+    w.end_row()?;
+    let mut rows = 0u64;
+    for s in generator {
+        w.number(s.rate_dps);
+        w.buf.push(b',');
+        w.unsigned(u64::from(s.run));
+        w.buf.push(b',');
+        w.text(s.stroke.label());
+        w.buf.push(b',');
+        w.number(s.output);
+        if flagged {
+            w.text(if s.settling { ",1" } else { ",0" });
+        }
+        w.end_row()?;
+        rows += 1;
+    }
+    let bytes = w.finish()?;
+    Ok(WriteSummary { rows, bytes })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gyrolab::sim::{Preset, SettlingRows, SimConfig};
+
+    fn static_bytes(seed: u64, options: &SimCsvOptions) -> Vec<u8> {
+        let model = SensorModel { rrw_deg_h_rt_h: 3.0, ..SensorModel::preset(Preset::Adxrs646) };
+        let spec =
+            StaticSpec { sample_rate_hz: 100.0, duration_s: 30.0, record_temperature: true, ..StaticSpec::default() };
+        let mut out = Vec::new();
+        let sum = write_static_csv(&mut out, &model, &spec, seed, options).unwrap();
+        assert_eq!(sum.rows, 3000);
+        assert_eq!(sum.bytes, out.len() as u64);
+        out
+    }
+
+    #[test]
+    fn same_seed_same_bytes_different_seed_different_bytes() {
+        let o = SimCsvOptions::default();
+        assert_eq!(static_bytes(42, &o), static_bytes(42, &o));
+        let pipelined = SimCsvOptions { pipelined: true, ..SimCsvOptions::default() };
+        assert_eq!(static_bytes(42, &o), static_bytes(42, &pipelined));
+        assert_ne!(static_bytes(42, &o), static_bytes(43, &o));
+        let spec = RateTableSpec { runs: 2, samples_per_plateau: 10, ..RateTableSpec::default() };
+        let model = SensorModel::preset(Preset::Adxrs646);
+        let bytes = |seed| {
+            let mut out = Vec::new();
+            write_rate_table_csv(&mut out, &model, &spec, seed, &o).unwrap();
+            out
+        };
+        assert_eq!(bytes(5), bytes(5));
+        assert_ne!(bytes(5), bytes(6));
+    }
+
+    #[test]
+    fn static_layout_has_comments_header_and_parsable_rows() {
+        let o = SimCsvOptions { comments: vec!["preset = adxrs646".into()], ..SimCsvOptions::default() };
+        let text = String::from_utf8(static_bytes(1, &o)).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(lines.next(), Some("# gyrolab simulated static record"));
+        assert_eq!(lines.next(), Some("# seed = 1"));
+        assert_eq!(lines.next(), Some("# preset = adxrs646"));
+        assert!(text.contains("# sensor.arw_deg_rt_h = 0.6\n"));
+        assert!(text.contains("# truth.flicker = sum of "));
+        let body: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).collect();
+        assert_eq!(body[0], "time_s,output_v,temp_c");
+        assert_eq!(body.len(), 3001);
+        assert!(body[1].starts_with("0.0,2.") && body[1].ends_with(",25.0"), "{}", body[1]);
+        let last: Vec<f64> = body[3000].split(',').map(|f| f.parse().unwrap()).collect();
+        assert_eq!(last[0], 29.99);
+        assert_eq!(last[2], 25.0);
+    }
+
+    #[test]
+    fn fixed_decimals_are_rounded_and_padded() {
+        let mut out = Vec::new();
+        let mut w = RowWriter::new(&mut out, NumberFormat::Fixed { decimals: 4 }).unwrap();
+        for v in [2.5, -0.00004, -0.00006, 1.23456, 0.0, 12345.25, 1e300] {
+            w.number(v);
+            w.buf.push(b' ');
+        }
+        w.finish().unwrap();
+        // A negative value that rounds to zero is written without its sign.
+        assert_eq!(String::from_utf8(out).unwrap(), "2.5000 0.0000 -0.0001 1.2346 0.0000 12345.2500 1e300 ");
+        assert!(RowWriter::new(Vec::new(), NumberFormat::Fixed { decimals: 16 }).is_err());
+        let mut out = Vec::new();
+        let mut w = RowWriter::new(&mut out, NumberFormat::Fixed { decimals: 3 }).unwrap();
+        for v in [0.005, -0.005, 9.9996, 1234567.0, 99.0] {
+            w.number(v);
+            w.buf.push(b' ');
+        }
+        w.unsigned(0);
+        w.buf.push(b' ');
+        w.unsigned(18_446_744_073_709_551_615);
+        w.finish().unwrap();
+        assert_eq!(String::from_utf8(out).unwrap(), "0.005 -0.005 10.000 1234567.000 99.000 0 18446744073709551615");
+    }
+
+    #[test]
+    fn rate_table_layout_matches_the_reader_layout() {
+        let spec = RateTableSpec {
+            rates_dps: vec![-10.0, 10.0],
+            runs: 1,
+            samples_per_plateau: 2,
+            settling_s: 0.01,
+            settling: SettlingRows::Flag,
+            rest_samples: 1,
+            ..RateTableSpec::default()
+        };
+        let model = SensorModel {
+            output_unit: OutputUnit::Volt,
+            scale_factor_per_dps: 0.01,
+            null: 2.5,
+            ..SensorModel::default()
+        };
+        let o = SimCsvOptions { number_format: NumberFormat::Fixed { decimals: 6 }, ..SimCsvOptions::default() };
+        let mut out = Vec::new();
+        let sum = write_rate_table_csv(&mut out, &model, &spec, 0, &o).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let body: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).collect();
+        assert_eq!(body[0], "rate_dps,run,stroke,output_v,settling");
+        assert_eq!(body[1], "0.000000,1,rest_start,2.500000,0");
+        assert_eq!(body[2], "-10.000000,1,fwd,2.400000,1");
+        assert_eq!(body[3], "-10.000000,1,fwd,2.400000,0");
+        assert_eq!(body.last(), Some(&"0.000000,1,rest_end,2.500000,0"));
+        assert_eq!(sum.rows as usize, body.len() - 1);
+    }
+
+    #[test]
+    fn bad_parameters_surface_as_sim_errors() {
+        let spec = StaticSpec { sample_rate_hz: 0.0, ..StaticSpec::default() };
+        let e = write_static_csv(Vec::new(), &SensorModel::default(), &spec, 0, &SimCsvOptions::default()).unwrap_err();
+        assert!(matches!(e, SimCsvError::Sim(_)) && e.to_string().contains("sample_rate_hz"), "{e}");
+    }
+
+    #[test]
+    fn a_toml_configuration_sets_preset_overrides_and_records() {
+        let cfg: SimConfig = toml::from_str(
+            r#"
+            seed = 7
+            preset = "adxrs646"
+            [sensor]
+            arw_deg_rt_h = 0.5
+            output_rail_high = 4.9
+            [static_record]
+            sample_rate_hz = 1.0
+            duration_s = 1200.0
+            latitude_deg = 34.2
+            temperature = { kind = "ramp", start_c = 20.0, rate_c_per_h = 5.0 }
+            [rate_table]
+            rates_dps = [-100.0, 0.0, 100.0]
+            settling = "flag"
+            "#,
+        )
+        .unwrap();
+        let m = cfg.sensor_model();
+        assert_eq!((m.arw_deg_rt_h, m.output_rail_high, m.null), (0.5, Some(4.9), 2.5));
+        assert_eq!(cfg.static_record.samples(), 1200);
+        assert_eq!(cfg.rate_table.runs, 4);
+        assert!(toml::from_str::<SimConfig>("seed = 1\n[sensor]\narw = 0.5\n").is_err());
+        assert!(toml::from_str::<SimConfig>(
+            "[static_record]\ntemperature = { kind = \"constant\", temp_c = 1.0, x = 2 }\n"
+        )
+        .is_err());
+    }
+}
