@@ -7,7 +7,6 @@
 //! - [`rate_test`]: rate-table (scale-factor) test figures;
 //! - [`static_test`]: static (bias) test figures, accumulated block by block;
 //! - [`published`]: comparison with figures printed in a publication;
-//! - [`published`]: comparison with figures printed in a publication;
 //! - [`sim`]: gyro simulator with known truth (static records, rate-table tests).
 //!
 //! Formulas and their sources are listed in `docs/METHODS.md`.
