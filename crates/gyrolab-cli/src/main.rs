@@ -4,6 +4,7 @@ mod cmd;
 mod error;
 mod output;
 mod paper_data;
+mod reference;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -20,6 +21,11 @@ struct Cli {
 enum Command {
     /// Evaluate rate-table records: scale factor, nonlinearity, linearity, hysteresis, repeatability...
     Rate(Box<cmd::rate::RateArgs>),
+    /// Evaluate static (bias) tests: bias, bias stability, repeatability, drift, temperature.
+    Bias(Box<cmd::bias::BiasArgs>),
+    /// Simulate records with known truth (static, rate-table) in the layouts gyrolab reads.
+    #[command(subcommand)]
+    Simulate(cmd::simulate::SimulateCommand),
     /// Run the paper's worked example on its data (built in) and compare with its printed tables.
     Demo(cmd::demo::DemoArgs),
 }
@@ -29,6 +35,8 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Rate(a) => cmd::rate::run(a),
         Command::Demo(a) => cmd::demo::run(a),
+        Command::Bias(a) => cmd::bias::run(a),
+        Command::Simulate(c) => cmd::simulate::run(c),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -734,7 +734,7 @@ pub fn collect_series<R: Read>(mut r: SeriesReader<R>) -> Result<SeriesData, Dat
 pub fn evaluate_static_file(
     path: impl AsRef<Path>,
     options: &SeriesOptions,
-    config_for: impl Fn(&ChannelInfo) -> StaticTestConfig,
+    mut config_for: impl FnMut(&ChannelInfo) -> StaticTestConfig,
 ) -> Result<(Vec<StaticTestResult>, SeriesSummary), DataError> {
     let path = path.as_ref();
     let mut r = SeriesReader::open(path, options)?;

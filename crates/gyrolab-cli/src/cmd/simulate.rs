@@ -1,0 +1,296 @@
+//! `gyrolab simulate static|rate-table`: records with known truth, in exactly the layouts that
+//! `gyrolab bias`, `gyrolab allan` and `gyrolab rate` read.
+
+use crate::cmd::rate::parse_output_unit;
+use crate::error::{CliError, CliResult};
+use clap::{Args, Subcommand};
+use gyrolab::sim::{Preset, SensorModel, SimConfig, TemperatureProfile};
+use gyrolab::units::OutputUnit;
+use gyrolab_io::sim_csv::{read_sim_config, write_rate_table_csv, write_static_csv, SimCsvError, SimCsvOptions};
+use std::io::Write;
+use std::path::PathBuf;
+
+/// What to simulate.
+#[derive(Debug, Subcommand)]
+pub enum SimulateCommand {
+    /// A static (bias) record: time_s and the output (deg/s by default), optional temp_c.
+    Static(Box<StaticArgs>),
+    /// A rate-table test: rate_dps, run, stroke, output per sample, with rest records.
+    RateTable(Box<RateTableArgs>),
+}
+
+/// Options shared by both records.
+#[derive(Debug, Args)]
+pub struct CommonArgs {
+    /// Write to this file (default: standard output); written whole or not at all.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// A TOML set-up (seed, preset, [sensor], [static_record], [rate_table]); flags override it.
+    #[arg(long, value_name = "FILE.toml")]
+    pub config: Option<PathBuf>,
+    /// Seed: the same seed gives the same bytes on every run (default 1).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Start from a sensor preset: adxrs646 (the paper's family), adis16470, stim300.
+    #[arg(long, value_parser = parse_preset)]
+    pub preset: Option<Preset>,
+    /// Sample rate, Hz.
+    #[arg(long, value_name = "HZ")]
+    pub sample_rate_hz: Option<f64>,
+    /// Output unit: dps (default without a preset), v, mv, lsb, rad_s.
+    #[arg(long, value_name = "UNIT", value_parser = parse_output_unit)]
+    pub output_unit: Option<OutputUnit>,
+    /// Scale factor, output units per deg/s.
+    #[arg(long, value_name = "K", allow_hyphen_values = true)]
+    pub scale_factor: Option<f64>,
+    /// Zero-rate output (null), output units.
+    #[arg(long, value_name = "F", allow_hyphen_values = true)]
+    pub null: Option<f64>,
+    /// Constant bias, deg/h.
+    #[arg(long, value_name = "DPH", allow_hyphen_values = true)]
+    pub bias_dph: Option<f64>,
+    /// Angle random walk N, deg/sqrt(h).
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
+    pub arw_deg_rt_h: Option<f64>,
+    /// Bias instability B, deg/h (flicker noise).
+    #[arg(long, value_name = "B", allow_hyphen_values = true)]
+    pub bias_instability_dph: Option<f64>,
+    /// Rate random walk K, deg/h/sqrt(h).
+    #[arg(long, value_name = "K", allow_hyphen_values = true)]
+    pub rrw_deg_h_rt_h: Option<f64>,
+    /// Rate ramp R, deg/h per hour.
+    #[arg(long, value_name = "R", allow_hyphen_values = true)]
+    pub rate_ramp_dph_per_h: Option<f64>,
+    /// Output quantization step, output units.
+    #[arg(long, value_name = "STEP", allow_hyphen_values = true)]
+    pub output_quantization_step: Option<f64>,
+    /// Bias temperature coefficient, (deg/h)/degC.
+    #[arg(long, value_name = "C", allow_hyphen_values = true)]
+    pub bias_temp_coeff_dph_per_c: Option<f64>,
+    /// Constant temperature, degC (with --temp-ramp-c-per-h: the start temperature).
+    #[arg(long, value_name = "C", allow_hyphen_values = true)]
+    pub temp_c: Option<f64>,
+    /// Temperature ramp, degC per hour.
+    #[arg(long, value_name = "C_PER_H", allow_hyphen_values = true)]
+    pub temp_ramp_c_per_h: Option<f64>,
+    /// Latitude, degrees: adds the earth rate seen by a vertical input axis.
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    pub latitude: Option<f64>,
+    /// Write numbers with this many decimals instead of the shortest round-trip form.
+    #[arg(long, value_name = "N")]
+    pub decimals: Option<u8>,
+}
+
+/// Options of `gyrolab simulate static`.
+#[derive(Debug, Args)]
+pub struct StaticArgs {
+    #[command(flatten)]
+    pub common: CommonArgs,
+    /// Record length, seconds.
+    #[arg(long, value_name = "S")]
+    pub duration_s: Option<f64>,
+    /// Add a temp_c column.
+    #[arg(long)]
+    pub record_temperature: bool,
+}
+
+/// Options of `gyrolab simulate rate-table`.
+#[derive(Debug, Args)]
+pub struct RateTableArgs {
+    #[command(flatten)]
+    pub common: CommonArgs,
+    /// Table rates, deg/s (default: the paper's 14 rates).
+    #[arg(long, value_name = "DPS,...", value_delimiter = ',', allow_hyphen_values = true)]
+    pub rates: Vec<f64>,
+    /// Number of runs (each a forward then a reverse stroke).
+    #[arg(long)]
+    pub runs: Option<u32>,
+    /// Samples recorded on each plateau (after settling).
+    #[arg(long, value_name = "N")]
+    pub samples_per_plateau: Option<u32>,
+    /// Settling time at the start of each plateau, dropped, seconds.
+    #[arg(long, value_name = "S")]
+    pub settling_s: Option<f64>,
+    /// Rest samples at the start and at the end (0: no rest records).
+    #[arg(long, value_name = "N")]
+    pub rest_samples: Option<u32>,
+    /// Hysteresis: forward-minus-reverse offset, deg/s.
+    #[arg(long, value_name = "DPS", allow_hyphen_values = true)]
+    pub hysteresis_dps: Option<f64>,
+    /// Quadratic nonlinearity coefficient k2 (rate' = w + k2 w^2 + k3 w^3), 1/(deg/s).
+    #[arg(long, value_name = "K2", allow_hyphen_values = true)]
+    pub nonlinearity_quadratic_per_dps: Option<f64>,
+    /// Scale-factor asymmetry (K+ - K-)/K, ppm.
+    #[arg(long, value_name = "PPM", allow_hyphen_values = true)]
+    pub scale_factor_asymmetry_ppm: Option<f64>,
+    /// Run-to-run scale-factor change (1 sigma), ppm.
+    #[arg(long, value_name = "PPM")]
+    pub run_to_run_scale_factor_sigma_ppm: Option<f64>,
+}
+
+fn parse_preset(s: &str) -> Result<Preset, String> {
+    Preset::parse(s).ok_or_else(|| {
+        let names: Vec<&str> = Preset::ALL.iter().map(|p| p.name()).collect();
+        format!("unknown preset '{s}': expected one of {}", names.join(", "))
+    })
+}
+
+fn load(common: &CommonArgs) -> CliResult<SimConfig> {
+    let mut cfg = match &common.config {
+        Some(p) => read_sim_config(p)?,
+        None => SimConfig { seed: 1, ..SimConfig::default() },
+    };
+    if let Some(s) = common.seed {
+        cfg.seed = s;
+    }
+    if common.preset.is_some() {
+        cfg.preset = common.preset;
+    }
+    let o = &mut cfg.sensor;
+    macro_rules! set {
+        ($($f:ident),*) => { $( if let Some(v) = common.$f { o.$f = Some(v); } )* };
+    }
+    set!(
+        output_unit,
+        null,
+        bias_dph,
+        arw_deg_rt_h,
+        bias_instability_dph,
+        rrw_deg_h_rt_h,
+        rate_ramp_dph_per_h,
+        output_quantization_step,
+        bias_temp_coeff_dph_per_c
+    );
+    if let Some(k) = common.scale_factor {
+        o.scale_factor_per_dps = Some(k);
+    }
+    if o.output_unit.is_some() && o.scale_factor_per_dps.is_none() && cfg.preset.is_none() {
+        if let Some(OutputUnit::Volt | OutputUnit::Millivolt | OutputUnit::Lsb) = o.output_unit {
+            return Err(CliError::Usage(
+                "an analog or digital output needs --scale-factor (and usually --null), or a --preset".into(),
+            ));
+        }
+    }
+    let temperature = match (common.temp_c, common.temp_ramp_c_per_h) {
+        (None, None) => None,
+        (t, None) => Some(TemperatureProfile::Constant { temp_c: t.unwrap_or(25.0) }),
+        (t, Some(r)) => Some(TemperatureProfile::Ramp { start_c: t.unwrap_or(25.0), rate_c_per_h: r }),
+    };
+    if let Some(t) = temperature {
+        cfg.static_record.temperature = t.clone();
+        cfg.rate_table.temperature = t;
+    }
+    if let Some(l) = common.latitude {
+        cfg.static_record.latitude_deg = Some(l);
+        cfg.rate_table.latitude_deg = Some(l);
+    }
+    if let Some(f) = common.sample_rate_hz {
+        cfg.static_record.sample_rate_hz = f;
+        cfg.rate_table.sample_rate_hz = f;
+    }
+    Ok(cfg)
+}
+
+fn csv_options(common: &CommonArgs) -> CliResult<SimCsvOptions> {
+    let mut o = SimCsvOptions::default();
+    if let Some(d) = common.decimals {
+        if d > 15 {
+            return Err(CliError::Usage(format!("--decimals must be 0 to 15, got {d}")));
+        }
+        o.number_format = gyrolab_io::sim_csv::NumberFormat::Fixed { decimals: d };
+    }
+    o.comments.push(format!("command: {}", std::env::args().collect::<Vec<_>>().join(" ")));
+    Ok(o)
+}
+
+fn sim_error(e: SimCsvError) -> CliError {
+    match e {
+        SimCsvError::Io(io) => CliError::Output(format!("cannot write the simulated record: {io}")),
+        other => CliError::Usage(format!("invalid simulation parameters: {other}")),
+    }
+}
+
+fn emit(out: &Option<PathBuf>, write: impl FnOnce(&mut dyn Write) -> Result<(), SimCsvError>) -> CliResult {
+    match out {
+        Some(path) => {
+            let mut failure = None;
+            let r = gyrolab_io::atomic::write_atomic_with(path, |w| {
+                write(w).map_err(|e| {
+                    let msg = e.to_string();
+                    failure = Some(e);
+                    std::io::Error::other(msg)
+                })
+            });
+            match (r, failure) {
+                (_, Some(e)) => Err(sim_error(e)),
+                (Err(e), None) => Err(CliError::Output(format!("{}: cannot write the file: {e}", path.display()))),
+                (Ok(()), None) => Ok(()),
+            }
+        }
+        None => {
+            let stdout = std::io::stdout();
+            let mut lock = stdout.lock();
+            match write(&mut lock) {
+                Err(SimCsvError::Io(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+                r => r.map_err(sim_error),
+            }
+        }
+    }
+}
+
+fn model(cfg: &SimConfig) -> SensorModel {
+    cfg.sensor_model()
+}
+
+/// Runs `gyrolab simulate`.
+pub fn run(cmd: &SimulateCommand) -> CliResult {
+    match cmd {
+        SimulateCommand::Static(a) => {
+            let mut cfg = load(&a.common)?;
+            if let Some(d) = a.duration_s {
+                cfg.static_record.duration_s = d;
+            }
+            if a.record_temperature {
+                cfg.static_record.record_temperature = true;
+            }
+            let m = model(&cfg);
+            let opts = csv_options(&a.common)?;
+            emit(&a.common.out, |w| write_static_csv(w, &m, &cfg.static_record, cfg.seed, &opts).map(|_| ()))
+        }
+        SimulateCommand::RateTable(a) => {
+            let mut cfg = load(&a.common)?;
+            let rt = &mut cfg.rate_table;
+            if !a.rates.is_empty() {
+                rt.rates_dps = a.rates.clone();
+            }
+            if let Some(v) = a.runs {
+                rt.runs = v;
+            }
+            if let Some(v) = a.samples_per_plateau {
+                rt.samples_per_plateau = v;
+            }
+            if let Some(v) = a.settling_s {
+                rt.settling_s = v;
+            }
+            if let Some(v) = a.rest_samples {
+                rt.rest_samples = v;
+            }
+            let o = &mut cfg.sensor;
+            if let Some(v) = a.hysteresis_dps {
+                o.hysteresis_dps = Some(v);
+            }
+            if let Some(v) = a.nonlinearity_quadratic_per_dps {
+                o.nonlinearity_quadratic_per_dps = Some(v);
+            }
+            if let Some(v) = a.scale_factor_asymmetry_ppm {
+                o.scale_factor_asymmetry_ppm = Some(v);
+            }
+            if let Some(v) = a.run_to_run_scale_factor_sigma_ppm {
+                o.run_to_run_scale_factor_sigma_ppm = Some(v);
+            }
+            let m = model(&cfg);
+            let opts = csv_options(&a.common)?;
+            emit(&a.common.out, |w| write_rate_table_csv(w, &m, &cfg.rate_table, cfg.seed, &opts).map(|_| ()))
+        }
+    }
+}

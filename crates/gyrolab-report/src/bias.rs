@@ -1,0 +1,198 @@
+//! Reports of static (bias) tests: the summary table, data-quality findings and JSON
+//! (keys in docs/JSON.md).
+
+use crate::format::{short, sig, sig_opt};
+use comfy_table::{presets::UTF8_FULL_CONDENSED, Cell, CellAlignment, Table};
+use gyrolab::static_test::{BiasRepeatability, QualityIssue, StaticTestResult};
+use serde::Serialize;
+
+/// One evaluated test (one channel of one file).
+#[derive(Debug, Clone, Serialize)]
+pub struct TestReport {
+    /// Source file.
+    pub file: String,
+    /// The figures (flattened into the JSON object).
+    #[serde(flatten)]
+    pub result: StaticTestResult,
+}
+
+/// Repeatability of one channel across the files.
+#[derive(Debug, Clone, Serialize)]
+pub struct ChannelRepeatability {
+    /// Channel name.
+    pub channel: String,
+    /// The figures.
+    #[serde(flatten)]
+    pub repeatability: BiasRepeatability,
+}
+
+/// JSON document of `gyrolab bias --json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct BiasJson {
+    /// Program version.
+    pub gyrolab_version: String,
+    /// One entry per file and channel.
+    pub tests: Vec<TestReport>,
+    /// Bias repeatability across the files, deg/h, when every test has one channel and is
+    /// calibrated (null otherwise; per channel in `repeatability`).
+    pub bias_repeatability_dph: Option<f64>,
+    /// Repeatability per channel (channels present in two or more files).
+    pub repeatability: Vec<ChannelRepeatability>,
+}
+
+/// Builds the JSON document.
+pub fn bias_json(tests: Vec<TestReport>, repeatability: Vec<ChannelRepeatability>) -> BiasJson {
+    let single = repeatability.len() == 1;
+    BiasJson {
+        gyrolab_version: env!("CARGO_PKG_VERSION").into(),
+        bias_repeatability_dph: if single { repeatability[0].repeatability.bias_repeatability_dph } else { None },
+        tests,
+        repeatability,
+    }
+}
+
+fn issue_text(name: &str, q: &QualityIssue) -> Option<String> {
+    if q.count == 0 {
+        return None;
+    }
+    let at = q.first.first().map(|p| match p.line {
+        Some(l) => format!(", first at line {l}"),
+        None => format!(", first at sample {}", p.sample),
+    });
+    Some(format!("{} {name}{}", q.count, at.unwrap_or_default()))
+}
+
+/// Data-quality findings of one test as text lines (empty when clean).
+pub fn quality_lines(t: &TestReport) -> Vec<String> {
+    let q = &t.result.quality;
+    let mut v: Vec<String> = [
+        issue_text("missing (NaN or empty) samples", &q.missing),
+        issue_text("time gaps", &q.time_gaps),
+        issue_text("repeated time stamps", &q.repeated_time),
+        issue_text("decreasing time stamps", &q.decreasing_time),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    for (name, r) in [("minimum", &q.stuck_at_min), ("maximum", &q.stuck_at_max)] {
+        if r.runs > 0 {
+            let at = r.first.first().and_then(|p| p.line).map(|l| format!(", first at line {l}")).unwrap_or_default();
+            v.push(format!(
+                "{} run(s) of {} samples stuck at the {name} {}{at}",
+                r.runs,
+                r.samples,
+                sig_opt(r.value, 6)
+            ));
+        }
+    }
+    if let Some(o) = &q.outliers {
+        if let Some(s) =
+            issue_text(&format!("outliers beyond {} sigma of the drift line", short(o.k_sigma, 3)), &o.outliers)
+        {
+            v.push(if o.dropped {
+                format!("{s} (dropped)")
+            } else {
+                format!("{s} (kept; --drop-outliers removes them)")
+            });
+        }
+    }
+    v
+}
+
+/// The summary table: one row per figure, one column per test.
+pub fn bias_table(tests: &[TestReport], repeatability: &[ChannelRepeatability]) -> String {
+    let mut t = Table::new();
+    t.load_preset(UTF8_FULL_CONDENSED);
+    let mut header = vec!["figure".to_string(), "unit".to_string()];
+    header.extend(tests.iter().map(|r| {
+        let stem =
+            std::path::Path::new(&r.file).file_stem().map_or(r.file.clone(), |s| s.to_string_lossy().into_owned());
+        format!("{stem}\n{}", r.result.channel)
+    }));
+    t.set_header(header);
+    let unit = |r: &TestReport| r.result.output_unit.symbol().to_string();
+    let same_unit = tests.windows(2).all(|w| w[0].result.output_unit == w[1].result.output_unit);
+    let ou = if same_unit { tests.first().map(unit).unwrap_or_default() } else { "output".into() };
+    let mut row = |label: String, unit: String, f: &dyn Fn(&StaticTestResult) -> String| {
+        let mut cells = vec![Cell::new(label), Cell::new(unit)];
+        cells.extend(tests.iter().map(|r| Cell::new(f(&r.result))));
+        t.add_row(cells);
+    };
+    row("samples".into(), String::new(), &|r| r.valid_samples.to_string());
+    row("sample rate".into(), "Hz".into(), &|r| short(r.sample_rate_hz, 6));
+    row("duration".into(), "s".into(), &|r| short(r.duration_s, 6));
+    row("zero-rate output mean".into(), ou.clone(), &|r| sig(r.mean_output, 8));
+    row("output std".into(), ou.clone(), &|r| sig(r.std_output, 4));
+    row("scale factor used".into(), format!("{ou}/(deg/s)"), &|r| sig_opt(r.scale_factor_output_per_dps, 6));
+    row("bias B0".into(), "deg/s".into(), &|r| sig_opt(r.bias_dps, 5));
+    row("bias B0".into(), "deg/h".into(), &|r| sig_opt(r.bias_dph, 5));
+    if tests.iter().any(|r| r.result.earth_rate_component_dph.is_some()) {
+        row("earth rate (subtracted)".into(), "deg/h".into(), &|r| sig_opt(r.earth_rate_component_dph, 5));
+    }
+    let mut keys: Vec<(f64, String)> = Vec::new();
+    for r in tests {
+        for k in r.result.bias_stability_output.keys() {
+            if let Ok(v) = k.parse::<f64>() {
+                if !keys.iter().any(|(_, s)| s == k) {
+                    keys.push((v, k.clone()));
+                }
+            }
+        }
+    }
+    keys.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let calibrated = tests.iter().any(|r| !r.result.bias_stability_dph.is_empty());
+    for (_, k) in &keys {
+        if calibrated {
+            row(format!("bias stability ({k} s)"), "deg/h".into(), &|r| {
+                sig_opt(r.bias_stability_dph.get(k.as_str()).copied(), 4)
+            });
+        } else {
+            row(format!("bias stability ({k} s)"), ou.clone(), &|r| {
+                sig_opt(r.bias_stability_output.get(k.as_str()).copied(), 4)
+            });
+        }
+    }
+    if calibrated {
+        row("drift".into(), "(deg/h)/h".into(), &|r| sig_opt(r.drift_dph_per_h, 4));
+    } else {
+        row("drift".into(), format!("{ou}/h"), &|r| sig_opt(r.drift_output_per_h, 4));
+    }
+    if tests.iter().any(|r| r.result.temperature.is_some()) {
+        row("temperature range".into(), "degC".into(), &|r| {
+            r.temperature
+                .as_ref()
+                .map_or("n/a".into(), |t| format!("{}..{}", short(t.temp_min_c, 4), short(t.temp_max_c, 4)))
+        });
+        row("temperature sensitivity".into(), "(deg/h)/degC".into(), &|r| {
+            sig_opt(r.temperature.as_ref().and_then(|t| t.temp_sensitivity_dph_per_c), 4)
+        });
+        row("stability after compensation".into(), "deg/h".into(), &|r| {
+            sig_opt(r.temperature.as_ref().and_then(|t| t.compensated_stability_dph), 4)
+        });
+    }
+    for i in 2..t.column_count() {
+        if let Some(c) = t.column_mut(i) {
+            c.set_cell_alignment(CellAlignment::Right);
+        }
+    }
+    let mut s = t.to_string();
+    for r in repeatability {
+        let rep = &r.repeatability;
+        s.push_str(&format!(
+            "\nchannel {} over {} tests: mean output {} {}, std {} {}",
+            r.channel,
+            rep.tests,
+            sig(rep.mean_output, 8),
+            ou,
+            sig(rep.output_repeatability, 4),
+            ou
+        ));
+        if let (Some(m), Some(b)) = (rep.mean_bias_dph, rep.bias_repeatability_dph) {
+            s.push_str(&format!("; mean bias {} deg/h, bias repeatability {} deg/h", sig(m, 5), sig(b, 4)));
+        }
+    }
+    if let Some(q) = tests.first().and_then(|r| r.result.bias_stability_quoted_s.clone()) {
+        s.push_str(&format!("\nbias stability is quoted at a smoothing time of {q} s (window means, n-1)."));
+    }
+    s
+}
