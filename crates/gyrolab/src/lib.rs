@@ -5,11 +5,19 @@
 //! - [`units`]: units of rates, outputs and noise coefficients, and every conversion;
 //! - [`fit`]: least-squares lines and polynomials;
 //! - [`rate_test`]: rate-table (scale-factor) test figures;
-//! - [`published`]: comparison with figures printed in a publication.
+//! - [`published`]: comparison with figures printed in a publication;
+//! - [`segment`]: plateaus, strokes and runs found in raw rate-table logs;
+//! - [`triad`]: three-axis scale-factor, misalignment and bias calibration (12 parameters);
+//! - [`apply`]: calibrations applied to output samples (output to rate).
 //!
 //! Formulas and their sources are listed in `docs/METHODS.md`.
 
+pub mod apply;
 pub mod fit;
 pub mod published;
 pub mod rate_test;
+pub mod segment;
+#[cfg(test)]
+mod testsim;
+pub mod triad;
 pub mod units;
