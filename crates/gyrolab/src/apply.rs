@@ -243,3 +243,98 @@ impl TriadApplier {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rate_test::{evaluate, RateTable, RateTestOptions};
+    use crate::segment::{rate_observations, segment_log, PlateauReduction, SegmentKind, SegmentOptions};
+    use crate::testsim::{generate, sweep, Profile};
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+    use rand_distr::{Distribution, Normal};
+
+    const RATES: [f64; 7] = [-300.0, -100.0, -30.0, 0.0, 30.0, 100.0, 300.0];
+
+    /// A single-axis gyro with a small quadratic term (5e-8 V/(deg/s)^2: 4.5 mV, 0.6 deg/s at
+    /// 300 deg/s, far above the noise of a plateau mean), calibrated by order 1 and order 2 through
+    /// the segmentation and `rate_test::evaluate`, then applied to the calibration's own plateaus.
+    /// A plateau mean's rate error is sigma / sqrt(n) / K with n >= 425 samples: 0.013 deg/s.
+    #[test]
+    fn applying_a_calibration_to_its_own_plateaus_returns_the_table_rates() {
+        let (k, f0, c2, sigma) = (0.0075, 2.5, 5e-8, 0.002);
+        let sim = generate(&sweep(&RATES, 2, true, true), &Profile::default(), 21);
+        let mut rng = ChaCha8Rng::seed_from_u64(22);
+        let noise = Normal::new(0.0, sigma).unwrap();
+        let out: Vec<f64> = sim.true_rate.iter().map(|w| f0 + k * w + c2 * w * w + noise.sample(&mut rng)).collect();
+        let o = SegmentOptions::default();
+        let seg = segment_log(&sim.time, &sim.logged_rate, &o).unwrap();
+        let (obs, rest) = rate_observations(&seg, &sim.time, &out, PlateauReduction::Mean, o.rest).unwrap();
+        let table = RateTable::from_observations(&obs, rest).unwrap();
+        let quad = evaluate(&table, &RateTestOptions { order: 2, ..Default::default() }).unwrap();
+        let cal = SingleAxisCalibration::polynomial(&quad.polynomial.coefficients, -300.0, 300.0).unwrap();
+        let line =
+            SingleAxisCalibration::line(quad.scale_factor(), quad.zero_offset(), -300.0, 300.0).unwrap();
+        let tol = 5.0 * sigma / 425f64.sqrt() / k + 5.0 * 0.01 / 425f64.sqrt();
+        let mut worst_line: f64 = 0.0;
+        for s in seg.iter().filter(|s| matches!(s.kind, SegmentKind::Plateau { .. })) {
+            let u = out[s.start_index..s.end_index].iter().sum::<f64>() / s.samples() as f64;
+            let got = cal.rate(u);
+            assert_eq!(got.status, RangeStatus::Inside, "{s:?}");
+            assert!((got.rate_dps - s.rate_dps).abs() < tol, "{} vs {} (tol {tol})", got.rate_dps, s.rate_dps);
+            worst_line = worst_line.max((line.rate(u).rate_dps - s.rate_dps).abs());
+        }
+        // The straight line cannot follow the quadratic term: the test can tell the models apart.
+        assert!(worst_line > 3.0 * tol, "{worst_line}");
+        let mut block = Vec::new();
+        cal.apply_block(&out[..100], &mut block);
+        assert_eq!(block.len(), 100);
+    }
+
+    #[test]
+    fn outside_the_range_is_flagged_and_continued_along_the_end_tangent() {
+        let c = [2.5, 0.0075, 2e-8];
+        let p = |w: f64| c[0] + c[1] * w + c[2] * w * w;
+        let cal = SingleAxisCalibration::polynomial(&c, -300.0, 300.0).unwrap();
+        // Inside: exact inverse.
+        let r = cal.rate(p(123.0));
+        assert_eq!(r.status, RangeStatus::Inside);
+        assert!((r.rate_dps - 123.0).abs() < 1e-9);
+        // Above: 300 + (u - p(300)) / p'(300), by hand.
+        let u = p(400.0);
+        let r = cal.rate(u);
+        assert_eq!(r.status, RangeStatus::Above);
+        let by_hand = 300.0 + (u - p(300.0)) / (c[1] + 2.0 * c[2] * 300.0);
+        assert!((r.rate_dps - by_hand).abs() < 1e-9, "{} vs {by_hand}", r.rate_dps);
+        let r = cal.rate(p(-400.0));
+        assert_eq!(r.status, RangeStatus::Below);
+        // Within the margin: inside.
+        assert_eq!(cal.rate(p(300.3)).status, RangeStatus::Inside);
+        // Line: (u - F0) / K.
+        let line = SingleAxisCalibration::line(0.0075, 2.5, -300.0, 300.0).unwrap();
+        assert!((line.rate(2.5 + 0.0075 * 77.0).rate_dps - 77.0).abs() < 1e-12);
+        assert_eq!(line.rate(2.5 + 0.0075 * 350.0).status, RangeStatus::Above);
+        assert_eq!(line.rate(f64::NAN).status, RangeStatus::NotFinite);
+    }
+
+    #[test]
+    fn bad_calibrations_are_errors() {
+        // Slope 1 + 0.02 x vanishes at -50 deg/s, inside the range.
+        assert!(matches!(
+            SingleAxisCalibration::polynomial(&[0.0, 1.0, 0.01], -100.0, 100.0),
+            Err(ApplyError::NotMonotonic { .. })
+        ));
+        assert!(SingleAxisCalibration::polynomial(&[0.0, 1.0, 0.01], 0.0, 100.0).is_ok());
+        assert!(matches!(SingleAxisCalibration::line(0.0, 2.5, -1.0, 1.0), Err(ApplyError::BadScaleFactor(_))));
+        assert!(matches!(SingleAxisCalibration::line(1.0, 2.5, 1.0, -1.0), Err(ApplyError::BadRange { .. })));
+        let singular = TriadCalibration { matrix: [[1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]], bias: [0.0; 3], rate_limit_dps: 1.0 };
+        assert_eq!(TriadApplier::new(&singular), Err(ApplyError::SingularMatrix));
+        let ok = TriadCalibration { matrix: [[2.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 5.0]], bias: [1.0; 3], rate_limit_dps: 10.0 };
+        let a = TriadApplier::new(&ok).unwrap();
+        let r = a.rates([3.0, 5.0, 6.0]);
+        assert_eq!(r.rates_dps, [1.0, 1.0, 1.0]);
+        assert_eq!(a.rates([41.0, 1.0, 1.0]).status, RangeStatus::Above);
+        let mut out = Vec::new();
+        assert!(matches!(a.apply_block(&[1.0], &[1.0, 2.0], &[1.0], &mut out), Err(ApplyError::LengthMismatch(_))));
+    }
+}

@@ -408,3 +408,180 @@ pub fn fit_triad(plateaus: &[TriadPlateau], options: &TriadOptions) -> Result<Tr
         plateaus: n,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::apply::{RangeStatus, TriadApplier};
+    use crate::segment::{find_steady_segments, SegmentOptions};
+    use crate::testsim::{generate, sweep, Profile, SimLog};
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+    use rand_distr::{Distribution, Normal};
+
+    const RATES: [f64; 6] = [-300.0, -100.0, -30.0, 30.0, 100.0, 300.0];
+    const SIGMA_U: f64 = 0.002; // output noise per sample, V
+    const K: [f64; 3] = [0.0075, 0.0076, 0.0074]; // V/(deg/s)
+    const BIAS: [f64; 3] = [2.50, 2.51, 2.49]; // V
+    /// Misalignment of gyro i's input axis towards table axis j, rad (2 to 5 mrad).
+    const ANGLE: [[f64; 3]; 3] = [[0.0, 3e-3, -2e-3], [4e-3, 0.0, 2.5e-3], [-5e-3, 3.5e-3, 0.0]];
+
+    /// True S: row i is K_i times gyro i's input-axis direction (unit along i, tan(angle) along j).
+    fn true_matrix() -> [[f64; 3]; 3] {
+        let mut s = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                s[i][j] = if i == j { K[i] } else { K[i] * ANGLE[i][j].tan() };
+            }
+        }
+        s
+    }
+
+    struct AxisLog {
+        sim: SimLog,
+        outputs: [Vec<f64>; 3],
+    }
+
+    fn axis_log(axis: TableAxis, seed: u64) -> AxisLog {
+        let sim = generate(&sweep(&RATES, 1, true, true), &Profile::default(), seed);
+        let s = true_matrix();
+        let mut rng = ChaCha8Rng::seed_from_u64(seed + 100);
+        let noise = Normal::new(0.0, SIGMA_U).unwrap();
+        let j = axis.index();
+        let outputs = [0, 1, 2].map(|i| {
+            sim.true_rate.iter().map(|w| BIAS[i] + s[i][j] * w + noise.sample(&mut rng)).collect::<Vec<f64>>()
+        });
+        AxisLog { sim, outputs }
+    }
+
+    fn plateaus_of(axis: TableAxis, log: &AxisLog) -> Vec<TriadPlateau> {
+        let steady = find_steady_segments(&log.sim.time, &log.sim.logged_rate, &SegmentOptions::default()).unwrap();
+        let o = [&log.outputs[0][..], &log.outputs[1][..], &log.outputs[2][..]];
+        plateaus_from_segments(axis, &steady, &log.sim.time, o).unwrap()
+    }
+
+    fn all_plateaus() -> (Vec<TriadPlateau>, Vec<AxisLog>) {
+        let logs: Vec<AxisLog> = TableAxis::ALL.iter().map(|&a| axis_log(a, 40 + a.index() as u64)).collect();
+        let p = TableAxis::ALL.iter().flat_map(|&a| plateaus_of(a, &logs[a.index()])).collect();
+        (p, logs)
+    }
+
+    /// Standard errors from the noise: each plateau mean has sigma_u / sqrt(n) with n >= 850 kept
+    /// samples (10 s holds at 100 Hz less 1 s settling and <= 0.5 s overshoot); S_ij is the slope
+    /// on omega_j, so its standard error is that over sqrt(sum of omega_j^2) (the design is
+    /// nearly centred: rests and both senses); an angle's is that divided by K_i.
+    fn standard_errors(p: &[TriadPlateau]) -> ([f64; 3], f64) {
+        let sigma_mean = SIGMA_U / 850f64.sqrt();
+        let se_s = TableAxis::ALL.map(|a| {
+            let sxx: f64 = p.iter().filter(|q| q.axis == a).map(|q| q.rate_dps * q.rate_dps).sum();
+            sigma_mean / sxx.sqrt()
+        });
+        (se_s, sigma_mean / (p.len() as f64).sqrt())
+    }
+
+    #[test]
+    fn matrix_angles_and_biases_recovered_from_simulated_logs() {
+        let (p, _) = all_plateaus();
+        // rest + 11 plateaus + rest per axis.
+        assert_eq!(p.len(), 3 * 13);
+        let f = fit_triad(&p, &TriadOptions::default()).unwrap();
+        let (se_s, se_b) = standard_errors(&p);
+        let s = true_matrix();
+        for i in 0..3 {
+            for j in 0..3 {
+                let got = f.calibration.matrix[i][j];
+                assert!((got - s[i][j]).abs() < 5.0 * se_s[j], "S[{i}][{j}] = {got} vs {} (se {})", s[i][j], se_s[j]);
+                if i != j {
+                    let tol_mrad = 5.0 * se_s[j] / K[i] * 1e3 * 1.01;
+                    assert!(tol_mrad < 0.1, "the test must resolve 0.1 mrad: {tol_mrad}");
+                    let got = f.misalignment_mrad[i][j];
+                    assert!((got - ANGLE[i][j] * 1e3).abs() < tol_mrad, "angle {i}{j}: {got} mrad");
+                    let pct = f.cross_axis_sensitivity_pct[i][j];
+                    assert!((pct - ANGLE[i][j].tan() * 100.0).abs() < tol_mrad / 10.0, "cross {i}{j}: {pct} %");
+                }
+            }
+            assert!((f.scale_factors[i] - K[i]).abs() < 5.0 * se_s[i]);
+            assert!((f.calibration.bias[i] - BIAS[i]).abs() < 5.0 * se_b, "b[{i}] = {}", f.calibration.bias[i]);
+            // RMS output residual: about the noise of a plateau mean.
+            assert!(f.rms_output_residual[i] < 2.0 * SIGMA_U / 850f64.sqrt(), "{:?}", f.rms_output_residual);
+        }
+        assert!(f.design_condition < 10.0, "{}", f.design_condition);
+        assert_eq!(f.calibration.rate_limit_dps.round(), 300.0);
+        assert_eq!(f.residuals.len(), p.len());
+        // S S^-1 = I.
+        for i in 0..3 {
+            for j in 0..3 {
+                let v: f64 = (0..3).map(|k| f.calibration.matrix[i][k] * f.inverse[k][j]).sum();
+                assert!((v - if i == j { 1.0 } else { 0.0 }).abs() < 1e-12);
+            }
+        }
+    }
+
+    /// Applying the calibration to its own plateaus gives the table rates back within the noise:
+    /// a plateau mean's rate error is sigma_u / sqrt(n) / K (about 0.01 deg/s), and on single
+    /// samples the spread of the calibrated rate is sigma_u / K (0.27 deg/s).
+    #[test]
+    fn applying_the_calibration_returns_the_table_rates() {
+        let (p, logs) = all_plateaus();
+        let f = fit_triad(&p, &TriadOptions::default()).unwrap();
+        let apply = TriadApplier::new(&f.calibration).unwrap();
+        let tol = 5.0 * SIGMA_U / 850f64.sqrt() / 0.0074 + 5.0 * 0.01 / 850f64.sqrt();
+        for q in &p {
+            let got = apply.rates(q.output);
+            assert_eq!(got.status, RangeStatus::Inside);
+            let w = q.rate_vector();
+            for i in 0..3 {
+                assert!((got.rates_dps[i] - w[i]).abs() < tol, "{q:?}: {:?}", got.rates_dps);
+            }
+        }
+        // Sample by sample over one plateau of the y log (the +300 deg/s hold).
+        let log = &logs[1];
+        let steady = find_steady_segments(&log.sim.time, &log.sim.logged_rate, &SegmentOptions::default()).unwrap();
+        let top = steady.iter().max_by(|a, b| a.rate_dps.total_cmp(&b.rate_dps)).unwrap();
+        let r = top.start_index..top.end_index;
+        let mut out = Vec::new();
+        apply.apply_block(&log.outputs[0][r.clone()], &log.outputs[1][r.clone()], &log.outputs[2][r], &mut out).unwrap();
+        let n = out.len() as f64;
+        let mean_y = out.iter().map(|a| a.rates_dps[1]).sum::<f64>() / n;
+        let std_y = (out.iter().map(|a| (a.rates_dps[1] - mean_y).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        assert!((mean_y - top.rate_dps).abs() < tol, "{mean_y} vs {}", top.rate_dps);
+        let expected_std = SIGMA_U / K[1];
+        assert!((std_y / expected_std - 1.0).abs() < 0.1, "{std_y} vs {expected_std}");
+    }
+
+    #[test]
+    fn a_set_missing_an_axis_or_a_sense_is_an_error() {
+        let (p, _) = all_plateaus();
+        let no_z: Vec<TriadPlateau> = p.iter().filter(|q| q.axis != TableAxis::Z).copied().collect();
+        let e = fit_triad(&no_z, &TriadOptions::default()).unwrap_err();
+        assert!(matches!(e, TriadError::MissingAxis { axis: TableAxis::Z, .. }), "{e}");
+        assert!(e.to_string().contains("no rotation about the z axis"), "{e}");
+        let y_positive: Vec<TriadPlateau> =
+            p.iter().filter(|q| !(q.axis == TableAxis::Y && q.rate_dps < 0.0)).copied().collect();
+        let e = fit_triad(&y_positive, &TriadOptions::default()).unwrap_err();
+        assert!(matches!(e, TriadError::MissingSense { axis: TableAxis::Y, present: "positive" }), "{e}");
+        // Accepted when one sense is allowed (rests pin the bias).
+        let o = TriadOptions { require_both_senses: false, ..Default::default() };
+        assert!(fit_triad(&y_positive, &o).is_ok());
+        assert_eq!(fit_triad(&[], &o), Err(TriadError::Empty));
+    }
+
+    #[test]
+    fn an_undetermined_set_is_ill_conditioned() {
+        let plateau = |axis, rate_dps| TriadPlateau { axis, rate_dps, output: [1.0, 2.0, 3.0], samples: 1, start_time_s: 0.0 };
+        let o = TriadOptions { require_both_senses: false, ..Default::default() };
+        // One rate per axis and no rest: bias and scale factors cannot be told apart.
+        let p = [
+            plateau(TableAxis::X, 100.0),
+            plateau(TableAxis::Y, 100.0),
+            plateau(TableAxis::Z, 100.0),
+            plateau(TableAxis::X, 100.0),
+        ];
+        let e = fit_triad(&p, &o).unwrap_err();
+        assert!(matches!(e, TriadError::IllConditioned { .. }), "{e}");
+        assert!(matches!(fit_triad(&p[..3], &o), Err(TriadError::TooFewPlateaus { found: 3 })));
+        let mut bad = p;
+        bad[1].output[2] = f64::NAN;
+        assert!(matches!(fit_triad(&bad, &o), Err(TriadError::NonFinite { index: 1, .. })));
+    }
+}
