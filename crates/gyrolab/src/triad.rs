@@ -209,6 +209,9 @@ pub enum TriadError {
     },
 }
 
+/// Largest condition number of S accepted for inversion (a gyro triad has about 1.0 to 1.1).
+pub const MAX_MATRIX_CONDITION: f64 = 1e10;
+
 /// A three-axis calibration: what must be stored to turn outputs into rates.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TriadCalibration {
@@ -221,8 +224,12 @@ pub struct TriadCalibration {
 }
 
 impl TriadCalibration {
-    /// S^-1 ((deg/s) per output unit), or `None` when S is singular.
+    /// S^-1 ((deg/s) per output unit), or `None` when S is singular (condition number above
+    /// [`MAX_MATRIX_CONDITION`] or not finite).
     pub fn inverse_matrix(&self) -> Option<[[f64; 3]; 3]> {
+        if !(matrix_condition(&self.matrix) <= MAX_MATRIX_CONDITION) {
+            return None;
+        }
         let m = to_matrix3(&self.matrix);
         let inv = m.try_inverse()?;
         if inv.iter().all(|v| v.is_finite()) {
