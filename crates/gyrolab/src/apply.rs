@@ -99,12 +99,7 @@ fn check_range(min: f64, max: f64) -> Result<(), ApplyError> {
 impl SingleAxisCalibration {
     /// The line output = K * rate + F0 (K output units per deg/s, F0 output units), valid on
     /// [rate_min_dps, rate_max_dps].
-    pub fn line(
-        scale_factor: f64,
-        zero_offset: f64,
-        rate_min_dps: f64,
-        rate_max_dps: f64,
-    ) -> Result<Self, ApplyError> {
+    pub fn line(scale_factor: f64, zero_offset: f64, rate_min_dps: f64, rate_max_dps: f64) -> Result<Self, ApplyError> {
         if !(scale_factor.is_finite() && scale_factor != 0.0) {
             return Err(ApplyError::BadScaleFactor(scale_factor));
         }
@@ -273,8 +268,7 @@ mod tests {
         let table = RateTable::from_observations(&obs, rest).unwrap();
         let quad = evaluate(&table, &RateTestOptions { order: 2, ..Default::default() }).unwrap();
         let cal = SingleAxisCalibration::polynomial(&quad.polynomial.coefficients, -300.0, 300.0).unwrap();
-        let line =
-            SingleAxisCalibration::line(quad.scale_factor(), quad.zero_offset(), -300.0, 300.0).unwrap();
+        let line = SingleAxisCalibration::line(quad.scale_factor(), quad.zero_offset(), -300.0, 300.0).unwrap();
         let tol = 5.0 * sigma / 425f64.sqrt() / k + 5.0 * 0.01 / 425f64.sqrt();
         let mut worst_line: f64 = 0.0;
         for s in seg.iter().filter(|s| matches!(s.kind, SegmentKind::Plateau { .. })) {
@@ -327,9 +321,17 @@ mod tests {
         assert!(SingleAxisCalibration::polynomial(&[0.0, 1.0, 0.01], 0.0, 100.0).is_ok());
         assert!(matches!(SingleAxisCalibration::line(0.0, 2.5, -1.0, 1.0), Err(ApplyError::BadScaleFactor(_))));
         assert!(matches!(SingleAxisCalibration::line(1.0, 2.5, 1.0, -1.0), Err(ApplyError::BadRange { .. })));
-        let singular = TriadCalibration { matrix: [[1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]], bias: [0.0; 3], rate_limit_dps: 1.0 };
+        let singular = TriadCalibration {
+            matrix: [[1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
+            bias: [0.0; 3],
+            rate_limit_dps: 1.0,
+        };
         assert_eq!(TriadApplier::new(&singular), Err(ApplyError::SingularMatrix));
-        let ok = TriadCalibration { matrix: [[2.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 5.0]], bias: [1.0; 3], rate_limit_dps: 10.0 };
+        let ok = TriadCalibration {
+            matrix: [[2.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 5.0]],
+            bias: [1.0; 3],
+            rate_limit_dps: 10.0,
+        };
         let a = TriadApplier::new(&ok).unwrap();
         let r = a.rates([3.0, 5.0, 6.0]);
         assert_eq!(r.rates_dps, [1.0, 1.0, 1.0]);

@@ -404,7 +404,9 @@ pub enum SegmentError {
         previous_end_s: f64,
     },
     /// A manual segment holds no sample.
-    #[error("segment {start_s} s .. {end_s} s holds no sample of the log (which spans {log_start_s} s .. {log_end_s} s)")]
+    #[error(
+        "segment {start_s} s .. {end_s} s holds no sample of the log (which spans {log_start_s} s .. {log_end_s} s)"
+    )]
     EmptySegment {
         /// Start asked for, s.
         start_s: f64,
@@ -595,7 +597,11 @@ pub fn label_segments(
     let need_rest = options.rest == RestPolicy::Required;
     let auto = options.rest == RestPolicy::Auto;
     if (need_rest || (auto && lead > 0)) && trail == 0 {
-        return Err(SegmentError::NoFinalRest { index: last.start_index, time_s: last.start_time_s, rate_dps: last.rate_dps });
+        return Err(SegmentError::NoFinalRest {
+            index: last.start_index,
+            time_s: last.start_time_s,
+            rate_dps: last.rate_dps,
+        });
     }
     if (need_rest || (auto && trail > 0)) && lead == 0 {
         return Err(SegmentError::NoInitialRest {
@@ -605,7 +611,11 @@ pub fn label_segments(
         });
     }
     if sweep.len() < 2 {
-        return Err(SegmentError::TooFewPlateaus { found: sweep.len(), index: first.start_index, time_s: first.start_time_s });
+        return Err(SegmentError::TooFewPlateaus {
+            found: sweep.len(),
+            index: first.start_index,
+            time_s: first.start_time_s,
+        });
     }
     // Direction of each step between consecutive plateaus: true = rising.
     let mut rising = Vec::with_capacity(sweep.len() - 1);
@@ -620,7 +630,8 @@ pub fn label_segments(
         }
         rising.push(step > 0.0);
     }
-    let mut out: Vec<Segment> = steady[..lead].iter().map(|s| Segment::from_steady(s, SegmentKind::RestStart)).collect();
+    let mut out: Vec<Segment> =
+        steady[..lead].iter().map(|s| Segment::from_steady(s, SegmentKind::RestStart)).collect();
     // Stroke index of each step, counting direction changes.
     let mut stroke_no = 0u32;
     let kind_of = |stroke_no: u32, up: bool| SegmentKind::Plateau {
@@ -630,15 +641,17 @@ pub fn label_segments(
     for (k, s) in sweep.iter().enumerate() {
         if k == 0 {
             out.push(Segment::from_steady(s, kind_of(0, rising[0])));
-        } else if k == sweep.len() - 1 {
-            out.push(Segment::from_steady(s, kind_of(stroke_no, rising[k - 1])));
-        } else if rising[k] == rising[k - 1] {
+        } else if k == sweep.len() - 1 || rising[k] == rising[k - 1] {
             out.push(Segment::from_steady(s, kind_of(stroke_no, rising[k - 1])));
         } else {
             // Turning plateau: split into the arriving and the leaving stroke.
             let mid = s.start_index + s.samples() / 2;
             if mid == s.start_index {
-                return Err(SegmentError::RepeatedRate { index: s.start_index, time_s: s.start_time_s, rate_dps: s.rate_dps });
+                return Err(SegmentError::RepeatedRate {
+                    index: s.start_index,
+                    time_s: s.start_time_s,
+                    rate_dps: s.rate_dps,
+                });
             }
             let (mut a, mut b) = (*s, *s);
             a.end_index = mid;
@@ -695,7 +708,14 @@ fn assign_nominal_rates(segments: &mut [Segment], options: &SegmentOptions) -> R
     for ((run, stroke), members) in &groups {
         if members.len() < expected {
             let (index, time_s) = last_of(members);
-            return Err(SegmentError::IncompleteRun { run: *run, stroke: *stroke, found: members.len(), expected, index, time_s });
+            return Err(SegmentError::IncompleteRun {
+                run: *run,
+                stroke: *stroke,
+                found: members.len(),
+                expected,
+                index,
+                time_s,
+            });
         }
     }
     let mut runs: Vec<u32> = groups.iter().map(|g| g.0 .0).collect();
@@ -753,8 +773,14 @@ pub fn segments_from_manual(
     for m in manual {
         let a = time_s.partition_point(|&t| t < m.start_time_s);
         let b = time_s.partition_point(|&t| t <= m.end_time_s);
-        if !(m.start_time_s <= m.end_time_s) || b <= a {
-            return Err(SegmentError::EmptySegment { start_s: m.start_time_s, end_s: m.end_time_s, log_start_s, log_end_s });
+        let ordered = m.start_time_s <= m.end_time_s;
+        if !ordered || b <= a {
+            return Err(SegmentError::EmptySegment {
+                start_s: m.start_time_s,
+                end_s: m.end_time_s,
+                log_start_s,
+                log_end_s,
+            });
         }
         if let Some(prev) = out.last() {
             if a < prev.end_index {
@@ -828,9 +854,12 @@ pub fn rate_observations(
                     stroke,
                     output: sum / values.len() as f64,
                 }),
-                PlateauReduction::EverySample => obs.extend(
-                    values.iter().map(|&output| RateObservation { rate_dps: s.nominal_rate_dps, run, stroke, output }),
-                ),
+                PlateauReduction::EverySample => obs.extend(values.iter().map(|&output| RateObservation {
+                    rate_dps: s.nominal_rate_dps,
+                    run,
+                    stroke,
+                    output,
+                })),
             },
         }
     }
@@ -935,10 +964,14 @@ mod tests {
         assert!((rest.end - f0_true).abs() < 5.0 * sigma / 600f64.sqrt());
         // Every-sample reduction: the grid averages the same samples.
         let (all, _) = rate_observations(&seg, &sim.time, &out, PlateauReduction::EverySample, o.rest).unwrap();
-        let e2 = evaluate(&RateTable::from_observations(&all, Some(rest)).unwrap(), &RateTestOptions::default()).unwrap();
+        let e2 =
+            evaluate(&RateTable::from_observations(&all, Some(rest)).unwrap(), &RateTestOptions::default()).unwrap();
         assert!((e2.scale_factor() - e.scale_factor()).abs() < 1e-12);
         // Unused rest policy drops the rest record.
-        assert!(rate_observations(&seg, &sim.time, &out, PlateauReduction::Mean, RestPolicy::Unused).unwrap().1.is_none());
+        assert!(rate_observations(&seg, &sim.time, &out, PlateauReduction::Mean, RestPolicy::Unused)
+            .unwrap()
+            .1
+            .is_none());
     }
 
     #[test]
@@ -1073,18 +1106,19 @@ mod tests {
             find_steady_segments(&t, &r, &SegmentOptions::default()),
             Err(SegmentError::NonFinite { index: 7, .. })
         ));
-        assert!(matches!(find_steady_segments(&t, &r[1..], &SegmentOptions::default()), Err(SegmentError::LengthMismatch { .. })));
+        assert!(matches!(
+            find_steady_segments(&t, &r[1..], &SegmentOptions::default()),
+            Err(SegmentError::LengthMismatch { .. })
+        ));
         let bad = SegmentOptions { min_duration_s: -1.0, ..Default::default() };
         assert!(matches!(find_steady_segments(&t, &r, &bad), Err(SegmentError::InvalidOption(_))));
     }
 
     #[test]
     fn kind_labels_round_trip() {
-        for k in [
-            SegmentKind::RestStart,
-            SegmentKind::RestEnd,
-            SegmentKind::Plateau { run: 2, stroke: Stroke::Reverse },
-        ] {
+        for k in
+            [SegmentKind::RestStart, SegmentKind::RestEnd, SegmentKind::Plateau { run: 2, stroke: Stroke::Reverse }]
+        {
             let (run, stroke) = match k {
                 SegmentKind::Plateau { run, stroke } => (Some(run), Some(stroke)),
                 _ => (None, None),

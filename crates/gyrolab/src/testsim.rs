@@ -130,7 +130,8 @@ pub fn generate(seq: &[(f64, Vec<SegmentKind>)], p: &Profile, seed: u64) -> SimL
         prev = Some(*rate);
     }
     let n = (t / p.dt).floor() as usize;
-    let (mut time, mut true_rate, mut logged_rate) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+    let (mut time, mut true_rate, mut logged_rate) =
+        (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
     let mut h = 0;
     for i in 0..n {
         let ti = i as f64 * p.dt;

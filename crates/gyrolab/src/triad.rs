@@ -227,7 +227,8 @@ impl TriadCalibration {
     /// S^-1 ((deg/s) per output unit), or `None` when S is singular (condition number above
     /// [`MAX_MATRIX_CONDITION`] or not finite).
     pub fn inverse_matrix(&self) -> Option<[[f64; 3]; 3]> {
-        if !(matrix_condition(&self.matrix) <= MAX_MATRIX_CONDITION) {
+        let acceptable = matrix_condition(&self.matrix) <= MAX_MATRIX_CONDITION; // false for NaN
+        if !acceptable {
             return None;
         }
         let m = to_matrix3(&self.matrix);
@@ -346,7 +347,8 @@ pub fn fit_triad(plateaus: &[TriadPlateau], options: &TriadOptions) -> Result<Tr
     let scaled = DMatrix::from_fn(n, 4, |r, c| design[(r, c)] / norms[c]);
     let sv = scaled.clone().singular_values();
     let design_condition = if sv.min() > 0.0 { sv.max() / sv.min() } else { f64::INFINITY };
-    if !(design_condition <= options.max_condition) {
+    let acceptable = design_condition <= options.max_condition; // false for NaN
+    if !acceptable {
         return Err(TriadError::IllConditioned { condition: design_condition, limit: options.max_condition });
     }
     let rhs = DMatrix::from_fn(n, 3, |r, c| plateaus[r].output[c]);
@@ -537,8 +539,8 @@ mod tests {
             let got = apply.rates(q.output);
             assert_eq!(got.status, RangeStatus::Inside);
             let w = q.rate_vector();
-            for i in 0..3 {
-                assert!((got.rates_dps[i] - w[i]).abs() < tol, "{q:?}: {:?}", got.rates_dps);
+            for (g, t) in got.rates_dps.iter().zip(w) {
+                assert!((g - t).abs() < tol, "{q:?}: {:?}", got.rates_dps);
             }
         }
         // Sample by sample over one plateau of the y log (the +300 deg/s hold).
@@ -547,7 +549,9 @@ mod tests {
         let top = steady.iter().max_by(|a, b| a.rate_dps.total_cmp(&b.rate_dps)).unwrap();
         let r = top.start_index..top.end_index;
         let mut out = Vec::new();
-        apply.apply_block(&log.outputs[0][r.clone()], &log.outputs[1][r.clone()], &log.outputs[2][r], &mut out).unwrap();
+        apply
+            .apply_block(&log.outputs[0][r.clone()], &log.outputs[1][r.clone()], &log.outputs[2][r], &mut out)
+            .unwrap();
         let n = out.len() as f64;
         let mean_y = out.iter().map(|a| a.rates_dps[1]).sum::<f64>() / n;
         let std_y = (out.iter().map(|a| (a.rates_dps[1] - mean_y).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
@@ -575,7 +579,8 @@ mod tests {
 
     #[test]
     fn an_undetermined_set_is_ill_conditioned() {
-        let plateau = |axis, rate_dps| TriadPlateau { axis, rate_dps, output: [1.0, 2.0, 3.0], samples: 1, start_time_s: 0.0 };
+        let plateau =
+            |axis, rate_dps| TriadPlateau { axis, rate_dps, output: [1.0, 2.0, 3.0], samples: 1, start_time_s: 0.0 };
         let o = TriadOptions { require_both_senses: false, ..Default::default() };
         // One rate per axis and no rest: bias and scale factors cannot be told apart.
         let p = [
