@@ -901,22 +901,23 @@ mod tests {
 
     /// Segmentation against the simulation's truth. Bounds: the overshoot (0.5 deg/s, tau 0.1 s)
     /// falls under the tolerance (>= 0.05 deg/s) within tau ln(0.5/0.02) = 0.32 s, so the steady
-    /// stretch starts between the ramp's end and 0.5 s later, and the kept part `settling` after
-    /// that; the ramp out moves 0.5 deg/s per sample (10 tolerances), so a plateau ends within a
-    /// sample or two of the ramp's start. A turning plateau splits at the middle of its kept part.
-    #[test]
-    fn segmentation_matches_the_simulated_truth() {
-        let p = Profile::default();
-        let sim = three_runs();
+    /// stretch starts between the ramp's end (less tolerance / acceleration, the part of the ramp
+    /// already within tolerance) and 0.5 s later, and the kept part `settling` after that; a
+    /// plateau ends within that ramp margin and a sample or two of the ramp out's start. A
+    /// turning plateau splits at the middle of its kept part.
+    fn check_segmentation(p: &Profile, seed: u64) {
+        let sim = generate(&sweep(&RATES, 3, true, true), p, seed);
         let o = SegmentOptions::default();
         let seg = segment_log(&sim.time, &sim.logged_rate, &o).unwrap();
         let expected: usize = sim.holds.iter().map(|h| h.labels.len()).sum();
         assert_eq!(seg.len(), expected);
-        let (dt, late) = (p.dt, 0.5);
+        let dt = p.dt;
+        let late = 0.5;
         let mut k = 0;
         for h in &sim.holds {
-            let (s_lo, s_hi) = (h.t_start + o.settling_s - dt, h.t_start + o.settling_s + late);
-            let (e_lo, e_hi) = (h.t_end - 2.0 * dt, h.t_end + dt);
+            let ramp = o.tolerance_at(h.rate) / p.accel_dps2;
+            let (s_lo, s_hi) = (h.t_start + o.settling_s - ramp - dt, h.t_start + o.settling_s + late);
+            let (e_lo, e_hi) = (h.t_end - 2.0 * dt, h.t_end + ramp + dt);
             let (m_lo, m_hi) = ((s_lo + e_lo) / 2.0 - 2.0 * dt, (s_hi + e_hi) / 2.0 + 2.0 * dt);
             for (j, label) in h.labels.iter().enumerate() {
                 let s = &seg[k];
@@ -932,6 +933,18 @@ mod tests {
                 k += 1;
             }
         }
+    }
+
+    #[test]
+    fn segmentation_matches_the_simulated_truth() {
+        check_segmentation(&Profile::default(), 7);
+    }
+
+    /// 1 kHz (the top of the range): the ramp moves one tolerance per sample, and the log
+    /// has about 600 000 samples (the single pass must stay fast even unoptimised).
+    #[test]
+    fn segmentation_matches_the_simulated_truth_at_1_khz() {
+        check_segmentation(&Profile { dt: 0.001, ..Profile::default() }, 8);
     }
 
     /// K and F0 through `rate_test::evaluate` within 5 standard errors computed from the noise.
