@@ -701,7 +701,6 @@ fn assign_nominal_rates(segments: &mut [Segment], options: &SegmentOptions) -> R
     }
     let expected = groups.iter().map(|g| g.1.len()).max().unwrap_or(0);
     let last_of = |members: &[usize]| {
-        // ok: groups are never empty
         let s = members.iter().map(|&i| &segments[i]).max_by_key(|s| s.end_index).copied();
         s.map_or((0, f64::NAN), |s| (s.end_index.saturating_sub(1), s.end_time_s))
     };
