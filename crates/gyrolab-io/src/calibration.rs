@@ -2,9 +2,11 @@
 //! outputs into rates (`bias --cal`, `allan --cal`, `apply`).
 //!
 //! Model per axis: output = sum_k c_k * rate_dps^k (polynomial, ascending powers), with the
-//! straight line output = K * rate_dps + F0 always present.
+//! straight line output = K * rate_dps + F0 always present. An optional `[triad]` table holds a
+//! three-axis calibration: outputs u = S * omega + b (S 3x3, rows = gyros, columns = axes).
 
 use crate::DataError;
+use gyrolab::triad::TriadCalibration;
 use gyrolab::units::OutputUnit;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -22,9 +24,54 @@ pub struct CalibrationFile {
     pub generator: String,
     /// Time of evaluation (RFC 3339, UTC).
     pub created: String,
-    /// One entry per axis.
-    #[serde(rename = "axis")]
+    /// One entry per axis (may be empty when the file holds a `[triad]` only).
+    #[serde(rename = "axis", default, skip_serializing_if = "Vec::is_empty")]
     pub axes: Vec<AxisCalibration>,
+    /// Three-axis calibration, when the file holds one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub triad: Option<TriadSection>,
+}
+
+/// The `[triad]` table: a three-axis calibration u = S * omega + b.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TriadSection {
+    /// Names of the three gyros / axes, in the order of the matrix rows and columns.
+    pub axes: [String; 3],
+    /// The records it was computed from.
+    pub source_files: Vec<String>,
+    /// Unit of the gyro outputs.
+    pub output_unit: OutputUnit,
+    /// S, row i = gyro i, column j = axis j, output units per deg/s.
+    pub matrix: [[f64; 3]; 3],
+    /// Bias vector b, output units.
+    pub bias: [f64; 3],
+    /// Largest |table rate| calibrated, deg/s: the model is valid inside it.
+    pub rate_limit_dps: f64,
+}
+
+impl TriadSection {
+    /// The core calibration (S, b, rate limit).
+    pub fn calibration(&self) -> TriadCalibration {
+        TriadCalibration { matrix: self.matrix, bias: self.bias, rate_limit_dps: self.rate_limit_dps }
+    }
+
+    /// A section from a core calibration and its description.
+    pub fn from_calibration(
+        cal: &TriadCalibration,
+        axes: [String; 3],
+        source_files: Vec<String>,
+        output_unit: OutputUnit,
+    ) -> TriadSection {
+        TriadSection {
+            axes,
+            source_files,
+            output_unit,
+            matrix: cal.matrix,
+            bias: cal.bias,
+            rate_limit_dps: cal.rate_limit_dps,
+        }
+    }
 }
 
 /// The calibration of one axis.
@@ -70,6 +117,7 @@ impl CalibrationFile {
                 format!("no axis '{n}' in the calibration: it has {}", names.join(", "))
             }),
             None if self.axes.len() == 1 => Ok(&self.axes[0]),
+            None if self.axes.is_empty() => Err("the calibration has no single-axis [[axis]] entry".to_string()),
             None => {
                 let names: Vec<&str> = self.axes.iter().map(|a| a.name.as_str()).collect();
                 Err(format!("the calibration has several axes ({}): choose one with --axis", names.join(", ")))
@@ -82,7 +130,8 @@ impl CalibrationFile {
         let body = toml::to_string_pretty(self)?;
         Ok(format!(
             "# gyrolab calibration. Model per axis: output = sum_k coefficients[k] * rate_dps^k;\n\
-             # scale_factor is in output units per deg/s, offsets in output units.\n{body}"
+             # scale_factor is in output units per deg/s, offsets in output units.\n\
+             # [triad]: outputs u = matrix * omega + bias (rows = gyros, columns = axes, omega in deg/s).\n{body}"
         ))
     }
 }
@@ -125,8 +174,17 @@ pub fn parse_calibration(path: &Path, text: &str) -> Result<CalibrationFile, Dat
             ));
         }
     }
-    if cal.axes.is_empty() {
-        return Err(DataError::new(path, "the calibration has no [[axis]] entry"));
+    if let Some(t) = &cal.triad {
+        let finite = t.matrix.iter().flatten().chain(&t.bias).all(|v| v.is_finite());
+        if !finite || t.calibration().inverse_matrix().is_none() {
+            return Err(DataError::new(path, "[triad]: matrix and bias must be finite numbers and matrix invertible"));
+        }
+        if !(t.rate_limit_dps.is_finite() && t.rate_limit_dps > 0.0) {
+            return Err(DataError::new(path, "[triad]: rate_limit_dps must be a positive number"));
+        }
+    }
+    if cal.axes.is_empty() && cal.triad.is_none() {
+        return Err(DataError::new(path, "the calibration has no [[axis]] entry and no [triad] table"));
     }
     Ok(cal)
 }
@@ -159,7 +217,53 @@ mod tests {
                 rate_max_dps: 300.0,
                 polynomial: PolynomialModel { order: 1, coefficients: vec![2.5, 0.0075] },
             }],
+            triad: None,
         }
+    }
+
+    fn triad() -> TriadSection {
+        TriadSection {
+            axes: ["x".into(), "y".into(), "z".into()],
+            source_files: vec!["x.csv".into(), "y.csv".into(), "z.csv".into()],
+            output_unit: OutputUnit::Volt,
+            matrix: [[0.0075, 2.25e-5, -1.5e-5], [3.04e-5, 0.0076, 1.9e-5], [-3.7e-5, 2.59e-5, 0.0074]],
+            bias: [2.5, 2.51, 2.49],
+            rate_limit_dps: 300.0,
+        }
+    }
+
+    #[test]
+    fn triad_round_trip_and_old_files_still_read() {
+        let mut c = sample();
+        // A file without [triad] (as written before it existed) reads with triad = None.
+        let old = c.to_toml().unwrap();
+        assert!(!old.contains("\n[triad]"), "{old}");
+        assert_eq!(parse_calibration(Path::new("c.toml"), &old).unwrap().triad, None);
+        c.triad = Some(triad());
+        let text = c.to_toml().unwrap();
+        assert!(text.contains("\n[triad]"), "{text}");
+        let back = parse_calibration(Path::new("c.toml"), &text).unwrap();
+        assert_eq!(back, c);
+        assert_eq!(back.triad.unwrap().calibration().matrix[1][0], 3.04e-5);
+        // Triad only.
+        c.axes.clear();
+        let text = c.to_toml().unwrap();
+        assert!(!text.contains("\n[[axis]]"), "{text}");
+        let back = parse_calibration(Path::new("c.toml"), &text).unwrap();
+        assert_eq!(back, c);
+        assert!(back.axis(None).is_err());
+        // Unknown keys are still refused, inside [triad] too.
+        let bad = text.replace("rate_limit_dps", "rate_limt_dps");
+        let e = parse_calibration(Path::new("c.toml"), &bad).unwrap_err();
+        assert!(e.to_string().contains("rate_limt_dps"), "{e}");
+        // A singular matrix is refused.
+        let mut t = triad();
+        t.matrix[2] = t.matrix[0];
+        c.triad = Some(t);
+        assert!(parse_calibration(Path::new("c.toml"), &c.to_toml().unwrap()).is_err());
+        // Neither [[axis]] nor [triad].
+        c.triad = None;
+        assert!(parse_calibration(Path::new("c.toml"), &c.to_toml().unwrap()).is_err());
     }
 
     #[test]

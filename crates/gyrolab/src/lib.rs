@@ -7,13 +7,21 @@
 //! - [`rate_test`]: rate-table (scale-factor) test figures;
 //! - [`static_test`]: static (bias) test figures, accumulated block by block;
 //! - [`published`]: comparison with figures printed in a publication;
-//! - [`sim`]: gyro simulator with known truth (static records, rate-table tests).
+//! - [`sim`]: gyro simulator with known truth (static records, rate-table tests);
+//! - [`segment`]: plateaus, strokes and runs found in raw rate-table logs;
+//! - [`triad`]: three-axis scale-factor, misalignment and bias calibration (12 parameters);
+//! - [`apply`]: calibrations applied to output samples (output to rate).
 //!
 //! Formulas and their sources are listed in `docs/METHODS.md`.
 
+pub mod apply;
 pub mod fit;
 pub mod published;
 pub mod rate_test;
+pub mod segment;
 pub mod sim;
 pub mod static_test;
+#[cfg(test)]
+mod testsim;
+pub mod triad;
 pub mod units;

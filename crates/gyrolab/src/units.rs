@@ -53,6 +53,16 @@ pub fn rad_to_deg(v: f64) -> f64 {
     v * DEG_PER_RAD
 }
 
+/// Converts an angle in radians to milliradians.
+pub fn rad_to_mrad(v: f64) -> f64 {
+    v * 1e3
+}
+
+/// Converts an angle in milliradians to radians.
+pub fn mrad_to_rad(v: f64) -> f64 {
+    v * 1e-3
+}
+
 /// Converts a dimensionless ratio to percent.
 pub fn ratio_to_pct(v: f64) -> f64 {
     v * 100.0

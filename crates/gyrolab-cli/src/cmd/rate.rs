@@ -164,6 +164,7 @@ pub fn calibration_file(axes: &[EvaluatedAxis]) -> CalibrationFile {
         generator: format!("gyrolab {}", env!("CARGO_PKG_VERSION")),
         created: humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string(),
         axes: axes.iter().map(EvaluatedAxis::calibration).collect(),
+        triad: None,
     }
 }
 
