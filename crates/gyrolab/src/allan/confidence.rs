@@ -18,6 +18,10 @@ use statrs::distribution::{ChiSquared, ContinuousCDF};
 /// Fewest decimated phase points for which the lag-1 autocorrelation is trusted (Riley & Greenhall).
 pub(crate) const LAG1_MIN_POINTS: usize = 30;
 
+/// Fewest m-sample averages for the B1 fallback. Stable32's result files show B1 used with 9 and
+/// more averages and the previous tau's alpha kept with 7 or fewer; 8 is not pinned down by them.
+pub(crate) const B1_MIN_AVERAGES: usize = 8;
+
 /// Lag-1 autocorrelation r1 of a series (Riley & Greenhall eq. 2); `None` if it has no spread.
 fn lag1_acf(z: &[f64]) -> Option<f64> {
     if z.len() < 3 {
@@ -122,7 +126,7 @@ fn rn_theory(m: f64, alpha: i32) -> f64 {
 /// ratio Mod AVAR / AVAR at this m (used only when B1 points to PM noise).
 pub(crate) fn b1_noise_id(averages: &[f64], m: usize, mod_over_allan: impl FnOnce() -> Option<f64>) -> Option<i32> {
     let n = averages.len();
-    if n < 3 {
+    if n < B1_MIN_AVERAGES {
         return None;
     }
     let mean = averages.iter().sum::<f64>() / n as f64;

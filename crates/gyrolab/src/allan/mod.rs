@@ -540,7 +540,8 @@ fn identify_noise(s: &[f64], m: usize, dmax: usize) -> Option<(i32, NoiseIdMetho
     if let Some(a) = confidence::lag1_noise_id(s, m, dmax) {
         return Some((a, NoiseIdMethod::Lag1Autocorrelation));
     }
-    let averages: Vec<f64> = s.iter().step_by(m).collect::<Vec<_>>().windows(2).map(|w| (w[1] - w[0]) / m as f64).collect();
+    let averages: Vec<f64> =
+        s.iter().step_by(m).collect::<Vec<_>>().windows(2).map(|w| (w[1] - w[0]) / m as f64).collect();
     let rn = || {
         if 3 * m > s.len() - 1 {
             return None;
