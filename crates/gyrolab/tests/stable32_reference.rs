@@ -230,5 +230,10 @@ fn gps_pps_phase() {
 
 #[test]
 fn pink_frequency_oadev() {
-    run(&[("pink_frequency", "pink_frequency.txt", Data::Frequency, &[("s32_oadev_octave.txt", Oadev, Some(TauList::Octave))])]);
+    run(&[(
+        "pink_frequency",
+        "pink_frequency.txt",
+        Data::Frequency,
+        &[("s32_oadev_octave.txt", Oadev, Some(TauList::Octave))],
+    )]);
 }

@@ -177,7 +177,9 @@ fn greenhall_sw(t: f64, alpha: i32) -> f64 {
 fn greenhall_sx(t: f64, f: Option<f64>, alpha: i32) -> f64 {
     match f {
         None => greenhall_sw(t, alpha + 2),
-        Some(f) => f * f * (2.0 * greenhall_sw(t, alpha) - greenhall_sw(t - 1.0 / f, alpha) - greenhall_sw(t + 1.0 / f, alpha)),
+        Some(f) => {
+            f * f * (2.0 * greenhall_sw(t, alpha) - greenhall_sw(t - 1.0 / f, alpha) - greenhall_sw(t + 1.0 / f, alpha))
+        }
     }
 }
 
@@ -197,9 +199,8 @@ fn greenhall_sz(t: f64, f: Option<f64>, alpha: i32, d: u32) -> f64 {
 fn greenhall_basic_sum(j: f64, mm: f64, s: f64, f: Option<f64>, alpha: i32, d: u32) -> f64 {
     let first = greenhall_sz(0.0, f, alpha, d).powi(2);
     let second = (1.0 - j / mm) * greenhall_sz(j / s, f, alpha, d).powi(2);
-    let third: f64 = (1..j as usize)
-        .map(|jj| 2.0 * (1.0 - jj as f64 / mm) * greenhall_sz(jj as f64 / s, f, alpha, d).powi(2))
-        .sum();
+    let third: f64 =
+        (1..j as usize).map(|jj| 2.0 * (1.0 - jj as f64 / mm) * greenhall_sz(jj as f64 / s, f, alpha, d).powi(2)).sum();
     first + second + third
 }
 
@@ -254,7 +255,8 @@ pub(crate) fn edf_greenhall(alpha: i32, d: u32, m: usize, n_phase: usize, overla
     let r = big_m / s;
     let inv = if modified {
         if j <= j_max {
-            greenhall_basic_sum(j, big_m, s, Some(1.0), alpha, d) / (greenhall_sz(0.0, Some(1.0), alpha, d).powi(2) * big_m)
+            greenhall_basic_sum(j, big_m, s, Some(1.0), alpha, d)
+                / (greenhall_sz(0.0, Some(1.0), alpha, d).powi(2) * big_m)
         } else if r > d as f64 + 1.0 {
             let (a0, a1) = table1(alpha, d);
             (a0 - a1 / r) / r
@@ -272,7 +274,8 @@ pub(crate) fn edf_greenhall(alpha: i32, d: u32, m: usize, n_phase: usize, overla
             (a0 - a1 / r) / r
         } else {
             let m_prime = j_max / r;
-            greenhall_basic_sum(j_max, j_max, m_prime, None, alpha, d) / (greenhall_sz(0.0, None, alpha, d).powi(2) * j_max)
+            greenhall_basic_sum(j_max, j_max, m_prime, None, alpha, d)
+                / (greenhall_sz(0.0, None, alpha, d).powi(2) * j_max)
         }
     } else if alpha == 1 {
         if j <= j_max {

@@ -151,14 +151,16 @@ pub(crate) fn hadamard_sum(s: &[f64], m: usize) -> (f64, usize) {
 /// Modified Allan: sum over j of (sum_{i=j}^{j+m-1} second difference_i)^2, L - 3m + 1 terms.
 ///
 /// The inner window sum slides (add the entering, drop the leaving second difference); it is
-/// recomputed from scratch every 4096 steps so rounding cannot accumulate along long records.
+/// recomputed from scratch every max(4096, m) steps, so rounding cannot accumulate along long
+/// records while the recomputation costs at most one extra pass.
 pub(crate) fn modified_allan_sum(s: &[f64], m: usize) -> (f64, usize) {
     let n = s.len() - 3 * m + 1;
     let d2 = |i: usize| (s[i + 2 * m] - s[i + m]) - (s[i + m] - s[i]);
     let mut total = 0.0;
     let mut window = 0.0;
+    let refresh = m.max(4096);
     for j in 0..n {
-        if j % 4096 == 0 {
+        if j % refresh == 0 {
             window = (j..j + m).map(d2).sum();
         } else {
             window += d2(j + m - 1) - d2(j - 1);

@@ -168,7 +168,12 @@ pub struct AllanOptions {
 
 impl Default for AllanOptions {
     fn default() -> Self {
-        AllanOptions { kind: DeviationKind::Oadev, taus: TauList::Octave, confidence: Some(DEFAULT_CONFIDENCE), max_factor: None }
+        AllanOptions {
+            kind: DeviationKind::Oadev,
+            taus: TauList::Octave,
+            confidence: Some(DEFAULT_CONFIDENCE),
+            max_factor: None,
+        }
     }
 }
 
@@ -344,7 +349,11 @@ pub fn deviation_from_rate_slice(rate: &[f64], tau0_s: f64, options: &AllanOptio
 ///
 /// Angle in rate units x seconds (deg for a rate in deg/s); N + 1 angle points correspond to N
 /// rate samples y_i = (x_{i+1} - x_i) / tau0.
-pub fn deviation_from_angle(mut angle: Vec<f64>, tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve, AllanError> {
+pub fn deviation_from_angle(
+    mut angle: Vec<f64>,
+    tau0_s: f64,
+    options: &AllanOptions,
+) -> Result<AllanCurve, AllanError> {
     if angle.is_empty() {
         return Err(AllanError::TooShort { n: 0, kind: options.kind.name() });
     }
@@ -358,7 +367,11 @@ pub fn deviation_from_angle(mut angle: Vec<f64>, tau0_s: f64, options: &AllanOpt
 }
 
 /// Computes a deviation curve from borrowed angle (phase) samples (copies them once).
-pub fn deviation_from_angle_slice(angle: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve, AllanError> {
+pub fn deviation_from_angle_slice(
+    angle: &[f64],
+    tau0_s: f64,
+    options: &AllanOptions,
+) -> Result<AllanCurve, AllanError> {
     deviation_from_angle(angle.to_vec(), tau0_s, options)
 }
 
@@ -380,7 +393,9 @@ pub fn averaging_factors(options: &AllanOptions, n_rate: usize, tau0_s: f64) -> 
     let hard = kind.hard_max_factor(n_rate);
     let stop = options.max_factor.unwrap_or_else(|| kind.stable32_max_factor(n_rate)).min(hard);
     let mut ms: Vec<usize> = match &options.taus {
-        TauList::Octave => std::iter::successors(Some(1usize), |m| m.checked_mul(2)).take_while(|&m| m <= stop).collect(),
+        TauList::Octave => {
+            std::iter::successors(Some(1usize), |m| m.checked_mul(2)).take_while(|&m| m <= stop).collect()
+        }
         TauList::Decade => {
             let mut v = Vec::new();
             let mut decade = 1usize;

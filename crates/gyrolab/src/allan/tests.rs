@@ -89,7 +89,12 @@ fn nbs14_10_point_published_values_from_frequency_and_phase() {
             // HDEV(1) and OHDEV(1) are the same estimator, yet printed 70.80608 and 70.80607; the
             // exact value is 70.8060732: HDEV is held to one unit of the last printed digit.
             let units = if kind == DeviationKind::Hdev { 1.0 } else { 0.5 };
-            assert!(agrees_within_units(printed[i], got[i], units), "{kind:?} freq: published {}, computed {}", printed[i], got[i]);
+            assert!(
+                agrees_within_units(printed[i], got[i], units),
+                "{kind:?} freq: published {}, computed {}",
+                printed[i],
+                got[i]
+            );
             // the printed phase values are rounded to 1e-5, so agreement is to about 1e-6 relative
             let ph = from_phase.points[i].deviation;
             assert!((ph - got[i]).abs() <= 2e-6 * got[i], "{kind:?} phase: {ph} vs {}", got[i]);
@@ -127,7 +132,12 @@ fn stop_limits_and_term_counts_follow_stable32() {
 fn large_offset_gives_same_deviations_as_offset_free_record() {
     let n = 1_000_000;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
-    let noise: Vec<f64> = (0..n).map(|_| { let z: f64 = StandardNormal.sample(&mut rng); 1e-4 * z }).collect();
+    let noise: Vec<f64> = (0..n)
+        .map(|_| {
+            let z: f64 = StandardNormal.sample(&mut rng);
+            1e-4 * z
+        })
+        .collect();
     let offset: Vec<f64> = noise.iter().map(|v| 2.5 + v).collect();
     for kind in [DeviationKind::Oadev, DeviationKind::Mdev, DeviationKind::Ohdev] {
         let opts = AllanOptions::new(kind).with_confidence(None);
