@@ -190,9 +190,9 @@ pub fn fit_polynomial(x: &[f64], y: &[f64], order: usize) -> Result<PolynomialFi
     for (k, &ak) in scaled_coefficients.iter().enumerate() {
         let scale = ak / half_range.powi(k as i32);
         let mut binom = 1.0;
-        for j in 0..=k {
+        for (j, coefficient) in coefficients.iter_mut().enumerate().take(k + 1) {
             // term: binom(k, j) x^j (-c)^(k-j)
-            coefficients[j] += scale * binom * (-centre).powi((k - j) as i32);
+            *coefficient += scale * binom * (-centre).powi((k - j) as i32);
             binom = binom * (k - j) as f64 / (j + 1) as f64;
         }
     }

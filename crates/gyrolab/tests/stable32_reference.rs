@@ -133,7 +133,10 @@ fn check_file(values: &[f64], data: Data, file: &Path, kind: DeviationKind, taus
     fails
 }
 
-fn run(cases: &[(&str, &str, Data, &[(&str, DeviationKind, Option<TauList>)])]) {
+/// One result file: name, deviation kind, tau list to generate (`None`: the file's own m values).
+type ResultFile<'a> = (&'a str, DeviationKind, Option<TauList>);
+
+fn run(cases: &[(&str, &str, Data, &[ResultFile])]) {
     let Some(dir) = reference_dir() else { return };
     let mut fails = Vec::new();
     let mut checked = 0;
