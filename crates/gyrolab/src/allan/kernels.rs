@@ -202,3 +202,36 @@ pub(crate) fn reflect_for_total(s: &[f64]) -> Vec<f64> {
     }
     out
 }
+
+/// Overlapping-Allan sums for many averaging factors at once, cache-blocked over k.
+///
+/// The k range is cut into blocks of 4096; within a block every m is summed before moving on, so
+/// the three windows s[k..], s[k+m..], s[k+2m..] of consecutive m overlap and stay in cache, and
+/// the record streams from memory a few times instead of once per m. Blocks run in parallel
+/// (rayon); per-block partial sums are added per m.
+pub(crate) fn overlapping_allan_sums(s: &[f64], ms: &[usize]) -> Vec<f64> {
+    use rayon::prelude::*;
+    const BLOCK: usize = 4096;
+    let len = s.len();
+    let n_max = ms.iter().map(|&m| len.saturating_sub(2 * m)).max().unwrap_or(0);
+    let blocks = n_max.div_ceil(BLOCK);
+    let zero = || vec![0.0f64; ms.len()];
+    (0..blocks)
+        .into_par_iter()
+        .fold(zero, |mut acc, b| {
+            let k0 = b * BLOCK;
+            for (slot, &m) in acc.iter_mut().zip(ms) {
+                let n = len - 2 * m;
+                if k0 >= n {
+                    continue;
+                }
+                let k1 = (k0 + BLOCK).min(n);
+                *slot += second_difference_sq_sum(&s[k0..k1], &s[k0 + m..k1 + m], &s[k0 + 2 * m..k1 + 2 * m]);
+            }
+            acc
+        })
+        .reduce(zero, |mut a, b| {
+            a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
+            a
+        })
+}

@@ -462,10 +462,19 @@ fn compute(s: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve,
     let n_rate = s.len().saturating_sub(1);
     let ms = averaging_factors(options, n_rate, tau0_s)?;
     let extended = (kind == DeviationKind::Totdev).then(|| kernels::reflect_for_total(s));
+    // OADEV, the common case, is summed for all taus in one cache-blocked sweep
+    let oadev_sums = (kind == DeviationKind::Oadev).then(|| kernels::overlapping_allan_sums(s, &ms));
     let mut points: Vec<AllanPoint> = ms
         .par_iter()
-        .map(|&m| {
-            let (variance, terms) = variance_at(s, extended.as_deref(), kind, m);
+        .enumerate()
+        .map(|(i, &m)| {
+            let (variance, terms) = match &oadev_sums {
+                Some(sums) => {
+                    let n = s.len() - 2 * m;
+                    (sums[i] / (2.0 * (m as f64).powi(2) * n as f64), n)
+                }
+                None => variance_at(s, extended.as_deref(), kind, m),
+            };
             let mut deviation = variance.sqrt();
             if kind == DeviationKind::Tdev {
                 deviation *= m as f64 * tau0_s / 3f64.sqrt();
