@@ -3,7 +3,9 @@
 //! This crate does no file, terminal or network I/O, so that it can be bound to other languages.
 //! One module per concern:
 //! - [`units`]: units of rates, outputs and noise coefficients, and every conversion;
+//! - [`allan`]: the Allan-variance family with noise identification and confidence intervals;
 //! - [`fit`]: least-squares lines and polynomials;
+//! - [`noise`]: IEEE 952 noise terms (ARW, bias instability, RRW, ...) from an Allan curve;
 //! - [`rate_test`]: rate-table (scale-factor) test figures;
 //! - [`static_test`]: static (bias) test figures, accumulated block by block;
 //! - [`published`]: comparison with figures printed in a publication;
@@ -14,8 +16,10 @@
 //!
 //! Formulas and their sources are listed in `docs/METHODS.md`.
 
+pub mod allan;
 pub mod apply;
 pub mod fit;
+pub mod noise;
 pub mod published;
 pub mod rate_test;
 pub mod segment;

@@ -43,6 +43,26 @@ pub fn rrw_dph_rt_h_to_dps_rt_s(v: f64) -> f64 {
     v / (SECONDS_PER_HOUR * SECONDS_PER_HOUR.sqrt())
 }
 
+/// Converts a bias instability (or any rate) from deg/s to deg/h; alias of [`dps_to_dph`] for noise terms.
+pub fn bias_dps_to_dph(v: f64) -> f64 {
+    dps_to_dph(v)
+}
+
+/// Converts a rate ramp from deg/s per s (deg/s^2) to deg/h per h (factor 3600^2).
+pub fn rate_ramp_dps_per_s_to_dph_per_h(v: f64) -> f64 {
+    v * SECONDS_PER_HOUR * SECONDS_PER_HOUR
+}
+
+/// Converts an angle random walk in deg/sqrt(s) to a Kalibr noise density in rad/s/sqrt(Hz).
+pub fn arw_deg_rt_s_to_rad_s_rt_hz(v: f64) -> f64 {
+    deg_to_rad(v)
+}
+
+/// Converts a rate random walk in deg/s/sqrt(s) to a Kalibr random walk in rad/s^2/sqrt(Hz).
+pub fn rrw_dps_rt_s_to_rad_s2_rt_hz(v: f64) -> f64 {
+    deg_to_rad(v)
+}
+
 /// Converts degrees (or deg/s, deg/s/sqrt(Hz), ...) to radians (rad/s, ...).
 pub fn deg_to_rad(v: f64) -> f64 {
     v / DEG_PER_RAD

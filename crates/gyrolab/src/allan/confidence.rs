@@ -1,0 +1,357 @@
+//! Noise identification, equivalent degrees of freedom and chi-squared confidence intervals.
+//!
+//! Sources:
+//! - W. J. Riley, C. A. Greenhall, "Power law noise identification using the lag 1
+//!   autocorrelation", EFTF 2004 (lag-1 ACF of the decimated, detrended phase; differencing
+//!   until delta = r1/(1+r1) < 0.25; alpha = -round(2 delta) - 2d + 2 for phase data).
+//! - NIST SP 1065 section 5.6 (B1 ratio of Barnes, R(n) = Mod AVAR / AVAR) for the largest
+//!   averaging factors where fewer than 30 decimated points are left (Stable32's fallback).
+//! - C. A. Greenhall, W. J. Riley, "Uncertainty of stability variances based on finite
+//!   differences", 35th PTTI, 2003/2004: EDF algorithm (eq. 7-10 and tables 1-3), the same one
+//!   allantools' `edf_greenhall` implements. Case 4 (white PM, unmodified) is evaluated here by
+//!   its exact finite sum, which equals the paper's a0 - a1/r when ceil(r) > d.
+//! - NIST SP 1065 section 5.2.11 table 11 (recalled as `b T/tau - c`) for TOTDEV's EDF.
+//! - NIST SP 1065 eq. (45): chi-squared bounds var*edf/chi2(p, edf).
+
+use statrs::distribution::{ChiSquared, ContinuousCDF};
+
+/// Fewest decimated phase points for which the lag-1 autocorrelation is trusted (Riley & Greenhall).
+pub(crate) const LAG1_MIN_POINTS: usize = 30;
+
+/// Fewest m-sample averages for the B1 fallback. Stable32's result files show B1 used with 9 and
+/// more averages and the previous tau's alpha kept with 7 or fewer; 8 is not pinned down by them.
+pub(crate) const B1_MIN_AVERAGES: usize = 8;
+
+/// Lag-1 autocorrelation r1 of a series (Riley & Greenhall eq. 2); `None` if it has no spread.
+fn lag1_acf(z: &[f64]) -> Option<f64> {
+    if z.len() < 3 {
+        return None;
+    }
+    let mean = z.iter().sum::<f64>() / z.len() as f64;
+    let den: f64 = z.iter().map(|v| (v - mean) * (v - mean)).sum();
+    if den <= 0.0 || !den.is_finite() {
+        return None;
+    }
+    let num: f64 = z.windows(2).map(|w| (w[0] - mean) * (w[1] - mean)).sum();
+    Some(num / den)
+}
+
+/// Removes the least-squares polynomial of degree <= 2 from equally spaced values, in place,
+/// by projection on discrete orthogonal (Gram) polynomials: no matrix, exact to rounding.
+fn detrend_quadratic(z: &mut [f64]) {
+    let n = z.len();
+    if n < 3 {
+        return;
+    }
+    let c = (n as f64 - 1.0) / 2.0;
+    let q = (n as f64 * n as f64 - 1.0) / 12.0;
+    let p1 = |t: usize| t as f64 - c;
+    let p2 = |t: usize| (t as f64 - c).powi(2) - q;
+    let (mut s0, mut s1, mut s2, mut n1, mut n2) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for (t, &v) in z.iter().enumerate() {
+        s0 += v;
+        s1 += v * p1(t);
+        s2 += v * p2(t);
+        n1 += p1(t) * p1(t);
+        n2 += p2(t) * p2(t);
+    }
+    let (a0, a1, a2) = (s0 / n as f64, s1 / n1, if n2 > 0.0 { s2 / n2 } else { 0.0 });
+    for (t, v) in z.iter_mut().enumerate() {
+        *v -= a0 + a1 * p1(t) + a2 * p2(t);
+    }
+}
+
+/// Lag-1 autocorrelation noise identification on phase `s` (sample units) at averaging factor m.
+///
+/// Returns the integer power-law exponent alpha of the rate (frequency) PSD, or `None` when fewer
+/// than [`LAG1_MIN_POINTS`] decimated points remain or the series is constant.
+pub(crate) fn lag1_noise_id(s: &[f64], m: usize, dmax: usize) -> Option<i32> {
+    let mut z: Vec<f64> = s.iter().step_by(m).copied().collect();
+    if z.len() < LAG1_MIN_POINTS {
+        return None;
+    }
+    detrend_quadratic(&mut z);
+    let mut d = 0usize;
+    loop {
+        let r1 = lag1_acf(&z)?;
+        let delta = r1 / (1.0 + r1);
+        if delta < 0.25 || d >= dmax {
+            let alpha = -(2.0 * delta).round() as i32 - 2 * d as i32 + 2;
+            return Some(alpha);
+        }
+        for i in 0..z.len() - 1 {
+            z[i] = z[i + 1] - z[i];
+        }
+        z.pop();
+        d += 1;
+    }
+}
+
+/// Allan-variance tau exponent mu for a power-law alpha (SP1065 table 4): mu = -alpha - 1, capped at -2.
+fn mu_of_alpha(alpha: i32) -> i32 {
+    (-alpha - 1).max(-2)
+}
+
+/// Barnes' B1 bias function for n averages and exponent mu (SP1065 eq. 62, limits for mu = -2..2).
+fn b1_theory(n: f64, mu: i32) -> f64 {
+    match mu {
+        2 => n * (n + 1.0) / 6.0,
+        1 => n / 2.0,
+        0 => n * n.ln() / (2.0 * (n - 1.0) * std::f64::consts::LN_2),
+        -1 => 1.0,
+        -2 => (n * n - 1.0) / (1.5 * n * (n - 1.0)),
+        _ => {
+            let mu = mu as f64;
+            n * (1.0 - n.powf(mu)) / (2.0 * (n - 1.0) * (1.0 - 2f64.powf(mu)))
+        }
+    }
+}
+
+/// R(n) = Mod AVAR / AVAR expected for white PM (alpha = 2) and flicker PM (alpha = 1), SP1065 5.6.
+/// The flicker value assumes the measurement bandwidth f_h = 1/(2 tau0) (recalled, as allantools).
+fn rn_theory(m: f64, alpha: i32) -> f64 {
+    if alpha == 2 {
+        1.0 / m
+    } else {
+        let pi2 = std::f64::consts::PI * std::f64::consts::PI;
+        let avar = (1.038 + 3.0 * (std::f64::consts::PI * m).ln()) / (4.0 * pi2);
+        let mvar = 3.0 * (256.0f64 / 27.0).ln() / (8.0 * pi2);
+        mvar / avar
+    }
+}
+
+/// B1-ratio noise identification (with R(n) to split white from flicker PM), SP1065 section 5.6.
+///
+/// `averages` are the non-overlapping m-sample means of the rate; `mod_over_allan` the measured
+/// ratio Mod AVAR / AVAR at this m (used only when B1 points to PM noise).
+pub(crate) fn b1_noise_id(averages: &[f64], m: usize, mod_over_allan: impl FnOnce() -> Option<f64>) -> Option<i32> {
+    let n = averages.len();
+    if n < B1_MIN_AVERAGES {
+        return None;
+    }
+    let mean = averages.iter().sum::<f64>() / n as f64;
+    let var = averages.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n as f64 - 1.0);
+    let avar = averages.windows(2).map(|w| (w[1] - w[0]) * (w[1] - w[0])).sum::<f64>() / (2.0 * (n as f64 - 1.0));
+    if avar <= 0.0 || !avar.is_finite() {
+        return None;
+    }
+    let b1 = var / avar;
+    let nf = n as f64;
+    // candidate alphas from random-walk FM up to PM; boundaries are geometric means
+    let mut alpha = -2;
+    for candidate in [-1, 0, 1] {
+        let lo = b1_theory(nf, mu_of_alpha(candidate - 1));
+        let hi = b1_theory(nf, mu_of_alpha(candidate));
+        let boundary = (lo * hi).sqrt();
+        if b1 < boundary {
+            alpha = candidate;
+        } else {
+            break;
+        }
+    }
+    if alpha == 1 {
+        if let Some(rn) = mod_over_allan() {
+            let boundary = (rn_theory(m as f64, 2) * rn_theory(m as f64, 1)).sqrt();
+            if rn < boundary {
+                alpha = 2;
+            }
+        }
+    }
+    Some(alpha)
+}
+
+fn greenhall_sw(t: f64, alpha: i32) -> f64 {
+    let ln_term = |p: i32| if t == 0.0 { 0.0 } else { t.powi(p) * t.abs().ln() };
+    match alpha {
+        2 => -t.abs(),
+        1 => ln_term(2),
+        0 => t.abs().powi(3),
+        -1 => ln_term(4),
+        -2 => t.abs().powi(5),
+        -3 => ln_term(6),
+        _ => t.abs().powi(7),
+    }
+}
+
+/// Greenhall's s_x(t); `f == None` stands for F = infinity.
+fn greenhall_sx(t: f64, f: Option<f64>, alpha: i32) -> f64 {
+    match f {
+        None => greenhall_sw(t, alpha + 2),
+        Some(f) => {
+            f * f * (2.0 * greenhall_sw(t, alpha) - greenhall_sw(t - 1.0 / f, alpha) - greenhall_sw(t + 1.0 / f, alpha))
+        }
+    }
+}
+
+fn greenhall_sz(t: f64, f: Option<f64>, alpha: i32, d: u32) -> f64 {
+    let sx = |u: f64| greenhall_sx(u, f, alpha);
+    match d {
+        1 => 2.0 * sx(t) - sx(t - 1.0) - sx(t + 1.0),
+        2 => 6.0 * sx(t) - 4.0 * (sx(t - 1.0) + sx(t + 1.0)) + sx(t - 2.0) + sx(t + 2.0),
+        _ => {
+            20.0 * sx(t) - 15.0 * (sx(t - 1.0) + sx(t + 1.0)) + 6.0 * (sx(t - 2.0) + sx(t + 2.0))
+                - sx(t - 3.0)
+                - sx(t + 3.0)
+        }
+    }
+}
+
+fn greenhall_basic_sum(j: f64, mm: f64, s: f64, f: Option<f64>, alpha: i32, d: u32) -> f64 {
+    let first = greenhall_sz(0.0, f, alpha, d).powi(2);
+    let second = (1.0 - j / mm) * greenhall_sz(j / s, f, alpha, d).powi(2);
+    let third: f64 =
+        (1..j as usize).map(|jj| 2.0 * (1.0 - jj as f64 / mm) * greenhall_sz(jj as f64 / s, f, alpha, d).powi(2)).sum();
+    first + second + third
+}
+
+fn table1(alpha: i32, d: u32) -> (f64, f64) {
+    let t: [[(f64, f64); 3]; 7] = [
+        [(2.0 / 3.0, 1.0 / 3.0), (7.0 / 9.0, 0.5), (22.0 / 25.0, 2.0 / 3.0)],
+        [(0.840, 0.345), (0.997, 0.616), (1.141, 0.843)],
+        [(1.079, 0.368), (1.033, 0.607), (1.184, 0.848)],
+        [(f64::NAN, f64::NAN), (1.048, 0.534), (1.180, 0.816)],
+        [(f64::NAN, f64::NAN), (1.302, 0.535), (1.175, 0.777)],
+        [(f64::NAN, f64::NAN), (f64::NAN, f64::NAN), (1.194, 0.703)],
+        [(f64::NAN, f64::NAN), (f64::NAN, f64::NAN), (1.489, 0.702)],
+    ];
+    t[(2 - alpha) as usize][(d - 1) as usize]
+}
+
+fn table2(alpha: i32, d: u32) -> (f64, f64) {
+    let t: [[(f64, f64); 3]; 7] = [
+        [(1.5, 0.5), (35.0 / 18.0, 1.0), (231.0 / 100.0, 1.5)],
+        [(78.6, 25.2), (790.0, 410.0), (9950.0, 6520.0)],
+        [(2.0 / 3.0, 1.0 / 6.0), (2.0 / 3.0, 1.0 / 3.0), (7.0 / 9.0, 0.5)],
+        [(f64::NAN, f64::NAN), (0.852, 0.375), (0.997, 0.617)],
+        [(f64::NAN, f64::NAN), (1.079, 0.368), (1.033, 0.607)],
+        [(f64::NAN, f64::NAN), (f64::NAN, f64::NAN), (1.053, 0.553)],
+        [(f64::NAN, f64::NAN), (f64::NAN, f64::NAN), (1.302, 0.535)],
+    ];
+    t[(2 - alpha) as usize][(d - 1) as usize]
+}
+
+fn table3(d: u32) -> (f64, f64) {
+    [(6.0, 4.0), (15.23, 12.0), (47.8, 40.0)][(d - 1) as usize]
+}
+
+fn binomial(n: u32, k: u32) -> f64 {
+    (0..k).fold(1.0, |acc, i| acc * (n - i) as f64 / (i + 1) as f64)
+}
+
+/// Equivalent degrees of freedom by Greenhall & Riley's algorithm.
+///
+/// `alpha` noise exponent (clamped to the valid range alpha + 2d > 1, alpha <= 2), `d` the
+/// difference order (2 Allan, 3 Hadamard), `m` averaging factor, `n_phase` number of phase
+/// points, `overlapping` and `modified` select the estimator.
+pub(crate) fn edf_greenhall(alpha: i32, d: u32, m: usize, n_phase: usize, overlapping: bool, modified: bool) -> f64 {
+    let alpha = alpha.clamp(2 - 2 * d as i32, 2);
+    let mf = m as f64;
+    let f = if modified { 1.0 } else { mf };
+    let s = if overlapping { mf } else { 1.0 };
+    let l = mf / f + mf * d as f64;
+    let big_m = 1.0 + (s * (n_phase as f64 - l) / mf).floor();
+    let j = big_m.min((d as f64 + 1.0) * s);
+    let j_max = 100.0;
+    let r = big_m / s;
+    let inv = if modified {
+        if j <= j_max {
+            greenhall_basic_sum(j, big_m, s, Some(1.0), alpha, d)
+                / (greenhall_sz(0.0, Some(1.0), alpha, d).powi(2) * big_m)
+        } else if r > d as f64 + 1.0 {
+            let (a0, a1) = table1(alpha, d);
+            (a0 - a1 / r) / r
+        } else {
+            let m_prime = j_max / r;
+            greenhall_basic_sum(j_max, j_max, m_prime, Some(1.0), alpha, d)
+                / (greenhall_sz(0.0, Some(1.0), alpha, d).powi(2) * j_max)
+        }
+    } else if alpha <= 0 {
+        if j <= j_max {
+            let fp = if mf * (d as f64 + 1.0) <= j_max { Some(mf) } else { None };
+            greenhall_basic_sum(j, big_m, s, fp, alpha, d) / (greenhall_sz(0.0, fp, alpha, d).powi(2) * big_m)
+        } else if r > d as f64 + 1.0 {
+            let (a0, a1) = table2(alpha, d);
+            (a0 - a1 / r) / r
+        } else {
+            let m_prime = j_max / r;
+            greenhall_basic_sum(j_max, j_max, m_prime, None, alpha, d)
+                / (greenhall_sz(0.0, None, alpha, d).powi(2) * j_max)
+        }
+    } else if alpha == 1 {
+        if j <= j_max {
+            greenhall_basic_sum(j, big_m, s, Some(mf), 1, d) / (greenhall_sz(0.0, Some(mf), 1, d).powi(2) * big_m)
+        } else if r > d as f64 + 1.0 {
+            let (a0, a1) = table2(1, d);
+            let (b0, b1) = table3(d);
+            (a0 - a1 / r) / ((b0 + b1 * mf.ln()).powi(2) * r)
+        } else {
+            let m_prime = j_max / r;
+            let (b0, b1) = table3(d);
+            greenhall_basic_sum(j_max, j_max, m_prime, Some(m_prime), 1, d) / ((b0 + b1 * mf.ln()).powi(2) * j_max)
+        }
+    } else {
+        // white PM, unmodified: only lags that are multiples of m correlate; exact finite sum
+        let k = r.ceil() as i64;
+        let norm = binomial(2 * d, d).powi(2);
+        let lmax = (k - 1).min(d as i64);
+        let mut sum = 1.0;
+        for lag in 1..=lmax {
+            sum += 2.0 * (1.0 - lag as f64 / r) * binomial(2 * d, d + lag as u32).powi(2) / norm;
+        }
+        sum / big_m
+    };
+    1.0 / inv
+}
+
+/// SP1065 simple EDF formulas (table 5, from Stein 1985) for the overlapping Allan variance.
+pub(crate) fn edf_simple(n_phase: usize, m: usize, alpha: i32) -> f64 {
+    let n = n_phase as f64;
+    let m = m as f64;
+    match alpha {
+        2 => (n + 1.0) * (n - 2.0 * m) / (2.0 * (n - m)),
+        1 => {
+            let a = (n - 1.0) / (2.0 * m);
+            let b = (2.0 * m + 1.0) * (n - 1.0) / 4.0;
+            (a.ln() * b.ln()).sqrt().exp()
+        }
+        0 => (3.0 * (n - 1.0) / (2.0 * m) - 2.0 * (n - 2.0) / n) * (4.0 * m * m / (4.0 * m * m + 5.0)),
+        -1 => {
+            if m == 1.0 {
+                2.0 * (n - 2.0) / (2.3 * n - 4.9)
+            } else {
+                5.0 * n * n / (4.0 * m * (n + 3.0 * m))
+            }
+        }
+        _ => (n - 2.0) / (m * (n - 3.0).powi(2)) * ((n - 1.0).powi(2) - 3.0 * m * (n - 1.0) + 4.0 * m * m),
+    }
+}
+
+/// EDF of the total deviation: b T/tau - c (SP1065 table 11) for alpha in {0, -1, -2};
+/// other noise types fall back to the simple overlapping-Allan formulas.
+pub(crate) fn edf_total(n_phase: usize, m: usize, alpha: i32) -> f64 {
+    let ratio = (n_phase - 1) as f64 / m as f64;
+    match alpha {
+        0 => 1.50 * ratio,
+        -1 => 1.17 * ratio - 0.22,
+        a if a <= -2 => 0.93 * ratio - 0.36,
+        _ => edf_simple(n_phase, m, alpha),
+    }
+}
+
+/// Bounds (dev_lo, dev_hi) from chi-squared quantiles at confidence c (SP1065 eq. 45).
+pub(crate) fn chi2_bounds(dev: f64, edf: f64, confidence: f64) -> Option<(f64, f64)> {
+    if !(edf.is_finite() && edf > 0.0) {
+        return None;
+    }
+    if dev == 0.0 {
+        return Some((0.0, 0.0));
+    }
+    let chi2 = ChiSquared::new(edf).ok()?;
+    let tail = (1.0 - confidence) / 2.0;
+    let hi_q = chi2.inverse_cdf(1.0 - tail);
+    let lo_q = chi2.inverse_cdf(tail);
+    let var = dev * dev;
+    let lo = (edf * var / hi_q).sqrt();
+    let hi = (edf * var / lo_q).sqrt();
+    (lo.is_finite() && hi.is_finite()).then_some((lo, hi))
+}

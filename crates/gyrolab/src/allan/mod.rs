@@ -1,0 +1,594 @@
+//! Allan-variance family of a gyro rate record: ADEV, overlapping ADEV, MDEV, TDEV, HDEV,
+//! overlapping HDEV and TOTDEV, with noise identification and confidence intervals.
+//!
+//! Sources: NIST Special Publication 1065, W. J. Riley, "Handbook of Frequency Stability
+//! Analysis" (2008), section 5.2 (definitions, eq. 9-25) and 5.3 (confidence, EDF); IEEE Std
+//! 952-1997 annex C (the Allan variance applied to gyro rate data); Riley & Greenhall (EFTF 2004)
+//! lag-1 noise identification; Greenhall & Riley (PTTI 2003) EDF algorithm. Stop limits and
+//! term counts follow Stable32 (read off its result files in `reference/stable32`).
+//!
+//! Gyro rate samples play the role of fractional frequency y ("freq" data in allantools), the
+//! integrated angle that of phase x: x_0 = 0, x_k = tau0 * sum_{i<k} (y_i - mean y). The mean is
+//! removed first with a Neumaier-compensated sum, so that a record with a large offset (a 2.5 V
+//! null with 1e-4 V noise) gives the same deviations as the offset-free record: to relative 1e-9,
+//! tested at 1e6 samples; the same error analysis holds at 1e8 samples (the compensated mean is
+//! exact to one rounding, y_i - mean is exact by Sterbenz's lemma, the cumulative sum is compensated).
+//!
+//! Memory: the owning entry points convert the caller's `Vec` to the angle series in place (it
+//! needs capacity N + 1 to avoid one reallocation); OADEV, ADEV, MDEV, TDEV, HDEV and OHDEV then
+//! allocate nothing proportional to N except the noise identification's decimated copy (N/m
+//! values, at most N for m = 1, only when confidence intervals are requested). TOTDEV builds a
+//! reflected copy of 3N values.
+
+mod confidence;
+mod kernels;
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// Default confidence level of the intervals: 68.3 % (one sigma), as Stable32.
+pub const DEFAULT_CONFIDENCE: f64 = 0.683;
+
+/// Which deviation to compute.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum DeviationKind {
+    /// Overlapping Allan deviation (SP1065 eq. 11); the default.
+    #[default]
+    Oadev,
+    /// Non-overlapping Allan deviation (SP1065 eq. 9).
+    Adev,
+    /// Modified Allan deviation (SP1065 eq. 13).
+    Mdev,
+    /// Time deviation, tau / sqrt(3) * MDEV (SP1065 eq. 15); in angle units.
+    Tdev,
+    /// Non-overlapping Hadamard deviation (SP1065 eq. 17).
+    Hdev,
+    /// Overlapping Hadamard deviation (SP1065 eq. 18).
+    Ohdev,
+    /// Total deviation (SP1065 eq. 25).
+    Totdev,
+}
+
+impl DeviationKind {
+    /// All kinds, in a fixed order.
+    pub const ALL: [DeviationKind; 7] = [
+        DeviationKind::Oadev,
+        DeviationKind::Adev,
+        DeviationKind::Mdev,
+        DeviationKind::Tdev,
+        DeviationKind::Hdev,
+        DeviationKind::Ohdev,
+        DeviationKind::Totdev,
+    ];
+
+    /// Parses a name such as "oadev", "ADEV", "totdev".
+    pub fn parse(name: &str) -> Result<DeviationKind, AllanError> {
+        let lower = name.trim().to_ascii_lowercase();
+        DeviationKind::ALL
+            .into_iter()
+            .find(|k| k.name() == lower)
+            .ok_or_else(|| AllanError::UnknownKind(name.to_string()))
+    }
+
+    /// Lower-case short name ("oadev", ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            DeviationKind::Oadev => "oadev",
+            DeviationKind::Adev => "adev",
+            DeviationKind::Mdev => "mdev",
+            DeviationKind::Tdev => "tdev",
+            DeviationKind::Hdev => "hdev",
+            DeviationKind::Ohdev => "ohdev",
+            DeviationKind::Totdev => "totdev",
+        }
+    }
+
+    /// Largest averaging factor Stable32 computes for n rate samples (its default "stop" rule:
+    /// N/4 for OADEV, MDEV, TDEV, OHDEV; N/5 for ADEV, HDEV; N/2 for TOTDEV).
+    pub fn stable32_max_factor(self, n_rate: usize) -> usize {
+        let limit = match self {
+            DeviationKind::Oadev | DeviationKind::Mdev | DeviationKind::Tdev | DeviationKind::Ohdev => n_rate / 4,
+            DeviationKind::Adev | DeviationKind::Hdev => n_rate / 5,
+            DeviationKind::Totdev => n_rate / 2,
+        };
+        limit.min(self.hard_max_factor(n_rate))
+    }
+
+    /// Largest averaging factor for which the estimator has at least one term.
+    pub fn hard_max_factor(self, n_rate: usize) -> usize {
+        match self {
+            DeviationKind::Oadev | DeviationKind::Adev => n_rate / 2,
+            DeviationKind::Mdev | DeviationKind::Tdev => (n_rate + 1) / 3,
+            DeviationKind::Ohdev | DeviationKind::Hdev => n_rate / 3,
+            DeviationKind::Totdev => n_rate.saturating_sub(1),
+        }
+    }
+
+    /// Difference order of the estimator (2 Allan family, 3 Hadamard).
+    fn difference_order(self) -> u32 {
+        match self {
+            DeviationKind::Hdev | DeviationKind::Ohdev => 3,
+            _ => 2,
+        }
+    }
+}
+
+/// Which averaging factors m (tau = m tau0) to evaluate.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+pub enum TauList {
+    /// m = 1, 2, 4, 8, ... (powers of two); the default.
+    #[default]
+    Octave,
+    /// m = 1, 2, 4, 10, 20, 40, 100, ... (1, 2, 4 x 10^k), as Stable32's "decade".
+    Decade,
+    /// n log-spaced values per decade, rounded to unique integers.
+    PerDecade(u32),
+    /// Every m from 1 to the stop limit.
+    All,
+    /// Explicit averaging factors (each >= 1; those beyond what the record allows are dropped).
+    Factors(Vec<usize>),
+    /// Explicit taus in seconds (each must be a whole multiple of tau0 within 1e-6 relative).
+    Seconds(Vec<f64>),
+}
+
+impl TauList {
+    /// Parses "octave", "decade", "all", "N/decade" or "N per decade" (e.g. "10/decade").
+    pub fn parse(text: &str) -> Result<TauList, AllanError> {
+        let t = text.trim().to_ascii_lowercase();
+        match t.as_str() {
+            "octave" => Ok(TauList::Octave),
+            "decade" => Ok(TauList::Decade),
+            "all" => Ok(TauList::All),
+            _ => {
+                let head = t.strip_suffix("/decade").or_else(|| t.strip_suffix(" per decade"));
+                match head.and_then(|h| h.trim().parse::<u32>().ok()) {
+                    Some(n) if n > 0 => Ok(TauList::PerDecade(n)),
+                    _ => Err(AllanError::UnknownTauList(text.to_string())),
+                }
+            }
+        }
+    }
+}
+
+/// Options of a deviation computation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AllanOptions {
+    /// Deviation to compute.
+    pub kind: DeviationKind,
+    /// Averaging factors to evaluate.
+    pub taus: TauList,
+    /// Confidence level of the intervals (e.g. 0.683); `None` skips noise identification and bounds.
+    pub confidence: Option<f64>,
+    /// Largest averaging factor; `None` uses Stable32's stop rule for the kind (lists other than
+    /// `Factors`/`Seconds`); explicit lists are only limited by what the record allows.
+    pub max_factor: Option<usize>,
+}
+
+impl Default for AllanOptions {
+    fn default() -> Self {
+        AllanOptions {
+            kind: DeviationKind::Oadev,
+            taus: TauList::Octave,
+            confidence: Some(DEFAULT_CONFIDENCE),
+            max_factor: None,
+        }
+    }
+}
+
+impl AllanOptions {
+    /// Options for one kind with octave taus and 68.3 % intervals.
+    pub fn new(kind: DeviationKind) -> Self {
+        AllanOptions { kind, ..AllanOptions::default() }
+    }
+
+    /// Same options with another tau list.
+    pub fn with_taus(mut self, taus: TauList) -> Self {
+        self.taus = taus;
+        self
+    }
+
+    /// Same options with another confidence level (`None`: no intervals).
+    pub fn with_confidence(mut self, confidence: Option<f64>) -> Self {
+        self.confidence = confidence;
+        self
+    }
+}
+
+/// How the noise type of a point was identified.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NoiseIdMethod {
+    /// Lag-1 autocorrelation (Riley & Greenhall), >= 30 decimated points.
+    Lag1Autocorrelation,
+    /// B1 ratio with R(n) (SP1065 5.6), used where fewer than 30 decimated points remain.
+    B1Ratio,
+    /// Taken over from the next smaller averaging factor (B1 not computable either).
+    Previous,
+}
+
+/// One point of a deviation curve.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AllanPoint {
+    /// Averaging factor m.
+    pub m: usize,
+    /// Averaging time tau = m tau0 in seconds.
+    pub tau_s: f64,
+    /// Deviation in rate units (TDEV: rate units x seconds, i.e. angle).
+    pub deviation: f64,
+    /// Number of terms in the estimator's sum (Stable32's `#` column).
+    pub terms: usize,
+    /// Identified power-law noise exponent alpha of the rate PSD (2 white PM .. -2 random-walk FM).
+    pub alpha: Option<i32>,
+    /// How alpha was identified.
+    pub noise_id: Option<NoiseIdMethod>,
+    /// Equivalent degrees of freedom used for the interval.
+    pub edf: Option<f64>,
+    /// Lower bound of the deviation's confidence interval.
+    pub lower: Option<f64>,
+    /// Upper bound of the deviation's confidence interval.
+    pub upper: Option<f64>,
+}
+
+/// A deviation curve with the context needed to interpret it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AllanCurve {
+    /// Which deviation.
+    pub kind: DeviationKind,
+    /// Sample interval in seconds.
+    pub tau0_s: f64,
+    /// Number of rate samples (angle points minus one).
+    pub n_rate: usize,
+    /// Confidence level of the intervals, if computed.
+    pub confidence: Option<f64>,
+    /// The points, in increasing tau.
+    pub points: Vec<AllanPoint>,
+}
+
+/// Why a deviation could not be computed.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum AllanError {
+    /// The record has too few samples for any requested tau.
+    #[error("record of {n} samples is too short for any tau of {kind}")]
+    TooShort {
+        /// Number of rate samples.
+        n: usize,
+        /// Short name of the deviation.
+        kind: &'static str,
+    },
+    /// A sample is NaN or infinite.
+    #[error("sample {index} is not finite ({value})")]
+    NonFinite {
+        /// Zero-based index of the first bad sample.
+        index: usize,
+        /// The bad value.
+        value: f64,
+    },
+    /// tau0 is not a positive finite number.
+    #[error("sample interval tau0 = {0} s must be positive and finite")]
+    BadTau0(f64),
+    /// Unknown deviation name.
+    #[error("unknown deviation kind '{0}' (expected adev, oadev, mdev, tdev, hdev, ohdev, totdev)")]
+    UnknownKind(String),
+    /// Unknown tau-list name.
+    #[error("unknown tau list '{0}' (expected octave, decade, all, or N/decade)")]
+    UnknownTauList(String),
+    /// An explicit tau is zero, negative or not a whole multiple of tau0.
+    #[error("tau {0} is not a positive whole multiple of tau0")]
+    BadTau(f64),
+    /// The confidence level is not in (0, 1).
+    #[error("confidence level {0} must lie strictly between 0 and 1")]
+    BadConfidence(f64),
+}
+
+/// Neumaier-compensated sum (Neumaier 1974), accurate for values of mixed size.
+pub fn compensated_sum(values: &[f64]) -> f64 {
+    let mut sum = 0.0f64;
+    let mut carry = 0.0f64;
+    for &v in values {
+        let t = sum + v;
+        if sum.abs() >= v.abs() {
+            carry += (sum - t) + v;
+        } else {
+            carry += (v - t) + sum;
+        }
+        sum = t;
+    }
+    sum + carry
+}
+
+fn check_finite(values: &[f64]) -> Result<(), AllanError> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(AllanError::NonFinite { index, value: values[index] }),
+        None => Ok(()),
+    }
+}
+
+/// Turns rate samples into the angle series in sample units (angle / tau0), in place:
+/// s_0 = 0, s_k = sum_{i<k} (y_i - mean y). The vector grows by one element.
+fn rate_to_sample_angle_in_place(data: &mut Vec<f64>) {
+    let n = data.len();
+    let mean = compensated_sum(data) / n as f64;
+    let mut sum = 0.0f64;
+    let mut carry = 0.0f64;
+    for v in data.iter_mut() {
+        let y = *v - mean;
+        *v = sum + carry;
+        let t = sum + y;
+        if sum.abs() >= y.abs() {
+            carry += (sum - t) + y;
+        } else {
+            carry += (y - t) + sum;
+        }
+        sum = t;
+    }
+    data.push(sum + carry);
+}
+
+/// Computes a deviation curve from gyro rate samples at interval `tau0_s`, consuming the record.
+///
+/// The vector is turned into the angle series in place; hand it over with capacity N + 1
+/// (`Vec::with_capacity(n + 1)`) so that peak memory stays at one copy of the record.
+pub fn deviation_from_rate(mut rate: Vec<f64>, tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve, AllanError> {
+    validate(&rate, tau0_s, options)?;
+    rate.reserve_exact(1);
+    rate_to_sample_angle_in_place(&mut rate);
+    compute(&rate, tau0_s, options)
+}
+
+/// Computes a deviation curve from borrowed gyro rate samples (copies them once).
+pub fn deviation_from_rate_slice(rate: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve, AllanError> {
+    validate(rate, tau0_s, options)?;
+    let mut v = Vec::with_capacity(rate.len() + 1);
+    v.extend_from_slice(rate);
+    deviation_from_rate(v, tau0_s, options)
+}
+
+/// Computes a deviation curve from angle (phase) samples at interval `tau0_s`, consuming them.
+///
+/// Angle in rate units x seconds (deg for a rate in deg/s); N + 1 angle points correspond to N
+/// rate samples y_i = (x_{i+1} - x_i) / tau0.
+pub fn deviation_from_angle(
+    mut angle: Vec<f64>,
+    tau0_s: f64,
+    options: &AllanOptions,
+) -> Result<AllanCurve, AllanError> {
+    if angle.is_empty() {
+        return Err(AllanError::TooShort { n: 0, kind: options.kind.name() });
+    }
+    validate(&angle[1..], tau0_s, options)?;
+    check_finite(&angle)?;
+    let x0 = angle[0];
+    for v in angle.iter_mut() {
+        *v = (*v - x0) / tau0_s;
+    }
+    compute(&angle, tau0_s, options)
+}
+
+/// Computes a deviation curve from borrowed angle (phase) samples (copies them once).
+pub fn deviation_from_angle_slice(
+    angle: &[f64],
+    tau0_s: f64,
+    options: &AllanOptions,
+) -> Result<AllanCurve, AllanError> {
+    deviation_from_angle(angle.to_vec(), tau0_s, options)
+}
+
+fn validate(rate: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<(), AllanError> {
+    if !(tau0_s.is_finite() && tau0_s > 0.0) {
+        return Err(AllanError::BadTau0(tau0_s));
+    }
+    if let Some(c) = options.confidence {
+        if !(c > 0.0 && c < 1.0) {
+            return Err(AllanError::BadConfidence(c));
+        }
+    }
+    check_finite(rate)
+}
+
+/// The averaging factors the options select for a record of `n_rate` rate samples.
+pub fn averaging_factors(options: &AllanOptions, n_rate: usize, tau0_s: f64) -> Result<Vec<usize>, AllanError> {
+    let kind = options.kind;
+    let hard = kind.hard_max_factor(n_rate);
+    let stop = options.max_factor.unwrap_or_else(|| kind.stable32_max_factor(n_rate)).min(hard);
+    let mut ms: Vec<usize> = match &options.taus {
+        TauList::Octave => {
+            std::iter::successors(Some(1usize), |m| m.checked_mul(2)).take_while(|&m| m <= stop).collect()
+        }
+        TauList::Decade => {
+            let mut v = Vec::new();
+            let mut decade = 1usize;
+            'outer: loop {
+                for f in [1, 2, 4] {
+                    let m = decade.saturating_mul(f);
+                    if m > stop {
+                        break 'outer;
+                    }
+                    v.push(m);
+                }
+                decade = decade.saturating_mul(10);
+            }
+            v
+        }
+        TauList::PerDecade(n) => {
+            let n = f64::from((*n).max(1));
+            let mut v = Vec::new();
+            let mut i = 0u32;
+            loop {
+                let m = 10f64.powf(f64::from(i) / n).round() as usize;
+                if m > stop {
+                    break;
+                }
+                v.push(m);
+                i += 1;
+            }
+            v
+        }
+        TauList::All => (1..=stop).collect(),
+        TauList::Factors(f) => {
+            if f.contains(&0) {
+                return Err(AllanError::BadTau(0.0));
+            }
+            let cap = options.max_factor.unwrap_or(hard).min(hard);
+            f.iter().copied().filter(|&m| m <= cap).collect()
+        }
+        TauList::Seconds(taus) => {
+            let cap = options.max_factor.unwrap_or(hard).min(hard);
+            let mut v = Vec::with_capacity(taus.len());
+            for &t in taus {
+                let m = (t / tau0_s).round();
+                if !(t.is_finite() && m >= 1.0 && ((t / tau0_s) - m).abs() <= 1e-6 * m) {
+                    return Err(AllanError::BadTau(t));
+                }
+                if (m as usize) <= cap {
+                    v.push(m as usize);
+                }
+            }
+            v
+        }
+    };
+    ms.sort_unstable();
+    ms.dedup();
+    if ms.is_empty() {
+        return Err(AllanError::TooShort { n: n_rate, kind: kind.name() });
+    }
+    Ok(ms)
+}
+
+/// Core: `s` is the angle series in sample units, L = N + 1 points.
+fn compute(s: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve, AllanError> {
+    let kind = options.kind;
+    let n_rate = s.len().saturating_sub(1);
+    let ms = averaging_factors(options, n_rate, tau0_s)?;
+    let extended = (kind == DeviationKind::Totdev).then(|| kernels::reflect_for_total(s));
+    // OADEV, the common case, is summed for all taus in one cache-blocked sweep
+    let oadev_sums = (kind == DeviationKind::Oadev).then(|| kernels::overlapping_allan_sums(s, &ms));
+    let mut points: Vec<AllanPoint> = ms
+        .par_iter()
+        .enumerate()
+        .map(|(i, &m)| {
+            let (variance, terms) = match &oadev_sums {
+                Some(sums) => {
+                    let n = s.len() - 2 * m;
+                    (sums[i] / (2.0 * (m as f64).powi(2) * n as f64), n)
+                }
+                None => variance_at(s, extended.as_deref(), kind, m),
+            };
+            let mut deviation = variance.sqrt();
+            if kind == DeviationKind::Tdev {
+                deviation *= m as f64 * tau0_s / 3f64.sqrt();
+            }
+            AllanPoint {
+                m,
+                tau_s: m as f64 * tau0_s,
+                deviation,
+                terms,
+                alpha: None,
+                noise_id: None,
+                edf: None,
+                lower: None,
+                upper: None,
+            }
+        })
+        .collect();
+    if let Some(confidence) = options.confidence {
+        let ids: Vec<Option<(i32, NoiseIdMethod)>> =
+            points.par_iter().map(|p| identify_noise(s, p.m, kind.difference_order() as usize)).collect();
+        let mut previous: Option<i32> = None;
+        for (p, id) in points.iter_mut().zip(ids) {
+            match id {
+                Some((a, method)) => {
+                    p.alpha = Some(a);
+                    p.noise_id = Some(method);
+                    previous = Some(a);
+                }
+                None if p.deviation > 0.0 => {
+                    p.alpha = previous;
+                    p.noise_id = previous.map(|_| NoiseIdMethod::Previous);
+                }
+                None => {}
+            }
+            if let Some(alpha) = p.alpha {
+                let edf = equivalent_dof(kind, alpha, p.m, s.len());
+                p.edf = Some(edf);
+                if let Some((lo, hi)) = confidence::chi2_bounds(p.deviation, edf, confidence) {
+                    p.lower = Some(lo);
+                    p.upper = Some(hi);
+                }
+            } else if p.deviation == 0.0 {
+                p.lower = Some(0.0);
+                p.upper = Some(0.0);
+            }
+        }
+    }
+    Ok(AllanCurve { kind, tau0_s, n_rate, confidence: options.confidence, points })
+}
+
+/// Variance (rate units squared; TDEV: MVAR) and number of terms at averaging factor m.
+fn variance_at(s: &[f64], extended: Option<&[f64]>, kind: DeviationKind, m: usize) -> (f64, usize) {
+    let mf = m as f64;
+    match kind {
+        DeviationKind::Oadev => {
+            let (sum, n) = kernels::overlapping_allan_sum(s, m);
+            (sum / (2.0 * mf * mf * n as f64), n)
+        }
+        DeviationKind::Adev => {
+            let (sum, n) = kernels::allan_sum(s, m);
+            (sum / (2.0 * mf * mf * n as f64), n)
+        }
+        DeviationKind::Mdev | DeviationKind::Tdev => {
+            let (sum, n) = kernels::modified_allan_sum(s, m);
+            (sum / (2.0 * mf.powi(4) * n as f64), n)
+        }
+        DeviationKind::Ohdev => {
+            let (sum, n) = kernels::overlapping_hadamard_sum(s, m);
+            (sum / (6.0 * mf * mf * n as f64), n)
+        }
+        DeviationKind::Hdev => {
+            let (sum, n) = kernels::hadamard_sum(s, m);
+            (sum / (6.0 * mf * mf * n as f64), n)
+        }
+        DeviationKind::Totdev => match extended {
+            Some(e) => {
+                let (sum, n) = kernels::total_sum(e, s.len(), m);
+                (sum / (2.0 * mf * mf * n as f64), n)
+            }
+            None => (f64::NAN, 0),
+        },
+    }
+}
+
+/// Noise identification at m: lag-1 ACF when >= 30 decimated points, else B1 ratio with R(n).
+fn identify_noise(s: &[f64], m: usize, dmax: usize) -> Option<(i32, NoiseIdMethod)> {
+    if let Some(a) = confidence::lag1_noise_id(s, m, dmax) {
+        return Some((a, NoiseIdMethod::Lag1Autocorrelation));
+    }
+    let averages: Vec<f64> =
+        s.iter().step_by(m).collect::<Vec<_>>().windows(2).map(|w| (w[1] - w[0]) / m as f64).collect();
+    let rn = || {
+        if 3 * m > s.len() - 1 {
+            return None;
+        }
+        let (msum, mn) = kernels::modified_allan_sum(s, m);
+        let (asum, an) = kernels::overlapping_allan_sum(s, m);
+        let mvar = msum / (2.0 * (m as f64).powi(4) * mn as f64);
+        let avar = asum / (2.0 * (m as f64).powi(2) * an as f64);
+        (avar > 0.0).then(|| mvar / avar)
+    };
+    confidence::b1_noise_id(&averages, m, rn).map(|a| (a, NoiseIdMethod::B1Ratio))
+}
+
+fn equivalent_dof(kind: DeviationKind, alpha: i32, m: usize, n_phase: usize) -> f64 {
+    match kind {
+        DeviationKind::Adev => confidence::edf_greenhall(alpha, 2, m, n_phase, false, false),
+        DeviationKind::Oadev => confidence::edf_greenhall(alpha, 2, m, n_phase, true, false),
+        DeviationKind::Mdev | DeviationKind::Tdev => confidence::edf_greenhall(alpha, 2, m, n_phase, true, true),
+        DeviationKind::Hdev => confidence::edf_greenhall(alpha, 3, m, n_phase, false, false),
+        DeviationKind::Ohdev => confidence::edf_greenhall(alpha, 3, m, n_phase, true, false),
+        DeviationKind::Totdev => confidence::edf_total(n_phase, m, alpha),
+    }
+}
+
+#[cfg(test)]
+mod tests;
