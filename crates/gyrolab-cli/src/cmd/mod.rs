@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+pub mod allan;
 pub mod bias;
 pub mod demo;
 pub mod rate;
