@@ -6,4 +6,5 @@
 
 pub mod format;
 pub mod paper;
+pub mod plot;
 pub mod rate;
