@@ -1,10 +1,18 @@
-//! gyrolab-report: text tables, JSON documents and (later) HTML reports of gyrolab results.
+//! gyrolab-report: text tables, JSON documents, SVG plots and the HTML report of gyrolab results.
 //!
 //! - [`rate`]: rate-table evaluation tables and JSON (keys in docs/JSON.md);
+//! - [`figures`]: the catalogue of figure names (limit names), units, formulas and sources;
+//! - [`limits`]: spec limits checked against the figures (PASS, FAIL, NOT EVALUATED);
+//! - [`plot`]: SVG plot building blocks; [`rate_plots`]: the rate-table plots;
+//! - [`html`]: the self-contained HTML report (header, summary, sections, methods appendix);
 //! - [`paper`]: the paper's printed tables beside the recomputation, for `gyrolab demo`;
 //! - [`format`]: number formatting.
 
+pub mod figures;
 pub mod format;
+pub mod html;
+pub mod limits;
 pub mod paper;
 pub mod plot;
 pub mod rate;
+pub mod rate_plots;
