@@ -4,12 +4,14 @@
 //! - [`atomic`]: outputs written to a temporary file and renamed into place;
 //! - [`text`]: a small delimited-text parser with line numbers;
 //! - [`rate_table`]: rate-table records in the long and wide layouts;
-//! - [`calibration`]: calibration files (TOML) written by `gyrolab rate --cal-out`.
+//! - [`calibration`]: calibration files (TOML) written by `gyrolab rate --cal-out`;
+//! - [`plan`]: test plans (TOML) for `gyrolab eval`.
 
 pub mod atomic;
 pub mod calibration;
 pub mod error;
 
 pub use error::DataError;
+pub mod plan;
 pub mod rate_table;
 pub mod text;
