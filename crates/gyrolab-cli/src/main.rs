@@ -20,6 +20,8 @@ struct Cli {
 enum Command {
     /// Evaluate rate-table records: scale factor, nonlinearity, linearity, hysteresis, repeatability...
     Rate(Box<cmd::rate::RateArgs>),
+    /// Evaluate a test plan and write the report folder (report.html, results.json, calibration, CSV).
+    Eval(cmd::eval::EvalArgs),
     /// Run the paper's worked example on its data (built in) and compare with its printed tables.
     Demo(cmd::demo::DemoArgs),
 }
@@ -28,10 +30,15 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Rate(a) => cmd::rate::run(a),
+        Command::Eval(a) => cmd::eval::run(a),
         Command::Demo(a) => cmd::demo::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e @ error::CliError::LimitFailed(_)) => {
+            eprintln!("FAIL: {e}");
+            e.exit_code()
+        }
         Err(e) => {
             eprintln!("error: {e}");
             e.exit_code()

@@ -5,6 +5,7 @@
 //! - [`limits`]: spec limits checked against the figures (PASS, FAIL, NOT EVALUATED);
 //! - [`plot`]: SVG plot building blocks; [`rate_plots`]: the rate-table plots;
 //! - [`html`]: the self-contained HTML report (header, summary, sections, methods appendix);
+//! - [`results`]: the results.json document of `gyrolab eval`;
 //! - [`paper`]: the paper's printed tables beside the recomputation, for `gyrolab demo`;
 //! - [`format`]: number formatting.
 
@@ -16,3 +17,4 @@ pub mod paper;
 pub mod plot;
 pub mod rate;
 pub mod rate_plots;
+pub mod results;
