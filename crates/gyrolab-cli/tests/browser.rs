@@ -60,10 +60,7 @@ fn load_rgb(png: &Path) -> (u32, u32, Vec<[u8; 3]>) {
     let info = reader.next_frame(&mut buf).unwrap();
     let channels = info.color_type.samples();
     assert!(info.bit_depth == png::BitDepth::Eight && channels >= 3, "unexpected PNG format {info:?}");
-    let px = buf[..info.buffer_size()]
-        .chunks(channels)
-        .map(|c| [c[0], c[1], c[2]])
-        .collect();
+    let px = buf[..info.buffer_size()].chunks(channels).map(|c| [c[0], c[1], c[2]]).collect();
     (info.width, info.height, px)
 }
 

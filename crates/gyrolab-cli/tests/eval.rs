@@ -43,7 +43,15 @@ fn paper_plan_writes_every_output_and_fails_its_limits_with_exit_3() {
     assert!(stderr.starts_with("FAIL: 3 spec limit check(s) failed"), "{stderr}");
     assert!(stderr.contains("axis x: linearity_pct = 5.543 % FS (limit ≤ 0.02)"), "{stderr}");
     assert!(!stderr.contains("panicked"));
-    for f in ["report.html", "results.json", "calibration.toml", "summary.csv", "points_x.csv", "points_z.csv", "scale_factor_runs.csv"] {
+    for f in [
+        "report.html",
+        "results.json",
+        "calibration.toml",
+        "summary.csv",
+        "points_x.csv",
+        "points_z.csv",
+        "scale_factor_runs.csv",
+    ] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
     let cal = gyrolab_io::calibration::read_calibration(&out.join("calibration.toml")).unwrap();
@@ -112,12 +120,20 @@ fn plan_errors_name_key_and_line() {
     assert!(e.contains(&format!("plan.toml:{l}:")) && e.contains("rate.y.file") && e.contains("missing_y.csv"), "{e}");
 
     let l = line_of("", "[rate.z]") + 1;
-    let e = plan_error(|t| t.replace("paper_rate_table_z.csv\"", "paper_rate_table_z.csv\"\noutput_unit = \"furlongs\""));
-    assert!(e.contains(&format!("plan.toml:{}:", l + 1)) && e.contains("rate.z.output_unit: unknown output unit 'furlongs'"), "{e}");
+    let e =
+        plan_error(|t| t.replace("paper_rate_table_z.csv\"", "paper_rate_table_z.csv\"\noutput_unit = \"furlongs\""));
+    assert!(
+        e.contains(&format!("plan.toml:{}:", l + 1))
+            && e.contains("rate.z.output_unit: unknown output unit 'furlongs'"),
+        "{e}"
+    );
 
     let l = line_of("", "hysteresis_pct = { max = 1.0 }");
     let e = plan_error(|t| t.replace("hysteresis_pct = { max = 1.0 }", "hysteresis = { max = 1.0 }"));
-    assert!(e.contains(&format!("plan.toml:{l}:")) && e.contains("limits.hysteresis: 'hysteresis' is not a figure"), "{e}");
+    assert!(
+        e.contains(&format!("plan.toml:{l}:")) && e.contains("limits.hysteresis: 'hysteresis' is not a figure"),
+        "{e}"
+    );
 }
 
 #[test]

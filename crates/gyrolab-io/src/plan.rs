@@ -194,7 +194,11 @@ impl Ctx<'_> {
             Err(self.err(
                 value.span(),
                 key,
-                format!("file '{}' not found (looked for {}; relative paths start at the plan's folder)", value.get_ref(), p.display()),
+                format!(
+                    "file '{}' not found (looked for {}; relative paths start at the plan's folder)",
+                    value.get_ref(),
+                    p.display()
+                ),
             ))
         }
     }
@@ -203,7 +207,11 @@ impl Ctx<'_> {
         v.as_ref()
             .map(|s| {
                 OutputUnit::parse(s.get_ref()).ok_or_else(|| {
-                    self.err(s.span(), key, format!("unknown output unit '{}': expected v, mv, lsb, dps or rad_s", s.get_ref()))
+                    self.err(
+                        s.span(),
+                        key,
+                        format!("unknown output unit '{}': expected v, mv, lsb, dps or rad_s", s.get_ref()),
+                    )
                 })
             })
             .transpose()
@@ -228,14 +236,21 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
 
     let axes = raw.device.axes.get_ref().clone();
     if axes.is_empty() {
-        return Err(cx.err(raw.device.axes.span(), "device.axes", "no axis: expected a list such as [\"x\", \"y\", \"z\"]"));
+        return Err(cx.err(
+            raw.device.axes.span(),
+            "device.axes",
+            "no axis: expected a list such as [\"x\", \"y\", \"z\"]",
+        ));
     }
     for (i, a) in axes.iter().enumerate() {
         if a.trim().is_empty() || axes[..i].contains(a) {
             return Err(cx.err(raw.device.axes.span(), "device.axes", format!("axis name '{a}' is empty or repeated")));
         }
     }
-    for (table, keys) in [("rate", raw.rate.iter().map(|(k, v)| (k, v.span())).collect::<Vec<_>>()), ("static", raw.static_tests.iter().map(|(k, v)| (k, v.span())).collect())] {
+    for (table, keys) in [
+        ("rate", raw.rate.iter().map(|(k, v)| (k, v.span())).collect::<Vec<_>>()),
+        ("static", raw.static_tests.iter().map(|(k, v)| (k, v.span())).collect()),
+    ] {
         for (k, span) in keys {
             if !axes.contains(k) {
                 return Err(cx.err(
@@ -273,7 +288,11 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
     };
     if let Some(l) = &o.nonlinearity_limit_pct {
         if !(l.get_ref().is_finite() && *l.get_ref() > 0.0) {
-            return Err(cx.err(l.span(), "options.nonlinearity_limit_pct", format!("must be a positive percentage, got {}", l.get_ref())));
+            return Err(cx.err(
+                l.span(),
+                "options.nonlinearity_limit_pct",
+                format!("must be a positive percentage, got {}", l.get_ref()),
+            ));
         }
     }
     let calibration = o.calibration.as_ref().map(|c| cx.existing_file("options.calibration", c)).transpose()?;
@@ -296,7 +315,11 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
                 .as_ref()
                 .map(|s| {
                     RateUnit::parse(s.get_ref()).ok_or_else(|| {
-                        cx.err(s.span(), &key("rate_unit"), format!("unknown rate unit '{}': expected dps, rad_s or dph", s.get_ref()))
+                        cx.err(
+                            s.span(),
+                            &key("rate_unit"),
+                            format!("unknown rate unit '{}': expected dps, rad_s or dph", s.get_ref()),
+                        )
                     })
                 })
                 .transpose()?;
@@ -332,11 +355,19 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
                 .collect::<Result<Vec<_>, _>>()?;
             let fs = *s.sample_rate_hz.get_ref();
             if !(fs.is_finite() && fs > 0.0) {
-                return Err(cx.err(s.sample_rate_hz.span(), &key("sample_rate_hz"), format!("must be a positive number of Hz, got {fs}")));
+                return Err(cx.err(
+                    s.sample_rate_hz.span(),
+                    &key("sample_rate_hz"),
+                    format!("must be a positive number of Hz, got {fs}"),
+                ));
             }
             if let Some(l) = &s.latitude_deg {
                 if !(l.get_ref().is_finite() && l.get_ref().abs() <= 90.0) {
-                    return Err(cx.err(l.span(), &key("latitude_deg"), format!("must be within -90..90 degrees, got {}", l.get_ref())));
+                    return Err(cx.err(
+                        l.span(),
+                        &key("latitude_deg"),
+                        format!("must be within -90..90 degrees, got {}", l.get_ref()),
+                    ));
                 }
             }
             static_tests.push(StaticAxisPlan {
@@ -443,7 +474,10 @@ bias_stability_dph_10s = { max = 20 }
         assert_eq!(p.rate[0].columns.output_unit, Some(OutputUnit::Volt));
         assert_eq!(p.static_tests[0].files, [dir.path().join("s1.csv")]);
         assert_eq!(p.limits.len(), 2);
-        assert_eq!((p.limits[0].figure.as_str(), p.limits[0].max, p.limits[0].line), ("nonlinearity_pct", Some(0.1), 20));
+        assert_eq!(
+            (p.limits[0].figure.as_str(), p.limits[0].max, p.limits[0].line),
+            ("nonlinearity_pct", Some(0.1), 20)
+        );
     }
 
     fn error(plan: &str) -> DataError {

@@ -341,7 +341,9 @@ fn write_summary(h: &mut String, s: &SummaryTable) {
     } else {
         h.push_str("<p class=\"note\">The plan sets no spec limits: figures are reported without verdicts.</p>\n");
     }
-    h.push_str("<table class=\"summary\"><thead><tr><th class=\"name\">figure</th><th class=\"name\">unit</th><th>limit</th>");
+    h.push_str(
+        "<table class=\"summary\"><thead><tr><th class=\"name\">figure</th><th class=\"name\">unit</th><th>limit</th>",
+    );
     for a in &s.axes {
         let _ = write!(h, "<th>axis {}</th>", escape(a));
     }
@@ -356,7 +358,12 @@ fn write_summary(h: &mut String, s: &SummaryTable) {
             escape(&r.limit)
         );
         for (v, verdict) in &r.cells {
-            let _ = write!(h, "<td>{}{}</td>", escape(v), verdict.map_or_else(String::new, |x| format!(" {}", verdict_span(x))));
+            let _ = write!(
+                h,
+                "<td>{}{}</td>",
+                escape(v),
+                verdict.map_or_else(String::new, |x| format!(" {}", verdict_span(x)))
+            );
         }
         h.push_str("</tr>\n");
     }
@@ -494,10 +501,7 @@ pub fn rate_section(a: &AxisReport<'_>, limits: &[Limit]) -> Result<ReportSectio
     ];
     if let Some(svg) = scale_factor_plot(a) {
         plots.push(PlotBlock {
-            caption: format!(
-                "Scale factor of each run of axis {} (both strokes), against K from all runs.",
-                a.name
-            ),
+            caption: format!("Scale factor of each run of axis {} (both strokes), against K from all runs.", a.name),
             svg: svg?,
         });
     }
@@ -591,7 +595,9 @@ mod tests {
         let h = render_html(&r);
         assert!(h.contains("SIMULATED DATA"));
         assert!(h.contains("<span class=\"verdict PASS\">PASS</span>"));
-        assert!(h.contains("href=\"#def-bias_stability_dph_-T-s\"") && h.contains("id=\"def-bias_stability_dph_-T-s\""));
+        assert!(
+            h.contains("href=\"#def-bias_stability_dph_-T-s\"") && h.contains("id=\"def-bias_stability_dph_-T-s\"")
+        );
         assert!(!h.contains("<script"));
     }
 }

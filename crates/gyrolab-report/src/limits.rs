@@ -134,7 +134,10 @@ mod tests {
 
     #[test]
     fn pass_fail_and_not_evaluated_by_hand() {
-        let axes = [axis("x", &[("nonlinearity_pct", 0.05), ("scale_factor", 0.0076)]), axis("y", &[("nonlinearity_pct", 0.2)])];
+        let axes = [
+            axis("x", &[("nonlinearity_pct", 0.05), ("scale_factor", 0.0076)]),
+            axis("y", &[("nonlinearity_pct", 0.2)]),
+        ];
         let limits = [
             limit("nonlinearity_pct", None, Some(0.1)),
             limit("scale_factor", Some(0.007), Some(0.008)),

@@ -235,12 +235,8 @@ fn clean_svg(svg: &str, title: &str) -> String {
         Some(end) if svg.starts_with("<svg") => &svg[end + 1..],
         _ => svg,
     };
-    let view_box = svg
-        .split("viewBox=\"")
-        .nth(1)
-        .and_then(|s| s.split('"').next())
-        .unwrap_or("0 0 760 440")
-        .to_string();
+    let view_box =
+        svg.split("viewBox=\"").nth(1).and_then(|s| s.split('"').next()).unwrap_or("0 0 760 440").to_string();
     let body = body.replace(">\n", ">").replace("\n</text>", "</text>").replace("><", ">\n<");
     format!(
         "<svg class=\"plot\" viewBox=\"{view_box}\" role=\"img\" aria-label=\"{}\" preserveAspectRatio=\"xMidYMid meet\">{body}",
@@ -379,9 +375,7 @@ where
         chart.draw_series(DashedLineSeries::new([a, b], 4, 4, grey.stroke_width(1))).map_err(|x| e(&x))?;
         if !r.label.is_empty() {
             let style = TextStyle::from(("sans-serif", px(11.0)).into_font()).color(&grey);
-            chart
-                .draw_series(std::iter::once(Text::new(r.label.clone(), label_at, style)))
-                .map_err(|x| e(&x))?;
+            chart.draw_series(std::iter::once(Text::new(r.label.clone(), label_at, style))).map_err(|x| e(&x))?;
         }
     }
     let mut legend = false;
@@ -556,8 +550,8 @@ mod tests {
         )
         .unwrap();
         assert!(t.contains(">T = 0.5 s<"));
-        let s = scatter_fit_plot("t", "temperature (degC)", "bias (deg/h)", vec![(20.0, 1.0), (30.0, 2.0)], None)
-            .unwrap();
+        let s =
+            scatter_fit_plot("t", "temperature (degC)", "bias (deg/h)", vec![(20.0, 1.0), (30.0, 2.0)], None).unwrap();
         assert!(s.contains(">temperature (degC)<"));
         assert_eq!(tick_label(0.001), "0.001");
         assert_eq!(tick_label(1e-4), "1e-4");

@@ -1,5 +1,6 @@
 //! `gyrolab demo`: the paper's worked example from data built into the binary.
 
+use crate::cmd::eval::{finish, progress, write_report, ReportInputs};
 use crate::cmd::rate::{evaluate_record, EvaluatedAxis};
 use crate::error::CliResult;
 use crate::output::{print, to_json};
@@ -7,13 +8,12 @@ use crate::paper_data;
 use clap::Args;
 use gyrolab::rate_test::RateTestOptions;
 use gyrolab_io::rate_table::{parse_rate_table, RateColumns};
-use gyrolab_report::paper::{compare_table2, compare_table6, table2_text, table5_text, table6_text};
-use gyrolab_report::rate::{rate_json, rate_summary_table, AxisReport};
-use crate::cmd::eval::{finish, progress, write_report, ReportInputs};
 use gyrolab_report::figures::AxisFigures;
 use gyrolab_report::format::sig;
 use gyrolab_report::html::{DataTable, ReportHeader, ReportSection};
+use gyrolab_report::paper::{compare_table2, compare_table6, table2_text, table5_text, table6_text};
 use gyrolab_report::paper::{ClaimVerdict, Table2Comparison};
+use gyrolab_report::rate::{rate_json, rate_summary_table, AxisReport};
 use gyrolab_report::results::DeviceJson;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -119,9 +119,18 @@ fn simulated_static_and_allan() -> (Vec<ReportSection>, Vec<AxisFigures>, BTreeM
 fn paper_section(table2: &[Table2Comparison], verdicts: &[ClaimVerdict]) -> ReportSection {
     let t2 = DataTable {
         caption: "Table 2 (axis x): stroke means recomputed from Table 1 beside the printed values (V)".into(),
-        header: ["rate (deg/s)", "fwd computed", "fwd printed", "rev computed", "rev printed", "mean computed", "mean printed", "agrees"]
-            .map(String::from)
-            .to_vec(),
+        header: [
+            "rate (deg/s)",
+            "fwd computed",
+            "fwd printed",
+            "rev computed",
+            "rev printed",
+            "mean computed",
+            "mean printed",
+            "agrees",
+        ]
+        .map(String::from)
+        .to_vec(),
         rows: table2
             .iter()
             .map(|r| {
@@ -137,7 +146,9 @@ fn paper_section(table2: &[Table2Comparison], verdicts: &[ClaimVerdict]) -> Repo
     };
     let t6 = DataTable {
         caption: "Table 6: the paper's claims beside the figures computed from its own data".into(),
-        header: ["axis", "figure", "unit", "computed", "paper claims", "supported by the data"].map(String::from).to_vec(),
+        header: ["axis", "figure", "unit", "computed", "paper claims", "supported by the data"]
+            .map(String::from)
+            .to_vec(),
         rows: verdicts
             .iter()
             .map(|v| {
@@ -180,10 +191,7 @@ fn write_paper_report(
     let bar = progress(quiet, axes.len() as u64 + 7);
     let (mut sections, figures, mut json) = simulated_static_and_allan();
     sections.insert(0, paper_section(table2, verdicts));
-    json.insert(
-        "paper".into(),
-        serde_json::json!({ "table2_x": table2, "table6": verdicts }),
-    );
+    json.insert("paper".into(), serde_json::json!({ "table2_x": table2, "table6": verdicts }));
     let created = humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string();
     let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
     let header = ReportHeader {

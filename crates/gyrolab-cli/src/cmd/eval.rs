@@ -118,10 +118,18 @@ pub fn points_csv(a: &AxisJson) -> String {
 
 /// The per-run scale factors of every axis.
 pub fn runs_csv(axes: &[AxisJson]) -> String {
-    let mut s = String::from("# gyrolab: scale factor K of each run (both strokes), output units per deg/s\naxis,run,scale_factor,unit\n");
+    let mut s = String::from(
+        "# gyrolab: scale factor K of each run (both strokes), output units per deg/s\naxis,run,scale_factor,unit\n",
+    );
     for a in axes {
         for r in &a.scale_factor_per_run {
-            s.push_str(&format!("{},{},{},{}\n", csv_field(&a.name), r.run, r.scale_factor, csv_field(&a.scale_factor_unit)));
+            s.push_str(&format!(
+                "{},{},{},{}\n",
+                csv_field(&a.name),
+                r.run,
+                r.scale_factor,
+                csv_field(&a.scale_factor_unit)
+            ));
         }
     }
     s
@@ -181,7 +189,14 @@ pub fn write_report(out: &Path, inputs: ReportInputs<'_>, bar: &ProgressBar) -> 
         .filter(|c| c.verdict == Verdict::Fail)
         .map(|c| {
             let l = Limit { figure: c.figure.clone(), min: c.min, max: c.max };
-            format!("axis {}: {} = {} {} (limit {})", c.axis, c.figure, sig(c.value.unwrap_or(f64::NAN), 4), c.unit, l.text())
+            format!(
+                "axis {}: {} = {} {} (limit {})",
+                c.axis,
+                c.figure,
+                sig(c.value.unwrap_or(f64::NAN), 4),
+                c.unit,
+                l.text()
+            )
         })
         .collect();
     let results = ResultsJson {
@@ -197,10 +212,8 @@ pub fn write_report(out: &Path, inputs: ReportInputs<'_>, bar: &ProgressBar) -> 
     };
     let html = render_html(&Report { header: inputs.header, summary: summary.clone(), sections });
     bar.set_message("writing files");
-    let mut files: Vec<(PathBuf, Vec<u8>)> = vec![
-        (out.join("report.html"), html.into_bytes()),
-        (out.join("results.json"), to_json(&results)?.into_bytes()),
-    ];
+    let mut files: Vec<(PathBuf, Vec<u8>)> =
+        vec![(out.join("report.html"), html.into_bytes()), (out.join("results.json"), to_json(&results)?.into_bytes())];
     if !inputs.axes.is_empty() {
         let cal = calibration_file(inputs.axes)
             .to_toml()
@@ -236,7 +249,10 @@ pub fn finish(out: &Path, written: &Written, quiet: bool) -> CliResult {
     if !quiet {
         let mut s = format!("Wrote {} files to {}:\n", written.files.len(), out.display());
         for f in &written.files {
-            s.push_str(&format!("  {}\n", f.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned())));
+            s.push_str(&format!(
+                "  {}\n",
+                f.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned())
+            ));
         }
         match written.verdict {
             Some(v) => s.push_str(&format!("Spec limits: {}\n", v.text())),
