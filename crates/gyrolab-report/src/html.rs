@@ -216,6 +216,7 @@ h3 { font-size: 12pt; margin: 16px 0 6px; }
 table { border-collapse: collapse; margin: 6px 0 12px; font-size: 10pt; }
 th, td { border: 1px solid #bbb; padding: 3px 7px; text-align: right; vertical-align: top; }
 th { background: #f0f0f0; }
+caption { text-align: left; font-weight: bold; padding: 2px 0; white-space: nowrap; }
 td.name, th.name { text-align: left; }
 table.header td { text-align: left; border: none; padding: 1px 10px 1px 0; }
 .verdict { font-weight: bold; white-space: nowrap; padding: 0 4px; border-radius: 3px; }
@@ -522,7 +523,7 @@ pub fn rate_section(a: &AxisReport<'_>, limits: &[Limit]) -> Result<ReportSectio
             .iter()
             .map(|p| {
                 vec![
-                    sig(p.rate_dps, 6),
+                    crate::format::short(p.rate_dps, 6),
                     format!("{:.8}", p.forward_mean),
                     format!("{:.8}", p.reverse_mean),
                     format!("{:.8}", p.mean),

@@ -18,6 +18,7 @@
 
 use plotters::coord::ranged1d::{AsRangedCoord, Ranged, ValueFormatter};
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::ops::Range;
 
 /// Colours of the series, by index (colour-blind-safe Okabe-Ito order).
@@ -52,17 +53,19 @@ pub struct Axis {
     pub scale: Scale,
     /// Fixed range; `None` fits the data with a margin.
     pub range: Option<(f64, f64)>,
+    /// Label only whole-number ticks (run numbers, counts).
+    pub integer: bool,
 }
 
 impl Axis {
     /// A linear axis fitted to the data.
     pub fn linear(label: impl Into<String>) -> Axis {
-        Axis { label: label.into(), scale: Scale::Linear, range: None }
+        Axis { label: label.into(), scale: Scale::Linear, range: None, integer: false }
     }
 
     /// A logarithmic axis fitted to the data.
     pub fn log(label: impl Into<String>) -> Axis {
-        Axis { label: label.into(), scale: Scale::Log, range: None }
+        Axis { label: label.into(), scale: Scale::Log, range: None, integer: false }
     }
 }
 
@@ -349,13 +352,14 @@ where
         builder.caption(&panel.caption, ("sans-serif", px(14.0)));
     }
     let mut chart = builder.build_cartesian_2d(xs, ys).map_err(|x| e(&x))?;
-    let fmt = |v: &f64| tick_label(*v);
+    let fmt_x = |v: &f64| if panel.x.integer && v.fract().abs() > 1e-9 { String::new() } else { tick_label(*v) };
+    let fmt_y = |v: &f64| if panel.y.integer && v.fract().abs() > 1e-9 { String::new() } else { tick_label(*v) };
     chart
         .configure_mesh()
         .x_desc(&panel.x.label)
         .y_desc(&panel.y.label)
-        .x_label_formatter(&fmt)
-        .y_label_formatter(&fmt)
+        .x_label_formatter(&fmt_x)
+        .y_label_formatter(&fmt_y)
         .x_labels(8)
         .y_labels(6)
         .label_style(("sans-serif", px(12.0)))
@@ -368,13 +372,13 @@ where
     let (y_lo, y_hi) = (chart.y_range().start, chart.y_range().end);
     let grey = RGBColor(120, 120, 120);
     for r in &panel.ref_lines {
-        let (a, b, label_at) = match r.orientation {
-            Orientation::Vertical => ((r.at, y_lo), (r.at, y_hi), (r.at, y_hi)),
-            Orientation::Horizontal => ((x_lo, r.at), (x_hi, r.at), (x_lo, r.at)),
+        let (a, b, label_at, anchor) = match r.orientation {
+            Orientation::Vertical => ((r.at, y_lo), (r.at, y_hi), (r.at, y_hi), Pos::new(HPos::Left, VPos::Top)),
+            Orientation::Horizontal => ((x_lo, r.at), (x_hi, r.at), (x_hi, r.at), Pos::new(HPos::Right, VPos::Bottom)),
         };
         chart.draw_series(DashedLineSeries::new([a, b], 4, 4, grey.stroke_width(1))).map_err(|x| e(&x))?;
         if !r.label.is_empty() {
-            let style = TextStyle::from(("sans-serif", px(11.0)).into_font()).color(&grey);
+            let style = TextStyle::from(("sans-serif", px(11.0)).into_font()).color(&grey).pos(anchor);
             chart.draw_series(std::iter::once(Text::new(r.label.clone(), label_at, style))).map_err(|x| e(&x))?;
         }
     }
@@ -404,7 +408,7 @@ where
                 chart.draw_series(LineSeries::new(pts.clone(), c.stroke_width(2))).map_err(|x| e(&x))?;
                 chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled())))
             }
-            SeriesStyle::Crosses => chart.draw_series(pts.iter().map(|&p| Cross::new(p, 3, c.stroke_width(1)))),
+            SeriesStyle::Crosses => chart.draw_series(pts.iter().map(|&p| Cross::new(p, 4, c.stroke_width(2)))),
         }
         .map_err(|x| e(&x))?;
         if !s.name.is_empty() {

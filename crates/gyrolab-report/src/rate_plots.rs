@@ -95,7 +95,9 @@ pub fn scale_factor_plot(a: &AxisReport<'_>) -> Option<Result<String, PlotError>
     let e = a.evaluation;
     let s = e.scale_factor_repeatability.as_ref()?;
     let (du, df) = display_unit(a);
-    let mut p = Panel::new(Axis::linear("run"), Axis::linear(format!("scale factor ({du}/(deg/s))")));
+    let mut run_axis = Axis::linear("run");
+    run_axis.integer = true;
+    let mut p = Panel::new(run_axis, Axis::linear(format!("scale factor ({du}/(deg/s))")));
     p.series.push(Series::new(
         "K of the run",
         s.per_run.iter().map(|&(run, k)| (f64::from(run), k * df)).collect(),
