@@ -143,6 +143,20 @@ pub struct RefLine {
     pub label: String,
 }
 
+/// Where a panel's legend sits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LegendCorner {
+    /// Upper left (the default).
+    #[default]
+    UpperLeft,
+    /// Upper right (Allan curves, which fall from the upper left).
+    UpperRight,
+    /// Lower left.
+    LowerLeft,
+    /// Lower right.
+    LowerRight,
+}
+
 /// One plot area with its axes and content.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Panel {
@@ -160,6 +174,8 @@ pub struct Panel {
     pub ref_lines: Vec<RefLine>,
     /// Relative height among the figure's panels.
     pub weight: f64,
+    /// Legend position.
+    pub legend: LegendCorner,
 }
 
 impl Panel {
@@ -173,6 +189,7 @@ impl Panel {
             annotations: Vec::new(),
             ref_lines: Vec::new(),
             weight: 1.0,
+            legend: LegendCorner::UpperLeft,
         }
     }
 }
@@ -440,7 +457,12 @@ where
     if legend {
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
+            .position(match panel.legend {
+                LegendCorner::UpperLeft => SeriesLabelPosition::UpperLeft,
+                LegendCorner::UpperRight => SeriesLabelPosition::UpperRight,
+                LegendCorner::LowerLeft => SeriesLabelPosition::LowerLeft,
+                LegendCorner::LowerRight => SeriesLabelPosition::LowerRight,
+            })
             .background_style(WHITE.mix(0.85))
             .border_style(RGBColor(180, 180, 180))
             .label_font(("sans-serif", px(12.0)))
@@ -484,6 +506,7 @@ pub fn log_log_plot(
         s
     }));
     p.annotations = read_offs;
+    p.legend = LegendCorner::UpperRight;
     Figure::single(title, p).to_svg()
 }
 
