@@ -1,5 +1,6 @@
 //! Errors of the command-line program and their exit codes (documented in README):
-//! 0 success; 1 an internal or output failure; 2 bad usage or bad data; 3 a spec limit failed.
+//! 0 success; 1 an internal or output failure; 2 bad usage or bad data (a plan error included);
+//! 3 a spec limit failed (`gyrolab eval`: every output was written, the report shows FAIL).
 
 use gyrolab_io::DataError;
 use std::fmt;
@@ -14,6 +15,8 @@ pub enum CliError {
     Usage(String),
     /// Could not write an output (exit 1).
     Output(String),
+    /// The evaluation succeeded and its outputs were written, but a spec limit failed (exit 3).
+    LimitFailed(String),
 }
 
 impl CliError {
@@ -22,6 +25,7 @@ impl CliError {
         match self {
             CliError::Data(_) | CliError::Usage(_) => ExitCode::from(2),
             CliError::Output(_) => ExitCode::from(1),
+            CliError::LimitFailed(_) => ExitCode::from(3),
         }
     }
 }
@@ -32,6 +36,7 @@ impl fmt::Display for CliError {
             CliError::Data(e) => write!(f, "{e}"),
             CliError::Usage(m) => write!(f, "{m}"),
             CliError::Output(m) => write!(f, "{m}"),
+            CliError::LimitFailed(m) => write!(f, "{m}"),
         }
     }
 }

@@ -28,6 +28,8 @@ enum Command {
     /// Simulate records with known truth (static, rate-table) in the layouts gyrolab reads.
     #[command(subcommand)]
     Simulate(cmd::simulate::SimulateCommand),
+    /// Evaluate a test plan and write the report folder (report.html, results.json, calibration, CSV).
+    Eval(cmd::eval::EvalArgs),
     /// Run the paper's worked example on its data (built in) and compare with its printed tables.
     Demo(cmd::demo::DemoArgs),
 }
@@ -36,6 +38,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Rate(a) => cmd::rate::run(a),
+        Command::Eval(a) => cmd::eval::run(a),
         Command::Demo(a) => cmd::demo::run(a),
         Command::Bias(a) => cmd::bias::run(a),
         Command::Allan(a) => cmd::allan::run(a),
@@ -43,6 +46,10 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e @ error::CliError::LimitFailed(_)) => {
+            eprintln!("FAIL: {e}");
+            e.exit_code()
+        }
         Err(e) => {
             eprintln!("error: {e}");
             e.exit_code()

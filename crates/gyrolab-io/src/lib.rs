@@ -6,7 +6,8 @@
 //! - [`rate_table`]: rate-table records in the long and wide layouts;
 //! - [`calibration`]: calibration files (TOML) written by `gyrolab rate --cal-out`;
 //! - [`series`]: streaming reader of time-series files, and the static test of a file;
-//! - [`sim_csv`]: fast CSV writer for simulated static records and rate-table tests.
+//! - [`sim_csv`]: fast CSV writer for simulated static records and rate-table tests;
+//! - [`plan`]: test plans (TOML) for `gyrolab eval`.
 
 pub mod atomic;
 pub mod calibration;
@@ -17,3 +18,4 @@ pub mod sim_csv;
 pub mod text;
 
 pub use error::DataError;
+pub mod plan;

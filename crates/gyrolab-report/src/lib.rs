@@ -1,13 +1,24 @@
-//! gyrolab-report: text tables, JSON documents and (later) HTML reports of gyrolab results.
+//! gyrolab-report: text tables, JSON documents, SVG plots and the HTML report of gyrolab results.
 //!
 //! - [`allan`]: Allan-deviation tables, CSV, JSON, noise terms and Kalibr YAML;
 //! - [`bias`]: static (bias) test tables and JSON;
 //! - [`rate`]: rate-table evaluation tables and JSON (keys in docs/JSON.md);
+//! - [`figures`]: the catalogue of figure names (limit names), units, formulas and sources;
+//! - [`limits`]: spec limits checked against the figures (PASS, FAIL, NOT EVALUATED);
+//! - [`plot`]: SVG plot building blocks; [`rate_plots`]: the rate-table plots;
+//! - [`html`]: the self-contained HTML report (header, summary, sections, methods appendix);
+//! - [`results`]: the results.json document of `gyrolab eval`;
 //! - [`paper`]: the paper's printed tables beside the recomputation, for `gyrolab demo`;
 //! - [`format`]: number formatting.
 
 pub mod allan;
 pub mod bias;
+pub mod figures;
 pub mod format;
+pub mod html;
+pub mod limits;
 pub mod paper;
+pub mod plot;
 pub mod rate;
+pub mod rate_plots;
+pub mod results;

@@ -1,5 +1,6 @@
 //! `gyrolab demo`: the paper's worked example from data built into the binary.
 
+use crate::cmd::eval::{finish, progress, write_report, ReportInputs};
 use crate::cmd::rate::{evaluate_record, EvaluatedAxis};
 use crate::error::CliResult;
 use crate::output::{print, to_json};
@@ -7,10 +8,16 @@ use crate::paper_data;
 use clap::Args;
 use gyrolab::rate_test::RateTestOptions;
 use gyrolab_io::rate_table::{parse_rate_table, RateColumns};
+use gyrolab_report::figures::AxisFigures;
+use gyrolab_report::format::sig;
+use gyrolab_report::html::{DataTable, ReportHeader, ReportSection};
 use gyrolab_report::paper::{compare_table2, compare_table6, table2_text, table5_text, table6_text};
+use gyrolab_report::paper::{ClaimVerdict, Table2Comparison};
 use gyrolab_report::rate::{rate_json, rate_summary_table, AxisReport};
+use gyrolab_report::results::DeviceJson;
 use serde::Serialize;
-use std::path::Path;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
 /// Options of `gyrolab demo`.
 #[derive(Debug, Args)]
@@ -18,6 +25,12 @@ pub struct DemoArgs {
     /// Print the demo's figures and comparisons as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Write the paper's report folder (report.html, results.json, calibration.toml, CSV) here.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// With --out: no progress bar and no summary on standard output.
+    #[arg(long, short, requires = "out")]
+    pub quiet: bool,
 }
 
 #[derive(Serialize)]
@@ -47,6 +60,9 @@ pub fn run(args: &DemoArgs) -> CliResult {
     let zero_bias: Vec<(&str, f64)> =
         t5.iter().map(|r| (r.axis.as_str(), gyrolab::fit::mean(&r.tests_v).unwrap_or(f64::NAN))).collect();
     let verdicts = compare_table6(&t6, &evals, &zero_bias);
+    if let Some(out) = &args.out {
+        return write_paper_report(out, args.quiet, &axes, &table2, &verdicts);
+    }
     if args.json {
         return print(&to_json(&DemoJson {
             rate: rate_json(&reports),
@@ -87,4 +103,126 @@ pub fn run(args: &DemoArgs) -> CliResult {
     s.push_str("\n\n4. Table 6: the paper's claims beside the figures computed from its own data\n");
     s.push_str(&table6_text(&verdicts, &t6, &evals));
     print(&s)
+}
+
+/// HOOK (issue 6, static and Allan part): sections built from simulated records of the paper's
+/// gyro family (ADXRS646: ARW 0.6 deg/sqrt(h), bias instability 12 deg/h; methods-notes §5).
+/// Each must be a `ReportSection` with `simulated: true`, its figures added to the summary via
+/// `AxisFigures` (keys such as `bias_stability_dph_10s`, `arw_deg_rt_h`) and its JSON under
+/// `results.json` `sections.static` / `sections.allan`. Empty until the simulator, bias and
+/// Allan evaluations are merged.
+fn simulated_static_and_allan() -> (Vec<ReportSection>, Vec<AxisFigures>, BTreeMap<String, serde_json::Value>) {
+    (Vec::new(), Vec::new(), BTreeMap::new())
+}
+
+/// The paper's comparison section: Table 2 recomputed and Table 6's claims beside the data.
+fn paper_section(table2: &[Table2Comparison], verdicts: &[ClaimVerdict]) -> ReportSection {
+    let t2 = DataTable {
+        caption: "Table 2 (axis x): stroke means recomputed from Table 1 beside the printed values (V)".into(),
+        header: [
+            "rate (deg/s)",
+            "fwd computed",
+            "fwd printed",
+            "rev computed",
+            "rev printed",
+            "mean computed",
+            "mean printed",
+            "agrees",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows: table2
+            .iter()
+            .map(|r| {
+                let mut row = vec![sig(r.rate_dps, 6)];
+                for k in 0..3 {
+                    row.push(format!("{:.8}", r.computed_v[k]));
+                    row.push(r.printed[k].clone());
+                }
+                row.push(if r.differs.is_empty() { "yes".into() } else { format!("NO: {}", r.differs.join(", ")) });
+                row
+            })
+            .collect(),
+    };
+    let t6 = DataTable {
+        caption: "Table 6: the paper's claims beside the figures computed from its own data".into(),
+        header: ["axis", "figure", "unit", "computed", "paper claims", "supported by the data"]
+            .map(String::from)
+            .to_vec(),
+        rows: verdicts
+            .iter()
+            .map(|v| {
+                vec![
+                    v.axis.clone(),
+                    v.figure.to_string(),
+                    v.unit.to_string(),
+                    if v.unit == "V" { format!("{:.8}", v.computed) } else { sig(v.computed, 5) },
+                    v.claimed.clone(),
+                    if v.supported { "yes".into() } else { "NO".into() },
+                ]
+            })
+            .collect(),
+    };
+    ReportSection {
+        title: "The paper's printed tables beside the recomputation".into(),
+        simulated: false,
+        paragraphs: vec![
+            "Rows 11 (135 deg/s) and 14 (300 deg/s) of Table 2 do not reproduce from Table 1 (a slip in the paper); \
+             gyrolab uses the means of Table 1."
+                .into(),
+            "The printed linearity, hysteresis, repeatability and accuracy are not supported by the data: the output \
+             saturates above about 230 deg/s, so no straight line fits the data to 0.01 %. See docs/METHODS.md section 1."
+                .into(),
+        ],
+        tables: vec![t2, t6],
+        page_break_before: true,
+        ..Default::default()
+    }
+}
+
+/// Writes the paper's report folder (`gyrolab demo --out DIR`).
+fn write_paper_report(
+    out: &Path,
+    quiet: bool,
+    axes: &[EvaluatedAxis],
+    table2: &[Table2Comparison],
+    verdicts: &[ClaimVerdict],
+) -> CliResult {
+    let bar = progress(quiet, axes.len() as u64 + 7);
+    let (mut sections, figures, mut json) = simulated_static_and_allan();
+    sections.insert(0, paper_section(table2, verdicts));
+    json.insert("paper".into(), serde_json::json!({ "table2_x": table2, "table6": verdicts }));
+    let created = humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string();
+    let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
+    let header = ReportHeader {
+        title: "Gyro test report: the paper's worked example".into(),
+        model: "MEMS rate gyro, ADXRS family (Cheng et al. 2014)".into(),
+        serial: "the paper's three units (axes x, y, z)".into(),
+        axes: names.clone(),
+        date: created,
+        gyrolab_version: env!("CARGO_PKG_VERSION").into(),
+        plan_file: "built-in: the paper's Tables 1, 3, 4 (data/paper/*.csv)".into(),
+        notes: vec![
+            "Rate-table part: the paper's published data. Static-bias and Allan sections are not yet produced; \
+             when they are, they come from simulated records of the paper's gyro family and are labelled SIMULATED."
+                .into(),
+        ],
+    };
+    let inputs = ReportInputs {
+        header,
+        device: DeviceJson {
+            model: "MEMS rate gyro, ADXRS family (Cheng et al. 2014)".into(),
+            serial: "paper".into(),
+            axes: names,
+            description: Some("the paper's worked example".into()),
+        },
+        axes,
+        limits: Vec::new(),
+        extra_figures: figures,
+        extra_sections: sections,
+        extra_json: json,
+    };
+    let written = write_report(out, inputs, &bar)?;
+    bar.finish_and_clear();
+    finish(out, &written, quiet)
 }

@@ -3,5 +3,6 @@
 pub mod allan;
 pub mod bias;
 pub mod demo;
+pub mod eval;
 pub mod rate;
 pub mod simulate;

@@ -1,0 +1,542 @@
+//! Test plans (TOML) for `gyrolab eval`: the device, the rate-table and static records per
+//! axis, evaluation options and spec limits. Every key is documented in docs/PLAN.md.
+//!
+//! Errors name the plan file, the line and column, and the key (`rate.x.output_unit`): unknown
+//! keys (`deny_unknown_fields`), missing files, bad units, limits on unknown figures, axes not
+//! listed in `[device] axes`. Relative paths are relative to the plan's folder.
+
+use crate::calibration::line_col;
+use crate::rate_table::RateColumns;
+use crate::DataError;
+use gyrolab::units::{OutputUnit, RateUnit};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPlan {
+    device: RawDevice,
+    #[serde(default)]
+    options: RawOptions,
+    #[serde(default)]
+    rate: BTreeMap<String, Spanned<RawRate>>,
+    #[serde(default, rename = "static")]
+    static_tests: BTreeMap<String, Spanned<RawStatic>>,
+    #[serde(default)]
+    limits: BTreeMap<String, Spanned<RawLimit>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawDevice {
+    model: String,
+    serial: String,
+    axes: Spanned<Vec<String>>,
+    #[serde(default)]
+    description: Option<String>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawOptions {
+    coverage: Option<Spanned<f64>>,
+    half_hysteresis: Option<bool>,
+    order: Option<Spanned<i64>>,
+    nonlinearity_limit_pct: Option<Spanned<f64>>,
+    calibration: Option<Spanned<String>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRate {
+    file: Spanned<String>,
+    rate_column: Option<String>,
+    run_column: Option<String>,
+    stroke_column: Option<String>,
+    output_column: Option<String>,
+    rate_unit: Option<Spanned<String>>,
+    output_unit: Option<Spanned<String>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawStatic {
+    files: Spanned<Vec<String>>,
+    sample_rate_hz: Spanned<f64>,
+    channel: Option<String>,
+    output_unit: Option<Spanned<String>>,
+    temperature_channel: Option<String>,
+    latitude_deg: Option<Spanned<f64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLimit {
+    min: Option<f64>,
+    max: Option<f64>,
+}
+
+/// The device under test.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DevicePlan {
+    /// Model.
+    pub model: String,
+    /// Serial number.
+    pub serial: String,
+    /// Axis names in report order.
+    pub axes: Vec<String>,
+    /// Free description.
+    pub description: Option<String>,
+}
+
+/// Evaluation options (`[options]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanOptions {
+    /// Coverage factor k of the repeatability (default 3).
+    pub coverage: f64,
+    /// Quote half the largest forward-reverse difference as hysteresis (default false).
+    pub half_hysteresis: bool,
+    /// Order of the polynomial model (default 1).
+    pub order: usize,
+    /// Nonlinearity limit for the linear input range, percent.
+    pub nonlinearity_limit_pct: Option<f64>,
+    /// An existing calibration file for the static sections (resolved path).
+    pub calibration: Option<PathBuf>,
+}
+
+/// The rate-table record of one axis (`[rate.<axis>]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RateAxisPlan {
+    /// Axis name.
+    pub axis: String,
+    /// The record, resolved against the plan's folder.
+    pub file: PathBuf,
+    /// The path as written in the plan.
+    pub file_as_written: String,
+    /// Column names and units, as for `gyrolab rate`.
+    pub columns: RateColumns,
+}
+
+/// The static records of one axis (`[static.<axis>]`), kept for the static and Allan sections.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StaticAxisPlan {
+    /// Axis name.
+    pub axis: String,
+    /// Records, one per static test, resolved against the plan's folder.
+    pub files: Vec<PathBuf>,
+    /// Sample rate, Hz.
+    pub sample_rate_hz: f64,
+    /// Name of the output column.
+    pub channel: Option<String>,
+    /// Output unit, overriding the column suffix.
+    pub output_unit: Option<OutputUnit>,
+    /// Name of the temperature column.
+    pub temperature_channel: Option<String>,
+    /// Latitude of the test site, degrees (for the earth-rate correction).
+    pub latitude_deg: Option<f64>,
+}
+
+/// One spec limit (`[limits] figure = { min = .., max = .. }`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanLimit {
+    /// Figure key (a JSON key with its unit suffix).
+    pub figure: String,
+    /// Lower bound, inclusive.
+    pub min: Option<f64>,
+    /// Upper bound, inclusive.
+    pub max: Option<f64>,
+    /// 1-based line in the plan.
+    pub line: u64,
+}
+
+/// A parsed and checked test plan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TestPlan {
+    /// The plan file.
+    pub file: PathBuf,
+    /// The device.
+    pub device: DevicePlan,
+    /// Options.
+    pub options: PlanOptions,
+    /// Rate-table records in device axis order.
+    pub rate: Vec<RateAxisPlan>,
+    /// Static records in device axis order.
+    pub static_tests: Vec<StaticAxisPlan>,
+    /// Spec limits, by figure name.
+    pub limits: Vec<PlanLimit>,
+}
+
+/// Reads and checks a plan file; `known_figure` tells which `[limits]` names exist.
+pub fn read_plan(path: &Path, known_figure: &dyn Fn(&str) -> bool) -> Result<TestPlan, DataError> {
+    let text = std::fs::read_to_string(path).map_err(|e| DataError::io(path, &e))?;
+    parse_plan(path, &text, known_figure)
+}
+
+struct Ctx<'a> {
+    path: &'a Path,
+    text: &'a str,
+    base: PathBuf,
+}
+
+impl Ctx<'_> {
+    fn err(&self, span: std::ops::Range<usize>, key: &str, msg: impl std::fmt::Display) -> DataError {
+        let (line, col) = line_col(self.text, span.start);
+        DataError::new(self.path, format!("{key}: {msg}")).at_line(line).at_column(col, None)
+    }
+
+    fn existing_file(&self, key: &str, value: &Spanned<String>) -> Result<PathBuf, DataError> {
+        let p = self.base.join(value.get_ref());
+        if p.is_file() {
+            Ok(p)
+        } else {
+            Err(self.err(
+                value.span(),
+                key,
+                format!(
+                    "file '{}' not found (looked for {}; relative paths start at the plan's folder)",
+                    value.get_ref(),
+                    p.display()
+                ),
+            ))
+        }
+    }
+
+    fn output_unit(&self, key: &str, v: &Option<Spanned<String>>) -> Result<Option<OutputUnit>, DataError> {
+        v.as_ref()
+            .map(|s| {
+                OutputUnit::parse(s.get_ref()).ok_or_else(|| {
+                    self.err(
+                        s.span(),
+                        key,
+                        format!("unknown output unit '{}': expected v, mv, lsb, dps or rad_s", s.get_ref()),
+                    )
+                })
+            })
+            .transpose()
+    }
+}
+
+/// Parses and checks plan text; `path` names it in errors and its folder anchors relative paths.
+pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) -> Result<TestPlan, DataError> {
+    let raw: RawPlan = toml::from_str(text).map_err(|e| {
+        let mut d = DataError::new(path, format!("not a valid test plan: {}", e.message().trim_end()));
+        if let Some(span) = e.span() {
+            let (line, col) = line_col(text, span.start);
+            d = d.at_line(line).at_column(col, None);
+        }
+        d
+    })?;
+    let base = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let cx = Ctx { path, text, base };
+
+    let axes = raw.device.axes.get_ref().clone();
+    if axes.is_empty() {
+        return Err(cx.err(
+            raw.device.axes.span(),
+            "device.axes",
+            "no axis: expected a list such as [\"x\", \"y\", \"z\"]",
+        ));
+    }
+    for (i, a) in axes.iter().enumerate() {
+        if a.trim().is_empty() || axes[..i].contains(a) {
+            return Err(cx.err(raw.device.axes.span(), "device.axes", format!("axis name '{a}' is empty or repeated")));
+        }
+    }
+    for (table, keys) in [
+        ("rate", raw.rate.iter().map(|(k, v)| (k, v.span())).collect::<Vec<_>>()),
+        ("static", raw.static_tests.iter().map(|(k, v)| (k, v.span())).collect()),
+    ] {
+        for (k, span) in keys {
+            if !axes.contains(k) {
+                return Err(cx.err(
+                    span,
+                    &format!("{table}.{k}"),
+                    format!("axis '{k}' is not in device.axes ({})", axes.join(", ")),
+                ));
+            }
+        }
+    }
+    for a in &axes {
+        if !raw.rate.contains_key(a) && !raw.static_tests.contains_key(a) {
+            return Err(cx.err(
+                raw.device.axes.span(),
+                "device.axes",
+                format!("axis '{a}' has neither a [rate.{a}] nor a [static.{a}] table"),
+            ));
+        }
+    }
+
+    let o = &raw.options;
+    let coverage = match &o.coverage {
+        Some(c) if !(c.get_ref().is_finite() && *c.get_ref() > 0.0) => {
+            return Err(cx.err(c.span(), "options.coverage", format!("must be a positive number, got {}", c.get_ref())))
+        }
+        Some(c) => *c.get_ref(),
+        None => 3.0,
+    };
+    let order = match &o.order {
+        Some(n) if !(1..=9).contains(n.get_ref()) => {
+            return Err(cx.err(n.span(), "options.order", format!("must be 1 to 9, got {}", n.get_ref())))
+        }
+        Some(n) => *n.get_ref() as usize, // ok: checked to be 1..=9 above
+        None => 1,
+    };
+    if let Some(l) = &o.nonlinearity_limit_pct {
+        if !(l.get_ref().is_finite() && *l.get_ref() > 0.0) {
+            return Err(cx.err(
+                l.span(),
+                "options.nonlinearity_limit_pct",
+                format!("must be a positive percentage, got {}", l.get_ref()),
+            ));
+        }
+    }
+    let calibration = o.calibration.as_ref().map(|c| cx.existing_file("options.calibration", c)).transpose()?;
+    let options = PlanOptions {
+        coverage,
+        half_hysteresis: o.half_hysteresis.unwrap_or(false),
+        order,
+        nonlinearity_limit_pct: o.nonlinearity_limit_pct.as_ref().map(|l| *l.get_ref()),
+        calibration,
+    };
+
+    let mut rate = Vec::new();
+    let mut static_tests = Vec::new();
+    for axis in &axes {
+        if let Some(r) = raw.rate.get(axis) {
+            let r = r.get_ref();
+            let key = |k: &str| format!("rate.{axis}.{k}");
+            let rate_unit = r
+                .rate_unit
+                .as_ref()
+                .map(|s| {
+                    RateUnit::parse(s.get_ref()).ok_or_else(|| {
+                        cx.err(
+                            s.span(),
+                            &key("rate_unit"),
+                            format!("unknown rate unit '{}': expected dps, rad_s or dph", s.get_ref()),
+                        )
+                    })
+                })
+                .transpose()?;
+            rate.push(RateAxisPlan {
+                axis: axis.clone(),
+                file: cx.existing_file(&key("file"), &r.file)?,
+                file_as_written: r.file.get_ref().clone(),
+                columns: RateColumns {
+                    rate: r.rate_column.clone(),
+                    run: r.run_column.clone(),
+                    stroke: r.stroke_column.clone(),
+                    output: r.output_column.clone(),
+                    rate_unit,
+                    output_unit: cx.output_unit(&key("output_unit"), &r.output_unit)?,
+                },
+            });
+        }
+        if let Some(s) = raw.static_tests.get(axis) {
+            let span = s.span();
+            let s = s.get_ref();
+            let key = |k: &str| format!("static.{axis}.{k}");
+            if s.files.get_ref().is_empty() {
+                return Err(cx.err(span, &key("files"), "no file: expected one record per static test"));
+            }
+            let files = s
+                .files
+                .get_ref()
+                .iter()
+                .enumerate()
+                .map(|(i, f)| {
+                    cx.existing_file(&format!("{}[{i}]", key("files")), &Spanned::new(s.files.span(), f.clone()))
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            let fs = *s.sample_rate_hz.get_ref();
+            if !(fs.is_finite() && fs > 0.0) {
+                return Err(cx.err(
+                    s.sample_rate_hz.span(),
+                    &key("sample_rate_hz"),
+                    format!("must be a positive number of Hz, got {fs}"),
+                ));
+            }
+            if let Some(l) = &s.latitude_deg {
+                if !(l.get_ref().is_finite() && l.get_ref().abs() <= 90.0) {
+                    return Err(cx.err(
+                        l.span(),
+                        &key("latitude_deg"),
+                        format!("must be within -90..90 degrees, got {}", l.get_ref()),
+                    ));
+                }
+            }
+            static_tests.push(StaticAxisPlan {
+                axis: axis.clone(),
+                files,
+                sample_rate_hz: fs,
+                channel: s.channel.clone(),
+                output_unit: cx.output_unit(&key("output_unit"), &s.output_unit)?,
+                temperature_channel: s.temperature_channel.clone(),
+                latitude_deg: s.latitude_deg.as_ref().map(|l| *l.get_ref()),
+            });
+        }
+    }
+
+    let mut limits = Vec::new();
+    for (name, l) in &raw.limits {
+        let key = format!("limits.{name}");
+        if !known_figure(name) {
+            return Err(cx.err(
+                l.span(),
+                &key,
+                format!("'{name}' is not a figure gyrolab reports: limit names are the JSON keys with their unit, such as nonlinearity_pct or bias_stability_dph_10s (docs/PLAN.md lists them)"),
+            ));
+        }
+        let v = l.get_ref();
+        let bad = |x: Option<f64>| x.is_some_and(|x| !x.is_finite());
+        if (v.min.is_none() && v.max.is_none()) || bad(v.min) || bad(v.max) {
+            return Err(cx.err(l.span(), &key, "expected { min = NUMBER } or { max = NUMBER } or both"));
+        }
+        if let (Some(lo), Some(hi)) = (v.min, v.max) {
+            if lo > hi {
+                return Err(cx.err(l.span(), &key, format!("min {lo} is above max {hi}")));
+            }
+        }
+        limits.push(PlanLimit { figure: name.clone(), min: v.min, max: v.max, line: line_col(text, l.span().start).0 });
+    }
+    limits.sort_by_key(|l| l.line);
+
+    Ok(TestPlan {
+        file: path.to_path_buf(),
+        device: DevicePlan {
+            model: raw.device.model,
+            serial: raw.device.serial,
+            axes,
+            description: raw.device.description,
+        },
+        options,
+        rate,
+        static_tests,
+        limits,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn known(n: &str) -> bool {
+        matches!(n, "nonlinearity_pct" | "bias_stability_dph_10s")
+    }
+
+    /// A folder with two record files and a plan around them.
+    fn setup(plan: &str) -> (tempfile::TempDir, Result<TestPlan, DataError>) {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("x.csv"), "rate_dps,run,stroke,output_v\n").unwrap();
+        std::fs::write(dir.path().join("s1.csv"), "t,v\n").unwrap();
+        let p = dir.path().join("plan.toml");
+        std::fs::write(&p, plan).unwrap();
+        let r = read_plan(&p, &known);
+        (dir, r)
+    }
+
+    const GOOD: &str = r#"# a plan
+[device]
+model = "ADXRS646"
+serial = "SN1"
+axes = ["x"]
+
+[options]
+coverage = 2
+order = 3
+
+[rate.x]
+file = "x.csv"
+output_unit = "v"
+
+[static.x]
+files = ["s1.csv"]
+sample_rate_hz = 1.0
+
+[limits]
+nonlinearity_pct = { max = 0.1 }
+bias_stability_dph_10s = { max = 20 }
+"#;
+
+    #[test]
+    fn good_plan() {
+        let (dir, r) = setup(GOOD);
+        let p = r.unwrap();
+        assert_eq!(p.device.axes, ["x"]);
+        assert_eq!(p.options.coverage, 2.0);
+        assert_eq!(p.options.order, 3);
+        assert_eq!(p.rate[0].file, dir.path().join("x.csv"));
+        assert_eq!(p.rate[0].columns.output_unit, Some(OutputUnit::Volt));
+        assert_eq!(p.static_tests[0].files, [dir.path().join("s1.csv")]);
+        assert_eq!(p.limits.len(), 2);
+        assert_eq!(
+            (p.limits[0].figure.as_str(), p.limits[0].max, p.limits[0].line),
+            ("nonlinearity_pct", Some(0.1), 20)
+        );
+    }
+
+    fn error(plan: &str) -> DataError {
+        let (_d, r) = setup(plan);
+        r.unwrap_err()
+    }
+
+    #[test]
+    fn unknown_key_names_key_and_line() {
+        let e = error(&GOOD.replace("output_unit = \"v\"", "output_unt = \"v\""));
+        assert_eq!(e.line, Some(13), "{e}");
+        assert!(e.to_string().contains("output_unt"), "{e}");
+        let e = error(&GOOD.replace("[options]", "[optons]"));
+        assert_eq!(e.line, Some(7), "{e}");
+        assert!(e.to_string().contains("optons"), "{e}");
+    }
+
+    #[test]
+    fn missing_file_names_key_line_and_path() {
+        let e = error(&GOOD.replace("file = \"x.csv\"", "file = \"nope.csv\""));
+        assert_eq!(e.line, Some(12), "{e}");
+        let s = e.to_string();
+        assert!(s.contains("rate.x.file") && s.contains("nope.csv") && s.contains("not found"), "{s}");
+        let e = error(&GOOD.replace("[\"s1.csv\"]", "[\"s1.csv\", \"s2.csv\"]"));
+        assert!(e.to_string().contains("static.x.files[1]") && e.to_string().contains("s2.csv"), "{e}");
+        assert_eq!(e.line, Some(16));
+    }
+
+    #[test]
+    fn bad_unit_names_key_and_line() {
+        let e = error(&GOOD.replace("output_unit = \"v\"", "output_unit = \"volt-ish\""));
+        assert_eq!(e.line, Some(13), "{e}");
+        assert!(e.to_string().contains("rate.x.output_unit: unknown output unit 'volt-ish'"), "{e}");
+    }
+
+    #[test]
+    fn limit_on_unknown_figure_names_key_and_line() {
+        let e = error(&GOOD.replace("nonlinearity_pct = { max = 0.1 }", "nonlinearity = { max = 0.1 }"));
+        assert_eq!(e.line, Some(20), "{e}");
+        assert!(e.to_string().contains("limits.nonlinearity: 'nonlinearity' is not a figure"), "{e}");
+        let e = error(&GOOD.replace("{ max = 0.1 }", "{ }"));
+        assert!(e.to_string().contains("limits.nonlinearity_pct: expected"), "{e}");
+        let e = error(&GOOD.replace("{ max = 0.1 }", "{ min = 2, max = 1 }"));
+        assert!(e.to_string().contains("min 2 is above max 1"), "{e}");
+    }
+
+    #[test]
+    fn axis_consistency_and_options() {
+        let e = error(&GOOD.replace("axes = [\"x\"]", "axes = [\"y\"]"));
+        assert!(e.to_string().contains("rate.x: axis 'x' is not in device.axes (y)"), "{e}");
+        let e = error(&GOOD.replace("axes = [\"x\"]", "axes = [\"x\", \"z\"]"));
+        assert!(e.to_string().contains("axis 'z' has neither"), "{e}");
+        assert_eq!(e.line, Some(5));
+        let e = error(&GOOD.replace("order = 3", "order = 0"));
+        assert!(e.to_string().contains("options.order: must be 1 to 9"), "{e}");
+        assert_eq!(e.line, Some(9));
+        let e = error(&GOOD.replace("sample_rate_hz = 1.0", "sample_rate_hz = -1"));
+        assert!(e.to_string().contains("static.x.sample_rate_hz"), "{e}");
+        let e = error(&GOOD.replace("serial = \"SN1\"\n", ""));
+        assert!(e.to_string().contains("serial"), "{e}");
+    }
+}

@@ -1,0 +1,180 @@
+//! The catalogue of reportable figures: the names a plan's `[limits]` may use (the JSON keys,
+//! each with its unit suffix), with unit, formula and source for the summary table and the
+//! methods appendix (taken from docs/METHODS.md; static and Allan entries from
+//! methods-notes sections 3 and 4, for the sections still to come).
+
+use crate::rate::AxisJson;
+
+/// Which part of a test a figure comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum FigureGroup {
+    /// Rate-table (scale-factor) test.
+    RateTable,
+    /// Static (bias) test.
+    Static,
+    /// Allan variance noise terms.
+    Allan,
+}
+
+impl FigureGroup {
+    /// Display name of the group.
+    pub fn title(self) -> &'static str {
+        match self {
+            FigureGroup::RateTable => "Rate-table test",
+            FigureGroup::Static => "Static (bias) test",
+            FigureGroup::Allan => "Allan variance",
+        }
+    }
+}
+
+/// A figure's definition: key (the JSON key and limit name), unit, formula and source.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FigureDef {
+    /// JSON key and `[limits]` name; `<T>` stands for a smoothing time in seconds.
+    pub key: &'static str,
+    /// Human name.
+    pub label: &'static str,
+    /// Unit as printed (`output` = the axis's output unit).
+    pub unit: &'static str,
+    /// Group.
+    pub group: FigureGroup,
+    /// Formula in plain text.
+    pub formula: &'static str,
+    /// Source label ([P], [GJB], [IEEE], [T], [SP1065]).
+    pub source: &'static str,
+}
+
+const fn def(
+    key: &'static str,
+    label: &'static str,
+    unit: &'static str,
+    group: FigureGroup,
+    formula: &'static str,
+    source: &'static str,
+) -> FigureDef {
+    FigureDef { key, label, unit, group, formula, source }
+}
+
+use FigureGroup::{Allan, RateTable, Static};
+
+/// Every figure gyrolab reports or will report, in report order.
+#[rustfmt::skip]
+pub const FIGURES: &[FigureDef] = &[
+    def("scale_factor", "scale factor K", "output/(deg/s)", RateTable, "least-squares slope of the point means ȳ_j on the rates Ω_j", "[P] eq. 1-2"),
+    def("zero_offset", "zero offset F0", "output", RateTable, "F0 = mean(ȳ) − K mean(Ω)", "[P] eq. 3"),
+    def("nonlinearity_pct", "nonlinearity K_a", "%", RateTable, "K_a = max_j |a_j|, a_j = (K Ω_j + F0 − F_r − (ȳ_j − F_r)) / F_m, F_m = max_j |ȳ_j − F_r|", "[P] eq. 7-9, [GJB]"),
+    def("nonlinearity_ppm", "nonlinearity K_a", "ppm", RateTable, "as nonlinearity_pct, in parts per million", "[P] eq. 9"),
+    def("linearity_pct", "linearity δ_L", "% FS", RateTable, "max_j |ȳ_j − (K Ω_j + F0)| / Y_FS, Y_FS = |K| (Ω_max − Ω_min)", "[T]"),
+    def("hysteresis_pct", "hysteresis δ_H", "% FS", RateTable, "max_j |ȳ_j,fwd − ȳ_j,rev| / Y_FS (half of it with half_hysteresis)", "[T]"),
+    def("repeatability_pct", "repeatability δ_R", "% FS", RateTable, "k σ_max / Y_FS, σ_max the largest std (n − 1) across runs at any point and stroke", "[T]"),
+    def("accuracy_pct", "accuracy (sum)", "% FS", RateTable, "δ_L + δ_H + δ_R (the paper's rule)", "[P], [T]"),
+    def("accuracy_rss_pct", "accuracy (RSS)", "% FS", RateTable, "√(δ_L² + δ_H² + δ_R²)", "[T]"),
+    def("asymmetry_pct", "scale-factor asymmetry K_as", "%", RateTable, "|K+ − K−| / |(K+ + K−)/2|, K± fitted on Ω ≥ 0 and Ω ≤ 0", "[GJB], [IEEE 528]"),
+    def("scale_factor_repeatability_ppm", "scale-factor repeatability K_r", "ppm", RateTable, "std(K_i, n − 1) / |mean(K_i)|, K_i fitted per run on both strokes", "[GJB]"),
+    def("scale_factor_repeatability_pct", "scale-factor repeatability K_r", "%", RateTable, "as scale_factor_repeatability_ppm, in percent", "[GJB]"),
+    def("bias_dph", "bias B_0", "deg/h", Static, "(mean output − F_null) / K", "[P] eq. 10"),
+    def("bias_stability_dph_<T>s", "bias stability B_s(T)", "deg/h", Static, "std(means of consecutive T-second windows, n − 1) / K", "[P] eq. 11, [GJB]"),
+    def("bias_repeatability_dph", "bias repeatability B_r", "deg/h", Static, "std(B_0i, n − 1) over the Q tests", "[P] eq. 12, [GJB]"),
+    def("drift_dph_per_h", "drift", "deg/h per h", Static, "least-squares slope of bias against time", "[GJB]"),
+    def("arw_deg_rt_h", "angle random walk N", "deg/√h", Allan, "ADEV slope −1/2 line read at τ = 1 s, × 60", "[IEEE 952], [SP1065]"),
+    def("bias_instability_dph", "bias instability B", "deg/h", Allan, "flat ADEV minimum / 0.6643", "[IEEE 952]"),
+    def("rrw_deg_h_rt_h", "rate random walk K", "deg/h/√h", Allan, "ADEV slope +1/2 line read at τ = 3 s, × 216000", "[IEEE 952]"),
+];
+
+/// The names a `[limits]` table may use (`<T>` stands for a smoothing time in seconds).
+pub fn figure_names() -> Vec<&'static str> {
+    FIGURES.iter().map(|f| f.key).collect()
+}
+
+/// Whether `name` matches a catalogue key, `<T>` matching a positive decimal number.
+pub fn name_matches(pattern: &str, name: &str) -> bool {
+    match pattern.split_once("<T>") {
+        None => pattern == name,
+        Some((pre, post)) => name
+            .strip_prefix(pre)
+            .and_then(|r| r.strip_suffix(post))
+            .is_some_and(|t| !t.is_empty() && t.parse::<f64>().is_ok_and(|v| v > 0.0 && v.is_finite())),
+    }
+}
+
+/// The definition of a figure name, if it is known.
+pub fn known_figure(name: &str) -> Option<&'static FigureDef> {
+    FIGURES.iter().find(|f| name_matches(f.key, name))
+}
+
+/// The values of one axis's figures, by key (figures that could not be computed are absent).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct AxisFigures {
+    /// Axis name.
+    pub axis: String,
+    /// Output unit of the axis (replaces `output` in units).
+    pub output_unit: String,
+    /// (key, value) in catalogue order; static and Allan sections append theirs.
+    pub values: Vec<(String, f64)>,
+}
+
+impl AxisFigures {
+    /// The value of a figure.
+    pub fn get(&self, key: &str) -> Option<f64> {
+        self.values.iter().find(|(k, _)| k == key).map(|(_, v)| *v)
+    }
+
+    /// Adds or replaces a figure value (non-finite values are left out).
+    pub fn set(&mut self, key: impl Into<String>, value: f64) {
+        let key = key.into();
+        self.values.retain(|(k, _)| *k != key);
+        if value.is_finite() {
+            self.values.push((key, value));
+        }
+    }
+
+    /// The unit of a figure for this axis.
+    pub fn unit_of(&self, key: &str) -> String {
+        known_figure(key).map_or_else(String::new, |d| d.unit.replace("output", &self.output_unit))
+    }
+}
+
+/// The rate-table figures of an axis, from its JSON.
+pub fn rate_figures(a: &AxisJson) -> AxisFigures {
+    let mut f = AxisFigures { axis: a.name.clone(), output_unit: a.output_unit.clone(), values: Vec::new() };
+    let opt = [
+        ("scale_factor", Some(a.scale_factor)),
+        ("zero_offset", Some(a.zero_offset)),
+        ("nonlinearity_pct", Some(a.nonlinearity_pct)),
+        ("nonlinearity_ppm", Some(a.nonlinearity_ppm)),
+        ("linearity_pct", Some(a.linearity_pct)),
+        ("hysteresis_pct", Some(a.hysteresis_pct)),
+        ("repeatability_pct", a.repeatability_pct),
+        ("accuracy_pct", a.accuracy_pct),
+        ("accuracy_rss_pct", a.accuracy_rss_pct),
+        ("asymmetry_pct", a.asymmetry_pct),
+        ("scale_factor_repeatability_ppm", a.scale_factor_repeatability_ppm),
+        ("scale_factor_repeatability_pct", a.scale_factor_repeatability_pct),
+    ];
+    for (k, v) in opt {
+        if let Some(v) = v {
+            f.set(k, v);
+        }
+    }
+    f
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_and_patterns() {
+        assert!(known_figure("nonlinearity_pct").is_some());
+        assert!(known_figure("bias_stability_dph_10s").is_some());
+        assert!(known_figure("bias_stability_dph_0.5s").is_some());
+        assert!(known_figure("bias_stability_dph_s").is_none());
+        assert!(known_figure("bias_stability_dph_-1s").is_none());
+        assert!(known_figure("nonlinearity").is_none());
+        assert!(figure_names().contains(&"arw_deg_rt_h"));
+        let mut keys = figure_names();
+        keys.sort();
+        keys.dedup();
+        assert_eq!(keys.len(), FIGURES.len(), "keys are unique");
+    }
+}

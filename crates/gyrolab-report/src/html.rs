@@ -1,0 +1,604 @@
+//! The self-contained HTML report: inline CSS and SVG, no script, no external URL, no web font;
+//! prints to A4 (each axis section starts on a new page, plots never split or clip).
+//!
+//! A report is a [`Report`]: a device header, the summary table of every figure with its limit
+//! and verdict ([`SummaryTable`]), a list of [`ReportSection`]s and the methods appendix built
+//! from the figure catalogue ([`crate::figures::FIGURES`]). A section is generic (title, a
+//! simulated-data flag, a figure table, data tables, plots), so the static-bias and Allan
+//! sections are added by building more `ReportSection`s: the page template does not change.
+
+use crate::figures::{known_figure, AxisFigures, FigureGroup, FIGURES};
+use crate::format::{sig, sig_opt};
+use crate::limits::{check_limits, overall, Limit, LimitCheck, Verdict};
+use crate::plot::PlotError;
+use crate::rate::AxisReport;
+use crate::rate_plots::{calibration_plot, hysteresis_plot, scale_factor_plot};
+use gyrolab::units::{ratio_to_pct, ratio_to_ppm};
+use std::fmt::Write;
+
+/// Escapes text for HTML element content and attribute values.
+pub fn escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// The report's header: what was tested, when, by which program, from which plan.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ReportHeader {
+    /// Report title.
+    pub title: String,
+    /// Device model.
+    pub model: String,
+    /// Device serial number.
+    pub serial: String,
+    /// Axes, in plan order.
+    pub axes: Vec<String>,
+    /// Date and time of the evaluation (RFC 3339).
+    pub date: String,
+    /// gyrolab version.
+    pub gyrolab_version: String,
+    /// The plan file (or a description of the built-in data).
+    pub plan_file: String,
+    /// Further lines shown under the header (plain text).
+    pub notes: Vec<String>,
+}
+
+/// One row of a section's figure table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FigureRow {
+    /// Figure name (human).
+    pub label: String,
+    /// Catalogue key, linking to the methods appendix; empty for none.
+    pub key: String,
+    /// Value as text.
+    pub value: String,
+    /// Unit.
+    pub unit: String,
+    /// Limit as text (empty for none).
+    pub limit: String,
+    /// Verdict when a limit applies.
+    pub verdict: Option<Verdict>,
+}
+
+/// A table of data (points, runs...).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct DataTable {
+    /// Caption.
+    pub caption: String,
+    /// Column headers (with units).
+    pub header: Vec<String>,
+    /// Rows of cells.
+    pub rows: Vec<Vec<String>>,
+}
+
+/// A plot with its caption.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlotBlock {
+    /// Caption under the plot.
+    pub caption: String,
+    /// Inline SVG from [`crate::plot::Figure::to_svg`].
+    pub svg: String,
+}
+
+/// A report section (one axis's rate-table test, its static test, its Allan analysis...).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ReportSection {
+    /// Section title.
+    pub title: String,
+    /// Whether the section's data are simulated (shown as a prominent label).
+    pub simulated: bool,
+    /// Introductory paragraphs (plain text).
+    pub paragraphs: Vec<String>,
+    /// The figure table.
+    pub figures: Vec<FigureRow>,
+    /// Plots.
+    pub plots: Vec<PlotBlock>,
+    /// Data tables, after the plots.
+    pub tables: Vec<DataTable>,
+    /// Start the section on a new printed page.
+    pub page_break_before: bool,
+}
+
+/// One row of the summary: a figure, its unit, its limit and the value and verdict per axis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SummaryRow {
+    /// Catalogue key.
+    pub key: String,
+    /// Human name.
+    pub label: String,
+    /// Unit (the first axis's, for output-valued figures).
+    pub unit: String,
+    /// Limit text, empty for none.
+    pub limit: String,
+    /// Per axis: value text and verdict (None when no limit applies).
+    pub cells: Vec<(String, Option<Verdict>)>,
+}
+
+/// The summary table of every figure.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SummaryTable {
+    /// Axis names (columns).
+    pub axes: Vec<String>,
+    /// Rows in catalogue order.
+    pub rows: Vec<SummaryRow>,
+    /// Every limit check.
+    pub checks: Vec<LimitCheck>,
+}
+
+impl SummaryTable {
+    /// Builds the summary from each axis's figures and the plan's limits.
+    pub fn build(axes: &[AxisFigures], limits: &[Limit]) -> SummaryTable {
+        let checks = check_limits(limits, axes);
+        let mut keys: Vec<String> = Vec::new();
+        for def in FIGURES {
+            for a in axes {
+                for (k, _) in &a.values {
+                    if crate::figures::name_matches(def.key, k) && !keys.contains(k) {
+                        keys.push(k.clone());
+                    }
+                }
+            }
+            for l in limits {
+                if crate::figures::name_matches(def.key, &l.figure) && !keys.contains(&l.figure) {
+                    keys.push(l.figure.clone());
+                }
+            }
+        }
+        let rows = keys
+            .into_iter()
+            .map(|key| {
+                let def = known_figure(&key);
+                let limit = limits.iter().find(|l| l.figure == key);
+                let cells = axes
+                    .iter()
+                    .map(|a| {
+                        let v = a.get(&key);
+                        let text = match v {
+                            Some(v) if key == "scale_factor" || key == "zero_offset" => sig(v, 6),
+                            Some(v) => sig(v, 4),
+                            None => "n/a".into(),
+                        };
+                        let verdict = limit.map(|_| {
+                            checks
+                                .iter()
+                                .find(|c| c.axis == a.axis && c.figure == key)
+                                .map_or(Verdict::NotEvaluated, |c| c.verdict)
+                        });
+                        (text, verdict)
+                    })
+                    .collect();
+                SummaryRow {
+                    label: def.map_or_else(|| key.clone(), |d| d.label.to_string()),
+                    unit: axes.first().map_or_else(String::new, |a| a.unit_of(&key)),
+                    limit: limit.map_or_else(String::new, Limit::text),
+                    key,
+                    cells,
+                }
+            })
+            .collect();
+        SummaryTable { axes: axes.iter().map(|a| a.axis.clone()).collect(), rows, checks }
+    }
+
+    /// The overall verdict of the limits.
+    pub fn overall(&self) -> Verdict {
+        overall(&self.checks)
+    }
+}
+
+/// The whole report.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Report {
+    /// Header.
+    pub header: ReportHeader,
+    /// Summary of every figure.
+    pub summary: SummaryTable,
+    /// Sections in order (rate-table per axis, then static and Allan when present).
+    pub sections: Vec<ReportSection>,
+}
+
+const CSS: &str = r#"
+:root { --pass: #1b7f3a; --pass-bg: #dff3e4; --fail: #b00020; --fail-bg: #fde2e4; --ne: #6b6b6b; --ne-bg: #eeeeee; }
+* { box-sizing: border-box; }
+body { font-family: sans-serif; font-size: 11pt; color: #111; margin: 0 auto; padding: 16px 24px; max-width: 1100px; line-height: 1.35; }
+h1 { font-size: 20pt; margin: 0 0 8px; }
+h2 { font-size: 15pt; margin: 24px 0 8px; border-bottom: 2px solid #333; padding-bottom: 2px; }
+h3 { font-size: 12pt; margin: 16px 0 6px; }
+table { border-collapse: collapse; margin: 6px 0 12px; font-size: 10pt; }
+th, td { border: 1px solid #bbb; padding: 3px 7px; text-align: right; vertical-align: top; }
+th { background: #f0f0f0; }
+caption { text-align: left; font-weight: bold; padding: 2px 0; white-space: nowrap; }
+td.name, th.name { text-align: left; }
+table.header td { text-align: left; border: none; padding: 1px 10px 1px 0; }
+.verdict { font-weight: bold; white-space: nowrap; padding: 0 4px; border-radius: 3px; }
+.PASS { color: var(--pass); background: var(--pass-bg); }
+.FAIL { color: var(--fail); background: var(--fail-bg); }
+.NOT_EVALUATED { color: var(--ne); background: var(--ne-bg); }
+.overall { font-size: 13pt; padding: 4px 10px; display: inline-block; margin: 4px 0; }
+.simulated { display: inline-block; background: #fff3cd; color: #7a5a00; border: 2px solid #e0b000; font-weight: bold; padding: 2px 10px; margin: 4px 0; }
+figure.plot { margin: 10px 0 16px; break-inside: avoid; page-break-inside: avoid; }
+figure.plot svg { display: block; width: 100%; max-width: 760px; height: auto; border: 1px solid #ddd; }
+figcaption { font-size: 9.5pt; color: #333; margin-top: 3px; }
+.note { font-size: 9.5pt; color: #333; }
+section.page-break { break-before: page; page-break-before: always; }
+tr { break-inside: avoid; page-break-inside: avoid; }
+@page { size: A4; margin: 14mm 12mm; }
+@media print {
+  body { max-width: none; padding: 0; font-size: 10pt; }
+  * { -webkit-print-color-adjust: exact; print-color-adjust: exact; }
+  figure.plot svg { max-width: 100%; max-height: 240mm; }
+  h2, h3 { break-after: avoid; page-break-after: avoid; }
+}
+"#;
+
+fn verdict_span(v: Verdict) -> String {
+    let class = match v {
+        Verdict::Pass => "PASS",
+        Verdict::Fail => "FAIL",
+        Verdict::NotEvaluated => "NOT_EVALUATED",
+    };
+    format!("<span class=\"verdict {class}\">{}</span>", v.text())
+}
+
+fn anchor(key: &str) -> String {
+    let pattern = known_figure(key).map_or(key, |d| d.key);
+    let id: String = pattern.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '-' }).collect();
+    format!("def-{id}")
+}
+
+fn figure_link(key: &str, label: &str) -> String {
+    if key.is_empty() || known_figure(key).is_none() {
+        escape(label)
+    } else {
+        format!("<a href=\"#{}\">{}</a>", anchor(key), escape(label))
+    }
+}
+
+fn write_table(h: &mut String, t: &DataTable) {
+    let _ = write!(h, "<table><caption>{}</caption><thead><tr>", escape(&t.caption));
+    for (i, c) in t.header.iter().enumerate() {
+        let class = if i == 0 { " class=\"name\"" } else { "" };
+        let _ = write!(h, "<th{class}>{}</th>", escape(c));
+    }
+    h.push_str("</tr></thead><tbody>\n");
+    for r in &t.rows {
+        h.push_str("<tr>");
+        for (i, c) in r.iter().enumerate() {
+            let class = if i == 0 { " class=\"name\"" } else { "" };
+            let _ = write!(h, "<td{class}>{}</td>", escape(c));
+        }
+        h.push_str("</tr>\n");
+    }
+    h.push_str("</tbody></table>\n");
+}
+
+fn write_section(h: &mut String, s: &ReportSection) {
+    let class = if s.page_break_before { " class=\"page-break\"" } else { "" };
+    let _ = write!(h, "<section{class}>\n<h2>{}</h2>\n", escape(&s.title));
+    if s.simulated {
+        h.push_str(
+            "<p class=\"simulated\">SIMULATED DATA: the records of this section were generated by gyrolab's \
+             simulator, not measured.</p>\n",
+        );
+    }
+    for p in &s.paragraphs {
+        let _ = writeln!(h, "<p>{}</p>", escape(p));
+    }
+    if !s.figures.is_empty() {
+        h.push_str(
+            "<table><thead><tr><th class=\"name\">figure</th><th>value</th><th class=\"name\">unit</th>\
+             <th>limit</th><th>verdict</th></tr></thead><tbody>\n",
+        );
+        for f in &s.figures {
+            let _ = writeln!(
+                h,
+                "<tr><td class=\"name\">{}</td><td>{}</td><td class=\"name\">{}</td><td>{}</td><td>{}</td></tr>",
+                figure_link(&f.key, &f.label),
+                escape(&f.value),
+                escape(&f.unit),
+                escape(&f.limit),
+                f.verdict.map_or_else(String::new, verdict_span)
+            );
+        }
+        h.push_str("</tbody></table>\n");
+    }
+    for p in &s.plots {
+        let _ = writeln!(h, "<figure class=\"plot\">{}<figcaption>{}</figcaption></figure>", p.svg, escape(&p.caption));
+    }
+    for t in &s.tables {
+        write_table(h, t);
+    }
+    h.push_str("</section>\n");
+}
+
+fn write_summary(h: &mut String, s: &SummaryTable) {
+    h.push_str("<section>\n<h2>Summary</h2>\n");
+    if !s.checks.is_empty() {
+        let o = s.overall();
+        let failed = s.checks.iter().filter(|c| c.verdict == Verdict::Fail).count();
+        let not_eval = s.checks.iter().filter(|c| c.verdict == Verdict::NotEvaluated).count();
+        let _ = writeln!(
+            h,
+            "<p>Overall: <span class=\"verdict overall {}\">{}</span> ({} limit check(s): {} failed, {} not evaluated)</p>",
+            match o {
+                Verdict::Pass => "PASS",
+                Verdict::Fail => "FAIL",
+                Verdict::NotEvaluated => "NOT_EVALUATED",
+            },
+            o.text(),
+            s.checks.len(),
+            failed,
+            not_eval
+        );
+    } else {
+        h.push_str("<p class=\"note\">The plan sets no spec limits: figures are reported without verdicts.</p>\n");
+    }
+    h.push_str(
+        "<table class=\"summary\"><thead><tr><th class=\"name\">figure</th><th class=\"name\">unit</th><th>limit</th>",
+    );
+    for a in &s.axes {
+        let _ = write!(h, "<th>axis {}</th>", escape(a));
+    }
+    h.push_str("</tr></thead><tbody>\n");
+    for r in &s.rows {
+        let _ = write!(
+            h,
+            "<tr><td class=\"name\">{} <small>({})</small></td><td class=\"name\">{}</td><td>{}</td>",
+            figure_link(&r.key, &r.label),
+            escape(&r.key),
+            escape(&r.unit),
+            escape(&r.limit)
+        );
+        for (v, verdict) in &r.cells {
+            let _ = write!(
+                h,
+                "<td>{}{}</td>",
+                escape(v),
+                verdict.map_or_else(String::new, |x| format!(" {}", verdict_span(x)))
+            );
+        }
+        h.push_str("</tr>\n");
+    }
+    h.push_str("</tbody></table>\n</section>\n");
+}
+
+fn write_methods(h: &mut String) {
+    h.push_str("<section class=\"page-break\">\n<h2>Appendix: methods</h2>\n<p class=\"note\">Each figure with its formula, unit and source. \
+        Notation: Ω_j table rates (deg/s), ȳ_j point means, ȳ_j,fwd and ȳ_j,rev stroke means, K scale factor, \
+        F0 zero offset, F_r rest reference, Y_FS full-scale output. Sources: [P] Cheng et al. 2014 (the paper), \
+        [GJB] GJB 2426A-2004 / JJF 1535-2015, [IEEE] IEEE Std 952-1997 / 528, [SP1065] NIST SP 1065, [T] sensor textbooks. \
+        Full definitions: docs/METHODS.md of gyrolab.</p>\n");
+    for group in [FigureGroup::RateTable, FigureGroup::Static, FigureGroup::Allan] {
+        let _ = writeln!(h, "<h3>{}</h3>", group.title());
+        h.push_str("<table><thead><tr><th class=\"name\">figure</th><th class=\"name\">key</th><th class=\"name\">formula</th><th class=\"name\">unit</th><th class=\"name\">source</th></tr></thead><tbody>\n");
+        for d in FIGURES.iter().filter(|d| d.group == group) {
+            let _ = writeln!(
+                h,
+                "<tr id=\"{}\"><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td></tr>",
+                anchor(d.key),
+                escape(d.label),
+                escape(d.key),
+                escape(d.formula),
+                escape(d.unit),
+                escape(d.source)
+            );
+        }
+        h.push_str("</tbody></table>\n");
+    }
+    h.push_str("</section>\n");
+}
+
+/// Renders the whole report as one self-contained HTML document.
+pub fn render_html(r: &Report) -> String {
+    let hd = &r.header;
+    let mut h = String::with_capacity(256 * 1024);
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
+         <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
+         <title>{}</title>\n<style>{CSS}</style>\n</head>\n<body>\n<header>\n<h1>{}</h1>\n<table class=\"header\">\n",
+        escape(&hd.title),
+        escape(&hd.title)
+    );
+    let rows = [
+        ("model", &hd.model),
+        ("serial", &hd.serial),
+        ("axes", &hd.axes.join(", ")),
+        ("date", &hd.date),
+        ("gyrolab", &hd.gyrolab_version),
+        ("plan", &hd.plan_file),
+    ];
+    for (k, v) in rows {
+        let _ = writeln!(h, "<tr><td><b>{k}</b></td><td>{}</td></tr>", escape(v));
+    }
+    h.push_str("</table>\n");
+    for n in &hd.notes {
+        let _ = writeln!(h, "<p class=\"note\">{}</p>", escape(n));
+    }
+    h.push_str("</header>\n");
+    write_summary(&mut h, &r.summary);
+    for s in &r.sections {
+        write_section(&mut h, s);
+    }
+    write_methods(&mut h);
+    h.push_str("</body>\n</html>\n");
+    h
+}
+
+/// The rate-table section of one axis: Table-6-style figures with limits and verdicts, the
+/// calibration, hysteresis and scale-factor plots, and the Table-2-style point table.
+pub fn rate_section(a: &AxisReport<'_>, limits: &[Limit]) -> Result<ReportSection, PlotError> {
+    let e = a.evaluation;
+    let u = a.output_unit.symbol();
+    let (du, df) = a.output_unit.scale_factor_display();
+    let figs = crate::figures::rate_figures(&crate::rate::AxisJson::new(a));
+    let checks = check_limits(limits, std::slice::from_ref(&figs));
+    let row = |key: &str, label: &str, value: String, unit: String| {
+        let c = checks.iter().find(|c| c.figure == key);
+        FigureRow {
+            label: label.into(),
+            key: key.into(),
+            value,
+            unit,
+            limit: limits.iter().find(|l| l.figure == key).map_or_else(String::new, Limit::text),
+            verdict: c.map(|c| c.verdict),
+        }
+    };
+    let hyst = if e.options.half_hysteresis { "hysteresis δ_H (half)" } else { "hysteresis δ_H" };
+    let mut figures = vec![
+        row("scale_factor", "scale factor K", sig(e.scale_factor() * df, 6), format!("{du}/(deg/s)")),
+        row("zero_offset", "zero offset F0", sig(e.zero_offset(), 7), u.into()),
+        row("", "rest reference F_r", sig(e.rest_reference, 7), u.into()),
+        row("", "full-scale output Y_FS", sig(e.full_scale_output, 5), u.into()),
+        row("nonlinearity_pct", "nonlinearity K_a", sig(ratio_to_pct(e.nonlinearity), 4), "%".into()),
+        row("nonlinearity_ppm", "nonlinearity K_a", sig(ratio_to_ppm(e.nonlinearity), 4), "ppm".into()),
+        row("linearity_pct", "linearity δ_L", sig(ratio_to_pct(e.linearity), 4), "% FS".into()),
+        row("hysteresis_pct", hyst, sig(ratio_to_pct(e.hysteresis), 4), "% FS".into()),
+        row(
+            "repeatability_pct",
+            &format!("repeatability δ_R (k = {})", e.options.coverage),
+            sig_opt(e.repeatability.map(ratio_to_pct), 4),
+            "% FS".into(),
+        ),
+        row("accuracy_pct", "accuracy (sum)", sig_opt(e.accuracy_sum.map(ratio_to_pct), 4), "% FS".into()),
+        row("accuracy_rss_pct", "accuracy (RSS)", sig_opt(e.accuracy_rss.map(ratio_to_pct), 4), "% FS".into()),
+        row("asymmetry_pct", "asymmetry K_as", sig_opt(e.asymmetry.map(|s| ratio_to_pct(s.asymmetry)), 4), "%".into()),
+        row(
+            "scale_factor_repeatability_ppm",
+            "scale-factor repeatability K_r",
+            sig_opt(e.scale_factor_repeatability.as_ref().map(|s| ratio_to_ppm(s.repeatability)), 4),
+            "ppm".into(),
+        ),
+    ];
+    // A limit on scale_factor is in output units per deg/s (as the JSON key), not in the display unit.
+    if let Some(f) = figures.iter_mut().find(|f| f.key == "scale_factor" && !f.limit.is_empty()) {
+        f.limit = format!("{} {u}/(deg/s)", f.limit);
+    }
+    let mut plots = vec![
+        PlotBlock {
+            caption: format!(
+                "Calibration curve of axis {}: forward (●) and reverse (×) stroke means with the least-squares line; \
+                 below, the residuals from the line (the paper's Figures 1 to 3).",
+                a.name
+            ),
+            svg: calibration_plot(a)?,
+        },
+        PlotBlock {
+            caption: format!(
+                "Hysteresis of axis {}: forward and reverse stroke means minus the line at each rate.",
+                a.name
+            ),
+            svg: hysteresis_plot(a)?,
+        },
+    ];
+    if let Some(svg) = scale_factor_plot(a) {
+        plots.push(PlotBlock {
+            caption: format!("Scale factor of each run of axis {} (both strokes), against K from all runs.", a.name),
+            svg: svg?,
+        });
+    }
+    let points = DataTable {
+        caption: format!("Axis {}: stroke means per rate (as the paper's Table 2) and residuals", a.name),
+        header: vec![
+            "rate (deg/s)".into(),
+            format!("fwd mean ({u})"),
+            format!("rev mean ({u})"),
+            format!("mean ({u})"),
+            format!("line residual ({u})"),
+            "a_j (%)".into(),
+            format!("fwd std ({u})"),
+            format!("rev std ({u})"),
+        ],
+        rows: e
+            .points
+            .iter()
+            .map(|p| {
+                vec![
+                    crate::format::short(p.rate_dps, 6),
+                    format!("{:.8}", p.forward_mean),
+                    format!("{:.8}", p.reverse_mean),
+                    format!("{:.8}", p.mean),
+                    sig(p.line_residual, 4),
+                    sig(ratio_to_pct(p.nonlinearity), 4),
+                    sig_opt(p.forward_std, 3),
+                    sig_opt(p.reverse_std, 3),
+                ]
+            })
+            .collect(),
+    };
+    let mut tables = vec![points];
+    if let Some(s) = &e.scale_factor_repeatability {
+        tables.push(DataTable {
+            caption: format!("Axis {}: scale factor per run", a.name),
+            header: vec!["run".into(), format!("K ({du}/(deg/s))")],
+            rows: s.per_run.iter().map(|(r, k)| vec![r.to_string(), sig(k * df, 6)]).collect(),
+        });
+    }
+    Ok(ReportSection {
+        title: format!("Axis {}: rate-table test", a.name),
+        simulated: false,
+        paragraphs: vec![format!(
+            "Record {} ({} layout, {} samples, {} runs × {} rates, output in {u}). Rest reference from {}.",
+            a.file,
+            a.layout,
+            a.samples,
+            e.runs,
+            e.points.len(),
+            match e.rest_reference_source {
+                gyrolab::rate_test::RestReferenceSource::RestRecords => "the rest records at start and end",
+                gyrolab::rate_test::RestReferenceSource::ZeroRatePoint => "the 0 deg/s point",
+                gyrolab::rate_test::RestReferenceSource::FitZeroOffset => "the fitted zero offset (no rest data)",
+            }
+        )],
+        figures,
+        plots,
+        tables,
+        page_break_before: true,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn escapes_and_anchors() {
+        assert_eq!(escape("<a href=\"x\">&'"), "&lt;a href=&quot;x&quot;&gt;&amp;&#39;");
+        assert_eq!(anchor("bias_stability_dph_10s"), "def-bias_stability_dph_-T-s");
+        assert_eq!(anchor("nonlinearity_pct"), "def-nonlinearity_pct");
+    }
+
+    #[test]
+    fn generic_section_renders_simulated_label_and_verdicts() {
+        let s = ReportSection {
+            title: "Axis x: static test".into(),
+            simulated: true,
+            figures: vec![FigureRow {
+                label: "bias stability".into(),
+                key: "bias_stability_dph_10s".into(),
+                value: "12".into(),
+                unit: "deg/h".into(),
+                limit: "≤ 20".into(),
+                verdict: Some(Verdict::Pass),
+            }],
+            ..Default::default()
+        };
+        let r = Report { sections: vec![s], ..Default::default() };
+        let h = render_html(&r);
+        assert!(h.contains("SIMULATED DATA"));
+        assert!(h.contains("<span class=\"verdict PASS\">PASS</span>"));
+        assert!(
+            h.contains("href=\"#def-bias_stability_dph_-T-s\"") && h.contains("id=\"def-bias_stability_dph_-T-s\"")
+        );
+        assert!(!h.contains("<script"));
+    }
+}
