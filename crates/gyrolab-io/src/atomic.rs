@@ -17,6 +17,12 @@ pub fn write_atomic_with(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::
         _ => Path::new("."),
     };
     let tmp = tempfile::Builder::new().prefix(".gyrolab-").suffix(".tmp").tempfile_in(dir)?;
+    // Temporary files are private (0600); an output file is an ordinary file (0644).
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        tmp.as_file().set_permissions(std::fs::Permissions::from_mode(0o644))?;
+    }
     {
         let mut w = std::io::BufWriter::with_capacity(1 << 20, tmp.as_file());
         fill(&mut w)?;
@@ -44,5 +50,10 @@ mod tests {
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
         write_atomic(&p, b"whole").unwrap();
         assert_eq!(std::fs::read(&p).unwrap(), b"whole");
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            assert_eq!(std::fs::metadata(&p).unwrap().permissions().mode() & 0o777, 0o644);
+        }
     }
 }
