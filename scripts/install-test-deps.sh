@@ -1,7 +1,14 @@
 #!/usr/bin/env bash
-# Installs what the tests need beyond the Rust toolchain: Chromium for the browser test of the
-# HTML report (crates/gyrolab-cli/tests/browser.rs). Does nothing when it is already there.
+# Installs what the tests need beyond the Rust toolchain: Python's allantools (from PyPI, into
+# .venv) for the equality check of the Allan deviations, and Chromium for the browser test of
+# the HTML report (crates/gyrolab-cli/tests/browser.rs). Does nothing that is already done.
 set -euo pipefail
+cd "$(dirname "$0")/.."
+if ! .venv/bin/python -c "import allantools" 2>/dev/null; then
+    echo "install-test-deps: installing allantools (PyPI) into .venv" >&2
+    python3 -m venv .venv
+    .venv/bin/pip install --quiet --disable-pip-version-check "allantools==2024.6" "numpy<3"
+fi
 if [ -x /usr/bin/chromium ]; then
     exit 0
 fi

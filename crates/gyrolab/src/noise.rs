@@ -190,11 +190,20 @@ pub fn slope_line_terms(curve: &AllanCurve) -> Result<SlopeLineResult, NoiseErro
             (i, slope, tau_mid, dev_mid)
         })
         .collect();
+    // A term on the rising side (K, R) sits where the curve has the fewest terms and the widest
+    // bounds; one segment there is weak evidence, so it must have a neighbouring segment whose
+    // slope is also near the target (within twice the tolerance).
+    let supported = |i: usize, target: f64, left: bool| {
+        left || [i.wrapping_sub(1), i + 1]
+            .iter()
+            .filter_map(|&j| segments.get(j))
+            .any(|n| n.0 >= i_min && (n.1 - target).abs() <= 2.0 * SLOPE_TOLERANCE)
+    };
     let find = |target: f64, left: bool| {
         segments
             .iter()
             .filter(|s| if left { s.0 < i_min } else { s.0 >= i_min })
-            .filter(|s| (s.1 - target).abs() <= SLOPE_TOLERANCE)
+            .filter(|s| (s.1 - target).abs() <= SLOPE_TOLERANCE && supported(s.0, target, left))
             .min_by(|a, b| (a.1 - target).abs().total_cmp(&(b.1 - target).abs()))
             .map(|&(i, slope, tau, dev)| {
                 (dev, SlopeReading { tau_s: tau, tau_range_s: (pts[i].tau_s, pts[i + 1].tau_s), local_slope: slope })
@@ -208,12 +217,36 @@ pub fn slope_line_terms(curve: &AllanCurve) -> Result<SlopeLineResult, NoiseErro
     let n = arw.map(|(dev, r)| dev * r.tau_s.sqrt()); // line sigma = N / sqrt(tau), read at 1 s
     let k = rrw.map(|(dev, r)| dev * (3.0 / r.tau_s).sqrt()); // line sigma = K sqrt(tau/3), read at 3 s
     let r = rate_ramp.map(|(dev, r)| dev * 2f64.sqrt() / r.tau_s);
-    let bias_instability = (i_min > 0 && i_min + 1 < pts.len()).then(|| SlopeReading {
-        tau_s: pts[i_min].tau_s,
-        tau_range_s: (pts[i_min - 1].tau_s, pts[i_min + 1].tau_s),
-        local_slope: 0.5 * (segments[i_min - 1].1 + segments[i_min].1),
+    // B: the median level of the flat region (segments with slope near 0; the median, not the
+    // lowest, because single long-tau points of one record scatter widely), else an interior
+    // minimum of the curve. A minimum at either end of the curve is not a flat region.
+    let mut flats: Vec<&(usize, f64, f64, f64)> = segments.iter().filter(|s| s.1.abs() <= SLOPE_TOLERANCE).collect();
+    flats.sort_by(|a, b| a.3.total_cmp(&b.3));
+    let flat = (!flats.is_empty()).then(|| {
+        let median = if flats.len() % 2 == 1 {
+            flats[flats.len() / 2].3
+        } else {
+            (flats[flats.len() / 2 - 1].3 * flats[flats.len() / 2].3).sqrt()
+        };
+        let near = flats.iter().min_by(|a, b| (a.3 / median).ln().abs().total_cmp(&(b.3 / median).ln().abs()));
+        let lo = flats.iter().map(|s| pts[s.0].tau_s).fold(f64::INFINITY, f64::min);
+        let hi = flats.iter().map(|s| pts[s.0 + 1].tau_s).fold(0.0, f64::max);
+        let (tau, slope) = near.map_or((lo, 0.0), |s| (s.2, s.1));
+        (median, SlopeReading { tau_s: tau, tau_range_s: (lo, hi), local_slope: slope })
     });
-    let b = bias_instability.map(|_| pts[i_min].deviation / BIAS_INSTABILITY_FACTOR);
+    let interior_min = (i_min > 0 && i_min + 1 < pts.len()).then(|| {
+        (
+            pts[i_min].deviation,
+            SlopeReading {
+                tau_s: pts[i_min].tau_s,
+                tau_range_s: (pts[i_min - 1].tau_s, pts[i_min + 1].tau_s),
+                local_slope: 0.5 * (segments[i_min - 1].1 + segments[i_min].1),
+            },
+        )
+    });
+    let floor = flat.or(interior_min);
+    let bias_instability = floor.map(|f| f.1);
+    let b = floor.map(|f| f.0 / BIAS_INSTABILITY_FACTOR);
     Ok(SlopeLineResult {
         coefficients: NoiseCoefficients::from_base_units(q, n, b, k, r),
         quantization: quantization.map(|x| x.1),
@@ -421,5 +454,45 @@ mod tests {
         assert_eq!(slope_line_terms(&curve), Err(NoiseError::WrongKind("tdev")));
         let curve = AllanCurve { kind: DeviationKind::Oadev, ..curve };
         assert!(matches!(fit_noise_model(&curve, None), Err(NoiseError::TooFewPoints { .. })));
+    }
+
+    fn curve_from(taus: &[f64], devs: &[f64]) -> AllanCurve {
+        let points = taus
+            .iter()
+            .zip(devs)
+            .map(|(&tau_s, &deviation)| AllanPoint {
+                m: tau_s as usize,
+                tau_s,
+                deviation,
+                terms: 100,
+                alpha: None,
+                noise_id: None,
+                edf: None,
+                lower: None,
+                upper: None,
+            })
+            .collect();
+        AllanCurve { kind: DeviationKind::Oadev, tau0_s: 1.0, n_rate: 1 << 20, confidence: None, points }
+    }
+
+    #[test]
+    fn a_single_rising_segment_at_the_end_is_not_rate_random_walk() {
+        // A flat (flicker) curve whose last octave rises with slope +1/2 by chance.
+        let mut taus = Vec::new();
+        let mut devs = Vec::new();
+        for k in 0..12 {
+            let tau = 2f64.powi(k);
+            taus.push(tau);
+            devs.push(if k < 11 { 1e-3 } else { 1e-3 * 2f64.sqrt() });
+        }
+        let curve = curve_from(&taus, &devs);
+        let r = slope_line_terms(&curve).unwrap();
+        assert!(r.rrw.is_none(), "{:?}", r.rrw);
+        // Two rising octaves are accepted.
+        devs[10] = 1e-3 * 2f64.sqrt();
+        devs[11] = 2e-3;
+        devs[9] = 1e-3;
+        let r = slope_line_terms(&curve_from(&taus, &devs)).unwrap();
+        assert!(r.rrw.is_some());
     }
 }
