@@ -23,6 +23,8 @@ enum Command {
     Rate(Box<cmd::rate::RateArgs>),
     /// Evaluate static (bias) tests: bias, bias stability, repeatability, drift, temperature.
     Bias(Box<cmd::bias::BiasArgs>),
+    /// Apply a calibration to a time series of outputs, streaming: outputs in, rates out.
+    Apply(Box<cmd::apply::ApplyArgs>),
     /// Simulate records with known truth (static, rate-table) in the layouts gyrolab reads.
     #[command(subcommand)]
     Simulate(cmd::simulate::SimulateCommand),
@@ -36,6 +38,7 @@ fn main() -> ExitCode {
         Command::Rate(a) => cmd::rate::run(a),
         Command::Demo(a) => cmd::demo::run(a),
         Command::Bias(a) => cmd::bias::run(a),
+        Command::Apply(a) => cmd::apply::run(a),
         Command::Simulate(c) => cmd::simulate::run(c),
     };
     match result {
