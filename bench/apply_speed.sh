@@ -52,7 +52,7 @@ TOML
 BYTES=$(stat -c %s "$IN")
 run() {
   local label=$1; shift
-  local log="$WORK/time-$label.txt"
+  local log="$WORK/time-${label//[^a-z]/_}.txt"
   local t0 t1
   t0=$(date +%s.%N)
   /usr/bin/time -v "$@" 2>"$log" >/dev/null

@@ -139,7 +139,17 @@ fn apply_on_the_calibration_record_gives_the_table_rates_back() {
     let (log, sim) = single_axis_log(dir.path(), "cal.csv", &sweep(&RATES, 2, true, true), 31);
     let cal = dir.path().join("cal.toml");
     gyrolab().arg("rate").arg(&log).arg("--cal-out").arg(&cal).assert().success();
-    let out = gyrolab().arg("apply").arg("--cal").arg(&cal).arg("--cal-axis").arg("gx").arg(&log).arg("--column").arg("gx_v").assert().success();
+    let out = gyrolab()
+        .arg("apply")
+        .arg("--cal")
+        .arg(&cal)
+        .arg("--cal-axis")
+        .arg("gx")
+        .arg(&log)
+        .arg("--column")
+        .arg("gx_v")
+        .assert()
+        .success();
     let text = String::from_utf8(out.get_output().stdout.clone()).unwrap();
     let (header, rows) = read_applied(&text);
     assert_eq!(header, ["time_s", "table_rate_dps", "rate_dps", "flag"]);
@@ -148,12 +158,13 @@ fn apply_on_the_calibration_record_gives_the_table_rates_back() {
     let se_k_rel = 5.0 * SIGMA_U / 850f64.sqrt() / 2.0 / 201_800f64.sqrt() / K;
     let mut sq = (0.0, 0usize);
     for h in &sim.holds {
-        let idx: Vec<usize> = (0..sim.time.len())
-            .filter(|&i| sim.time[i] >= h.t_start + SETTLING_S && sim.time[i] < h.t_end)
-            .collect();
+        let idx: Vec<usize> =
+            (0..sim.time.len()).filter(|&i| sim.time[i] >= h.t_start + SETTLING_S && sim.time[i] < h.t_end).collect();
         let rates: Vec<f64> = idx.iter().map(|&i| rows[i][2].parse::<f64>().unwrap()).collect();
         let mean = rates.iter().sum::<f64>() / rates.len() as f64;
-        let tol = 5.0 * sigma_rate / (rates.len() as f64).sqrt() + se_k_rel * h.rate.abs() + 5.0 * sigma_rate / 1400f64.sqrt();
+        let tol = 5.0 * sigma_rate / (rates.len() as f64).sqrt()
+            + se_k_rel * h.rate.abs()
+            + 5.0 * sigma_rate / 1400f64.sqrt();
         assert!((mean - h.rate).abs() < tol, "hold at {} deg/s: mean {mean}, tolerance {tol}", h.rate);
         for (&i, r) in idx.iter().zip(&rates) {
             sq.0 += (r - sim.true_rate[i]).powi(2);
@@ -200,7 +211,14 @@ fn apply_on_the_calibration_record_gives_the_table_rates_back() {
     // --out writes atomically; a bad cell is flagged, not an error.
     let bad = write(dir.path(), "nan.csv", "time_s,gx_v\n0,2.5\n0.01,\n0.02,5.0\n");
     let dest = dir.path().join("out.csv");
-    gyrolab().args(["apply", "--cal-axis", "gx", "--cal"]).arg(&cal).arg(&bad).arg("--out").arg(&dest).assert().success();
+    gyrolab()
+        .args(["apply", "--cal-axis", "gx", "--cal"])
+        .arg(&cal)
+        .arg(&bad)
+        .arg("--out")
+        .arg(&dest)
+        .assert()
+        .success();
     let (_, r) = read_applied(&std::fs::read_to_string(&dest).unwrap());
     assert_eq!(r[0][2], "ok");
     assert_eq!(r[1][1..], ["NaN", "not_finite"]);
@@ -339,9 +357,17 @@ fn bad_raw_logs_exit_2_naming_file_and_line() {
     // Manual segments that overlap: out of order in the file (the reader), and sharing a sample
     // (the segmentation).
     let (p, _) = single_axis_log(d, "ok.csv", &sweep(&RATES, 1, true, true), 7);
-    let seg = write(d, "seg.csv", "start_time_s,end_time_s,kind,run,stroke\n1,5,rest_start,,\n20,28,plateau,1,fwd\n25,30,plateau,1,fwd\n");
+    let seg = write(
+        d,
+        "seg.csv",
+        "start_time_s,end_time_s,kind,run,stroke\n1,5,rest_start,,\n20,28,plateau,1,fwd\n25,30,plateau,1,fwd\n",
+    );
     assert_exit2(gyrolab().arg("rate").arg(&p).arg("--segments").arg(&seg), &["seg.csv:4:", "must not overlap"]);
-    let seg = write(d, "seg2.csv", "start_time_s,end_time_s,kind,run,stroke\n1,5,rest_start,,\n20,28,plateau,1,fwd\n28,30,plateau,1,fwd\n");
+    let seg = write(
+        d,
+        "seg2.csv",
+        "start_time_s,end_time_s,kind,run,stroke\n1,5,rest_start,,\n20,28,plateau,1,fwd\n28,30,plateau,1,fwd\n",
+    );
     assert_exit2(gyrolab().arg("rate").arg(&p).arg("--segments").arg(&seg), &["seg2.csv:4:", "overlaps", "ok.csv:"]);
 
     // A three-axis set without z, and one whose z log turns in one sense only.

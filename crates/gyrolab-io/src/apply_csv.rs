@@ -97,7 +97,11 @@ pub fn apply_file(
         ApplyModel::Triad(_) => 3,
     };
     if plan.columns.len() != n || plan.rate_names.len() != n {
-        return Err(DataError::new(path, format!("the calibration needs {n} output column(s), {} given", plan.columns.len())).into());
+        return Err(DataError::new(
+            path,
+            format!("the calibration needs {n} output column(s), {} given", plan.columns.len()),
+        )
+        .into());
     }
     let options = SeriesOptions {
         channels: Some(plan.columns.clone()),
@@ -110,12 +114,10 @@ pub fn apply_file(
     // Channel slot and unit factor of each wanted column, in the plan's order.
     let mut slots = Vec::with_capacity(n);
     for want in &plan.columns {
-        let (k, ch) = header
-            .channels
-            .iter()
-            .enumerate()
-            .find(|(_, c)| c.name.eq_ignore_ascii_case(want))
-            .ok_or_else(|| DataError::new(path, format!("no output column '{want}'")).at_line(header.header_line))?;
+        let (k, ch) =
+            header.channels.iter().enumerate().find(|(_, c)| c.name.eq_ignore_ascii_case(want)).ok_or_else(|| {
+                DataError::new(path, format!("no output column '{want}'")).at_line(header.header_line)
+            })?;
         let factor = ch.unit.factor_to(plan.output_unit).ok_or_else(|| {
             DataError::new(
                 path,

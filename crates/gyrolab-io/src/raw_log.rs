@@ -104,10 +104,19 @@ pub fn read_raw_log(path: &Path, table_rate: &str, channels: Option<Vec<String>>
     let options = SeriesOptions { table_rate_column: Some(table_rate.to_string()), channels, ..Default::default() };
     let data = read_series_all(path, &options)?;
     let Some(time_s) = data.time else {
-        return Err(DataError::new(path, "a raw log needs a time column named 'time_s'").at_line(data.header.header_line));
+        return Err(
+            DataError::new(path, "a raw log needs a time column named 'time_s'").at_line(data.header.header_line)
+        );
     };
     let table_rate_dps = data.table_rate.unwrap_or_default();
-    Ok(RawLog { file: path.to_path_buf(), header: data.header, lines: data.lines, time_s, table_rate_dps, channels: data.channels })
+    Ok(RawLog {
+        file: path.to_path_buf(),
+        header: data.header,
+        lines: data.lines,
+        time_s,
+        table_rate_dps,
+        channels: data.channels,
+    })
 }
 
 /// A segment read from a manual segment file, with its line.
@@ -145,7 +154,8 @@ pub fn read_manual_segments(path: &Path) -> Result<Vec<ManualSegmentRow>, DataEr
         let field = |c: usize| row.fields.get(c).map(String::as_str).unwrap_or("");
         let num = |c: usize| parse_number(path, row.line, c + 1, &t.header[c], field(c));
         let (start, end) = (num(cs)?, num(ce)?);
-        let at = |c: usize, msg: String| DataError::new(path, msg).at_line(row.line).at_column(c + 1, Some(&t.header[c]));
+        let at =
+            |c: usize, msg: String| DataError::new(path, msg).at_line(row.line).at_column(c + 1, Some(&t.header[c]));
         if end < start {
             return Err(at(ce, format!("end {end} s is before start {start} s")));
         }
@@ -162,9 +172,10 @@ pub fn read_manual_segments(path: &Path) -> Result<Vec<ManualSegmentRow>, DataEr
             }
         }
         let run = match cr.map(field).map(str::trim).filter(|s| !s.is_empty()) {
-            Some(s) => Some(s.parse::<u32>().map_err(|_| {
-                at(cr.unwrap_or(0), format!("found '{s}', expected a run number (1, 2, ...)"))
-            })?),
+            Some(s) => Some(
+                s.parse::<u32>()
+                    .map_err(|_| at(cr.unwrap_or(0), format!("found '{s}', expected a run number (1, 2, ...)")))?,
+            ),
             None => None,
         };
         let stroke = match cst.map(field).map(str::trim).filter(|s| !s.is_empty()) {
@@ -184,7 +195,10 @@ pub fn read_manual_segments(path: &Path) -> Result<Vec<ManualSegmentRow>, DataEr
                 ),
             )
         })?;
-        out.push(ManualSegmentRow { line: row.line, segment: ManualSegment { start_time_s: start, end_time_s: end, kind } });
+        out.push(ManualSegmentRow {
+            line: row.line,
+            segment: ManualSegment { start_time_s: start, end_time_s: end, kind },
+        });
     }
     if out.is_empty() {
         return Err(DataError::new(path, "the segment file has a header but no segments").at_line(t.header_line));

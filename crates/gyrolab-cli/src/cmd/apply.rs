@@ -37,7 +37,10 @@ fn choose_columns(input: &Path, given: &[String], axis_names: &[String], skip: &
     let n = axis_names.len();
     if !given.is_empty() {
         if given.len() != n {
-            return Err(CliError::Usage(format!("--column needs {n} name(s) for this calibration, got {}", given.len())));
+            return Err(CliError::Usage(format!(
+                "--column needs {n} name(s) for this calibration, got {}",
+                given.len()
+            )));
         }
         return Ok(given.to_vec());
     }
@@ -92,12 +95,9 @@ pub fn run(args: &ApplyArgs) -> CliResult {
         }
         (_, name) => {
             let axis = cal.axis(name.as_deref()).map_err(cal_err)?;
-            let model = SingleAxisCalibration::polynomial(
-                &axis.polynomial.coefficients,
-                axis.rate_min_dps,
-                axis.rate_max_dps,
-            )
-            .map_err(|e| cal_err(format!("axis '{}': {e}", axis.name)))?;
+            let model =
+                SingleAxisCalibration::polynomial(&axis.polynomial.coefficients, axis.rate_min_dps, axis.rate_max_dps)
+                    .map_err(|e| cal_err(format!("axis '{}': {e}", axis.name)))?;
             ApplyPlan {
                 model: ApplyModel::Single(model),
                 output_unit: axis.output_unit,

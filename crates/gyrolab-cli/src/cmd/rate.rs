@@ -1,16 +1,16 @@
 //! `gyrolab rate FILE...`: evaluate rate-table records, one axis per file.
 
+use crate::cmd::raw;
 use crate::error::{CliError, CliResult};
 use crate::output::{print, to_json, write_file};
 use clap::Args;
 use gyrolab::rate_test::{evaluate, RateEvaluation, RateTestOptions};
 use gyrolab::units::{OutputUnit, RateUnit};
+use gyrolab_io::calibration::TriadSection;
 use gyrolab_io::calibration::{AxisCalibration, CalibrationFile, PolynomialModel, CALIBRATION_FORMAT};
 use gyrolab_io::rate_table::{read_rate_table, RateColumns, RateLayout, RateTableFile};
-use gyrolab_report::rate::{rate_json, rate_points_table, rate_summary_table, AxisReport};
-use crate::cmd::raw;
-use gyrolab_io::calibration::TriadSection;
 use gyrolab_io::raw_log::{detect_raw_log, header_names, segments_csv};
+use gyrolab_report::rate::{rate_json, rate_points_table, rate_summary_table, AxisReport};
 use gyrolab_report::segments::{segmentation_text, SegmentationJson, SegmentationReport};
 use gyrolab_report::triad::{triad_json, triad_text, TriadReport};
 use std::path::PathBuf;

@@ -10,8 +10,8 @@ use gyrolab::segment::{
 };
 use gyrolab::triad::{fit_triad, plateaus_from_segments, TableAxis, TriadError, TriadFit, TriadOptions, TriadPlateau};
 use gyrolab::units::{split_unit_suffix, OutputUnit, RateUnit};
-use gyrolab_io::raw_log::{header_names, read_manual_segments, read_raw_log, table_rate_column, RawLog};
 use gyrolab_io::rate_table::{RateLayout, RateTableFile};
+use gyrolab_io::raw_log::{header_names, read_manual_segments, read_raw_log, table_rate_column, RawLog};
 use gyrolab_io::DataError;
 use std::path::{Path, PathBuf};
 
@@ -210,14 +210,18 @@ pub fn triad(args: &RateArgs, options: &SegmentOptions) -> CliResult<TriadResult
         for &k in &order {
             let c = &chans[k];
             let f = c.unit.factor_to(u0).ok_or_else(|| {
-                DataError::new(path, format!("output in {}, but the set's outputs are in {u0}: the units do not convert", c.unit))
-                    .at_line(log.header.header_line)
-                    .at_column(c.column, Some(&c.name))
+                DataError::new(
+                    path,
+                    format!("output in {}, but the set's outputs are in {u0}: the units do not convert", c.unit),
+                )
+                .at_line(log.header.header_line)
+                .at_column(c.column, Some(&c.name))
             })?;
             outputs.push(log.channels[k].iter().map(|v| v * f).collect());
         }
         gyro_columns.get_or_insert_with(|| [0, 1, 2].map(|i| chans[order[i]].name.clone()));
-        let steady = find_steady_segments(&log.time_s, &log.table_rate_dps, options).map_err(|e| log.segment_error(&e))?;
+        let steady =
+            find_steady_segments(&log.time_s, &log.table_rate_dps, options).map_err(|e| log.segment_error(&e))?;
         let o = [&outputs[0][..], &outputs[1][..], &outputs[2][..]];
         plateaus.extend(plateaus_from_segments(*axis, &steady, &log.time_s, o).map_err(|e| log.segment_error(&e))?);
         described.push((*axis, path.display().to_string()));
@@ -230,11 +234,8 @@ pub fn triad(args: &RateArgs, options: &SegmentOptions) -> CliResult<TriadResult
             TriadError::NonFinite { axis, .. } => Some(*axis),
             _ => None,
         };
-        let names: Vec<String> = files
-            .iter()
-            .filter(|(a, _)| axis.is_none_or(|x| x == *a))
-            .map(|(_, f)| f.display().to_string())
-            .collect();
+        let names: Vec<String> =
+            files.iter().filter(|(a, _)| axis.is_none_or(|x| x == *a)).map(|(_, f)| f.display().to_string()).collect();
         CliError::Data(DataError::new(names.join(", "), format!("three-axis calibration: {e}")))
     })?;
     Ok(TriadResult {
