@@ -270,4 +270,18 @@ mod tests {
         std::fs::write(&p, "start_time_s,end_time_s,kind\n0,5,plateau\n").unwrap();
         assert!(read_manual_segments(&p).unwrap_err().to_string().contains("kind 'plateau'"));
     }
+
+    #[test]
+    fn table_rate_read_apart_from_outputs_in_deg_per_s() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("r.csv");
+        std::fs::write(&p, "# c\ntime_s,rate_rad_s,gx_v\n0,0,2.5\n0.01,3.141592653589793,2.6\n").unwrap();
+        let log = read_raw_log(&p, "rate_rad_s", None).unwrap();
+        assert_eq!(log.header.channels.len(), 1);
+        assert_eq!(log.lines, [3, 4]);
+        assert!((log.table_rate_dps[1] - 180.0).abs() < 1e-12);
+        assert_eq!(log.channels[0], [2.5, 2.6]);
+        let e = read_raw_log(&p, "table_rate_dps", None).unwrap_err();
+        assert!(e.to_string().contains("'table_rate_dps' is not in the header"), "{e}");
+    }
 }
