@@ -25,6 +25,8 @@ enum Command {
     Bias(Box<cmd::bias::BiasArgs>),
     /// Allan-variance family with confidence intervals and noise terms (N, B, K, Kalibr YAML).
     Allan(Box<cmd::allan::AllanArgs>),
+    /// Apply a calibration to a time series of outputs, streaming: outputs in, rates out.
+    Apply(Box<cmd::apply::ApplyArgs>),
     /// Simulate records with known truth (static, rate-table) in the layouts gyrolab reads.
     #[command(subcommand)]
     Simulate(cmd::simulate::SimulateCommand),
@@ -42,6 +44,7 @@ fn main() -> ExitCode {
         Command::Demo(a) => cmd::demo::run(a),
         Command::Bias(a) => cmd::bias::run(a),
         Command::Allan(a) => cmd::allan::run(a),
+        Command::Apply(a) => cmd::apply::run(a),
         Command::Simulate(c) => cmd::simulate::run(c),
     };
     match result {

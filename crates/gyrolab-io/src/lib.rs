@@ -5,14 +5,18 @@
 //! - [`text`]: a small delimited-text parser with line numbers;
 //! - [`rate_table`]: rate-table records in the long and wide layouts;
 //! - [`calibration`]: calibration files (TOML) written by `gyrolab rate --cal-out`;
+//! - [`raw_log`]: raw rate-table logs (detection, reading, segment files);
+//! - [`apply_csv`]: streaming application of a calibration to a time-series file;
 //! - [`series`]: streaming reader of time-series files, and the static test of a file;
 //! - [`sim_csv`]: fast CSV writer for simulated static records and rate-table tests;
 //! - [`plan`]: test plans (TOML) for `gyrolab eval`.
 
+pub mod apply_csv;
 pub mod atomic;
 pub mod calibration;
 pub mod error;
 pub mod rate_table;
+pub mod raw_log;
 pub mod series;
 pub mod sim_csv;
 pub mod text;

@@ -38,6 +38,8 @@ pub enum RateLayout {
     Long,
     /// One row per rate, one column per run and stroke.
     Wide,
+    /// A raw log (time, table rate, outputs) segmented into plateaus.
+    Raw,
 }
 
 /// A rate-table record read from a file.

@@ -15,7 +15,7 @@
 
 use crate::error::DataError;
 use gyrolab::static_test::{OutlierScan, SampleBlock, StaticTestAccumulator, StaticTestConfig, StaticTestResult};
-use gyrolab::units::{split_unit_suffix, OutputUnit};
+use gyrolab::units::{split_unit_suffix, OutputUnit, RateUnit};
 use serde::{Deserialize, Serialize};
 use std::fs::File;
 use std::io::Read;
@@ -43,6 +43,9 @@ pub struct SeriesOptions {
     pub column_units: Vec<(String, OutputUnit)>,
     /// Output channels to read by header name; `None` reads every non-time, non-temperature column.
     pub channels: Option<Vec<String>>,
+    /// Header name of a table-rate column (raw rate-table logs, such as `table_rate_dps`): read
+    /// separately from the output channels, converted to deg/s; `None` treats no column so.
+    pub table_rate_column: Option<String>,
     /// Tolerant mode: NaN and empty cells become NaN and are listed, instead of being errors.
     pub tolerant: bool,
     /// Bytes read from the file at once.
@@ -58,6 +61,7 @@ impl Default for SeriesOptions {
             sample_rate_hz: None,
             column_units: Vec::new(),
             channels: None,
+            table_rate_column: None,
             tolerant: false,
             chunk_bytes: DEFAULT_CHUNK_BYTES,
             block_rows: DEFAULT_BLOCK_ROWS,
@@ -76,6 +80,8 @@ pub enum ColumnRole {
     Channel(usize),
     /// Not read (not among the selected channels).
     Ignored,
+    /// The table rate of a raw rate-table log (see [`SeriesOptions::table_rate_column`]).
+    TableRate,
 }
 
 /// A column of the file.
@@ -119,6 +125,10 @@ pub struct SeriesHeader {
     pub channels: Vec<ChannelInfo>,
     /// Sample rate given by the caller, Hz.
     pub sample_rate_hz: Option<f64>,
+    /// 1-based column of the table rate, when one was asked for.
+    pub table_rate_column: Option<usize>,
+    /// Unit of the table-rate column as written (values are handed out in deg/s).
+    pub table_rate_unit: Option<RateUnit>,
 }
 
 /// A NaN or empty cell accepted in tolerant mode.
@@ -154,6 +164,8 @@ pub struct SeriesBlock<'a> {
     pub time: Option<&'a [f64]>,
     /// Temperature, degC.
     pub temp: Option<&'a [f64]>,
+    /// Table rate, deg/s (raw rate-table logs).
+    pub table_rate: Option<&'a [f64]>,
     /// One column per output channel, in the order of [`SeriesHeader::channels`].
     pub channels: &'a [Vec<f64>],
 }
@@ -200,6 +212,7 @@ pub struct SeriesReader<R: Read> {
     targets: Vec<u32>,
     time_slot: Option<usize>,
     temp_slot: Option<usize>,
+    rate_slot: Option<usize>,
     cols: Vec<Vec<f64>>,
     lines: Vec<u64>,
     quality: ReaderQuality,
@@ -235,6 +248,8 @@ impl<R: Read> SeriesReader<R> {
                 temperature_column: None,
                 channels: Vec::new(),
                 sample_rate_hz: options.sample_rate_hz,
+                table_rate_column: None,
+                table_rate_unit: None,
             },
             tolerant: options.tolerant,
             block_rows: options.block_rows.max(1),
@@ -249,6 +264,7 @@ impl<R: Read> SeriesReader<R> {
             targets: Vec::new(),
             time_slot: None,
             temp_slot: None,
+            rate_slot: None,
             cols: Vec::new(),
             lines: Vec::new(),
             quality: ReaderQuality::default(),
@@ -317,7 +333,19 @@ impl<R: Read> SeriesReader<R> {
             let (base, suffix) = split_unit_suffix(name);
             let sfx = suffix.as_deref();
             let unit_override = options.column_units.iter().find(|(c, _)| c.eq_ignore_ascii_case(name)).map(|p| p.1);
-            let role = if matches!(base.as_str(), "time" | "t" | "timestamp") {
+            let is_rate = options.table_rate_column.as_ref().is_some_and(|c| c.eq_ignore_ascii_case(name));
+            let role = if is_rate {
+                let Some(unit) = sfx.and_then(RateUnit::parse) else {
+                    return err(
+                        i + 1,
+                        Some(name),
+                        format!("table-rate column '{name}': expected a rate unit suffix (as in 'table_rate_dps')"),
+                    );
+                };
+                self.header.table_rate_column = Some(i + 1);
+                self.header.table_rate_unit = Some(unit);
+                ColumnRole::TableRate
+            } else if matches!(base.as_str(), "time" | "t" | "timestamp") {
                 if sfx != Some("s") {
                     return err(i + 1, Some(name), format!("time column '{name}': expected seconds, named 'time_s'"));
                 }
@@ -364,6 +392,15 @@ impl<R: Read> SeriesReader<R> {
             };
             columns.push(ColumnInfo { index: i + 1, name: name.clone(), role });
         }
+        if let Some(rate) = &options.table_rate_column {
+            if self.header.table_rate_column.is_none() {
+                return Err(DataError::new(
+                    &file,
+                    format!("table-rate column '{rate}' is not in the header: found {}", names.join(", ")),
+                )
+                .at_line(line));
+            }
+        }
         if let Some(list) = &options.channels {
             if let Some(missing) = list.iter().find(|c| !names.iter().any(|n| n.eq_ignore_ascii_case(c))) {
                 return Err(DataError::new(
@@ -387,13 +424,18 @@ impl<R: Read> SeriesReader<R> {
         let nch = channels.len();
         self.time_slot = self.header.time_column.map(|_| nch);
         self.temp_slot = self.header.temperature_column.map(|_| nch + usize::from(self.time_slot.is_some()));
-        let nslots = nch + usize::from(self.time_slot.is_some()) + usize::from(self.temp_slot.is_some());
+        let mut nslots = nch + usize::from(self.time_slot.is_some()) + usize::from(self.temp_slot.is_some());
+        if self.header.table_rate_column.is_some() {
+            self.rate_slot = Some(nslots);
+            nslots += 1;
+        }
         self.targets = columns
             .iter()
             .map(|c| match c.role {
                 ColumnRole::Channel(k) => k as u32,
                 ColumnRole::Time => self.time_slot.map_or(SKIP, |s| s as u32),
                 ColumnRole::Temperature => self.temp_slot.map_or(SKIP, |s| s as u32),
+                ColumnRole::TableRate => self.rate_slot.map_or(SKIP, |s| s as u32),
                 ColumnRole::Ignored => SKIP,
             })
             .collect();
@@ -491,12 +533,18 @@ impl<R: Read> SeriesReader<R> {
             }
             return Ok(None);
         }
+        if let (Some(s), Some(unit)) = (self.rate_slot, self.header.table_rate_unit) {
+            if unit != RateUnit::DegPerSec {
+                self.cols[s].iter_mut().for_each(|v| *v = unit.to_dps(*v));
+            }
+        }
         let nch = self.header.channels.len();
         Ok(Some(SeriesBlock {
             first_line: self.lines[0],
             lines: &self.lines,
             time: self.time_slot.map(|s| &self.cols[s][..]),
             temp: self.temp_slot.map(|s| &self.cols[s][..]),
+            table_rate: self.rate_slot.map(|s| &self.cols[s][..]),
             channels: &self.cols[..nch],
         }))
     }
@@ -694,6 +742,8 @@ pub struct SeriesData {
     pub time: Option<Vec<f64>>,
     /// Temperature, degC.
     pub temperature: Option<Vec<f64>>,
+    /// Table rate, deg/s (when a table-rate column was asked for).
+    pub table_rate: Option<Vec<f64>>,
     /// One column per output channel, in the order of `header.channels`.
     pub channels: Vec<Vec<f64>>,
     /// NaN and empty cells passed on (tolerant mode).
@@ -712,6 +762,7 @@ pub fn collect_series<R: Read>(mut r: SeriesReader<R>) -> Result<SeriesData, Dat
     let mut lines = Vec::new();
     let mut time = header.time_column.map(|_| Vec::new());
     let mut temperature = header.temperature_column.map(|_| Vec::new());
+    let mut table_rate = header.table_rate_column.map(|_| Vec::new());
     let mut channels = vec![Vec::new(); header.channels.len()];
     while let Some(b) = r.next_block()? {
         lines.extend_from_slice(b.lines);
@@ -721,12 +772,15 @@ pub fn collect_series<R: Read>(mut r: SeriesReader<R>) -> Result<SeriesData, Dat
         if let (Some(t), Some(bt)) = (temperature.as_mut(), b.temp) {
             t.extend_from_slice(bt);
         }
+        if let (Some(t), Some(bt)) = (table_rate.as_mut(), b.table_rate) {
+            t.extend_from_slice(bt);
+        }
         for (c, bc) in channels.iter_mut().zip(b.channels) {
             c.extend_from_slice(bc);
         }
     }
     let quality = r.quality.clone();
-    Ok(SeriesData { header, lines, time, temperature, channels, quality })
+    Ok(SeriesData { header, lines, time, temperature, table_rate, channels, quality })
 }
 
 /// Evaluates the static (bias) test of every channel of a file, streaming it twice (figures,

@@ -8,6 +8,8 @@
 //! - [`plot`]: SVG plot building blocks; [`rate_plots`]: the rate-table plots;
 //! - [`html`]: the self-contained HTML report (header, summary, sections, methods appendix);
 //! - [`results`]: the results.json document of `gyrolab eval`;
+//! - [`segments`]: segmentation summaries of raw rate-table logs;
+//! - [`triad`]: three-axis calibration tables and JSON;
 //! - [`paper`]: the paper's printed tables beside the recomputation, for `gyrolab demo`;
 //! - [`format`]: number formatting.
 
@@ -22,3 +24,5 @@ pub mod plot;
 pub mod rate;
 pub mod rate_plots;
 pub mod results;
+pub mod segments;
+pub mod triad;

@@ -30,8 +30,11 @@ pub struct AxisReport<'a> {
 pub struct RateJson {
     /// Program version.
     pub gyrolab_version: String,
-    /// One entry per file.
+    /// One entry per file (per output channel of a raw log).
     pub axes: Vec<AxisJson>,
+    /// Segmentation of each raw log read (absent when none was).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub segmentation: Vec<crate::segments::SegmentationJson>,
 }
 
 /// JSON of one axis.
@@ -241,7 +244,11 @@ impl AxisJson {
 
 /// Builds the JSON document for several axes.
 pub fn rate_json(axes: &[AxisReport<'_>]) -> RateJson {
-    RateJson { gyrolab_version: env!("CARGO_PKG_VERSION").into(), axes: axes.iter().map(AxisJson::new).collect() }
+    RateJson {
+        gyrolab_version: env!("CARGO_PKG_VERSION").into(),
+        axes: axes.iter().map(AxisJson::new).collect(),
+        segmentation: Vec::new(),
+    }
 }
 
 fn new_table(header: Vec<String>) -> Table {

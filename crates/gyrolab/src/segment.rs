@@ -5,7 +5,7 @@
 //! 2014, eq. 4-6): each rate held for a while and its output averaged, forward strokes (rates
 //! rising) and reverse strokes (rates falling) in each run, rest outputs F_s and F_e recorded at
 //! the start and end. The detection rules (tolerance, settling, minimum duration, sequence
-//! inference) are gyrolab's own and are stated in `docs/METHODS-triad.md`.
+//! inference) are gyrolab's own and are stated in `docs/METHODS.md`, section 5.
 //!
 //! Everything here is O(N) in the number of samples: one pass finds the steady stretches (each
 //! sample is looked at a bounded number of times), and each kept stretch is read once more.

@@ -12,7 +12,7 @@
 //! least-squares problem [omega_x omega_y omega_z 1] [S_i1 S_i2 S_i3 b_i]^T = u_i, solved by
 //! Householder QR on the column-equilibrated design (Golub & Van Loan, Matrix Computations,
 //! section 5.3), never by normal equations; the condition number comes from its SVD.
-//! `docs/METHODS-triad.md` gives every formula with its units.
+//! `docs/METHODS.md` (section 5) gives every formula with its units.
 
 use crate::segment::{SegmentError, SteadySegment};
 use crate::units;

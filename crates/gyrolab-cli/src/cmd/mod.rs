@@ -1,8 +1,10 @@
 //! One module per subcommand.
 
 pub mod allan;
+pub mod apply;
 pub mod bias;
 pub mod demo;
 pub mod eval;
 pub mod rate;
+pub mod raw;
 pub mod simulate;

@@ -1,22 +1,60 @@
 //! `gyrolab rate FILE...`: evaluate rate-table records, one axis per file.
 
+use crate::cmd::raw;
 use crate::error::{CliError, CliResult};
 use crate::output::{print, to_json, write_file};
 use clap::Args;
 use gyrolab::rate_test::{evaluate, RateEvaluation, RateTestOptions};
 use gyrolab::units::{OutputUnit, RateUnit};
+use gyrolab_io::calibration::TriadSection;
 use gyrolab_io::calibration::{AxisCalibration, CalibrationFile, PolynomialModel, CALIBRATION_FORMAT};
 use gyrolab_io::rate_table::{read_rate_table, RateColumns, RateLayout, RateTableFile};
+use gyrolab_io::raw_log::{detect_raw_log, header_names, segments_csv};
 use gyrolab_report::rate::{rate_json, rate_points_table, rate_summary_table, AxisReport};
+use gyrolab_report::segments::{segmentation_text, SegmentationJson, SegmentationReport};
+use gyrolab_report::triad::{triad_json, triad_text, TriadReport};
 use std::path::PathBuf;
 
 /// Options of `gyrolab rate`.
 #[derive(Debug, Args)]
 pub struct RateArgs {
     /// Rate-table records, one axis per file (long layout: rate_dps,run,stroke,output_v; or the
-    /// wide layout of the paper's Table 1).
-    #[arg(required = true, value_name = "FILE")]
+    /// wide layout of the paper's Table 1), or raw logs (time_s,table_rate_dps,OUTPUT...: one
+    /// axis per output column).
+    #[arg(required_unless_present = "triad", value_name = "FILE")]
     pub files: Vec<PathBuf>,
+    /// Treat every file as a raw log (time, table rate, outputs) even if its header does not say so.
+    #[arg(long)]
+    pub raw: bool,
+    /// Raw logs: name of the table-rate column (default: table_rate_<unit> or rate_<unit>).
+    #[arg(long, value_name = "NAME")]
+    pub table_rate_column: Option<String>,
+    /// Raw logs: a plateau's rate stays within this of its mean (plus 0.1 % of the rate), deg/s [0.05].
+    #[arg(long, value_name = "DPS")]
+    pub steady_tolerance_dps: Option<f64>,
+    /// Raw logs: shortest plateau kept, after the settling time, s [5].
+    #[arg(long, value_name = "S")]
+    pub min_plateau_s: Option<f64>,
+    /// Raw logs: time dropped at the start of each plateau, s [1].
+    #[arg(long, value_name = "S")]
+    pub settling_s: Option<f64>,
+    /// Raw logs: a steady |rate| at most this at the start or end is a rest record, deg/s [0.05].
+    #[arg(long, value_name = "DPS")]
+    pub rest_tolerance_dps: Option<f64>,
+    /// Raw log: write the segmentation (one row per segment) to this CSV file.
+    #[arg(long, value_name = "FILE.csv")]
+    pub segments_out: Option<PathBuf>,
+    /// Raw log: use these segments instead of finding them (start_time_s,end_time_s,kind,run,stroke;
+    /// a --segments-out file is accepted).
+    #[arg(long, value_name = "FILE.csv")]
+    pub segments: Option<PathBuf>,
+    /// Three-axis calibration: a raw log of rotations about a table axis, both senses, as
+    /// AXIS=FILE (x, y and z each at least once).
+    #[arg(long, value_name = "AXIS=FILE", value_parser = crate::cmd::raw::parse_triad_file)]
+    pub triad: Vec<(gyrolab::triad::TableAxis, PathBuf)>,
+    /// Three-axis calibration: the gyro output columns x, y, z (default: the file's three outputs).
+    #[arg(long, value_name = "GX,GY,GZ", value_delimiter = ',')]
+    pub gyro_columns: Vec<String>,
     /// Axis names, one per file in order (default: each file's stem).
     #[arg(long = "axis", value_name = "NAME")]
     pub axes: Vec<String>,
@@ -117,6 +155,7 @@ impl EvaluatedAxis {
             layout: match self.record.layout {
                 RateLayout::Long => "long".into(),
                 RateLayout::Wide => "wide".into(),
+                RateLayout::Raw => "raw".into(),
             },
             output_unit: self.record.output_unit,
             samples: self.record.samples,
@@ -170,14 +209,21 @@ pub fn calibration_file(axes: &[EvaluatedAxis]) -> CalibrationFile {
 
 /// Runs `gyrolab rate`.
 pub fn run(args: &RateArgs) -> CliResult {
-    if !args.axes.is_empty() && args.axes.len() != args.files.len() {
-        return Err(CliError::Usage(format!(
-            "--axis given {} time(s) for {} file(s): give one name per file, in order",
-            args.axes.len(),
-            args.files.len()
-        )));
+    let seg_options = raw::segment_options(args)?;
+    if !args.triad.is_empty() {
+        return run_triad(args, &seg_options);
     }
     let options = args.options()?;
+    let mut is_raw = Vec::with_capacity(args.files.len());
+    for path in &args.files {
+        is_raw.push(args.raw || detect_raw_log(&header_names(path)?).is_some());
+    }
+    let raw_count = is_raw.iter().filter(|r| **r).count();
+    if (args.segments_out.is_some() || args.segments.is_some()) && raw_count != 1 {
+        return Err(CliError::Usage(format!(
+            "--segments and --segments-out take exactly one raw log, but {raw_count} of the files are raw logs"
+        )));
+    }
     let columns = RateColumns {
         rate: args.rate_column.clone(),
         run: args.run_column.clone(),
@@ -186,16 +232,40 @@ pub fn run(args: &RateArgs) -> CliResult {
         rate_unit: args.rate_unit,
         output_unit: args.output_unit,
     };
-    let mut axes = Vec::new();
+    let mut axes: Vec<EvaluatedAxis> = Vec::new();
+    let mut logs: Vec<raw::SegmentedLog> = Vec::new();
+    let mut names = args.axes.iter().cloned();
     for (i, path) in args.files.iter().enumerate() {
-        let record = read_rate_table(path, &columns)?;
-        let name = args.axes.get(i).cloned().unwrap_or_else(|| {
-            path.file_stem().map_or_else(|| format!("axis{}", i + 1), |s| s.to_string_lossy().into_owned())
-        });
-        if axes.iter().any(|a: &EvaluatedAxis| a.name == name) {
-            return Err(CliError::Usage(format!("two files give axis name '{name}': name them with --axis")));
+        let start = axes.len();
+        if is_raw[i] {
+            let log = raw::segment_file(path, args, &seg_options, args.segments.as_ref())?;
+            if let Some(out) = &args.segments_out {
+                write_file(out, segments_csv(&log.segments, &log.log.lines).as_bytes())?;
+            }
+            axes.extend(raw::evaluate_channels(&log, &options, &seg_options, &mut || names.next())?);
+            logs.push(log);
+        } else {
+            let record = read_rate_table(path, &columns)?;
+            let name = names.next().unwrap_or_else(|| {
+                path.file_stem().map_or_else(|| format!("axis{}", i + 1), |s| s.to_string_lossy().into_owned())
+            });
+            axes.push(evaluate_record(name, path.display().to_string(), record, &options)?);
         }
-        axes.push(evaluate_record(name, path.display().to_string(), record, &options)?);
+        for a in &axes[start..] {
+            if axes.iter().filter(|b| b.name == a.name).count() > 1 {
+                return Err(CliError::Usage(format!(
+                    "two axes are named '{}': name them with --axis (one per file, or per output column of a raw log)",
+                    a.name
+                )));
+            }
+        }
+    }
+    if !args.axes.is_empty() && args.axes.len() != axes.len() {
+        return Err(CliError::Usage(format!(
+            "--axis given {} time(s) for {} axes: give one name per file (per output column of a raw log), in order",
+            args.axes.len(),
+            axes.len()
+        )));
     }
     if let Some(cal) = &args.cal_out {
         let text = calibration_file(&axes)
@@ -204,10 +274,30 @@ pub fn run(args: &RateArgs) -> CliResult {
         write_file(cal, text.as_bytes())?;
     }
     let reports: Vec<AxisReport<'_>> = axes.iter().map(EvaluatedAxis::report).collect();
+    let seg_reports: Vec<SegmentationReport<'_>> = logs
+        .iter()
+        .map(|l| SegmentationReport {
+            file: l.log.file.display().to_string(),
+            mode: l.mode,
+            samples: l.log.time_s.len(),
+            segments: &l.segments,
+            lines: &l.log.lines,
+        })
+        .collect();
     if args.json {
-        return print(&to_json(&rate_json(&reports))?);
+        let mut doc = rate_json(&reports);
+        doc.segmentation = seg_reports.iter().map(SegmentationJson::new).collect();
+        return print(&to_json(&doc)?);
     }
-    let mut text = rate_summary_table(&reports);
+    let mut text = String::new();
+    for r in &seg_reports {
+        text.push_str(&segmentation_text(r));
+        text.push('\n');
+    }
+    if let Some(out) = &args.segments_out {
+        text.push_str(&format!("Segments written to {}\n\n", out.display()));
+    }
+    text.push_str(&rate_summary_table(&reports));
     text.push('\n');
     if args.points {
         for r in &reports {
@@ -218,6 +308,42 @@ pub fn run(args: &RateArgs) -> CliResult {
     }
     if let Some(cal) = &args.cal_out {
         text.push_str(&format!("\nCalibration written to {}\n", cal.display()));
+    }
+    print(&text)
+}
+
+/// Runs the three-axis mode of `gyrolab rate`.
+fn run_triad(args: &RateArgs, seg_options: &gyrolab::segment::SegmentOptions) -> CliResult {
+    if !args.files.is_empty() {
+        return Err(CliError::Usage(format!(
+            "{} is given as a positional file with --triad: give every log of the set as --triad AXIS=FILE",
+            args.files[0].display()
+        )));
+    }
+    let t = raw::triad(args, seg_options)?;
+    if let Some(cal) = &args.cal_out {
+        let mut file = calibration_file(&[]);
+        file.triad = Some(TriadSection::from_calibration(
+            &t.fit.calibration,
+            ["x".into(), "y".into(), "z".into()],
+            t.files.iter().map(|(_, f)| f.clone()).collect(),
+            t.output_unit,
+        ));
+        let text = file.to_toml().map_err(|e| CliError::Output(format!("cannot serialise the calibration: {e}")))?;
+        write_file(cal, text.as_bytes())?;
+    }
+    let report = TriadReport {
+        files: t.files.clone(),
+        gyro_columns: t.gyro_columns.clone(),
+        output_unit: t.output_unit,
+        fit: &t.fit,
+    };
+    if args.json {
+        return print(&to_json(&triad_json(&report))?);
+    }
+    let mut text = triad_text(&report);
+    if let Some(cal) = &args.cal_out {
+        text.push_str(&format!("\nCalibration ([triad]) written to {}\n", cal.display()));
     }
     print(&text)
 }
