@@ -27,6 +27,9 @@ enum Command {
     Allan(Box<cmd::allan::AllanArgs>),
     /// Apply a calibration to a time series of outputs, streaming: outputs in, rates out.
     Apply(Box<cmd::apply::ApplyArgs>),
+    /// Plan a test: the record length needed to measure a noise term to a stated precision.
+    #[command(subcommand)]
+    Plan(cmd::plan::PlanCommand),
     /// Simulate records with known truth (static, rate-table) in the layouts gyrolab reads.
     #[command(subcommand)]
     Simulate(cmd::simulate::SimulateCommand),
@@ -46,6 +49,7 @@ fn main() -> ExitCode {
         Command::Allan(a) => cmd::allan::run(a),
         Command::Apply(a) => cmd::apply::run(a),
         Command::Simulate(c) => cmd::simulate::run(c),
+        Command::Plan(c) => cmd::plan::run(c),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -8,6 +8,7 @@
 //! - [`noise`]: IEEE 952 noise terms (ARW, bias instability, RRW, ...) from an Allan curve;
 //! - [`rate_test`]: rate-table (scale-factor) test figures;
 //! - [`static_test`]: static (bias) test figures, accumulated block by block;
+//! - [`plan`]: test planning: record length for a noise term's precision;
 //! - [`published`]: comparison with figures printed in a publication;
 //! - [`sim`]: gyro simulator with known truth (static records, rate-table tests);
 //! - [`segment`]: plateaus, strokes and runs found in raw rate-table logs;
@@ -20,6 +21,7 @@ pub mod allan;
 pub mod apply;
 pub mod fit;
 pub mod noise;
+pub mod plan;
 pub mod published;
 pub mod rate_test;
 pub mod segment;

@@ -5,6 +5,7 @@ pub mod apply;
 pub mod bias;
 pub mod demo;
 pub mod eval;
+pub mod plan;
 pub mod rate;
 pub mod raw;
 pub mod simulate;

@@ -579,7 +579,9 @@ fn identify_noise(s: &[f64], m: usize, dmax: usize) -> Option<(i32, NoiseIdMetho
     confidence::b1_noise_id(&averages, m, rn).map(|a| (a, NoiseIdMethod::B1Ratio))
 }
 
-fn equivalent_dof(kind: DeviationKind, alpha: i32, m: usize, n_phase: usize) -> f64 {
+/// Equivalent degrees of freedom of a deviation of `kind` at averaging factor `m` for noise
+/// type `alpha` and `n_phase` phase points (Greenhall & Riley 2004; totdev: SP1065 table 12).
+pub fn equivalent_dof(kind: DeviationKind, alpha: i32, m: usize, n_phase: usize) -> f64 {
     match kind {
         DeviationKind::Adev => confidence::edf_greenhall(alpha, 2, m, n_phase, false, false),
         DeviationKind::Oadev => confidence::edf_greenhall(alpha, 2, m, n_phase, true, false),
@@ -588,6 +590,12 @@ fn equivalent_dof(kind: DeviationKind, alpha: i32, m: usize, n_phase: usize) -> 
         DeviationKind::Ohdev => confidence::edf_greenhall(alpha, 3, m, n_phase, true, false),
         DeviationKind::Totdev => confidence::edf_total(n_phase, m, alpha),
     }
+}
+
+/// Chi-squared confidence bounds (low, high) of a deviation with `edf` degrees of freedom at the
+/// two-sided `confidence` level (SP1065 section 5.3).
+pub fn deviation_bounds(deviation: f64, edf: f64, confidence: f64) -> Option<(f64, f64)> {
+    confidence::chi2_bounds(deviation, edf, confidence)
 }
 
 #[cfg(test)]

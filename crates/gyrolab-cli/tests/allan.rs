@@ -1,0 +1,141 @@
+//! `gyrolab allan` end to end: known truth from the simulator, JSON keys, Kalibr YAML, bad input.
+
+mod common;
+use common::{gyrolab, write};
+
+fn json(args: &[&str], file: &std::path::Path) -> serde_json::Value {
+    let out = gyrolab().arg("allan").arg(file).args(args).arg("--json").assert().success().get_output().stdout.clone();
+    serde_json::from_slice(&out).unwrap()
+}
+
+fn simulate(dir: &std::path::Path, name: &str, args: &[&str]) -> std::path::PathBuf {
+    let p = dir.join(name);
+    gyrolab().args(["simulate", "static"]).args(args).arg("--out").arg(&p).assert().success();
+    p
+}
+
+/// Relative error.
+fn rel(a: f64, b: f64) -> f64 {
+    (a / b - 1.0).abs()
+}
+
+#[test]
+fn recovers_known_noise_terms_of_simulated_records() {
+    // 10 h at 10 Hz. Tolerances: N within 5 % (thousands of degrees of freedom at short tau);
+    // B and K within 25 % (few degrees of freedom at long tau; spread over seeds 1-8 was
+    // B 11.6-12.3 by the fit, 12.0-14.0 by slope lines; K 54-62 for 60 by the fit).
+    let dir = tempfile::tempdir().unwrap();
+    let nb = simulate(
+        dir.path(),
+        "nb.csv",
+        &[
+            "--duration-s",
+            "36000",
+            "--sample-rate-hz",
+            "10",
+            "--arw-deg-rt-h",
+            "0.6",
+            "--bias-instability-dph",
+            "12",
+            "--seed",
+            "5",
+        ],
+    );
+    let v = json(&[], &nb);
+    let n = &v["noise"];
+    assert!(rel(n["arw_deg_rt_h"].as_f64().unwrap(), 0.6) < 0.05, "{n}");
+    assert!(rel(n["bias_instability_dph"].as_f64().unwrap(), 12.0) < 0.25, "{n}");
+    assert!(rel(n["fit"]["bias_instability_dph"].as_f64().unwrap(), 12.0) < 0.25, "{n}");
+    assert!(n["rrw_deg_h_rt_h"].is_null(), "no rate random walk was simulated: {n}");
+    let nk = simulate(
+        dir.path(),
+        "nk.csv",
+        &[
+            "--duration-s",
+            "36000",
+            "--sample-rate-hz",
+            "10",
+            "--arw-deg-rt-h",
+            "0.6",
+            "--rrw-deg-h-rt-h",
+            "60",
+            "--seed",
+            "5",
+        ],
+    );
+    let w = json(&[], &nk);
+    let k = &w["noise"];
+    assert!(rel(k["arw_deg_rt_h"].as_f64().unwrap(), 0.6) < 0.05, "{k}");
+    assert!(rel(k["fit"]["rrw_deg_h_rt_h"].as_f64().unwrap(), 60.0) < 0.25, "{k}");
+    assert!(rel(k["rrw_deg_h_rt_h"].as_f64().unwrap(), 60.0) < 0.25, "{k}");
+}
+
+#[test]
+fn json_keys_csv_and_kalibr() {
+    let dir = tempfile::tempdir().unwrap();
+    let p =
+        simulate(dir.path(), "w.csv", &["--duration-s", "600", "--sample-rate-hz", "100", "--arw-deg-rt-h", "0.36"]);
+    let v = json(&["--kind", "oadev", "--taus", "decade"], &p);
+    for key in ["kind", "taus_s", "dev", "ci_low", "ci_high", "n_terms"] {
+        assert!(!v[key].is_null(), "{key}");
+    }
+    assert_eq!(v["kind"], "oadev");
+    assert_eq!(v["taus_s"].as_array().unwrap().len(), v["dev"].as_array().unwrap().len());
+    // White noise: ADEV(tau) = N / sqrt(tau) with N = 0.36 / 60 deg/sqrt(s); at tau = 1 s: 0.006.
+    let taus = v["taus_s"].as_array().unwrap();
+    let i = taus.iter().position(|t| t.as_f64() == Some(1.0)).unwrap();
+    assert!(rel(v["dev"][i].as_f64().unwrap(), 0.006) < 0.05, "{}", v["dev"][i]);
+    let lo = v["ci_low"][i].as_f64().unwrap();
+    let hi = v["ci_high"][i].as_f64().unwrap();
+    assert!(lo < v["dev"][i].as_f64().unwrap() && hi > v["dev"][i].as_f64().unwrap());
+    let out = gyrolab().arg("allan").arg(&p).arg("--csv").assert().success().get_output().stdout.clone();
+    let csv = String::from_utf8(out).unwrap();
+    assert!(csv.starts_with("file,channel,tau_s,m,dev,ci_low,ci_high,n_terms,alpha\n"), "{csv}");
+    let yaml = dir.path().join("imu.yaml");
+    gyrolab().arg("allan").arg(&p).arg("--kalibr-yaml").arg(&yaml).assert().success();
+    let y = std::fs::read_to_string(&yaml).unwrap();
+    // N = 0.006 deg/sqrt(s) = 1.047e-4 rad/s/sqrt(Hz).
+    let line = y.lines().find(|l| l.starts_with("gyroscope_noise_density:")).unwrap();
+    let nd: f64 = line.split(':').nth(1).unwrap().trim().parse().unwrap();
+    assert!(rel(nd, 0.006_f64.to_radians()) < 0.05, "{y}");
+    assert!(y.contains("update_rate: 100"), "{y}");
+}
+
+#[test]
+fn constant_data_gives_zero_not_nan() {
+    let dir = tempfile::tempdir().unwrap();
+    let text: String = std::iter::once("rate_dps\n".to_string()).chain((0..100).map(|_| "0.5\n".to_string())).collect();
+    let p = write(dir.path(), "c.csv", &text);
+    let v = json(&["--sample-rate-hz", "1"], &p);
+    for d in v["dev"].as_array().unwrap() {
+        assert_eq!(d.as_f64(), Some(0.0));
+    }
+}
+
+fn allan_error(text: &str, args: &[&str]) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "bad.csv", text);
+    let out = gyrolab().arg("allan").arg(&p).args(args).assert().code(2).get_output().clone();
+    let e = String::from_utf8(out.stderr).unwrap();
+    assert!(e.starts_with("error: ") && !e.contains("panicked"), "{e}");
+    e
+}
+
+#[test]
+fn bad_input() {
+    let e = allan_error("rate_dps\n1\n", &["--sample-rate-hz", "1"]);
+    assert!(e.contains("too short"), "{e}");
+    let e = allan_error("rate_dps\n1\n2\nnan\n4\n5\n6\n7\n8\n9\n", &["--sample-rate-hz", "1"]);
+    assert!(e.contains("bad.csv:4:1"), "{e}");
+    let ok = "rate_dps\n1\n2\n3\n4\n5\n6\n7\n8\n9\n";
+    let e = allan_error(ok, &["--sample-rate-hz", "1", "--kind", "xdev"]);
+    assert!(e.contains("unknown deviation kind 'xdev'"), "{e}");
+    let e = allan_error(ok, &["--sample-rate-hz", "1", "--taus", "weekly"]);
+    assert!(e.contains("weekly"), "{e}");
+    let e = allan_error(ok, &["--sample-rate-hz", "1", "--confidence", "1.5"]);
+    assert!(e.contains("confidence"), "{e}");
+    let e = allan_error("time_s,rate_dps\n0,1\n1,2\n2,3\n5,4\n6,5\n7,6\n", &[]);
+    assert!(e.contains("bad.csv:5") && e.contains("irregular sampling"), "{e}");
+    let e = allan_error(ok, &[]);
+    assert!(e.contains("sample rate") || e.contains("time"), "{e}");
+}

@@ -1,0 +1,253 @@
+//! Test planning: how long a static record must be to measure a noise term from the overlapping
+//! Allan deviation to a stated precision at a stated confidence.
+//!
+//! Sources: equivalent degrees of freedom of the overlapping Allan deviation by Greenhall &
+//! Riley (2004) as in [`crate::allan::equivalent_dof`]; chi-squared confidence intervals
+//! (NIST SP 1065 section 5.3); the noise types at which each term is read (IEEE Std 952-1997
+//! annex C: angle random walk on white rate noise, alpha = 0; bias instability on flicker rate
+//! noise, alpha = -1).
+
+use crate::allan::{deviation_bounds, equivalent_dof, DeviationKind};
+use crate::noise::BIAS_INSTABILITY_FACTOR;
+use crate::units::{arw_deg_rt_h_to_deg_rt_s, dph_to_dps};
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// The noise term a static test is planned for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlannedTerm {
+    /// Bias instability B, read on the flat (flicker, alpha = -1) part of the curve.
+    BiasInstability,
+    /// Angle random walk N, read on the white-noise (alpha = 0) part.
+    AngleRandomWalk,
+}
+
+impl PlannedTerm {
+    /// Noise type alpha (power-law exponent of the rate noise) at which the term is read.
+    pub fn alpha(self) -> i32 {
+        match self {
+            PlannedTerm::BiasInstability => -1,
+            PlannedTerm::AngleRandomWalk => 0,
+        }
+    }
+
+    /// Parses `bias-instability` / `b` or `arw` / `angle-random-walk` / `n`.
+    pub fn parse(s: &str) -> Option<PlannedTerm> {
+        match s.trim().to_ascii_lowercase().replace('_', "-").as_str() {
+            "bias-instability" | "b" | "bi" => Some(PlannedTerm::BiasInstability),
+            "arw" | "angle-random-walk" | "n" => Some(PlannedTerm::AngleRandomWalk),
+            _ => None,
+        }
+    }
+}
+
+/// What to plan for.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanRequest {
+    /// The term to measure.
+    pub term: PlannedTerm,
+    /// Wanted half-width of the interval relative to the value (0.1 = plus or minus 10 %).
+    pub relative_precision: f64,
+    /// Two-sided confidence level (0.95).
+    pub confidence: f64,
+    /// Sample rate of the record, Hz.
+    pub sample_rate_hz: f64,
+    /// Averaging time at which the term is read, s.
+    pub tau_s: f64,
+}
+
+/// The plan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanResult {
+    /// The request.
+    pub request: PlanRequest,
+    /// Noise type alpha assumed at tau.
+    pub alpha: i32,
+    /// Averaging factor m = tau * f_s.
+    pub m: usize,
+    /// Degrees of freedom needed.
+    pub required_edf: f64,
+    /// Samples needed.
+    pub samples: u64,
+    /// Record length needed, s.
+    pub duration_s: f64,
+    /// Record length needed, h.
+    pub duration_h: f64,
+    /// The interval such a record gives, relative to the value: (low, high) such as (0.9, 1.08).
+    pub relative_interval: (f64, f64),
+}
+
+/// Why a plan cannot be made.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum PlanError {
+    /// A parameter is out of range.
+    #[error("{parameter} = {value} is out of range: expected {expected}")]
+    OutOfRange {
+        /// Parameter name.
+        parameter: &'static str,
+        /// Value given.
+        value: f64,
+        /// What is allowed.
+        expected: &'static str,
+    },
+    /// No record shorter than the search limit reaches the precision.
+    #[error("no record of up to {0} samples reaches that precision")]
+    Unreachable(u64),
+}
+
+/// The averaging time at which bias instability is read for a gyro with angle random walk
+/// `arw_deg_rt_h` and bias instability `bias_instability_dph`: where the white-noise line has
+/// fallen to half the flicker floor, N / sqrt(tau) = 0.5 * 0.6643 B.
+pub fn bias_instability_tau_s(arw_deg_rt_h: f64, bias_instability_dph: f64) -> f64 {
+    let n = arw_deg_rt_h_to_deg_rt_s(arw_deg_rt_h);
+    let floor = BIAS_INSTABILITY_FACTOR * dph_to_dps(bias_instability_dph);
+    (2.0 * n / floor).powi(2)
+}
+
+/// Relative interval (low, high) of a deviation with `edf` degrees of freedom.
+fn relative_interval(edf: f64, confidence: f64) -> Option<(f64, f64)> {
+    deviation_bounds(1.0, edf, confidence)
+}
+
+/// Plans a static record: the shortest record whose overlapping Allan deviation at tau has a
+/// confidence interval within plus or minus the requested precision.
+pub fn plan_static(req: &PlanRequest) -> Result<PlanResult, PlanError> {
+    let bad = |parameter, value, expected| Err(PlanError::OutOfRange { parameter, value, expected });
+    if !(req.relative_precision > 0.0 && req.relative_precision < 1.0) {
+        return bad("relative precision", req.relative_precision, "between 0 and 1 (0.1 = 10 %)");
+    }
+    if !(req.confidence > 0.0 && req.confidence < 1.0) {
+        return bad("confidence", req.confidence, "between 0 and 1");
+    }
+    if !(req.sample_rate_hz.is_finite() && req.sample_rate_hz > 0.0) {
+        return bad("sample rate (Hz)", req.sample_rate_hz, "a positive number");
+    }
+    if !(req.tau_s.is_finite() && req.tau_s * req.sample_rate_hz >= 1.0) {
+        return bad("tau (s)", req.tau_s, "at least one sample interval");
+    }
+    let m = (req.tau_s * req.sample_rate_hz).round().max(1.0) as usize;
+    let alpha = req.term.alpha();
+    let x = req.relative_precision;
+    let good = |n: u64| {
+        let edf = equivalent_dof(DeviationKind::Oadev, alpha, m, n as usize + 1);
+        relative_interval(edf, req.confidence).is_some_and(|(lo, hi)| lo >= 1.0 - x && hi <= 1.0 + x)
+    };
+    // Stable32's stop limit for OADEV: m <= N / 4.
+    let mut lo = 4 * m as u64;
+    if good(lo) {
+        return finish(req, alpha, m, lo);
+    }
+    const LIMIT: u64 = 1 << 40;
+    let mut hi = lo;
+    while !good(hi) {
+        lo = hi;
+        hi = hi.saturating_mul(2);
+        if hi > LIMIT {
+            return Err(PlanError::Unreachable(LIMIT));
+        }
+    }
+    while hi - lo > 1.max(lo / 100_000) {
+        let mid = lo + (hi - lo) / 2;
+        if good(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    finish(req, alpha, m, hi)
+}
+
+fn finish(req: &PlanRequest, alpha: i32, m: usize, n: u64) -> Result<PlanResult, PlanError> {
+    let edf = equivalent_dof(DeviationKind::Oadev, alpha, m, n as usize + 1);
+    let interval = relative_interval(edf, req.confidence).unwrap_or((f64::NAN, f64::NAN));
+    let duration_s = n as f64 / req.sample_rate_hz;
+    Ok(PlanResult {
+        request: req.clone(),
+        alpha,
+        m,
+        required_edf: edf,
+        samples: n,
+        duration_s,
+        duration_h: duration_s / 3600.0,
+        relative_interval: interval,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::allan::{deviation_from_rate, AllanOptions, TauList};
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+
+    #[test]
+    fn planned_white_noise_record_meets_its_precision_in_simulation() {
+        // Plan ARW to +-10 % at 90 % confidence, tau = 1 s at 10 Hz; then simulate many records
+        // of that length and count how often the measured ADEV(1 s) lies within +-10 % of the
+        // true sigma / sqrt(m): the fraction must be close to 90 % (binomial standard error of
+        // 300 trials is 1.7 %; allow 6 %).
+        let req = PlanRequest {
+            term: PlannedTerm::AngleRandomWalk,
+            relative_precision: 0.10,
+            confidence: 0.90,
+            sample_rate_hz: 10.0,
+            tau_s: 1.0,
+        };
+        let plan = plan_static(&req).unwrap();
+        assert!(plan.relative_interval.0 >= 0.9 && plan.relative_interval.1 <= 1.1);
+        let n = plan.samples as usize;
+        assert!(n > 100 && n < 100_000, "{n}");
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let truth = 1.0 / (10f64).sqrt();
+        let trials = 300;
+        let mut inside = 0;
+        for _ in 0..trials {
+            let v: Vec<f64> = (0..n).map(|_| StandardNormal.sample(&mut rng)).collect();
+            let c = deviation_from_rate(
+                v,
+                0.1,
+                &AllanOptions::default().with_taus(TauList::Factors(vec![10])).with_confidence(None),
+            )
+            .unwrap();
+            if (c.points[0].deviation / truth - 1.0).abs() <= 0.10 {
+                inside += 1;
+            }
+        }
+        let frac = inside as f64 / trials as f64;
+        assert!((frac - 0.90).abs() < 0.06, "fraction within +-10 %: {frac}");
+    }
+
+    #[test]
+    fn tighter_precision_needs_a_longer_record() {
+        let mut req = PlanRequest {
+            term: PlannedTerm::BiasInstability,
+            relative_precision: 0.25,
+            confidence: 0.683,
+            sample_rate_hz: 100.0,
+            tau_s: bias_instability_tau_s(0.6, 12.0),
+        };
+        let a = plan_static(&req).unwrap();
+        req.relative_precision = 0.10;
+        let b = plan_static(&req).unwrap();
+        assert!(b.duration_s > 3.0 * a.duration_s, "{} vs {}", b.duration_s, a.duration_s);
+        // tau for N = 0.6 deg/sqrt(h), B = 12 deg/h: (2 * 0.01 / (0.6643 * 12 / 3600))^2 = 81.6 s.
+        assert!((req.tau_s - 81.6).abs() < 0.2, "{}", req.tau_s);
+    }
+
+    #[test]
+    fn bad_requests() {
+        let ok = PlanRequest {
+            term: PlannedTerm::BiasInstability,
+            relative_precision: 0.2,
+            confidence: 0.95,
+            sample_rate_hz: 100.0,
+            tau_s: 100.0,
+        };
+        assert!(plan_static(&PlanRequest { relative_precision: 0.0, ..ok.clone() }).is_err());
+        assert!(plan_static(&PlanRequest { confidence: 1.0, ..ok.clone() }).is_err());
+        assert!(plan_static(&PlanRequest { sample_rate_hz: 0.0, ..ok.clone() }).is_err());
+        assert!(plan_static(&PlanRequest { tau_s: 0.001, ..ok.clone() }).is_err());
+        assert!(plan_static(&PlanRequest { relative_precision: 1e-6, ..ok }).is_err());
+    }
+}
