@@ -22,3 +22,4 @@ pub mod plot;
 pub mod rate;
 pub mod rate_plots;
 pub mod results;
+pub mod static_report;
