@@ -6,3 +6,4 @@ pub mod demo;
 pub mod eval;
 pub mod rate;
 pub mod simulate;
+pub mod static_eval;
