@@ -159,7 +159,7 @@ fn simulated_static_and_allan(args: &DemoArgs, axes: &[EvaluatedAxis], bar: &Pro
     let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.subsec_nanos());
     let dir = TempDir(std::env::temp_dir().join(format!("gyrolab-demo-{}-{nanos}", std::process::id())));
     std::fs::create_dir_all(&dir.0).map_err(|e| sim_error(&dir.0, e))?;
-    let temperature = TemperatureProfile::Ramp { start_c: 25.0, rate_c_per_h: 3.0 };
+    let temperature = TemperatureProfile::Ramp { start_c: 25.0, rate_c_per_h: 15.0 };
     let test_spec = StaticSpec {
         sample_rate_hz: SIM_RATE_HZ,
         duration_s: args.sim_static_s,
@@ -195,7 +195,7 @@ fn simulated_static_and_allan(args: &DemoArgs, axes: &[EvaluatedAxis], bar: &Pro
                  family: ARW 0.6 deg/√h, bias instability 12 deg/h over 10..10000 s, no rate random walk, no bias \
                  temperature coefficient, no earth rate), with K = {} V/(deg/s) and null = {} V set to axis {}'s \
                  rate-table K and F0: {SIM_TESTS} static tests of {} s at {} Hz (seeds {}..{}) and one {} s record at \
-                 {} Hz for the Allan analysis (seed {}), temperature ramp 25 degC + 3 degC/h. The paper sampled its \
+                 {} Hz for the Allan analysis (seed {}), temperature ramp 25 degC + 15 degC/h. The paper sampled its \
                  static tests once a second (too coarse for the Allan curve below 2 s) and did not publish its raw \
                  static records; these figures show the evaluation on records of the same gyro class, not the paper's gyros.",
                 sig(cal.scale_factor, 6),
