@@ -161,12 +161,18 @@ fn demo_out_writes_the_papers_report() {
         assert!((arw / 0.6 - 1.0).abs() < 0.05, "axis {axis}: ARW {arw}");
         assert!(html.contains(&format!("Axis {axis}: static (bias) test (SIMULATED)")));
         assert!(html.contains(&format!("Axis {axis}: Allan variance (SIMULATED)")));
-        assert!(out.join(format!("allan_{axis}.csv")).is_file() && out.join(format!("bias_windows_{axis}.csv")).is_file());
+        assert!(
+            out.join(format!("allan_{axis}.csv")).is_file() && out.join(format!("bias_windows_{axis}.csv")).is_file()
+        );
     }
     assert!(html.matches("SIMULATED DATA").count() >= 6, "banner on every simulated section");
     assert!(html.contains("<span class=\"sim-tag\">SIMULATED</span>"), "summary rows marked");
     assert!(html.contains("did not publish its raw"));
-    assert_eq!(html.matches("<svg class=\"plot\"").count(), 9 + 3 * 3, "rate plots + bias, temperature, Allan per axis");
+    assert_eq!(
+        html.matches("<svg class=\"plot\"").count(),
+        9 + 3 * 3,
+        "rate plots + bias, temperature, Allan per axis"
+    );
     assert!(read(&out.join("bias_tests.csv")).contains("SIMULATED"));
     // Same inputs, same report apart from the time stamp.
     let out2 = dir.path().join("demo2");
@@ -198,7 +204,9 @@ fn write_static_records(dir: &Path) {
         record_temperature: true,
     };
     let opts = gyrolab_io::sim_csv::SimCsvOptions::default();
-    for (name, seed, len) in [("s1", 11, 600.0), ("s2", 12, 600.0), ("s3", 13, 600.0), ("s4", 14, 600.0), ("long", 1, 3600.0)] {
+    for (name, seed, len) in
+        [("s1", 11, 600.0), ("s2", 12, 600.0), ("s3", 13, 600.0), ("s4", 14, 600.0), ("long", 1, 3600.0)]
+    {
         let f = std::fs::File::create(dir.join(format!("{name}.csv"))).unwrap();
         gyrolab_io::sim_csv::write_static_csv(std::io::BufWriter::new(f), &model, &spec(len), seed, &opts).unwrap();
     }
@@ -247,7 +255,8 @@ fn static_plan_evaluates_bias_and_allan_against_the_simulation_truth() {
     let f = |k: &str| figs[k].as_f64().unwrap_or_else(|| panic!("{k} missing: {figs}"));
 
     // Bias and repeatability against per-file means computed here (deg/s output: bias = mean).
-    let stats: Vec<(f64, Vec<f64>)> = ["s1", "s2", "s3", "s4"].iter().map(|n| file_stats(&dir.path().join(format!("{n}.csv")))).collect();
+    let stats: Vec<(f64, Vec<f64>)> =
+        ["s1", "s2", "s3", "s4"].iter().map(|n| file_stats(&dir.path().join(format!("{n}.csv")))).collect();
     let biases: Vec<f64> = stats.iter().map(|s| s.0 * 3600.0).collect();
     let mean_bias = biases.iter().sum::<f64>() / 4.0;
     assert!((f("bias_dph") - mean_bias).abs() < 1e-6 * mean_bias.abs(), "{} vs {mean_bias}", f("bias_dph"));
@@ -290,6 +299,12 @@ fn static_plan_evaluates_bias_and_allan_against_the_simulation_truth() {
     let tests_csv = read(&out.join("bias_tests.csv"));
     assert_eq!(tests_csv.lines().filter(|l| l.starts_with("x,")).count(), 4, "{tests_csv}");
 
+    insta::assert_json_snapshot!("static_plan_results", v, {
+        ".created" => "[time]",
+        ".plan_file" => "[path]",
+        ".gyrolab_version" => "[version]",
+    });
+
     // The same plan with a passing limit exits 0.
     let plan = static_plan(dir.path(), "bias_stability_dph_10s = { max = 1000 }");
     gyrolab().arg("eval").arg(&plan).arg("--out").arg(dir.path().join("out2")).arg("-q").assert().code(0).stdout("");
@@ -304,7 +319,8 @@ fn static_plan_errors_name_the_key() {
     let a = gyrolab().arg("eval").arg(&plan).arg("--out").arg(dir.path().join("o")).assert().code(2);
     let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
     assert!(err.contains("plan.toml:8:") && err.contains("static.x.allan_file") && err.contains("nope.csv"), "{err}");
-    let text = read(&plan).replace("allan_file = \"nope.csv\"", "allan_file = \"long.csv\"").replace("\"temp_c\"", "\"t_c\"");
+    let text =
+        read(&plan).replace("allan_file = \"nope.csv\"", "allan_file = \"long.csv\"").replace("\"temp_c\"", "\"t_c\"");
     let plan = write(dir.path(), "plan.toml", &text);
     let a = gyrolab().arg("eval").arg(&plan).arg("--out").arg(dir.path().join("o")).assert().code(2);
     let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();

@@ -818,9 +818,8 @@ pub fn window_means_file(
             }
         }
     };
-    let mut acc = gyrolab::window_means::WindowMeanAccumulator::new(window_s, fs).ok_or_else(|| {
-        DataError::new(path, format!("window of {window_s} s at {fs} Hz: expected positive numbers"))
-    })?;
+    let mut acc = gyrolab::window_means::WindowMeanAccumulator::new(window_s, fs)
+        .ok_or_else(|| DataError::new(path, format!("window of {window_s} s at {fs} Hz: expected positive numbers")))?;
     while let Some(b) = r.next_block()? {
         let Some(out) = b.channels.get(channel) else {
             return Err(DataError::new(path, format!("no output channel number {}", channel + 1)));

@@ -406,6 +406,20 @@ pub fn write_rate_table_csv<W: Write>(
     Ok(WriteSummary { rows, bytes })
 }
 
+/// Reads a simulation set-up (TOML: `seed`, `preset`, `[sensor]`, `[static_record]`,
+/// `[rate_table]`); errors name the line and column.
+pub fn read_sim_config(path: &std::path::Path) -> Result<gyrolab::sim::SimConfig, crate::DataError> {
+    let text = std::fs::read_to_string(path).map_err(|e| crate::DataError::io(path, &e))?;
+    toml::from_str(&text).map_err(|e| {
+        let mut d = crate::DataError::new(path, format!("not a valid simulation set-up: {}", e.message()));
+        if let Some(span) = e.span() {
+            let (line, col) = crate::calibration::line_col(&text, span.start);
+            d = d.at_line(line).at_column(col, None);
+        }
+        d
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -551,18 +565,4 @@ mod tests {
         )
         .is_err());
     }
-}
-
-/// Reads a simulation set-up (TOML: `seed`, `preset`, `[sensor]`, `[static_record]`,
-/// `[rate_table]`); errors name the line and column.
-pub fn read_sim_config(path: &std::path::Path) -> Result<gyrolab::sim::SimConfig, crate::DataError> {
-    let text = std::fs::read_to_string(path).map_err(|e| crate::DataError::io(path, &e))?;
-    toml::from_str(&text).map_err(|e| {
-        let mut d = crate::DataError::new(path, format!("not a valid simulation set-up: {}", e.message()));
-        if let Some(span) = e.span() {
-            let (line, col) = crate::calibration::line_col(&text, span.start);
-            d = d.at_line(line).at_column(col, None);
-        }
-        d
-    })
 }

@@ -123,11 +123,8 @@ impl StaticAxisReport {
             f.set("bias_dph", m);
         }
         for k in self.smoothing_keys() {
-            let worst = self
-                .tests
-                .iter()
-                .filter_map(|t| t.result.bias_stability_dph.get(&k).copied())
-                .fold(f64::NAN, f64::max);
+            let worst =
+                self.tests.iter().filter_map(|t| t.result.bias_stability_dph.get(&k).copied()).fold(f64::NAN, f64::max);
             f.set(format!("bias_stability_dph_{k}s"), worst);
         }
         if let Some(b) = self.repeatability.as_ref().and_then(|r| r.bias_repeatability_dph) {
@@ -167,7 +164,9 @@ impl StaticAxisReport {
         let figures: serde_json::Map<String, serde_json::Value> = figs
             .values
             .iter()
-            .filter(|(k, _)| crate::figures::known_figure(k).is_some_and(|d| d.group != crate::figures::FigureGroup::Allan))
+            .filter(|(k, _)| {
+                crate::figures::known_figure(k).is_some_and(|d| d.group != crate::figures::FigureGroup::Allan)
+            })
             .map(|(k, v)| (k.clone(), serde_json::json!(v)))
             .collect();
         serde_json::json!({
@@ -304,10 +303,8 @@ pub fn allan_axis_csv(a: &StaticAxisReport) -> Option<String> {
 pub fn bias_time_plot(a: &StaticAxisReport) -> Result<String, PlotError> {
     let u = a.bias_unit();
     let w = short(a.window_s, 4);
-    let mut p = Panel::new(
-        Axis::linear("time from record start (s)"),
-        Axis::linear(format!("bias, {w}-s window means ({u})")),
-    );
+    let mut p =
+        Panel::new(Axis::linear("time from record start (s)"), Axis::linear(format!("bias, {w}-s window means ({u})")));
     for (i, (t, tw)) in a.tests.iter().zip(&a.windows).enumerate().take(6) {
         let mut pts = Vec::with_capacity(2 * tw.windows.len());
         for m in &tw.windows {
@@ -389,9 +386,7 @@ pub fn allan_plot(a: &StaticAxisReport) -> Option<Result<String, PlotError>> {
         0,
     )
     .with_error_bars(
-        pts.iter()
-            .map(|p| (p.lower.map_or(f64::NAN, |x| x * f), p.upper.map_or(f64::NAN, |x| x * f)))
-            .collect(),
+        pts.iter().map(|p| (p.lower.map_or(f64::NAN, |x| x * f), p.upper.map_or(f64::NAN, |x| x * f))).collect(),
     );
     let mut p = Panel::new(Axis::log("averaging time τ (s)"), Axis::log(format!("Allan deviation σ(τ) ({unit})")));
     p.series.push(measured);
@@ -404,7 +399,8 @@ pub fn allan_plot(a: &StaticAxisReport) -> Option<Result<String, PlotError>> {
         let k = &s.coefficients;
         let t_min = s.bias_instability.map_or((t_lo * t_hi).sqrt(), |r| r.tau_s);
         if let Some(n) = k.arw_deg_rt_s {
-            let line: Vec<(f64, f64)> = grid(t_lo.min(1.0), (t_min * 2.0).max(1.0)).into_iter().map(|t| (t, n / t.sqrt() * f)).collect();
+            let line: Vec<(f64, f64)> =
+                grid(t_lo.min(1.0), (t_min * 2.0).max(1.0)).into_iter().map(|t| (t, n / t.sqrt() * f)).collect();
             p.series.push(Series::new("N asymptote: σ = N/√τ", line, SeriesStyle::Dashed, 1));
             p.annotations.push(Annotation {
                 x: 1.0,
@@ -422,8 +418,10 @@ pub fn allan_plot(a: &StaticAxisReport) -> Option<Result<String, PlotError>> {
             });
         }
         if let Some(kk) = k.rrw_deg_s_rt_s {
-            let line: Vec<(f64, f64)> =
-                grid((t_min / 2.0).min(3.0), t_hi.max(3.0)).into_iter().map(|t| (t, kk * (t / 3.0).sqrt() * f)).collect();
+            let line: Vec<(f64, f64)> = grid((t_min / 2.0).min(3.0), t_hi.max(3.0))
+                .into_iter()
+                .map(|t| (t, kk * (t / 3.0).sqrt() * f))
+                .collect();
             p.series.push(Series::new("K asymptote: σ = K √(τ/3)", line, SeriesStyle::Dashed, 3));
             p.annotations.push(Annotation {
                 x: 3.0,
@@ -559,13 +557,21 @@ pub fn static_section(a: &StaticAxisReport, limits: &[Limit]) -> Result<ReportSe
         table_rows.push(row);
     }
     Ok(ReportSection {
-        title: format!("Axis {}: static (bias) test{}", a.axis, if a.simulated.is_some() { " (SIMULATED)" } else { "" }),
+        title: format!(
+            "Axis {}: static (bias) test{}",
+            a.axis,
+            if a.simulated.is_some() { " (SIMULATED)" } else { "" }
+        ),
         simulated: a.simulated.is_some(),
         paragraphs,
         figures,
         plots,
         tables: vec![DataTable {
-            caption: format!("Axis {}: static tests (as the paper's Table 5){}", a.axis, if a.simulated.is_some() { ", SIMULATED" } else { "" }),
+            caption: format!(
+                "Axis {}: static tests (as the paper's Table 5){}",
+                a.axis,
+                if a.simulated.is_some() { ", SIMULATED" } else { "" }
+            ),
             header,
             rows: table_rows,
         }],
@@ -601,6 +607,15 @@ pub fn allan_section(a: &StaticAxisReport, limits: &[Limit]) -> Option<Result<Re
         c.rate_unit,
         c.curve.confidence.map_or("no".into(), |x| format!("{} %", short(100.0 * x, 4)))
     ));
+    if let Some(s) = &c.slope_lines {
+        if s.bias_instability.is_none() {
+            paragraphs.push(
+                "B is not read: the curve has no interior minimum (it still falls at the longest tau; a longer record \
+                 is needed)."
+                    .into(),
+            );
+        }
+    }
     if let Some(n) = &c.noise_note {
         paragraphs.push(format!("No noise terms: {n}."));
     }

@@ -106,7 +106,7 @@ mod tests {
     fn whole_windows_only_across_blocks() {
         let mut a = WindowMeanAccumulator::new(1.0, 4.0).unwrap();
         let y: Vec<f64> = (0..10).map(f64::from).collect();
-        let t = vec![20.0; 10];
+        let t = [20.0; 10];
         a.push(&y[..3], Some(&t[..3]));
         a.push(&y[3..], Some(&t[3..]));
         let w = a.finish();

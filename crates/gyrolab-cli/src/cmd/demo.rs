@@ -10,15 +10,15 @@ use clap::Args;
 use gyrolab::rate_test::RateTestOptions;
 use gyrolab::sim::{Preset, SensorModel, StaticSpec, TemperatureProfile};
 use gyrolab_io::plan::StaticAxisPlan;
-use gyrolab_io::sim_csv::{write_static_csv, SimCsvOptions};
-use indicatif::ProgressBar;
 use gyrolab_io::rate_table::{parse_rate_table, RateColumns};
+use gyrolab_io::sim_csv::{write_static_csv, SimCsvOptions};
 use gyrolab_report::format::sig;
 use gyrolab_report::html::{DataTable, ReportHeader, ReportSection};
 use gyrolab_report::paper::{compare_table2, compare_table6, table2_text, table5_text, table6_text};
 use gyrolab_report::paper::{ClaimVerdict, Table2Comparison};
 use gyrolab_report::rate::{rate_json, rate_summary_table, AxisReport};
 use gyrolab_report::results::DeviceJson;
+use indicatif::ProgressBar;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -222,7 +222,8 @@ fn simulated_static_and_allan(args: &DemoArgs, axes: &[EvaluatedAxis], bar: &Pro
         });
     }
     let describe = |axis: &str| texts.get(axis).cloned().unwrap_or_default();
-    let ctx = StaticContext { rate_axes: axes, calibration: None, limits: &[], base: &dir.0, simulated: Some(&describe) };
+    let ctx =
+        StaticContext { rate_axes: axes, calibration: None, limits: &[], base: &dir.0, simulated: Some(&describe) };
     evaluate_static(&plans, &ctx, bar)
 }
 

@@ -235,7 +235,8 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, bar: &ProgressBar)
     let allan_path: PathBuf = match &s.allan_file {
         Some(p) => p.clone(),
         None => {
-            let longest = samples.iter().enumerate().max_by_key(|(i, n)| (**n, std::cmp::Reverse(*i))).map_or(0, |x| x.0);
+            let longest =
+                samples.iter().enumerate().max_by_key(|(i, n)| (**n, std::cmp::Reverse(*i))).map_or(0, |x| x.0);
             s.files[longest].clone() // ok: the plan has at least one file per [static] table
         }
     };
@@ -243,7 +244,17 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, bar: &ProgressBar)
     let allan = allan_of(&allan_path, &options, &reference, s.sample_rate_hz, ctx.base)?;
     bar.inc(1);
     let simulated = ctx.simulated.map(|f| f(axis));
-    Ok(StaticAxisReport { axis: axis.clone(), reference: reference_json, tests, repeatability, window_s, windows, allan: Some(allan), simulated, notes })
+    Ok(StaticAxisReport {
+        axis: axis.clone(),
+        reference: reference_json,
+        tests,
+        repeatability,
+        window_s,
+        windows,
+        allan: Some(allan),
+        simulated,
+        notes,
+    })
 }
 
 /// OADEV (octave taus, 68.3 % bounds) of one record's first selected channel, converted to deg/s
@@ -274,9 +285,12 @@ fn allan_of(
     let curve = deviation_from_rate(values, 1.0 / sample_rate_hz, &AllanOptions::new(DeviationKind::Oadev)).map_err(
         |e| match e {
             AllanError::NonFinite { index, value } => CliError::Data(
-                DataError::new(path, format!("sample {value} is not a finite number: the Allan variance needs a complete record"))
-                    .at_line(lines.get(index).copied().unwrap_or(0))
-                    .at_column(info.column, Some(&info.name)),
+                DataError::new(
+                    path,
+                    format!("sample {value} is not a finite number: the Allan variance needs a complete record"),
+                )
+                .at_line(lines.get(index).copied().unwrap_or(0))
+                .at_column(info.column, Some(&info.name)),
             ),
             other => CliError::Data(DataError::new(path, format!("channel '{}': {other}", info.name))),
         },
@@ -288,7 +302,10 @@ fn allan_of(
             info.unit.symbol().to_string(),
             None,
             None,
-            Some(format!("the data are in {}: give the axis a rate-table record or a calibration file", info.unit.symbol())),
+            Some(format!(
+                "the data are in {}: give the axis a rate-table record or a calibration file",
+                info.unit.symbol()
+            )),
         )
     };
     Ok(ChannelAnalysis {
