@@ -85,9 +85,17 @@ fn report_renders_with_plots_in_headless_chromium() {
     );
     let dir = tempfile::tempdir().unwrap();
     let out: PathBuf = dir.path().join("report");
-    gyrolab().arg("demo").arg("--out").arg(&out).arg("--quiet").assert().code(0);
+    // Shorter simulated static tests than the default keep the debug-build test fast; the Allan
+    // record keeps its default length (7200 s), which shows the minimum (bias instability read-off).
+    gyrolab().arg("demo").arg("--out").arg(&out).args(["--sim-static-s", "600", "--quiet"]).assert().code(0);
+    if let Ok(keep) = std::env::var("GYROLAB_KEEP_SCREENSHOT") {
+        let _ = std::fs::copy(out.join("report.html"), format!("{keep}.html"));
+    }
     let png = dir.path().join("shot.png");
     screenshot(&out.join("report.html"), &png, &dir.path().join("profile"));
+    if let Ok(keep) = std::env::var("GYROLAB_KEEP_SCREENSHOT") {
+        let _ = std::fs::copy(&png, format!("{keep}.png"));
+    }
     let (w, h, px) = load_rgb(&png);
     assert_eq!((w, h), (WIDTH, HEIGHT), "screenshot size");
 

@@ -140,7 +140,8 @@ fn plan_errors_name_key_and_line() {
 fn demo_out_writes_the_papers_report() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("demo");
-    gyrolab().arg("demo").arg("--out").arg(&out).arg("--quiet").assert().code(0).stdout("");
+    let short = ["--sim-static-s", "300", "--sim-allan-s", "1200"];
+    gyrolab().arg("demo").arg("--out").arg(&out).args(short).arg("--quiet").assert().code(0).stdout("");
     let html = read(&out.join("report.html"));
     assert_self_contained(&html);
     assert!(html.contains("The paper&#39;s printed tables beside the recomputation"));
@@ -149,9 +150,179 @@ fn demo_out_writes_the_papers_report() {
     assert_eq!(v["rate_axes"].as_array().unwrap().len(), 3);
     assert!(v["verdict"].is_null());
     assert_eq!(v["sections"]["paper"]["table2_x"].as_array().unwrap().len(), 14);
+    // The static and Allan part: simulated, labelled so, evaluated per axis.
+    for axis in ["x", "y", "z"] {
+        let s = &v["sections"]["static"][axis];
+        assert!(s["simulated"].as_str().unwrap().contains("adxrs646"), "{s}");
+        assert_eq!(s["tests"].as_array().unwrap().len(), 4);
+        assert_eq!(s["reference"]["source"], "rate_table");
+        assert!(v["sections"]["allan"][axis]["simulated"].is_string());
+        let arw = v["sections"]["allan"][axis]["noise"]["arw_deg_rt_h"].as_f64().unwrap();
+        assert!((arw / 0.6 - 1.0).abs() < 0.05, "axis {axis}: ARW {arw}");
+        assert!(html.contains(&format!("Axis {axis}: static (bias) test (SIMULATED)")));
+        assert!(html.contains(&format!("Axis {axis}: Allan variance (SIMULATED)")));
+        assert!(
+            out.join(format!("allan_{axis}.csv")).is_file() && out.join(format!("bias_windows_{axis}.csv")).is_file()
+        );
+    }
+    assert!(html.matches("SIMULATED DATA").count() >= 6, "banner on every simulated section");
+    assert!(html.contains("<span class=\"sim-tag\">SIMULATED</span>"), "summary rows marked");
+    assert!(html.contains("did not publish its raw"));
+    assert_eq!(
+        html.matches("<svg class=\"plot\"").count(),
+        9 + 3 * 3,
+        "rate plots + bias, temperature, Allan per axis"
+    );
+    assert!(read(&out.join("bias_tests.csv")).contains("SIMULATED"));
     // Same inputs, same report apart from the time stamp.
     let out2 = dir.path().join("demo2");
-    gyrolab().arg("demo").arg("--out").arg(&out2).arg("--quiet").assert().code(0);
+    gyrolab().arg("demo").arg("--out").arg(&out2).args(short).arg("--quiet").assert().code(0);
     let strip = |s: String| s.lines().filter(|l| !l.contains("<td><b>date</b>")).collect::<Vec<_>>().join("\n");
     assert_eq!(strip(html), strip(read(&out2.join("report.html"))));
+}
+
+/// Simulated static records with known truth (deg/s output, so the bias needs no reference):
+/// four tests of 600 s and one 3600-s record for the Allan analysis, 100 Hz, with a temperature ramp.
+const TRUTH_BIAS_DPH: f64 = 50.0;
+const TRUTH_ARW: f64 = 0.5;
+const TRUTH_B: f64 = 10.0;
+
+fn write_static_records(dir: &Path) {
+    use gyrolab::sim::{SensorModel, StaticSpec, TemperatureProfile};
+    let model = SensorModel {
+        bias_dph: TRUTH_BIAS_DPH,
+        run_to_run_bias_sigma_dph: 30.0,
+        arw_deg_rt_h: TRUTH_ARW,
+        bias_instability_dph: TRUTH_B,
+        ..SensorModel::default()
+    };
+    let spec = |duration_s: f64| StaticSpec {
+        sample_rate_hz: 100.0,
+        duration_s,
+        temperature: TemperatureProfile::Ramp { start_c: 20.0, rate_c_per_h: 10.0 },
+        latitude_deg: None,
+        record_temperature: true,
+    };
+    let opts = gyrolab_io::sim_csv::SimCsvOptions::default();
+    for (name, seed, len) in
+        [("s1", 11, 600.0), ("s2", 12, 600.0), ("s3", 13, 600.0), ("s4", 14, 600.0), ("long", 1, 3600.0)]
+    {
+        let f = std::fs::File::create(dir.join(format!("{name}.csv"))).unwrap();
+        gyrolab_io::sim_csv::write_static_csv(std::io::BufWriter::new(f), &model, &spec(len), seed, &opts).unwrap();
+    }
+}
+
+fn static_plan(dir: &Path, limits: &str) -> PathBuf {
+    let text = format!(
+        "[device]\nmodel = \"sim\"\nserial = \"1\"\naxes = [\"x\"]\n\n[static.x]\n\
+         files = [\"s1.csv\", \"s2.csv\", \"s3.csv\", \"s4.csv\"]\nallan_file = \"long.csv\"\nsample_rate_hz = 100\n\
+         channel = \"rate_dps\"\ntemperature_channel = \"temp_c\"\n\n[limits]\n{limits}\n"
+    );
+    write(dir, "plan.toml", &text)
+}
+
+/// (mean, 10-s window means) of a simulated record's rate_dps column, read independently.
+fn file_stats(p: &Path) -> (f64, Vec<f64>) {
+    let text = read(p);
+    let v: Vec<f64> = text
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("time_s"))
+        .map(|l| l.split(',').nth(1).unwrap().parse::<f64>().unwrap())
+        .collect();
+    let windows = v.chunks_exact(1000).map(|c| c.iter().sum::<f64>() / c.len() as f64).collect();
+    (v.iter().sum::<f64>() / v.len() as f64, windows)
+}
+
+fn std_n1(v: &[f64]) -> f64 {
+    let m = v.iter().sum::<f64>() / v.len() as f64;
+    (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64).sqrt()
+}
+
+#[test]
+fn static_plan_evaluates_bias_and_allan_against_the_simulation_truth() {
+    let dir = tempfile::tempdir().unwrap();
+    write_static_records(dir.path());
+    let plan = static_plan(
+        dir.path(),
+        "bias_stability_dph_10s = { max = 1 }\narw_deg_rt_h = { max = 1 }\nbias_stability_dph_30s = { max = 1000 }",
+    );
+    let out = dir.path().join("out");
+    let a = gyrolab().arg("eval").arg(&plan).arg("--out").arg(&out).assert().code(3);
+    let stderr = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(stderr.contains("axis x: bias_stability_dph_10s ="), "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&read(&out.join("results.json"))).unwrap();
+    let figs = &v["sections"]["static"]["x"]["figures"];
+    let f = |k: &str| figs[k].as_f64().unwrap_or_else(|| panic!("{k} missing: {figs}"));
+
+    // Bias and repeatability against per-file means computed here (deg/s output: bias = mean).
+    let stats: Vec<(f64, Vec<f64>)> =
+        ["s1", "s2", "s3", "s4"].iter().map(|n| file_stats(&dir.path().join(format!("{n}.csv")))).collect();
+    let biases: Vec<f64> = stats.iter().map(|s| s.0 * 3600.0).collect();
+    let mean_bias = biases.iter().sum::<f64>() / 4.0;
+    assert!((f("bias_dph") - mean_bias).abs() < 1e-6 * mean_bias.abs(), "{} vs {mean_bias}", f("bias_dph"));
+    assert!((f("bias_dph") - TRUTH_BIAS_DPH).abs() < 60.0, "bias near the truth given 30 deg/h run-to-run");
+    let rep = std_n1(&biases);
+    assert!((f("bias_repeatability_dph") - rep).abs() < 1e-6 * rep, "{} vs {rep}", f("bias_repeatability_dph"));
+    // Bias stability at 10 s: the worst test's std of 10-s window means.
+    let worst = stats.iter().map(|s| std_n1(&s.1) * 3600.0).fold(0.0, f64::max);
+    assert!((f("bias_stability_dph_10s") - worst).abs() < 1e-6 * worst, "{} vs {worst}", f("bias_stability_dph_10s"));
+    assert!(figs["bias_stability_dph_30s"].is_f64(), "smoothing time taken from the limits");
+    assert!(figs["drift_dph_per_h"].is_f64() && figs["temp_sensitivity_dph_per_c"].is_f64());
+
+    // Allan noise terms against the truth: ARW within 5 %, B within 25 %.
+    let noise = &v["sections"]["allan"]["x"]["noise"];
+    let arw = noise["arw_deg_rt_h"].as_f64().unwrap();
+    let b = noise["bias_instability_dph"].as_f64().unwrap();
+    assert!((arw / TRUTH_ARW - 1.0).abs() < 0.05, "ARW {arw}");
+    assert!((b / TRUTH_B - 1.0).abs() < 0.25, "B {b}");
+    assert_eq!(v["sections"]["allan"]["x"]["file"], "long.csv");
+    assert_eq!(v["sections"]["static"]["x"]["reference"]["source"], "none");
+
+    // Limits on static figures: 10 s FAIL, ARW PASS, 30 s PASS.
+    let checks = v["limit_checks"].as_array().unwrap();
+    let verdict = |fig: &str| checks.iter().find(|c| c["figure"] == fig).map(|c| c["verdict"].clone()).unwrap();
+    assert_eq!(verdict("bias_stability_dph_10s"), "FAIL");
+    assert_eq!(verdict("arw_deg_rt_h"), "PASS");
+    assert_eq!(verdict("bias_stability_dph_30s"), "PASS");
+    assert_eq!(v["verdict"], "FAIL");
+
+    let html = read(&out.join("report.html"));
+    assert_self_contained(&html);
+    assert_eq!(html.matches("<svg class=\"plot\"").count(), 3, "bias time series, bias-temperature, Allan");
+    assert!(html.contains("Axis x: Allan deviation (OADEV)") && html.contains("Axis x: bias time series"));
+    assert!(html.contains("N = 0.") && html.contains("B = ") && html.contains("averaging time τ (s)"));
+    assert!(!html.contains("SIMULATED DATA"), "measured records are not labelled simulated");
+    for f in ["bias_tests.csv", "bias_windows_x.csv", "allan_x.csv", "summary.csv"] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    assert!(!out.join("calibration.toml").exists(), "no rate-table axis, no calibration");
+    let tests_csv = read(&out.join("bias_tests.csv"));
+    assert_eq!(tests_csv.lines().filter(|l| l.starts_with("x,")).count(), 4, "{tests_csv}");
+
+    insta::assert_json_snapshot!("static_plan_results", v, {
+        ".created" => "[time]",
+        ".plan_file" => "[path]",
+        ".gyrolab_version" => "[version]",
+    });
+
+    // The same plan with a passing limit exits 0.
+    let plan = static_plan(dir.path(), "bias_stability_dph_10s = { max = 1000 }");
+    gyrolab().arg("eval").arg(&plan).arg("--out").arg(dir.path().join("out2")).arg("-q").assert().code(0).stdout("");
+}
+
+#[test]
+fn static_plan_errors_name_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    write_static_records(dir.path());
+    let text = read(&static_plan(dir.path(), "")).replace("allan_file = \"long.csv\"", "allan_file = \"nope.csv\"");
+    let plan = write(dir.path(), "plan.toml", &text);
+    let a = gyrolab().arg("eval").arg(&plan).arg("--out").arg(dir.path().join("o")).assert().code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(err.contains("plan.toml:8:") && err.contains("static.x.allan_file") && err.contains("nope.csv"), "{err}");
+    let text =
+        read(&plan).replace("allan_file = \"nope.csv\"", "allan_file = \"long.csv\"").replace("\"temp_c\"", "\"t_c\"");
+    let plan = write(dir.path(), "plan.toml", &text);
+    let a = gyrolab().arg("eval").arg(&plan).arg("--out").arg(dir.path().join("o")).assert().code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(err.contains("static.x.temperature_channel") && !err.contains("panicked"), "{err}");
 }

@@ -69,6 +69,7 @@ struct RawStatic {
     output_unit: Option<Spanned<String>>,
     temperature_channel: Option<String>,
     latitude_deg: Option<Spanned<f64>>,
+    allan_file: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -119,7 +120,7 @@ pub struct RateAxisPlan {
     pub columns: RateColumns,
 }
 
-/// The static records of one axis (`[static.<axis>]`), kept for the static and Allan sections.
+/// The static records of one axis (`[static.<axis>]`), evaluated by the static and Allan sections.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StaticAxisPlan {
     /// Axis name.
@@ -136,6 +137,8 @@ pub struct StaticAxisPlan {
     pub temperature_channel: Option<String>,
     /// Latitude of the test site, degrees (for the earth-rate correction).
     pub latitude_deg: Option<f64>,
+    /// Record for the Allan analysis (resolved); `None`: the longest of `files`.
+    pub allan_file: Option<PathBuf>,
 }
 
 /// One spec limit (`[limits] figure = { min = .., max = .. }`).
@@ -378,6 +381,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
                 output_unit: cx.output_unit(&key("output_unit"), &s.output_unit)?,
                 temperature_channel: s.temperature_channel.clone(),
                 latitude_deg: s.latitude_deg.as_ref().map(|l| *l.get_ref()),
+                allan_file: s.allan_file.as_ref().map(|f| cx.existing_file(&key("allan_file"), f)).transpose()?,
             });
         }
     }

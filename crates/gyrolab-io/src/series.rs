@@ -837,3 +837,48 @@ pub fn evaluate_static_file(
     }
     Ok((results, summary))
 }
+
+/// Means of consecutive `window_s`-second windows of one output channel (index into the
+/// header's channels) and the temperature, streaming the file once (memory per window, not
+/// per sample). The sample rate is the options' one, else the mean interval of the time column.
+pub fn window_means_file(
+    path: impl AsRef<Path>,
+    options: &SeriesOptions,
+    channel: usize,
+    window_s: f64,
+) -> Result<Vec<gyrolab::window_means::WindowMean>, DataError> {
+    let path = path.as_ref();
+    let mut r = SeriesReader::open(path, options)?;
+    let fs = match options.sample_rate_hz {
+        Some(f) => f,
+        None => {
+            // The time column's mean interval, from a first pass over the time stamps.
+            let (mut first, mut last, mut n) = (None, 0.0, 0u64);
+            read_series(path, options, |_, b| {
+                if let Some(t) = b.time {
+                    if first.is_none() {
+                        first = t.first().copied();
+                    }
+                    if let Some(&l) = t.last() {
+                        last = l;
+                    }
+                    n += t.len() as u64;
+                }
+                Ok(())
+            })?;
+            match first {
+                Some(f0) if n > 1 && last > f0 => (n - 1) as f64 / (last - f0),
+                _ => return Err(DataError::new(path, "cannot tell the sample rate: give it (sample_rate_hz)")),
+            }
+        }
+    };
+    let mut acc = gyrolab::window_means::WindowMeanAccumulator::new(window_s, fs)
+        .ok_or_else(|| DataError::new(path, format!("window of {window_s} s at {fs} Hz: expected positive numbers")))?;
+    while let Some(b) = r.next_block()? {
+        let Some(out) = b.channels.get(channel) else {
+            return Err(DataError::new(path, format!("no output channel number {}", channel + 1)));
+        };
+        acc.push(out, b.temp);
+    }
+    Ok(acc.finish())
+}

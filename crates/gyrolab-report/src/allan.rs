@@ -237,6 +237,9 @@ pub fn allan_csv(channels: &[ChannelAnalysis]) -> String {
     s
 }
 
+/// A row of the noise-term table: name, unit, slope-line value, reading, five-term fit value.
+type NoiseRow<'a> = (&'a str, &'a str, Option<f64>, &'a Option<SlopeReading>, Option<f64>);
+
 /// The deviation table and noise summary of one channel, as text.
 pub fn allan_text(a: &ChannelAnalysis) -> String {
     let c = &a.curve;
@@ -291,7 +294,7 @@ pub fn allan_text(a: &ChannelAnalysis) -> String {
                     format!("{} ({}..{})", short(r.tau_s, 4), short(r.tau_range_s.0, 4), short(r.tau_range_s.1, 4))
                 })
             };
-            let rows: [(&str, &str, Option<f64>, &Option<SlopeReading>, Option<f64>); 5] = [
+            let rows: [NoiseRow<'_>; 5] = [
                 ("angle random walk N", "deg/sqrt(h)", k.arw_deg_rt_h, &sl.arw, f.and_then(|f| f.arw_deg_rt_h)),
                 (
                     "bias instability B",

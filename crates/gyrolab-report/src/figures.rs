@@ -1,7 +1,7 @@
 //! The catalogue of reportable figures: the names a plan's `[limits]` may use (the JSON keys,
 //! each with its unit suffix), with unit, formula and source for the summary table and the
 //! methods appendix (taken from docs/METHODS.md; static and Allan entries from
-//! methods-notes sections 3 and 4, for the sections still to come).
+//! methods-notes sections 3 and 4).
 
 use crate::rate::AxisJson;
 
@@ -57,7 +57,7 @@ const fn def(
 
 use FigureGroup::{Allan, RateTable, Static};
 
-/// Every figure gyrolab reports or will report, in report order.
+/// Every figure gyrolab reports, in report order.
 #[rustfmt::skip]
 pub const FIGURES: &[FigureDef] = &[
     def("scale_factor", "scale factor K", "output/(deg/s)", RateTable, "least-squares slope of the point means ȳ_j on the rates Ω_j", "[P] eq. 1-2"),
@@ -72,13 +72,16 @@ pub const FIGURES: &[FigureDef] = &[
     def("asymmetry_pct", "scale-factor asymmetry K_as", "%", RateTable, "|K+ − K−| / |(K+ + K−)/2|, K± fitted on Ω ≥ 0 and Ω ≤ 0", "[GJB], [IEEE 528]"),
     def("scale_factor_repeatability_ppm", "scale-factor repeatability K_r", "ppm", RateTable, "std(K_i, n − 1) / |mean(K_i)|, K_i fitted per run on both strokes", "[GJB]"),
     def("scale_factor_repeatability_pct", "scale-factor repeatability K_r", "%", RateTable, "as scale_factor_repeatability_ppm, in percent", "[GJB]"),
-    def("bias_dph", "bias B_0", "deg/h", Static, "(mean output − F_null) / K", "[P] eq. 10"),
-    def("bias_stability_dph_<T>s", "bias stability B_s(T)", "deg/h", Static, "std(means of consecutive T-second windows, n − 1) / K", "[P] eq. 11, [GJB]"),
+    def("bias_dph", "bias B_0", "deg/h", Static, "(mean output − F_null) / K per test; the summary quotes the mean over the Q tests", "[P] eq. 10"),
+    def("bias_stability_dph_<T>s", "bias stability B_s(T)", "deg/h", Static, "std(means of consecutive T-second windows, n − 1) / K; the summary quotes the worst test", "[P] eq. 11, [GJB]"),
     def("bias_repeatability_dph", "bias repeatability B_r", "deg/h", Static, "std(B_0i, n − 1) over the Q tests", "[P] eq. 12, [GJB]"),
-    def("drift_dph_per_h", "drift", "deg/h per h", Static, "least-squares slope of bias against time", "[GJB]"),
+    def("drift_dph_per_h", "drift", "deg/h per h", Static, "least-squares slope of bias against time; the summary quotes the test of largest magnitude", "[GJB]"),
+    def("temp_sensitivity_dph_per_c", "bias temperature sensitivity", "(deg/h)/degC", Static, "least-squares slope of 10-s window-mean bias against window-mean temperature; the test of largest magnitude", "[GJB], [T]"),
     def("arw_deg_rt_h", "angle random walk N", "deg/√h", Allan, "ADEV slope −1/2 line read at τ = 1 s, × 60", "[IEEE 952], [SP1065]"),
     def("bias_instability_dph", "bias instability B", "deg/h", Allan, "flat ADEV minimum / 0.6643", "[IEEE 952]"),
     def("rrw_deg_h_rt_h", "rate random walk K", "deg/h/√h", Allan, "ADEV slope +1/2 line read at τ = 3 s, × 216000", "[IEEE 952]"),
+    def("quantization_deg", "quantization noise Q", "deg", Allan, "ADEV slope −1 line: Q = σ(τ) τ / √3", "[IEEE 952]"),
+    def("rate_ramp_dph_per_h", "rate ramp R", "deg/h per h", Allan, "ADEV slope +1 line: R = √2 σ(τ) / τ, × 3600²", "[IEEE 952]"),
 ];
 
 /// The names a `[limits]` table may use (`<T>` stands for a smoothing time in seconds).
@@ -111,6 +114,8 @@ pub struct AxisFigures {
     pub output_unit: String,
     /// (key, value) in catalogue order; static and Allan sections append theirs.
     pub values: Vec<(String, f64)>,
+    /// Keys whose values come from simulated data (marked SIMULATED in the summary).
+    pub simulated: Vec<String>,
 }
 
 impl AxisFigures {
@@ -136,7 +141,7 @@ impl AxisFigures {
 
 /// The rate-table figures of an axis, from its JSON.
 pub fn rate_figures(a: &AxisJson) -> AxisFigures {
-    let mut f = AxisFigures { axis: a.name.clone(), output_unit: a.output_unit.clone(), values: Vec::new() };
+    let mut f = AxisFigures { axis: a.name.clone(), output_unit: a.output_unit.clone(), ..Default::default() };
     let opt = [
         ("scale_factor", Some(a.scale_factor)),
         ("zero_offset", Some(a.zero_offset)),

@@ -122,6 +122,8 @@ pub struct SummaryRow {
     pub limit: String,
     /// Per axis: value text and verdict (None when no limit applies).
     pub cells: Vec<(String, Option<Verdict>)>,
+    /// Whether the figure comes from simulated data on some axis (marked SIMULATED).
+    pub simulated: bool,
 }
 
 /// The summary table of every figure.
@@ -178,6 +180,7 @@ impl SummaryTable {
                     })
                     .collect();
                 SummaryRow {
+                    simulated: axes.iter().any(|a| a.simulated.contains(&key)),
                     label: def.map_or_else(|| key.clone(), |d| d.label.to_string()),
                     unit: axes.first().map_or_else(String::new, |a| a.unit_of(&key)),
                     limit: limit.map_or_else(String::new, Limit::text),
@@ -225,6 +228,7 @@ table.header td { text-align: left; border: none; padding: 1px 10px 1px 0; }
 .NOT_EVALUATED { color: var(--ne); background: var(--ne-bg); }
 .overall { font-size: 13pt; padding: 4px 10px; display: inline-block; margin: 4px 0; }
 .simulated { display: inline-block; background: #fff3cd; color: #7a5a00; border: 2px solid #e0b000; font-weight: bold; padding: 2px 10px; margin: 4px 0; }
+.sim-tag { font-size: 8.5pt; font-weight: bold; color: #7a5a00; background: #fff3cd; border: 1px solid #e0b000; padding: 0 4px; }
 figure.plot { margin: 10px 0 16px; break-inside: avoid; page-break-inside: avoid; }
 figure.plot svg { display: block; width: 100%; max-width: 760px; height: auto; border: 1px solid #ddd; }
 figcaption { font-size: 9.5pt; color: #333; margin-top: 3px; }
@@ -352,8 +356,9 @@ fn write_summary(h: &mut String, s: &SummaryTable) {
     for r in &s.rows {
         let _ = write!(
             h,
-            "<tr><td class=\"name\">{} <small>({})</small></td><td class=\"name\">{}</td><td>{}</td>",
+            "<tr><td class=\"name\">{}{} <small>({})</small></td><td class=\"name\">{}</td><td>{}</td>",
             figure_link(&r.key, &r.label),
+            if r.simulated { " <span class=\"sim-tag\">SIMULATED</span>" } else { "" },
             escape(&r.key),
             escape(&r.unit),
             escape(&r.limit)

@@ -25,4 +25,5 @@ pub mod rate;
 pub mod rate_plots;
 pub mod results;
 pub mod segments;
+pub mod static_report;
 pub mod triad;

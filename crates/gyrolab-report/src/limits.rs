@@ -121,7 +121,7 @@ mod tests {
     use super::*;
 
     fn axis(name: &str, values: &[(&str, f64)]) -> AxisFigures {
-        let mut a = AxisFigures { axis: name.into(), output_unit: "V".into(), values: Vec::new() };
+        let mut a = AxisFigures { axis: name.into(), output_unit: "V".into(), ..Default::default() };
         for (k, v) in values {
             a.set(*k, *v);
         }

@@ -1,6 +1,6 @@
 //! The `results.json` document of `gyrolab eval` and `gyrolab demo --out`: device, every
 //! rate-table figure per axis (the `gyrolab rate --json` axis objects), the limits and their
-//! verdicts. Sections added later (static bias, Allan) go under their own key in `sections`.
+//! verdicts. The static (bias) and Allan sections (and the demo's `paper`) go under their own key in `sections`.
 
 use crate::limits::{LimitCheck, Verdict};
 use crate::rate::AxisJson;
@@ -44,7 +44,7 @@ pub struct ResultsJson {
     pub device: DeviceJson,
     /// Rate-table figures per axis (keys in docs/JSON.md).
     pub rate_axes: Vec<AxisJson>,
-    /// Further sections by name (`static`, `allan`), added by their evaluations.
+    /// Further sections by name (`static`, `allan`, `paper`), keys in docs/JSON.md.
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub sections: BTreeMap<String, serde_json::Value>,
     /// The plan's limits.

@@ -13,7 +13,8 @@
 //! - [`sim`]: gyro simulator with known truth (static records, rate-table tests);
 //! - [`segment`]: plateaus, strokes and runs found in raw rate-table logs;
 //! - [`triad`]: three-axis scale-factor, misalignment and bias calibration (12 parameters);
-//! - [`apply`]: calibrations applied to output samples (output to rate).
+//! - [`apply`]: calibrations applied to output samples (output to rate);
+//! - [`window_means`]: streaming means of consecutive windows (bias time series).
 //!
 //! Formulas and their sources are listed in `docs/METHODS.md`.
 
@@ -31,3 +32,4 @@ pub mod static_test;
 mod testsim;
 pub mod triad;
 pub mod units;
+pub mod window_means;

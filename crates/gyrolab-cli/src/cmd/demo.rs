@@ -2,19 +2,23 @@
 
 use crate::cmd::eval::{finish, progress, write_report, ReportInputs};
 use crate::cmd::rate::{evaluate_record, EvaluatedAxis};
-use crate::error::CliResult;
+use crate::cmd::static_eval::{evaluate_static, StaticContext, StaticParts};
+use crate::error::{CliError, CliResult};
 use crate::output::{print, to_json};
 use crate::paper_data;
 use clap::Args;
 use gyrolab::rate_test::RateTestOptions;
+use gyrolab::sim::{Preset, SensorModel, StaticSpec, TemperatureProfile};
+use gyrolab_io::plan::StaticAxisPlan;
 use gyrolab_io::rate_table::{parse_rate_table, RateColumns};
-use gyrolab_report::figures::AxisFigures;
+use gyrolab_io::sim_csv::{write_static_csv, SimCsvOptions};
 use gyrolab_report::format::sig;
 use gyrolab_report::html::{DataTable, ReportHeader, ReportSection};
 use gyrolab_report::paper::{compare_table2, compare_table6, table2_text, table5_text, table6_text};
 use gyrolab_report::paper::{ClaimVerdict, Table2Comparison};
 use gyrolab_report::rate::{rate_json, rate_summary_table, AxisReport};
 use gyrolab_report::results::DeviceJson;
+use indicatif::ProgressBar;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -31,6 +35,13 @@ pub struct DemoArgs {
     /// With --out: no progress bar and no summary on standard output.
     #[arg(long, short, requires = "out")]
     pub quiet: bool,
+    /// With --out: length of each simulated static test, s (4 per axis, 100 Hz).
+    #[arg(long, value_name = "S", default_value_t = 1200.0, requires = "out")]
+    pub sim_static_s: f64,
+    /// With --out: length of the simulated record of each axis's Allan section, s (100 Hz);
+    /// shorter records run faster but end the Allan curve at a quarter of their length.
+    #[arg(long, value_name = "S", default_value_t = 7200.0, requires = "out")]
+    pub sim_allan_s: f64,
 }
 
 #[derive(Serialize)]
@@ -61,7 +72,7 @@ pub fn run(args: &DemoArgs) -> CliResult {
         t5.iter().map(|r| (r.axis.as_str(), gyrolab::fit::mean(&r.tests_v).unwrap_or(f64::NAN))).collect();
     let verdicts = compare_table6(&t6, &evals, &zero_bias);
     if let Some(out) = &args.out {
-        return write_paper_report(out, args.quiet, &axes, &table2, &verdicts);
+        return write_paper_report(out, args, &axes, &table2, &verdicts);
     }
     if args.json {
         return print(&to_json(&DemoJson {
@@ -105,14 +116,115 @@ pub fn run(args: &DemoArgs) -> CliResult {
     print(&s)
 }
 
-/// HOOK (issue 6, static and Allan part): sections built from simulated records of the paper's
-/// gyro family (ADXRS646: ARW 0.6 deg/sqrt(h), bias instability 12 deg/h; methods-notes §5).
-/// Each must be a `ReportSection` with `simulated: true`, its figures added to the summary via
-/// `AxisFigures` (keys such as `bias_stability_dph_10s`, `arw_deg_rt_h`) and its JSON under
-/// `results.json` `sections.static` / `sections.allan`. Empty until the simulator, bias and
-/// Allan evaluations are merged.
-fn simulated_static_and_allan() -> (Vec<ReportSection>, Vec<AxisFigures>, BTreeMap<String, serde_json::Value>) {
-    (Vec::new(), Vec::new(), BTreeMap::new())
+/// Sample rate of the simulated static records, Hz.
+const SIM_RATE_HZ: f64 = 100.0;
+/// Simulated static tests per axis (the paper's Table 5 has four).
+const SIM_TESTS: usize = 4;
+/// Base of the fixed seeds: axis i, test j (1..=4) uses BASE + 10 i + j; the Allan record j = 9.
+const SIM_SEED_BASE: u64 = 201_400;
+
+/// A temporary folder removed when dropped.
+struct TempDir(PathBuf);
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn sim_error(path: &Path, e: impl std::fmt::Display) -> CliError {
+    CliError::Output(format!("{}: cannot write the simulated record: {e}", path.display()))
+}
+
+/// Writes one simulated static record.
+fn write_sim(path: &Path, model: &SensorModel, spec: &StaticSpec, seed: u64) -> CliResult {
+    let f = std::fs::File::create(path).map_err(|e| sim_error(path, e))?;
+    let opts = SimCsvOptions {
+        comments: vec!["SIMULATED: gyrolab demo, preset adxrs646 (the paper's gyro family)".into()],
+        ..SimCsvOptions::default()
+    };
+    write_static_csv(std::io::BufWriter::new(f), model, spec, seed, &opts).map_err(|e| sim_error(path, e))?;
+    Ok(())
+}
+
+/// The static and Allan part of the demo: simulated records of the paper's gyro family
+/// (ADXRS646 preset; K and null set to each axis's rate-table K and F0), written to a temporary
+/// folder with fixed seeds and evaluated by the same code as `gyrolab eval` (`static_eval`).
+fn simulated_static_and_allan(args: &DemoArgs, axes: &[EvaluatedAxis], bar: &ProgressBar) -> CliResult<StaticParts> {
+    for (name, v) in [("--sim-static-s", args.sim_static_s), ("--sim-allan-s", args.sim_allan_s)] {
+        if !(v.is_finite() && (60.0..=86_400.0).contains(&v)) {
+            return Err(CliError::Usage(format!("{name} must be 60 to 86400 seconds, got {v}")));
+        }
+    }
+    let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.subsec_nanos());
+    let dir = TempDir(std::env::temp_dir().join(format!("gyrolab-demo-{}-{nanos}", std::process::id())));
+    std::fs::create_dir_all(&dir.0).map_err(|e| sim_error(&dir.0, e))?;
+    let temperature = TemperatureProfile::Ramp { start_c: 25.0, rate_c_per_h: 15.0 };
+    let test_spec = StaticSpec {
+        sample_rate_hz: SIM_RATE_HZ,
+        duration_s: args.sim_static_s,
+        temperature: temperature.clone(),
+        latitude_deg: None,
+        record_temperature: true,
+    };
+    let allan_spec = StaticSpec { duration_s: args.sim_allan_s, ..test_spec.clone() };
+    let mut plans = Vec::new();
+    let mut texts = BTreeMap::new();
+    for (i, a) in axes.iter().enumerate() {
+        let cal = a.calibration();
+        let model = SensorModel {
+            scale_factor_per_dps: cal.scale_factor,
+            null: cal.zero_offset,
+            ..SensorModel::preset(Preset::Adxrs646)
+        };
+        let seed0 = SIM_SEED_BASE + 10 * i as u64;
+        let mut files = Vec::new();
+        for j in 1..=SIM_TESTS {
+            bar.set_message(format!("simulating axis {} static test {j}", a.name));
+            let path = dir.0.join(format!("static_{}_{j}.csv", a.name));
+            write_sim(&path, &model, &test_spec, seed0 + j as u64)?;
+            files.push(path);
+        }
+        bar.set_message(format!("simulating axis {} Allan record", a.name));
+        let allan_path = dir.0.join(format!("allan_{}.csv", a.name));
+        write_sim(&allan_path, &model, &allan_spec, seed0 + 9)?;
+        texts.insert(
+            a.name.clone(),
+            format!(
+                "the records of this section were generated by gyrolab's simulator (preset adxrs646, the paper's gyro \
+                 family: ARW 0.6 deg/√h, bias instability 12 deg/h over 10..10000 s, no rate random walk, no bias \
+                 temperature coefficient, no earth rate), with K = {} V/(deg/s) and null = {} V set to axis {}'s \
+                 rate-table K and F0: {SIM_TESTS} static tests of {} s at {} Hz (seeds {}..{}) and one {} s record at \
+                 {} Hz for the Allan analysis (seed {}), temperature ramp 25 degC + 15 degC/h. The paper sampled its \
+                 static tests once a second (too coarse for the Allan curve below 2 s) and did not publish its raw \
+                 static records; these figures show the evaluation on records of the same gyro class, not the paper's gyros.",
+                sig(cal.scale_factor, 6),
+                sig(cal.zero_offset, 7),
+                a.name,
+                sig(args.sim_static_s, 6),
+                sig(SIM_RATE_HZ, 4),
+                seed0 + 1,
+                seed0 + SIM_TESTS as u64,
+                sig(args.sim_allan_s, 6),
+                sig(SIM_RATE_HZ, 4),
+                seed0 + 9
+            ),
+        );
+        plans.push(StaticAxisPlan {
+            axis: a.name.clone(),
+            files,
+            sample_rate_hz: SIM_RATE_HZ,
+            channel: Some("output_v".into()),
+            output_unit: None,
+            temperature_channel: Some("temp_c".into()),
+            latitude_deg: None,
+            allan_file: Some(allan_path),
+        });
+    }
+    let describe = |axis: &str| texts.get(axis).cloned().unwrap_or_default();
+    let ctx =
+        StaticContext { rate_axes: axes, calibration: None, limits: &[], base: &dir.0, simulated: Some(&describe) };
+    evaluate_static(&plans, &ctx, bar)
 }
 
 /// The paper's comparison section: Table 2 recomputed and Table 6's claims beside the data.
@@ -183,13 +295,15 @@ fn paper_section(table2: &[Table2Comparison], verdicts: &[ClaimVerdict]) -> Repo
 /// Writes the paper's report folder (`gyrolab demo --out DIR`).
 fn write_paper_report(
     out: &Path,
-    quiet: bool,
+    args: &DemoArgs,
     axes: &[EvaluatedAxis],
     table2: &[Table2Comparison],
     verdicts: &[ClaimVerdict],
 ) -> CliResult {
-    let bar = progress(quiet, axes.len() as u64 + 7);
-    let (mut sections, figures, mut json) = simulated_static_and_allan();
+    let quiet = args.quiet;
+    let bar = progress(quiet, axes.len() as u64 + 7 + 2 * (SIM_TESTS as u64 + 1) * axes.len() as u64);
+    let parts = simulated_static_and_allan(args, axes, &bar)?;
+    let (mut sections, figures, mut json) = (parts.sections, parts.figures, parts.json);
     sections.insert(0, paper_section(table2, verdicts));
     json.insert("paper".into(), serde_json::json!({ "table2_x": table2, "table6": verdicts }));
     let created = humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string();
@@ -203,8 +317,9 @@ fn write_paper_report(
         gyrolab_version: env!("CARGO_PKG_VERSION").into(),
         plan_file: "built-in: the paper's Tables 1, 3, 4 (data/paper/*.csv)".into(),
         notes: vec![
-            "Rate-table part: the paper's published data. Static-bias and Allan sections are not yet produced; \
-             when they are, they come from simulated records of the paper's gyro family and are labelled SIMULATED."
+            "Rate-table part: the paper's published data. Static (bias) and Allan sections: SIMULATED records of the \
+             paper's gyro family (ADXRS646 preset), because the paper did not publish its raw static records; every \
+             such section, table and summary row is labelled SIMULATED."
                 .into(),
         ],
     };
@@ -221,6 +336,7 @@ fn write_paper_report(
         extra_figures: figures,
         extra_sections: sections,
         extra_json: json,
+        extra_files: parts.files,
     };
     let written = write_report(out, inputs, &bar)?;
     bar.finish_and_clear();

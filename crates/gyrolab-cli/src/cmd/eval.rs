@@ -1,11 +1,11 @@
 //! `gyrolab eval PLAN.toml --out DIR`: evaluate a test plan and write the report folder
 //! (report.html, results.json, calibration.toml, CSV tables). Exit code 3 when a limit fails.
 //!
-//! The rate-table part is evaluated now; `[static.<axis>]` records are parsed and checked
-//! (files exist) and listed in the report, their evaluation comes with the static-bias and
-//! Allan sections (see [`ReportInputs::extra_sections`]).
+//! The rate-table part per axis, then the static (bias) and Allan part of every
+//! `[static.<axis>]` table ([`crate::cmd::static_eval`], shared with `gyrolab demo --out`).
 
 use crate::cmd::rate::{calibration_file, evaluate_record, EvaluatedAxis};
+use crate::cmd::static_eval;
 use crate::error::{CliError, CliResult};
 use crate::output::{print, to_json, write_file};
 use clap::Args;
@@ -66,6 +66,8 @@ pub struct ReportInputs<'a> {
     pub extra_sections: Vec<ReportSection>,
     /// Further results.json sections by key (`static`, `allan`, `paper`).
     pub extra_json: BTreeMap<String, serde_json::Value>,
+    /// Further files (name in DIR, content): the static and Allan CSV tables.
+    pub extra_files: Vec<(String, Vec<u8>)>,
 }
 
 /// What was written.
@@ -170,7 +172,10 @@ pub fn write_report(out: &Path, inputs: ReportInputs<'_>, bar: &ProgressBar) -> 
     let mut figures: Vec<AxisFigures> = axis_json.iter().map(rate_figures).collect();
     for extra in inputs.extra_figures {
         match figures.iter_mut().find(|f| f.axis == extra.axis) {
-            Some(f) => extra.values.into_iter().for_each(|(k, v)| f.set(k, v)),
+            Some(f) => {
+                extra.values.into_iter().for_each(|(k, v)| f.set(k, v));
+                f.simulated.extend(extra.simulated);
+            }
             None => figures.push(extra),
         }
     }
@@ -227,6 +232,7 @@ pub fn write_report(out: &Path, inputs: ReportInputs<'_>, bar: &ProgressBar) -> 
     if axis_json.iter().any(|a| !a.scale_factor_per_run.is_empty()) {
         files.push((out.join("scale_factor_runs.csv"), runs_csv(&axis_json).into_bytes()));
     }
+    files.extend(inputs.extra_files.into_iter().map(|(name, bytes)| (out.join(name), bytes)));
     for (path, bytes) in &files {
         write_file(path, bytes)?;
         bar.inc(1);
@@ -278,7 +284,7 @@ pub fn finish(out: &Path, written: &Written, quiet: bool) -> CliResult {
 pub fn run(args: &EvalArgs) -> CliResult {
     let plan = read_plan(&args.plan, &|n| known_figure(n).is_some())?;
     let options = plan_options(&plan);
-    let steps = 2 * plan.rate.len() as u64 + 6;
+    let steps = 2 * plan.rate.len() as u64 + 6 + 2 * static_eval::progress_steps(&plan.static_tests);
     let bar = progress(args.quiet, steps);
     let mut axes = Vec::new();
     for r in &plan.rate {
@@ -291,15 +297,20 @@ pub fn run(args: &EvalArgs) -> CliResult {
     if let Some(l) = plan.options.nonlinearity_limit_pct {
         notes.push(format!("Linear input range searched with a nonlinearity limit of {} %.", sig(l, 4)));
     }
-    if !plan.static_tests.is_empty() {
-        let listed: Vec<String> =
-            plan.static_tests.iter().map(|s| format!("{} ({} file(s))", s.axis, s.files.len())).collect();
-        notes.push(format!(
-            "Static records are listed for axes {}; their bias and Allan evaluation is not part of this version of \
-             gyrolab eval, so limits on those figures show NOT EVALUATED.",
-            listed.join(", ")
-        ));
-    }
+    let limits: Vec<Limit> =
+        plan.limits.iter().map(|l| Limit { figure: l.figure.clone(), min: l.min, max: l.max }).collect();
+    let base = match plan.file.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let ctx = static_eval::StaticContext {
+        rate_axes: &axes,
+        calibration: plan.options.calibration.as_deref(),
+        limits: &limits,
+        base: &base,
+        simulated: None,
+    };
+    let parts = static_eval::evaluate_static(&plan.static_tests, &ctx, &bar)?;
     let created = humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string();
     let header = ReportHeader {
         title: format!("Gyro test report: {} {}", plan.device.model, plan.device.serial),
@@ -311,8 +322,6 @@ pub fn run(args: &EvalArgs) -> CliResult {
         plan_file: args.plan.display().to_string(),
         notes,
     };
-    let limits: Vec<Limit> =
-        plan.limits.iter().map(|l| Limit { figure: l.figure.clone(), min: l.min, max: l.max }).collect();
     let inputs = ReportInputs {
         header,
         device: DeviceJson {
@@ -323,9 +332,10 @@ pub fn run(args: &EvalArgs) -> CliResult {
         },
         axes: &axes,
         limits,
-        extra_figures: Vec::new(),
-        extra_sections: Vec::new(),
-        extra_json: BTreeMap::new(),
+        extra_figures: parts.figures,
+        extra_sections: parts.sections,
+        extra_json: parts.json,
+        extra_files: parts.files,
     };
     let written = write_report(&args.out, inputs, &bar)?;
     bar.finish_and_clear();

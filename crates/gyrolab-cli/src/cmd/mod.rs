@@ -9,3 +9,4 @@ pub mod plan;
 pub mod rate;
 pub mod raw;
 pub mod simulate;
+pub mod static_eval;

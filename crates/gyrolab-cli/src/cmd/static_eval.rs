@@ -1,0 +1,361 @@
+//! The static (bias) and Allan part of `gyrolab eval` and `gyrolab demo --out`: evaluates the
+//! `[static.<axis>]` records of a plan (the same code path for both commands) and returns the
+//! report sections, summary figures, results.json sections and CSV files.
+
+use crate::cmd::rate::EvaluatedAxis;
+use crate::error::{CliError, CliResult};
+use crate::reference::Reference;
+use gyrolab::allan::{deviation_from_rate, AllanError, AllanOptions, DeviationKind};
+use gyrolab::noise::{fit_noise_model, slope_line_terms};
+use gyrolab::static_test::{bias_repeatability, smoothing_key, StaticTestConfig};
+use gyrolab_io::calibration::read_calibration;
+use gyrolab_io::plan::StaticAxisPlan;
+use gyrolab_io::series::{evaluate_static_file, read_series_all, window_means_file, SeriesOptions};
+use gyrolab_io::DataError;
+use gyrolab_report::allan::ChannelAnalysis;
+use gyrolab_report::bias::TestReport;
+use gyrolab_report::figures::{name_matches, AxisFigures};
+use gyrolab_report::html::ReportSection;
+use gyrolab_report::limits::Limit;
+use gyrolab_report::static_report::{
+    allan_axis_csv, allan_section, bias_tests_csv, bias_windows_csv, static_section, ReferenceJson, StaticAxisReport,
+    TestWindows,
+};
+use indicatif::ProgressBar;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Default smoothing times of the bias stability, s (one sample is added by the core).
+pub const DEFAULT_SMOOTHING_S: [f64; 3] = [1.0, 10.0, 100.0];
+
+/// What the static part adds to a report folder.
+#[derive(Default)]
+pub struct StaticParts {
+    /// Static and Allan sections, per axis.
+    pub sections: Vec<ReportSection>,
+    /// Summary figures per axis.
+    pub figures: Vec<AxisFigures>,
+    /// results.json sections: `static` and `allan`, each keyed by axis.
+    pub json: BTreeMap<String, serde_json::Value>,
+    /// CSV files (name, content).
+    pub files: Vec<(String, Vec<u8>)>,
+}
+
+/// Inputs of the static part besides the plan's `[static.*]` tables.
+pub struct StaticContext<'a> {
+    /// This plan's rate-table evaluations (their K and F0 are the first choice of reference).
+    pub rate_axes: &'a [EvaluatedAxis],
+    /// The plan's `[options] calibration` file (second choice).
+    pub calibration: Option<&'a Path>,
+    /// The plan's limits (their `bias_stability_dph_<T>s` names add smoothing times).
+    pub limits: &'a [Limit],
+    /// File names are shown relative to this folder.
+    pub base: &'a Path,
+    /// Simulated data: the description shown with every section, table and JSON object.
+    pub simulated: Option<&'a dyn Fn(&str) -> String>,
+}
+
+fn shown(path: &Path, base: &Path) -> String {
+    path.strip_prefix(base).unwrap_or(path).display().to_string()
+}
+
+/// Smoothing times: the defaults plus every T named by a `bias_stability_dph_<T>s` limit.
+pub fn smoothing_times(limits: &[Limit]) -> Vec<f64> {
+    let mut t: Vec<f64> = DEFAULT_SMOOTHING_S.to_vec();
+    for l in limits {
+        if name_matches("bias_stability_dph_<T>s", &l.figure) {
+            let v = l.figure.trim_start_matches("bias_stability_dph_").trim_end_matches('s').parse::<f64>();
+            if let Ok(v) = v {
+                if !t.iter().any(|x| smoothing_key(*x) == smoothing_key(v)) {
+                    t.push(v);
+                }
+            }
+        }
+    }
+    t.sort_by(f64::total_cmp);
+    t
+}
+
+/// The output-to-rate reference of an axis: this plan's rate-table K and F0, else the plan's
+/// calibration file, else none (output units only).
+fn reference_of(axis: &str, ctx: &StaticContext<'_>) -> CliResult<(Reference, ReferenceJson)> {
+    if let Some(r) = ctx.rate_axes.iter().find(|a| a.name == axis) {
+        let c = r.calibration();
+        return Ok((
+            Reference::Calibrated { scale_factor: c.scale_factor, null: c.zero_offset, unit: c.output_unit },
+            ReferenceJson {
+                source: "rate_table".into(),
+                scale_factor: Some(c.scale_factor),
+                null_output: Some(c.zero_offset),
+                output_unit: Some(c.output_unit.symbol().into()),
+                text: format!(
+                    "K = {} {u}/(deg/s) and F0 = {} {u} from this plan's rate-table evaluation of axis {axis} ({}).",
+                    gyrolab_report::format::sig(c.scale_factor, 6),
+                    gyrolab_report::format::sig(c.zero_offset, 7),
+                    r.file,
+                    u = c.output_unit.symbol()
+                ),
+            },
+        ));
+    }
+    if let Some(path) = ctx.calibration {
+        let cal = read_calibration(path)?;
+        if let Ok(c) = cal.axis(Some(axis)) {
+            return Ok((
+                Reference::Calibrated { scale_factor: c.scale_factor, null: c.zero_offset, unit: c.output_unit },
+                ReferenceJson {
+                    source: "calibration_file".into(),
+                    scale_factor: Some(c.scale_factor),
+                    null_output: Some(c.zero_offset),
+                    output_unit: Some(c.output_unit.symbol().into()),
+                    text: format!(
+                        "K = {} {u}/(deg/s) and F0 = {} {u} from the calibration file {} (axis {axis}).",
+                        gyrolab_report::format::sig(c.scale_factor, 6),
+                        gyrolab_report::format::sig(c.zero_offset, 7),
+                        shown(path, ctx.base),
+                        u = c.output_unit.symbol()
+                    ),
+                },
+            ));
+        }
+    }
+    Ok((
+        Reference::None,
+        ReferenceJson {
+            source: "none".into(),
+            scale_factor: None,
+            null_output: None,
+            output_unit: None,
+            text: format!(
+                "none: axis {axis} has no rate-table record in this plan and no entry in a calibration file, so figures \
+                 are in output units only (outputs already in deg/s or rad/s are rates)."
+            ),
+        },
+    ))
+}
+
+fn usage(e: impl std::fmt::Display) -> CliError {
+    CliError::Usage(e.to_string())
+}
+
+/// Evaluates one axis's static records: every test, their repeatability, window means and the
+/// Allan analysis of the Allan record (the plan's `allan_file`, else the longest test).
+fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, bar: &ProgressBar) -> CliResult<StaticAxisReport> {
+    let axis = &s.axis;
+    let (reference, reference_json) = reference_of(axis, ctx)?;
+    if s.output_unit.is_some() && s.channel.is_none() {
+        return Err(usage(format!(
+            "{}: static.{axis}.output_unit needs static.{axis}.channel (the column it applies to)",
+            ctx.base.display()
+        )));
+    }
+    let options = SeriesOptions {
+        sample_rate_hz: Some(s.sample_rate_hz),
+        channels: s.channel.clone().map(|c| vec![c]),
+        column_units: match (&s.channel, s.output_unit) {
+            (Some(c), Some(u)) => vec![(c.clone(), u)],
+            _ => Vec::new(),
+        },
+        ..SeriesOptions::default()
+    };
+    let smoothing = smoothing_times(ctx.limits);
+    let mut tests = Vec::new();
+    let mut notes = Vec::new();
+    let mut samples = Vec::new();
+    for path in &s.files {
+        bar.set_message(format!("axis {axis}: static test {}", shown(path, ctx.base)));
+        let mut mismatch = None;
+        let (results, summary) = evaluate_static_file(path, &options, |ch| {
+            let mut cfg = StaticTestConfig {
+                latitude_deg: s.latitude_deg,
+                smoothing_times_s: smoothing.clone(),
+                ..StaticTestConfig::default()
+            };
+            match reference.for_unit(ch.unit) {
+                Ok(Some((k, null))) => {
+                    cfg.scale_factor = Some(k);
+                    cfg.null_output = null;
+                }
+                Ok(None) => {}
+                Err(m) => mismatch = Some(format!("channel '{}': {m}", ch.name)),
+            }
+            cfg
+        })?;
+        if let Some(m) = mismatch {
+            return Err(usage(format!("{}: {m}", path.display())));
+        }
+        if let Some(want) = &s.temperature_channel {
+            let found = summary
+                .header
+                .temperature_column
+                .and_then(|c| summary.header.columns.get(c - 1))
+                .map(|c| c.name.clone());
+            if !found.as_deref().is_some_and(|f| f.eq_ignore_ascii_case(want)) {
+                return Err(CliError::Data(DataError::new(
+                    path,
+                    format!(
+                        "static.{axis}.temperature_channel = '{want}': the file's temperature column is {} \
+                         (the temperature column must be named temp_c or temperature_c)",
+                        found.map_or("missing".to_string(), |f| format!("'{f}'"))
+                    ),
+                )));
+            }
+        }
+        if results.len() > 1 {
+            notes.push(format!(
+                "{}: {} output columns; the first, '{}', is evaluated (name one with static.{axis}.channel).",
+                shown(path, ctx.base),
+                results.len(),
+                results[0].channel
+            ));
+        }
+        let Some(result) = results.into_iter().next() else {
+            return Err(CliError::Data(DataError::new(path, "no output channel to evaluate")));
+        };
+        samples.push(summary.rows);
+        tests.push(TestReport { file: shown(path, ctx.base), result });
+        bar.inc(1);
+    }
+    let window_s = tests
+        .first()
+        .and_then(|t| t.result.bias_stability_quoted_s.as_deref())
+        .and_then(|q| q.parse::<f64>().ok())
+        .unwrap_or(10.0);
+    let mut windows = Vec::new();
+    for (path, t) in s.files.iter().zip(&tests) {
+        bar.set_message(format!("axis {axis}: window means of {}", t.file));
+        windows.push(TestWindows { file: t.file.clone(), windows: window_means_file(path, &options, 0, window_s)? });
+    }
+    let repeatability = if tests.len() >= 2 {
+        let results: Vec<_> = tests.iter().map(|t| t.result.clone()).collect();
+        bias_repeatability(&results).ok()
+    } else {
+        None
+    };
+    let allan_path: PathBuf = match &s.allan_file {
+        Some(p) => p.clone(),
+        None => {
+            let longest =
+                samples.iter().enumerate().max_by_key(|(i, n)| (**n, std::cmp::Reverse(*i))).map_or(0, |x| x.0);
+            s.files[longest].clone() // ok: the plan has at least one file per [static] table
+        }
+    };
+    bar.set_message(format!("axis {axis}: Allan deviation of {}", shown(&allan_path, ctx.base)));
+    let allan = allan_of(&allan_path, &options, &reference, s.sample_rate_hz, ctx.base)?;
+    bar.inc(1);
+    let simulated = ctx.simulated.map(|f| f(axis));
+    Ok(StaticAxisReport {
+        axis: axis.clone(),
+        reference: reference_json,
+        tests,
+        repeatability,
+        window_s,
+        windows,
+        allan: Some(allan),
+        simulated,
+        notes,
+    })
+}
+
+/// OADEV (octave taus, 68.3 % bounds) of one record's first selected channel, converted to deg/s
+/// with the reference (or the unit's native factor), with slope-line and five-term noise terms.
+fn allan_of(
+    path: &Path,
+    options: &SeriesOptions,
+    reference: &Reference,
+    sample_rate_hz: f64,
+    base: &Path,
+) -> CliResult<ChannelAnalysis> {
+    let mut data = read_series_all(path, options)?;
+    data.time = None;
+    data.temperature = None;
+    let Some(info) = data.header.channels.first().cloned() else {
+        return Err(CliError::Data(DataError::new(path, "no output channel to analyse")));
+    };
+    let lines = std::mem::take(&mut data.lines);
+    let mut values = std::mem::take(&mut data.channels).into_iter().next().unwrap_or_default();
+    let (k, null) = match reference.for_unit(info.unit).map_err(|m| usage(format!("{}: {m}", path.display())))? {
+        Some((k, null)) => (Some(k), null.unwrap_or(0.0)),
+        None => (info.unit.native_scale_factor_per_dps(), 0.0),
+    };
+    if let Some(k) = k {
+        values.iter_mut().for_each(|v| *v = (*v - null) / k);
+    }
+    values.reserve_exact(1);
+    let curve = deviation_from_rate(values, 1.0 / sample_rate_hz, &AllanOptions::new(DeviationKind::Oadev)).map_err(
+        |e| match e {
+            AllanError::NonFinite { index, value } => CliError::Data(
+                DataError::new(
+                    path,
+                    format!("sample {value} is not a finite number: the Allan variance needs a complete record"),
+                )
+                .at_line(lines.get(index).copied().unwrap_or(0))
+                .at_column(info.column, Some(&info.name)),
+            ),
+            other => CliError::Data(DataError::new(path, format!("channel '{}': {other}", info.name))),
+        },
+    )?;
+    let (rate_unit, slope_lines, model_fit, noise_note) = if k.is_some() {
+        ("deg/s".to_string(), slope_line_terms(&curve).ok(), fit_noise_model(&curve, None).ok(), None)
+    } else {
+        (
+            info.unit.symbol().to_string(),
+            None,
+            None,
+            Some(format!(
+                "the data are in {}: give the axis a rate-table record or a calibration file",
+                info.unit.symbol()
+            )),
+        )
+    };
+    Ok(ChannelAnalysis {
+        file: shown(path, base),
+        channel: info.name.clone(),
+        rate_unit,
+        curve,
+        slope_lines,
+        model_fit,
+        noise_note,
+    })
+}
+
+/// Number of progress steps of the static part.
+pub fn progress_steps(plans: &[StaticAxisPlan]) -> u64 {
+    plans.iter().map(|s| s.files.len() as u64 + 1).sum()
+}
+
+/// Evaluates every `[static.<axis>]` table and builds the sections, figures, JSON and CSV files.
+pub fn evaluate_static(plans: &[StaticAxisPlan], ctx: &StaticContext<'_>, bar: &ProgressBar) -> CliResult<StaticParts> {
+    let mut parts = StaticParts::default();
+    if plans.is_empty() {
+        return Ok(parts);
+    }
+    let mut reports = Vec::new();
+    for s in plans {
+        reports.push(evaluate_axis(s, ctx, bar)?);
+    }
+    let plot_err = |e: gyrolab_report::plot::PlotError| CliError::Output(e.to_string());
+    let mut static_json = serde_json::Map::new();
+    let mut allan_json = serde_json::Map::new();
+    for r in &reports {
+        parts.sections.push(static_section(r, ctx.limits).map_err(plot_err)?);
+        if let Some(s) = allan_section(r, ctx.limits) {
+            parts.sections.push(s.map_err(plot_err)?);
+        }
+        parts.figures.push(r.figures());
+        static_json.insert(r.axis.clone(), r.static_json());
+        if let Some(a) = r.allan_json() {
+            allan_json.insert(r.axis.clone(), a);
+        }
+        parts.files.push((format!("bias_windows_{}.csv", r.axis), bias_windows_csv(r).into_bytes()));
+        if let Some(csv) = allan_axis_csv(r) {
+            parts.files.push((format!("allan_{}.csv", r.axis), csv.into_bytes()));
+        }
+    }
+    parts.files.insert(0, ("bias_tests.csv".into(), bias_tests_csv(&reports).into_bytes()));
+    parts.json.insert("static".into(), serde_json::Value::Object(static_json));
+    if !allan_json.is_empty() {
+        parts.json.insert("allan".into(), serde_json::Value::Object(allan_json));
+    }
+    Ok(parts)
+}
