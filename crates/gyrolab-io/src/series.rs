@@ -825,6 +825,11 @@ pub fn evaluate_static_file(
         scans.push(OutlierScan::new(&first, cfg).map_err(|e| wrap(&cfg.channel, e))?);
         firsts.push(first);
     }
+    // The second pass can only find outliers where the first pass's extremes allow them.
+    if firsts.iter().all(|f| !f.outlier_scan_needed) {
+        let results = firsts.into_iter().zip(&configs).map(|(f, cfg)| f.with_no_outliers(cfg)).collect();
+        return Ok((results, summary));
+    }
     let mut r = SeriesReader::open(path, options)?;
     while let Some(b) = r.next_block()? {
         for (k, scan) in scans.iter_mut().enumerate() {

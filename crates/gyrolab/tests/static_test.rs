@@ -339,3 +339,42 @@ fn errors_are_reported_not_panicked() {
     assert_eq!(smoothing_key(0.01), "0.01");
     assert_eq!(smoothing_key(100.0), "100");
 }
+
+/// The outlier pass is skipped only when the first pass proves it cannot find anything; the
+/// result is then identical to running it.
+#[test]
+fn skipping_the_outlier_pass_changes_nothing() {
+    use gyrolab::static_test::{evaluate_static, OutlierScan, SampleBlock, StaticTestAccumulator, StaticTestConfig};
+    use rand_distr::StandardNormal;
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let mut x: Vec<f64> = (0..200_000)
+        .map(|i| {
+            let z: f64 = StandardNormal.sample(&mut rng);
+            2.5 + 1e-6 * i as f64 + 1e-3 * z
+        })
+        .collect();
+    let cfg = StaticTestConfig { sample_rate_hz: Some(100.0), ..StaticTestConfig::default() };
+    let two_pass = |x: &[f64]| {
+        let block = SampleBlock { output: x, time_s: None, temperature_c: None, lines: None };
+        let mut acc = StaticTestAccumulator::new(cfg.clone()).unwrap();
+        acc.push(&block).unwrap();
+        let first = acc.finish().unwrap();
+        let needed = first.outlier_scan_needed;
+        let mut scan = OutlierScan::new(&first, &cfg).unwrap();
+        scan.push(&block).unwrap();
+        (needed, scan.finish(first).unwrap())
+    };
+    let block = SampleBlock { output: &x, time_s: None, temperature_c: None, lines: None };
+    let (needed, full) = two_pass(&x);
+    assert!(!needed, "Gaussian noise stays within 6 sigma of the drift line here");
+    assert_eq!(evaluate_static(&block, &cfg).unwrap(), full);
+    // A spike of 20 sigma: the pass is needed and finds it.
+    x[123_456] += 0.02;
+    let (needed, full) = two_pass(&x);
+    assert!(needed);
+    let o = full.quality.outliers.as_ref().unwrap();
+    assert_eq!(o.outliers.count, 1);
+    assert_eq!(o.outliers.first[0].sample, 123_456);
+    let block = SampleBlock { output: &x, time_s: None, temperature_c: None, lines: None };
+    assert_eq!(evaluate_static(&block, &cfg).unwrap(), full);
+}
