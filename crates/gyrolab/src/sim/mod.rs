@@ -4,7 +4,7 @@
 //! K, rate ramp R, quantization, and the Allan variance of a first-order Gauss-Markov process);
 //! Brown & Hwang, *Introduction to Random Signals and Applied Kalman Filtering* (Gauss-Markov
 //! processes and their exact discretisation); the project's methods notes sections 1, 2 and 5
-//! (test structure, indicator definitions, realistic parameters). `docs/METHODS-sim.md` gives the
+//! (test structure, indicator definitions, realistic parameters). `docs/METHODS.md` (section 4) gives the
 //! model equation and every formula.
 //!
 //! Model, per sample k at time t (sensed rate w in deg/s, output F in the output unit):

@@ -2,7 +2,7 @@
 //!
 //! Sources: IEEE Std 952-1997 annex C (noise terms and their units); the presets follow the
 //! datasheet classes listed in the project's methods notes, section 5 (ADXRS646, ADIS16470,
-//! STIM300); `docs/METHODS-sim.md` gives the model equation.
+//! STIM300); `docs/METHODS.md` (section 4) gives the model equation.
 
 use crate::units::OutputUnit;
 use serde::{Deserialize, Serialize};
