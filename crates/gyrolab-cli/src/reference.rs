@@ -4,6 +4,7 @@
 
 use crate::error::{CliError, CliResult};
 use clap::Args;
+use gyrolab::static_test::StaticTestConfig;
 use gyrolab::units::OutputUnit;
 use gyrolab_io::calibration::read_calibration;
 use std::path::PathBuf;
@@ -91,6 +92,20 @@ impl Reference {
                 Some(f) => Ok(Some((scale_factor * f, Some(null * f)))),
                 None => Err(format!("the calibration is for {cal_unit} outputs but this channel is in {unit}")),
             },
+        }
+    }
+
+    /// Sets the scale factor and null of a static-test configuration for a channel in `unit`
+    /// (nothing when no reference was given); the message of an error names the channel.
+    pub fn configure(&self, cfg: &mut StaticTestConfig, channel: &str, unit: OutputUnit) -> Result<(), String> {
+        match self.for_unit(unit) {
+            Ok(Some((k, null))) => {
+                cfg.scale_factor = Some(k);
+                cfg.null_output = null;
+                Ok(())
+            }
+            Ok(None) => Ok(()),
+            Err(m) => Err(format!("channel '{channel}': {m}")),
         }
     }
 }

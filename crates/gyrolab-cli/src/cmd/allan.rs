@@ -5,9 +5,9 @@ use crate::error::{CliError, CliResult};
 use crate::output::{print, to_json, write_file};
 use crate::reference::{Reference, ReferenceArgs};
 use clap::Args;
-use gyrolab::allan::{deviation_from_rate, AllanError, AllanOptions, DeviationKind, TauList};
+use gyrolab::allan::{deviation_from_rate, AllanCurve, AllanError, AllanOptions, DeviationKind, TauList};
 use gyrolab::noise::{fit_noise_model, slope_line_terms};
-use gyrolab_io::series::{read_series_all, SeriesData, SeriesOptions};
+use gyrolab_io::series::{read_series_all, ChannelInfo, SeriesData, SeriesOptions};
 use gyrolab_io::DataError;
 use gyrolab_report::allan::{allan_csv, allan_document, allan_text, kalibr_yaml, ChannelAnalysis};
 use rayon::prelude::*;
@@ -94,6 +94,29 @@ fn sample_interval(data: &SeriesData, path: &Path, given_hz: Option<f64>) -> Cli
     Ok((t[t.len() - 1] - t[0]) / (t.len() - 1) as f64)
 }
 
+/// The deviation curve of one channel's rate samples; a non-finite sample is an error naming
+/// its file line and column (`lines[i]` is the line of sample i).
+pub fn channel_curve(
+    path: &Path,
+    info: &ChannelInfo,
+    values: Vec<f64>,
+    lines: &[u64],
+    tau0_s: f64,
+    opts: &AllanOptions,
+) -> CliResult<AllanCurve> {
+    deviation_from_rate(values, tau0_s, opts).map_err(|e| match e {
+        AllanError::NonFinite { index, value } => CliError::Data(
+            DataError::new(
+                path,
+                format!("sample {value} is not a finite number: the Allan variance needs a complete record"),
+            )
+            .at_line(lines.get(index).copied().unwrap_or(0))
+            .at_column(info.column, Some(&info.name)),
+        ),
+        other => CliError::Data(DataError::new(path, format!("channel '{}': {other}", info.name))),
+    })
+}
+
 /// Runs `gyrolab allan`.
 pub fn run(args: &AllanArgs) -> CliResult {
     let kind = DeviationKind::parse(&args.kind).map_err(usage)?;
@@ -162,17 +185,7 @@ pub fn run(args: &AllanArgs) -> CliResult {
                 },
             };
             values.reserve_exact(1);
-            let curve = deviation_from_rate(values, tau0, &opts).map_err(|e| match e {
-                AllanError::NonFinite { index, value } => CliError::Data(
-                    DataError::new(
-                        path,
-                        format!("sample {value} is not a finite number: the Allan variance needs a complete record"),
-                    )
-                    .at_line(lines.get(index).copied().unwrap_or(0))
-                    .at_column(info.column, Some(&info.name)),
-                ),
-                other => CliError::Data(DataError::new(path, format!("channel '{}': {other}", info.name))),
-            })?;
+            let curve = channel_curve(path, &info, values, &lines, tau0, &opts)?;
             let allan_kind = matches!(kind, DeviationKind::Oadev | DeviationKind::Adev);
             let (slope_lines, model_fit, noise_note) = if !calibrated {
                 (

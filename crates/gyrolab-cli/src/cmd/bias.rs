@@ -89,13 +89,8 @@ pub fn run(args: &BiasArgs) -> CliResult {
             if !args.smoothing.is_empty() {
                 cfg.smoothing_times_s = args.smoothing.clone();
             }
-            match reference.for_unit(ch.unit) {
-                Ok(Some((k, null))) => {
-                    cfg.scale_factor = Some(k);
-                    cfg.null_output = null;
-                }
-                Ok(None) => {}
-                Err(m) => mismatch = Some(format!("channel '{}': {m}", ch.name)),
+            if let Err(m) = reference.configure(&mut cfg, &ch.name, ch.unit) {
+                mismatch = Some(m);
             }
             cfg
         })?;

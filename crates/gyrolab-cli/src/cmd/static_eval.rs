@@ -5,7 +5,7 @@
 use crate::cmd::rate::EvaluatedAxis;
 use crate::error::{CliError, CliResult};
 use crate::reference::Reference;
-use gyrolab::allan::{deviation_from_rate, AllanError, AllanOptions, DeviationKind};
+use gyrolab::allan::{AllanOptions, DeviationKind};
 use gyrolab::noise::{fit_noise_model, slope_line_terms};
 use gyrolab::static_test::{bias_repeatability, smoothing_key, StaticTestConfig};
 use gyrolab_io::calibration::read_calibration;
@@ -171,13 +171,8 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, bar: &ProgressBar)
                 smoothing_times_s: smoothing.clone(),
                 ..StaticTestConfig::default()
             };
-            match reference.for_unit(ch.unit) {
-                Ok(Some((k, null))) => {
-                    cfg.scale_factor = Some(k);
-                    cfg.null_output = null;
-                }
-                Ok(None) => {}
-                Err(m) => mismatch = Some(format!("channel '{}': {m}", ch.name)),
+            if let Err(m) = reference.configure(&mut cfg, &ch.name, ch.unit) {
+                mismatch = Some(m);
             }
             cfg
         })?;
@@ -282,18 +277,13 @@ fn allan_of(
         values.iter_mut().for_each(|v| *v = (*v - null) / k);
     }
     values.reserve_exact(1);
-    let curve = deviation_from_rate(values, 1.0 / sample_rate_hz, &AllanOptions::new(DeviationKind::Oadev)).map_err(
-        |e| match e {
-            AllanError::NonFinite { index, value } => CliError::Data(
-                DataError::new(
-                    path,
-                    format!("sample {value} is not a finite number: the Allan variance needs a complete record"),
-                )
-                .at_line(lines.get(index).copied().unwrap_or(0))
-                .at_column(info.column, Some(&info.name)),
-            ),
-            other => CliError::Data(DataError::new(path, format!("channel '{}': {other}", info.name))),
-        },
+    let curve = crate::cmd::allan::channel_curve(
+        path,
+        &info,
+        values,
+        &lines,
+        1.0 / sample_rate_hz,
+        &AllanOptions::new(DeviationKind::Oadev),
     )?;
     let (rate_unit, slope_lines, model_fit, noise_note) = if k.is_some() {
         ("deg/s".to_string(), slope_line_terms(&curve).ok(), fit_noise_model(&curve, None).ok(), None)
