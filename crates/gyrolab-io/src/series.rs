@@ -582,7 +582,11 @@ impl<R: Read> SeriesReader<R> {
                         p += 1;
                     }
                 } else {
-                    let value = match fast_float2::parse_partial::<f64, _>(&bytes[p..end]) {
+                    let parsed = match plain_decimal(&bytes[p..end]) {
+                        Some(hit) => Ok(hit),
+                        None => fast_float2::parse_partial::<f64, _>(&bytes[p..end]),
+                    };
+                    let value = match parsed {
                         Ok((v, n)) => {
                             p += n;
                             v
@@ -886,4 +890,65 @@ pub fn window_means_file(
         acc.push(out, b.temp);
     }
     Ok(acc.finish())
+}
+
+/// Exact powers of ten representable in f64 (10^0 to 10^22).
+const POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20,
+    1e21, 1e22,
+];
+
+/// Fast path for the plain decimals that fill most logs (`-12.3456`, `+0.5`, `7`): at most 15
+/// significant digits, no exponent. The significand w < 10^15 and 10^k (k <= 22) are exact in
+/// f64, so w / 10^k is one correctly rounded operation: the same value every correct parser
+/// returns (Clinger 1990, the fast path). Anything else returns `None` for the full parser.
+/// Returns the value and the bytes used.
+#[inline]
+pub fn plain_decimal(b: &[u8]) -> Option<(f64, usize)> {
+    let mut i = 0;
+    let negative = match b.first() {
+        Some(b'-') => {
+            i = 1;
+            true
+        }
+        Some(b'+') => {
+            i = 1;
+            false
+        }
+        _ => false,
+    };
+    let mut w: u64 = 0;
+    let mut digits = 0usize;
+    while let Some(&c) = b.get(i) {
+        if !c.is_ascii_digit() {
+            break;
+        }
+        w = w * 10 + u64::from(c - b'0');
+        digits += 1;
+        i += 1;
+        if digits > 15 {
+            return None;
+        }
+    }
+    let mut decimals = 0usize;
+    if b.get(i) == Some(&b'.') {
+        i += 1;
+        while let Some(&c) = b.get(i) {
+            if !c.is_ascii_digit() {
+                break;
+            }
+            w = w * 10 + u64::from(c - b'0');
+            digits += 1;
+            decimals += 1;
+            i += 1;
+            if digits > 15 {
+                return None;
+            }
+        }
+    }
+    if digits == 0 || matches!(b.get(i), Some(b'e' | b'E' | b'.')) || decimals >= POW10.len() {
+        return None;
+    }
+    let v = w as f64 / POW10[decimals];
+    Some((if negative { -v } else { v }, i))
 }

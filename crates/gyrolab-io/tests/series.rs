@@ -250,3 +250,32 @@ proptest! {
         prop_assert_eq!(d.lines, lines);
     }
 }
+
+proptest! {
+    /// The plain-decimal fast path returns exactly what the full parser returns.
+    #[test]
+    fn plain_decimal_fast_path_is_bit_exact(int in 0u64..10_000_000, frac in 0u64..100_000_000, width in 0usize..9, sign in 0u8..3) {
+        let sign = ["", "-", "+"][sign as usize];
+        let frac = format!("{frac:08}");
+        let text = if width == 0 { format!("{sign}{int}") } else { format!("{sign}{int}.{}", &frac[..width]) };
+        let fast = gyrolab_io::series::plain_decimal(text.as_bytes());
+        let full: f64 = text.trim_start_matches('+').parse().unwrap();
+        if let Some((v, n)) = fast {
+            prop_assert_eq!(n, text.len());
+            prop_assert_eq!(v.to_bits(), full.to_bits(), "{}", text);
+        }
+    }
+}
+
+#[test]
+fn plain_decimal_declines_what_it_cannot_do_exactly() {
+    use gyrolab_io::series::plain_decimal;
+    assert_eq!(plain_decimal(b"1e5"), None);
+    assert_eq!(plain_decimal(b"1234567890.123456"), None); // 16 digits
+    assert_eq!(plain_decimal(b"nan"), None);
+    assert_eq!(plain_decimal(b"-"), None);
+    assert_eq!(plain_decimal(b"1.2.3"), None);
+    assert_eq!(plain_decimal(b"2.5,1"), Some((2.5, 3)));
+    assert_eq!(plain_decimal(b"-0.001\n"), Some((-0.001, 6)));
+    assert_eq!(plain_decimal(b".5"), Some((0.5, 2)));
+}
