@@ -58,8 +58,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "bias (one pass unless outliers are possible): {:.3} s CPU: {:.0} MB/s, {:.1} M rows/s; mean {:.7} V, B_s(1 s) {:?} V",
         s,
-        2.0 * bytes / 1e6 / s,
-        2.0 * summary.rows as f64 / 1e6 / s,
+        bytes / 1e6 / s,
+        summary.rows as f64 / 1e6 / s,
         results[0].mean_output,
         results[0].bias_stability_output.get("1")
     );
