@@ -305,25 +305,125 @@ fn check_finite(values: &[f64]) -> Result<(), AllanError> {
     }
 }
 
+/// Knuth's branch-free TwoSum: `s + e == a + b` exactly, `s = fl(a + b)`.
+#[inline(always)]
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let bp = s - a;
+    (s, (a - (s - bp)) + (b - bp))
+}
+
+/// Elements per chunk of the parallel angle conversion (128 KiB of f64).
+const PHASE_CHUNK: usize = 1 << 14;
+
+/// Double-double sum (hi, lo) of one chunk, 8 compensated lanes (vectorisable, branch-free),
+/// and whether every value is finite (x * 0 is 0 for finite x, NaN otherwise).
+fn chunk_sum_dd(values: &[f64]) -> (f64, f64, bool) {
+    const LANES: usize = 8;
+    let mut hi = [0.0f64; LANES];
+    let mut lo = [0.0f64; LANES];
+    let mut zero = [0.0f64; LANES];
+    let chunks = values.chunks_exact(LANES);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for l in 0..LANES {
+            let (s, e) = two_sum(hi[l], c[l]);
+            hi[l] = s;
+            lo[l] += e;
+            zero[l] += c[l] * 0.0;
+        }
+    }
+    let (mut h, mut e_sum, mut z) = (0.0f64, 0.0f64, 0.0f64);
+    for l in 0..LANES {
+        let (s, e) = two_sum(h, hi[l]);
+        h = s;
+        e_sum += e + lo[l];
+        z += zero[l];
+    }
+    for &v in rest {
+        let (s, e) = two_sum(h, v);
+        h = s;
+        e_sum += e;
+        z += v * 0.0;
+    }
+    let (s, e) = two_sum(h, e_sum);
+    (s, e, z == 0.0)
+}
+
 /// Turns rate samples into the angle series in sample units (angle / tau0), in place:
 /// s_0 = 0, s_k = sum_{i<k} (y_i - mean y). The vector grows by one element.
-fn rate_to_sample_angle_in_place(data: &mut Vec<f64>) {
+///
+/// Two parallel passes. Pass 1: double-double sums of each chunk of [`PHASE_CHUNK`] samples
+/// (also the finiteness check); they give the mean (the record's double-double sum over n,
+/// rounded once) and each chunk's starting angle sum_{i<start} y_i - start * mean in
+/// double-double (the product by an exact FMA split). Pass 2: every chunk runs its own
+/// compensated (TwoSum) cumulative sum of y_i - mean from that start; four chunks are
+/// interleaved per thread so that the add latency chain does not bound the speed. The result
+/// is the compensated cumulative sum of the sequential version up to a few units of rounding.
+fn rate_to_sample_angle_in_place(data: &mut Vec<f64>) -> Result<(), AllanError> {
     let n = data.len();
-    let mean = compensated_sum(data) / n as f64;
-    let mut sum = 0.0f64;
-    let mut carry = 0.0f64;
-    for v in data.iter_mut() {
-        let y = *v - mean;
-        *v = sum + carry;
-        let t = sum + y;
-        if sum.abs() >= y.abs() {
-            carry += (sum - t) + y;
-        } else {
-            carry += (y - t) + sum;
-        }
-        sum = t;
+    if n == 0 {
+        data.push(0.0);
+        return Ok(());
     }
-    data.push(sum + carry);
+    let sums: Vec<(f64, f64, bool)> = data.par_chunks(PHASE_CHUNK).map(chunk_sum_dd).collect();
+    if sums.iter().any(|s| !s.2) {
+        check_finite(data)?;
+    }
+    let (mut hi, mut lo) = (0.0f64, 0.0f64);
+    for &(h, l, _) in &sums {
+        let (s, e) = two_sum(hi, h);
+        hi = s;
+        lo += e + l;
+    }
+    let mean = (hi + lo) / n as f64;
+    // starting angle of every chunk, double-double
+    let mut starts = Vec::with_capacity(sums.len() + 1);
+    let (mut ah, mut al) = (0.0f64, 0.0f64);
+    for (i, &(h, l, _)) in sums.iter().enumerate() {
+        starts.push((ah, al));
+        let len = (n - i * PHASE_CHUNK).min(PHASE_CHUNK) as f64;
+        let p = len * mean;
+        let p_err = len.mul_add(mean, -p);
+        let (s1, e1) = two_sum(ah, h);
+        let (s2, e2) = two_sum(s1, -p);
+        ah = s2;
+        al += (e1 + e2) + (l - p_err);
+    }
+    data.par_chunks_mut(PHASE_CHUNK).zip(starts).for_each(|(chunk, start)| cumulative_chunk(chunk, mean, start));
+    data.push(ah + al);
+    Ok(())
+}
+
+/// In-place exclusive cumulative sum of y - mean over one chunk, starting from the double-double
+/// `start`: blocks of 8 get a plain local prefix sum (vectorisable; its rounding is that of at
+/// most 8 terms of the size of y), which is added to the compensated running total (hi, lo).
+#[inline]
+fn cumulative_chunk(chunk: &mut [f64], mean: f64, start: (f64, f64)) {
+    const B: usize = 8;
+    let (mut hi, mut lo) = start;
+    let mut blocks = chunk.chunks_exact_mut(B);
+    for block in &mut blocks {
+        let mut q = [0.0f64; B];
+        let mut run = 0.0f64;
+        for l in 0..B {
+            q[l] = run;
+            run += block[l] - mean;
+        }
+        for l in 0..B {
+            block[l] = hi + (lo + q[l]);
+        }
+        let (s, e) = two_sum(hi, run);
+        hi = s;
+        lo += e;
+    }
+    for v in blocks.into_remainder() {
+        let y = *v - mean;
+        *v = hi + lo;
+        let (s, e) = two_sum(hi, y);
+        hi = s;
+        lo += e;
+    }
 }
 
 /// Computes a deviation curve from gyro rate samples at interval `tau0_s`, consuming the record.
@@ -331,15 +431,19 @@ fn rate_to_sample_angle_in_place(data: &mut Vec<f64>) {
 /// The vector is turned into the angle series in place; hand it over with capacity N + 1
 /// (`Vec::with_capacity(n + 1)`) so that peak memory stays at one copy of the record.
 pub fn deviation_from_rate(mut rate: Vec<f64>, tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve, AllanError> {
-    validate(&rate, tau0_s, options)?;
+    validate_parameters(tau0_s, options)?;
     rate.reserve_exact(1);
-    rate_to_sample_angle_in_place(&mut rate);
-    compute(&rate, tau0_s, options)
+    let t = std::time::Instant::now();
+    rate_to_sample_angle_in_place(&mut rate)?;
+    if std::env::var_os("ALLAN_PROF").is_some() { eprintln!("phase {:?}", t.elapsed()); }
+    let r = compute(&rate, tau0_s, options);
+    if std::env::var_os("ALLAN_PROF").is_some() { eprintln!("total {:?}", t.elapsed()); }
+    r
 }
 
 /// Computes a deviation curve from borrowed gyro rate samples (copies them once).
 pub fn deviation_from_rate_slice(rate: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve, AllanError> {
-    validate(rate, tau0_s, options)?;
+    validate_parameters(tau0_s, options)?;
     let mut v = Vec::with_capacity(rate.len() + 1);
     v.extend_from_slice(rate);
     deviation_from_rate(v, tau0_s, options)
@@ -376,6 +480,11 @@ pub fn deviation_from_angle_slice(
 }
 
 fn validate(rate: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<(), AllanError> {
+    validate_parameters(tau0_s, options)?;
+    check_finite(rate)
+}
+
+fn validate_parameters(tau0_s: f64, options: &AllanOptions) -> Result<(), AllanError> {
     if !(tau0_s.is_finite() && tau0_s > 0.0) {
         return Err(AllanError::BadTau0(tau0_s));
     }
@@ -384,7 +493,7 @@ fn validate(rate: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<(), All
             return Err(AllanError::BadConfidence(c));
         }
     }
-    check_finite(rate)
+    Ok(())
 }
 
 /// The averaging factors the options select for a record of `n_rate` rate samples.
