@@ -21,6 +21,7 @@
 //! reflected copy of 3N values.
 
 mod confidence;
+mod fast;
 mod kernels;
 
 use rayon::prelude::*;
@@ -572,7 +573,7 @@ fn compute(s: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve,
     let ms = averaging_factors(options, n_rate, tau0_s)?;
     let extended = (kind == DeviationKind::Totdev).then(|| kernels::reflect_for_total(s));
     // OADEV, the common case, is summed for all taus in one cache-blocked sweep
-    let oadev_sums = (kind == DeviationKind::Oadev).then(|| kernels::overlapping_allan_sums(s, &ms));
+    let oadev_sums = (kind == DeviationKind::Oadev).then(|| oadev_sums(s, &ms));
     let mut points: Vec<AllanPoint> = ms
         .par_iter()
         .enumerate()
@@ -632,6 +633,38 @@ fn compute(s: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve,
         }
     }
     Ok(AllanCurve { kind, tau0_s, n_rate, confidence: options.confidence, points })
+}
+
+/// Tau lists at least this long (and records at least 4 times as long) use the FFT expansion.
+const FAST_MIN_TAUS: usize = 256;
+
+/// Relative accuracy demanded of an FFT-expanded sum's error bound; sums that miss it are
+/// recomputed directly. The bound is at least 4 times the observed error (fast.rs tests), so the
+/// FFT-expanded values are good to a few 1e-11, well inside the 1e-9 promised.
+const FAST_RELATIVE_BOUND: f64 = 1e-10;
+
+/// Overlapping Allan sums for the sorted factors `ms`: directly (fused octave runs) for short
+/// lists, through [`fast::overlapping_allan_sums_fft`] for long ones, with the factors whose
+/// error bound is too loose (small m on wandering records) summed directly.
+fn oadev_sums(s: &[f64], ms: &[usize]) -> Vec<f64> {
+    if ms.len() >= FAST_MIN_TAUS && s.len() >= 4 * FAST_MIN_TAUS {
+        let t = std::time::Instant::now();
+        if let Some(fast) = fast::overlapping_allan_sums_fft(s, ms) {
+            if std::env::var_os("ALLAN_PROF").is_some() { eprintln!("fft {:?}", t.elapsed()); }
+            let redo: Vec<usize> = (0..ms.len())
+                .filter(|&i| !(fast[i].1 <= FAST_RELATIVE_BOUND * fast[i].0 && fast[i].0.is_finite()))
+                .collect();
+            let redo_ms: Vec<usize> = redo.iter().map(|&i| ms[i]).collect();
+            if std::env::var_os("ALLAN_PROF").is_some() { eprintln!("redo {} of {}, last {:?}", redo.len(), ms.len(), redo_ms.last()); }
+            let direct = kernels::overlapping_allan_sums(s, &redo_ms);
+            let mut sums: Vec<f64> = fast.iter().map(|f| f.0).collect();
+            for (&i, d) in redo.iter().zip(direct) {
+                sums[i] = d;
+            }
+            return sums;
+        }
+    }
+    kernels::overlapping_allan_sums(s, ms)
 }
 
 /// Variance (rate units squared; TDEV: MVAR) and number of terms at averaging factor m.
