@@ -101,7 +101,10 @@ pub(crate) fn overlapping_allan_sums_fft(s: &[f64], ms: &[usize]) -> Option<Vec<
                 acc.add(4.0 * tail[m]);
                 acc.add(2.0 * r[2 * m]);
                 // rounding of the quadratic's terms (g, D and their products), a few eps each
-                let q_size = q(len).0.abs() + q(2 * m).0.abs() + 2.0 * (q(len - m).0.abs() + q(m).0.abs()) + q(len - 2 * m).0.abs();
+                let q_size = q(len).0.abs()
+                    + q(2 * m).0.abs()
+                    + 2.0 * (q(len - m).0.abs() + q(m).0.abs())
+                    + q(len - 2 * m).0.abs();
                 let extra = 16.0 * f64::EPSILON * (n * g * g + 2.0 * g.abs() * (d.value().abs() + q_size));
                 (acc.value(), bound + extra)
             })

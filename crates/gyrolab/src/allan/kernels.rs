@@ -462,7 +462,9 @@ pub(crate) fn overlapping_allan_sums(s: &[f64], ms: &[usize]) -> Vec<f64> {
     let mut runs: Vec<(usize, usize, bool)> = Vec::new();
     for (i, &m) in ms.iter().enumerate() {
         match runs.last_mut() {
-            Some((start, count, octave)) if *count < RUN_MAX && ms[*start + *count - 1] * 2 == m && (*octave || *count == 1) => {
+            Some((start, count, octave))
+                if *count < RUN_MAX && ms[*start + *count - 1] * 2 == m && (*octave || *count == 1) =>
+            {
                 *count += 1;
                 *octave = true;
             }
@@ -494,7 +496,13 @@ pub(crate) fn overlapping_allan_sums(s: &[f64], ms: &[usize]) -> Vec<f64> {
                 for i in 0..active - 1 {
                     let end = (k0 + BLOCK).min(n_of(start + i));
                     if end > common_end {
-                        spread_run(s, &ms[start + i..start + i + 1], common_end, end, &mut acc[start + i..start + i + 1]);
+                        spread_run(
+                            s,
+                            &ms[start + i..start + i + 1],
+                            common_end,
+                            end,
+                            &mut acc[start + i..start + i + 1],
+                        );
                     }
                 }
             }

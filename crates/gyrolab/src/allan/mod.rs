@@ -434,12 +434,8 @@ fn cumulative_chunk(chunk: &mut [f64], mean: f64, start: (f64, f64)) {
 pub fn deviation_from_rate(mut rate: Vec<f64>, tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve, AllanError> {
     validate_parameters(tau0_s, options)?;
     rate.reserve_exact(1);
-    let t = std::time::Instant::now();
     rate_to_sample_angle_in_place(&mut rate)?;
-    if std::env::var_os("ALLAN_PROF").is_some() { eprintln!("phase {:?}", t.elapsed()); }
-    let r = compute(&rate, tau0_s, options);
-    if std::env::var_os("ALLAN_PROF").is_some() { eprintln!("total {:?}", t.elapsed()); }
-    r
+    compute(&rate, tau0_s, options)
 }
 
 /// Computes a deviation curve from borrowed gyro rate samples (copies them once).
@@ -648,14 +644,11 @@ const FAST_RELATIVE_BOUND: f64 = 1e-10;
 /// error bound is too loose (small m on wandering records) summed directly.
 fn oadev_sums(s: &[f64], ms: &[usize]) -> Vec<f64> {
     if ms.len() >= FAST_MIN_TAUS && s.len() >= 4 * FAST_MIN_TAUS {
-        let t = std::time::Instant::now();
         if let Some(fast) = fast::overlapping_allan_sums_fft(s, ms) {
-            if std::env::var_os("ALLAN_PROF").is_some() { eprintln!("fft {:?}", t.elapsed()); }
             let redo: Vec<usize> = (0..ms.len())
                 .filter(|&i| !(fast[i].1 <= FAST_RELATIVE_BOUND * fast[i].0 && fast[i].0.is_finite()))
                 .collect();
             let redo_ms: Vec<usize> = redo.iter().map(|&i| ms[i]).collect();
-            if std::env::var_os("ALLAN_PROF").is_some() { eprintln!("redo {} of {}, last {:?}", redo.len(), ms.len(), redo_ms.last()); }
             let direct = kernels::overlapping_allan_sums(s, &redo_ms);
             let mut sums: Vec<f64> = fast.iter().map(|f| f.0).collect();
             for (&i, d) in redo.iter().zip(direct) {
