@@ -7,7 +7,9 @@
 //! The angle series `s` here is in "sample units": s_k = sum_{i<k} (y_i - mean y), i.e. the
 //! phase divided by tau0. With tau = m tau0 the factor tau0 cancels from every variance, so the
 //! kernels need only m. The inner loops use 16 independent accumulators over `chunks_exact`, so
-//! that LLVM vectorises them; an AVX2+FMA copy is selected at run time on x86-64.
+//! that LLVM vectorises them; an AVX2+FMA copy is selected at run time on x86-64. The multi-tau
+//! OADEV sweep uses explicit AVX2+FMA kernels that share loads between taus: an octave run
+//! (m, 2m, 4m, ...) needs one load per tau, any other group of up to 8 taus two.
 
 /// Sum over k of (c_k - 2 b_k + a_k)^2 for k < n, where a, b, c are three views of one series.
 #[inline(always)]

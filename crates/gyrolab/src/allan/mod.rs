@@ -9,16 +9,22 @@
 //!
 //! Gyro rate samples play the role of fractional frequency y ("freq" data in allantools), the
 //! integrated angle that of phase x: x_0 = 0, x_k = tau0 * sum_{i<k} (y_i - mean y). The mean is
-//! removed first with a Neumaier-compensated sum, so that a record with a large offset (a 2.5 V
-//! null with 1e-4 V noise) gives the same deviations as the offset-free record: to relative 1e-9,
-//! tested at 1e6 samples; the same error analysis holds at 1e8 samples (the compensated mean is
-//! exact to one rounding, y_i - mean is exact by Sterbenz's lemma, the cumulative sum is compensated).
+//! a double-double sum (compensated), and the cumulative sum is compensated too (double-double
+//! running total, plain sums only inside blocks of 8), so that a record with a large offset (a
+//! 2.5 V null with 1e-4 V noise) gives the same deviations as the offset-free record: to relative
+//! 1e-9, tested at 1e6 samples; the same error analysis holds at 1e8 samples (the mean is exact
+//! to one rounding, y_i - mean is exact by Sterbenz's lemma, the cumulative sum is compensated).
+//!
+//! Speed: the conversion runs in two parallel passes; OADEV sums all taus of a list in one
+//! cache-blocked parallel sweep with fused, AVX2+FMA kernels (`kernels`); lists of 256 taus and
+//! more go through the FFT expansion of `fast` (O(N log N + M log^2 M) instead of O(N M)), with
+//! every tau whose error bound is not below 1e-10 relative summed directly.
 //!
 //! Memory: the owning entry points convert the caller's `Vec` to the angle series in place (it
 //! needs capacity N + 1 to avoid one reallocation); OADEV, ADEV, MDEV, TDEV, HDEV and OHDEV then
-//! allocate nothing proportional to N except the noise identification's decimated copy (N/m
-//! values, at most N for m = 1, only when confidence intervals are requested). TOTDEV builds a
-//! reflected copy of 3N values.
+//! allocate nothing proportional to N (the noise identification streams over the record) except
+//! the FFT path of long OADEV tau lists (a few copies of the record) and the B1 fallback's N/m
+//! averages (m > N/30 in practice). TOTDEV builds a reflected copy of 3N values.
 
 mod confidence;
 mod fast;
