@@ -23,6 +23,7 @@ pub(crate) const LAG1_MIN_POINTS: usize = 30;
 pub(crate) const B1_MIN_AVERAGES: usize = 8;
 
 /// Lag-1 autocorrelation r1 of a series (Riley & Greenhall eq. 2); `None` if it has no spread.
+#[cfg(test)]
 fn lag1_acf(z: &[f64]) -> Option<f64> {
     if z.len() < 3 {
         return None;
@@ -38,6 +39,7 @@ fn lag1_acf(z: &[f64]) -> Option<f64> {
 
 /// Removes the least-squares polynomial of degree <= 2 from equally spaced values, in place,
 /// by projection on discrete orthogonal (Gram) polynomials: no matrix, exact to rounding.
+#[cfg(test)]
 fn detrend_quadratic(z: &mut [f64]) {
     let n = z.len();
     if n < 3 {
@@ -65,24 +67,82 @@ fn detrend_quadratic(z: &mut [f64]) {
 ///
 /// Returns the integer power-law exponent alpha of the rate (frequency) PSD, or `None` when fewer
 /// than [`LAG1_MIN_POINTS`] decimated points remain or the series is constant.
+///
+/// Streaming, without a copy of the decimated series: one pass over z_t = s[t m] gives the
+/// quadratic's coefficients (orthogonal polynomials, as [`detrend_quadratic`]), a second pass
+/// forms the residual r_t and its differences of every order up to `dmax` on the fly and sums,
+/// per order, w, w^2 and w_t w_{t+1}; r1 = (S11 - mu (S1 - w_last + S1 - w_first) + (n-1) mu^2)
+/// / (S2 - n mu^2). The residual has zero mean and its differences a mean of order
+/// (spread) / n, so the expanded sums lose nothing against the centred ones.
 pub(crate) fn lag1_noise_id(s: &[f64], m: usize, dmax: usize) -> Option<i32> {
-    let mut z: Vec<f64> = s.iter().step_by(m).copied().collect();
-    if z.len() < LAG1_MIN_POINTS {
+    const ORDERS: usize = 4;
+    if s.is_empty() || m == 0 {
         return None;
     }
-    detrend_quadratic(&mut z);
+    let n = (s.len() - 1) / m + 1;
+    if n < LAG1_MIN_POINTS {
+        return None;
+    }
+    let dmax = dmax.min(ORDERS - 1);
+    let c = (n as f64 - 1.0) / 2.0;
+    let q = (n as f64 * n as f64 - 1.0) / 12.0;
+    let p1 = |t: usize| t as f64 - c;
+    let p2 = |t: usize| (t as f64 - c).powi(2) - q;
+    let (mut s0, mut s1, mut s2, mut n1, mut n2) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for (t, &v) in s.iter().step_by(m).enumerate() {
+        s0 += v;
+        s1 += v * p1(t);
+        s2 += v * p2(t);
+        n1 += p1(t) * p1(t);
+        n2 += p2(t) * p2(t);
+    }
+    let (a0, a1, a2) = (s0 / n as f64, s1 / n1, if n2 > 0.0 { s2 / n2 } else { 0.0 });
+    // per order d: sum w, sum w^2, sum w_t w_{t+1}, first w, last w
+    let mut sum1 = [0.0f64; ORDERS];
+    let mut sum2 = [0.0f64; ORDERS];
+    let mut sum11 = [0.0f64; ORDERS];
+    let mut first = [0.0f64; ORDERS];
+    let mut last = [0.0f64; ORDERS];
+    // prev[d]: the order-d value at t - 1 (defined once t - 1 >= d)
+    let mut prev = [0.0f64; ORDERS];
+    for (t, &v) in s.iter().step_by(m).enumerate() {
+        let mut cur = [0.0f64; ORDERS];
+        cur[0] = v - (a0 + a1 * p1(t) + a2 * p2(t));
+        let top = dmax.min(t);
+        for d in 1..=top {
+            cur[d] = cur[d - 1] - prev[d - 1];
+        }
+        for d in 0..=top {
+            if t == d {
+                first[d] = cur[d];
+            } else {
+                sum11[d] += prev[d] * cur[d];
+            }
+            sum1[d] += cur[d];
+            sum2[d] += cur[d] * cur[d];
+        }
+        prev[..=top].copy_from_slice(&cur[..=top]);
+    }
+    last.copy_from_slice(&prev);
     let mut d = 0usize;
     loop {
-        let r1 = lag1_acf(&z)?;
+        let len = n - d;
+        if len < 3 {
+            return None;
+        }
+        let lf = len as f64;
+        let mu = sum1[d] / lf;
+        let den = sum2[d] - lf * mu * mu;
+        if den <= 0.0 || !den.is_finite() {
+            return None;
+        }
+        let num = sum11[d] - mu * ((sum1[d] - last[d]) + (sum1[d] - first[d])) + (lf - 1.0) * mu * mu;
+        let r1 = num / den;
         let delta = r1 / (1.0 + r1);
         if delta < 0.25 || d >= dmax {
             let alpha = -(2.0 * delta).round() as i32 - 2 * d as i32 + 2;
             return Some(alpha);
         }
-        for i in 0..z.len() - 1 {
-            z[i] = z[i + 1] - z[i];
-        }
-        z.pop();
         d += 1;
     }
 }
@@ -354,4 +414,59 @@ pub(crate) fn chi2_bounds(dev: f64, edf: f64, confidence: f64) -> Option<(f64, f
     let lo = (edf * var / hi_q).sqrt();
     let hi = (edf * var / lo_q).sqrt();
     (lo.is_finite() && hi.is_finite()).then_some((lo, hi))
+}
+
+/// The copying reference implementation of [`lag1_noise_id`] (decimate, detrend, difference).
+#[cfg(test)]
+fn lag1_noise_id_copy(s: &[f64], m: usize, dmax: usize) -> Option<i32> {
+    let mut z: Vec<f64> = s.iter().step_by(m).copied().collect();
+    if z.len() < LAG1_MIN_POINTS {
+        return None;
+    }
+    detrend_quadratic(&mut z);
+    let mut d = 0usize;
+    loop {
+        let r1 = lag1_acf(&z)?;
+        let delta = r1 / (1.0 + r1);
+        if delta < 0.25 || d >= dmax {
+            return Some(-(2.0 * delta).round() as i32 - 2 * d as i32 + 2);
+        }
+        for i in 0..z.len() - 1 {
+            z[i] = z[i + 1] - z[i];
+        }
+        z.pop();
+        d += 1;
+    }
+}
+
+#[cfg(test)]
+mod streaming_tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+
+    #[test]
+    fn streaming_noise_id_equals_the_copying_one() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let white: Vec<f64> = (0..5000).map(|_| StandardNormal.sample(&mut rng)).collect();
+        let mut walk = white.clone();
+        for i in 1..walk.len() {
+            walk[i] += walk[i - 1];
+        }
+        let mut walk2 = walk.clone();
+        for i in 1..walk2.len() {
+            walk2[i] += walk2[i - 1];
+        }
+        let mut count = 0;
+        for series in [&white, &walk, &walk2] {
+            for m in [1, 2, 3, 7, 16, 100, 166] {
+                for dmax in [2, 3] {
+                    assert_eq!(lag1_noise_id(series, m, dmax), lag1_noise_id_copy(series, m, dmax), "m={m}");
+                    count += usize::from(lag1_noise_id(series, m, dmax).is_some());
+                }
+            }
+        }
+        assert!(count > 30);
+        assert_eq!(lag1_noise_id(&[1.0; 100], 1, 2), None);
+    }
 }

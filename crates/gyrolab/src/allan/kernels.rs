@@ -7,7 +7,9 @@
 //! The angle series `s` here is in "sample units": s_k = sum_{i<k} (y_i - mean y), i.e. the
 //! phase divided by tau0. With tau = m tau0 the factor tau0 cancels from every variance, so the
 //! kernels need only m. The inner loops use 16 independent accumulators over `chunks_exact`, so
-//! that LLVM vectorises them; an AVX2+FMA copy is selected at run time on x86-64.
+//! that LLVM vectorises them; an AVX2+FMA copy is selected at run time on x86-64. The multi-tau
+//! OADEV sweep uses explicit AVX2+FMA kernels that share loads between taus: an octave run
+//! (m, 2m, 4m, ...) needs one load per tau, any other group of up to 8 taus two.
 
 /// Sum over k of (c_k - 2 b_k + a_k)^2 for k < n, where a, b, c are three views of one series.
 #[inline(always)]
@@ -203,16 +205,275 @@ pub(crate) fn reflect_for_total(s: &[f64]) -> Vec<f64> {
     out
 }
 
+/// Four consecutive values as an array (one bounds check; vectorises).
+#[inline(always)]
+fn quad(s: &[f64], j: usize) -> [f64; 4] {
+    let q = &s[j..j + 4];
+    [q[0], q[1], q[2], q[3]]
+}
+
+/// Sums, for the G taus m 2^i (i < G) of an octave run, of the squared second differences over
+/// k in `k0..k1`: with a_i = s[k + 2^i m] - s[k], the second difference at 2^i m is
+/// a_{i+1} - 2 a_i (one rounding; 2 a_i is exact). One load per tau and k instead of three,
+/// shared by neighbouring taus; 4 lanes per tau so that LLVM keeps each tau's accumulator in a
+/// vector register (portable version; x86-64 with AVX2+FMA uses [`octave_run_avx2`]).
+#[inline(always)]
+fn octave_run_body<const G: usize>(s: &[f64], m: usize, k0: usize, k1: usize) -> [f64; G] {
+    const L: usize = 4;
+    let mut out = [0.0f64; G];
+    if k1 <= k0 {
+        return out;
+    }
+    let n = k1 - k0;
+    let base = &s[k0..k1];
+    let first = &s[k0 + m..k1 + m];
+    let w: [&[f64]; G] = std::array::from_fn(|i| &s[k0 + (m << (i + 1))..k1 + (m << (i + 1))]);
+    let madd = |a: f64, b: f64, c: f64| a * b + c;
+    let mut acc = [[0.0f64; L]; G];
+    let full = n - n % L;
+    let mut j = 0;
+    while j < full {
+        let b = quad(base, j);
+        let f = quad(first, j);
+        let mut prev = [f[0] - b[0], f[1] - b[1], f[2] - b[2], f[3] - b[3]];
+        for (wi, ai) in w.iter().zip(acc.iter_mut()) {
+            let x = quad(wi, j);
+            let next = [x[0] - b[0], x[1] - b[1], x[2] - b[2], x[3] - b[3]];
+            for l in 0..L {
+                let d = madd(-2.0, prev[l], next[l]);
+                ai[l] = madd(d, d, ai[l]);
+            }
+            prev = next;
+        }
+        j += L;
+    }
+    for j in full..n {
+        let mut prev = first[j] - base[j];
+        for i in 0..G {
+            let next = w[i][j] - base[j];
+            let d = madd(-2.0, prev, next);
+            acc[i][0] = madd(d, d, acc[i][0]);
+            prev = next;
+        }
+    }
+    for i in 0..G {
+        out[i] = (acc[i][0] + acc[i][2]) + (acc[i][1] + acc[i][3]);
+    }
+    out
+}
+
+/// AVX2+FMA version of [`octave_run_body`] with explicit vectors (LLVM's SLP vectoriser
+/// transposes the portable body across taus, which is slower than scalar code).
+///
+/// # Safety
+/// The CPU must support AVX2 and FMA. Every vector load reads 4 values from a slice that was
+/// bounds-checked to hold them (`&x[j..j + 4]`), so no access leaves the record.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn octave_run_avx2<const G: usize>(s: &[f64], m: usize, k0: usize, k1: usize) -> [f64; G] {
+    use std::arch::x86_64::*;
+    let mut out = [0.0f64; G];
+    if k1 <= k0 {
+        return out;
+    }
+    let n = k1 - k0;
+    let base = &s[k0..k1];
+    let first = &s[k0 + m..k1 + m];
+    let w: [&[f64]; G] = std::array::from_fn(|i| &s[k0 + (m << (i + 1))..k1 + (m << (i + 1))]);
+    let load = |x: &[f64], j: usize| _mm256_loadu_pd(x[j..j + 4].as_ptr());
+    let minus2 = _mm256_set1_pd(-2.0);
+    let mut acc = [_mm256_setzero_pd(); G];
+    let full = n - n % 4;
+    let mut j = 0;
+    while j < full {
+        let b = load(base, j);
+        let mut prev = _mm256_sub_pd(load(first, j), b);
+        for i in 0..G {
+            let next = _mm256_sub_pd(load(w[i], j), b);
+            let d = _mm256_fmadd_pd(minus2, prev, next);
+            acc[i] = _mm256_fmadd_pd(d, d, acc[i]);
+            prev = next;
+        }
+        j += 4;
+    }
+    for i in 0..G {
+        let mut lanes = [0.0f64; 4];
+        _mm256_storeu_pd(lanes.as_mut_ptr(), acc[i]);
+        out[i] = (lanes[0] + lanes[2]) + (lanes[1] + lanes[3]);
+    }
+    for j in full..n {
+        let mut prev = first[j] - base[j];
+        for i in 0..G {
+            let next = w[i][j] - base[j];
+            let d = (-2.0f64).mul_add(prev, next);
+            out[i] = d.mul_add(d, out[i]);
+            prev = next;
+        }
+    }
+    out
+}
+
+fn octave_run_g<const G: usize>(s: &[f64], m: usize, k0: usize, k1: usize, out: &mut [f64]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU supports AVX2 and FMA (checked just above); see the function's doc.
+            let r = unsafe { octave_run_avx2::<G>(s, m, k0, k1) };
+            out.iter_mut().zip(r).for_each(|(o, v)| *o += v);
+            return;
+        }
+    }
+    let r = octave_run_body::<G>(s, m, k0, k1);
+    out.iter_mut().zip(r).for_each(|(o, v)| *o += v);
+}
+
+/// Adds to `out[i]` the sum over k in `k0..k1` of the squared second difference at m 2^i,
+/// for i < out.len() <= [`RUN_MAX`].
+fn octave_run(s: &[f64], m: usize, k0: usize, k1: usize, out: &mut [f64]) {
+    match out.len() {
+        0 => {}
+        1 => octave_run_g::<1>(s, m, k0, k1, out),
+        2 => octave_run_g::<2>(s, m, k0, k1, out),
+        3 => octave_run_g::<3>(s, m, k0, k1, out),
+        4 => octave_run_g::<4>(s, m, k0, k1, out),
+        5 => octave_run_g::<5>(s, m, k0, k1, out),
+        6 => octave_run_g::<6>(s, m, k0, k1, out),
+        7 => octave_run_g::<7>(s, m, k0, k1, out),
+        _ => octave_run_g::<RUN_MAX>(s, m, k0, k1, &mut out[..RUN_MAX]),
+    }
+}
+
+/// Portable version of [`spread_run_avx2`]: sums over k in `k0..k1` of the squared second
+/// difference for each of G arbitrary factors `ms`, as (a_{2m} - 2 a_m) with a_j = s[k + j] - s[k].
+#[inline(always)]
+fn spread_run_body<const G: usize>(s: &[f64], ms: &[usize; G], k0: usize, k1: usize) -> [f64; G] {
+    let mut out = [0.0f64; G];
+    if k1 <= k0 {
+        return out;
+    }
+    let base = &s[k0..k1];
+    for (o, &m) in out.iter_mut().zip(ms) {
+        let near = &s[k0 + m..k1 + m];
+        let far = &s[k0 + 2 * m..k1 + 2 * m];
+        *o = base
+            .iter()
+            .zip(near)
+            .zip(far)
+            .map(|((b, x), z)| {
+                let d = (z - b) - 2.0 * (x - b);
+                d * d
+            })
+            .sum();
+    }
+    out
+}
+
+/// AVX2+FMA sums for G arbitrary factors sharing the loads of s[k] (a consecutive tau list has
+/// no shared windows otherwise): 2 loads, 2 subtractions and 2 FMAs per tau and 4 k.
+///
+/// # Safety
+/// The CPU must support AVX2 and FMA. Every vector load reads 4 values from a slice that was
+/// bounds-checked to hold them (`&x[j..j + 4]`), so no access leaves the record.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn spread_run_avx2<const G: usize>(s: &[f64], ms: &[usize; G], k0: usize, k1: usize) -> [f64; G] {
+    use std::arch::x86_64::*;
+    let mut out = [0.0f64; G];
+    if k1 <= k0 {
+        return out;
+    }
+    let n = k1 - k0;
+    let base = &s[k0..k1];
+    let near: [&[f64]; G] = std::array::from_fn(|i| &s[k0 + ms[i]..k1 + ms[i]]);
+    let far: [&[f64]; G] = std::array::from_fn(|i| &s[k0 + 2 * ms[i]..k1 + 2 * ms[i]]);
+    let load = |x: &[f64], j: usize| _mm256_loadu_pd(x[j..j + 4].as_ptr());
+    let minus2 = _mm256_set1_pd(-2.0);
+    let mut acc = [_mm256_setzero_pd(); G];
+    let full = n - n % 4;
+    let mut j = 0;
+    while j < full {
+        let b = load(base, j);
+        for i in 0..G {
+            let a = _mm256_sub_pd(load(near[i], j), b);
+            let c = _mm256_sub_pd(load(far[i], j), b);
+            let d = _mm256_fmadd_pd(minus2, a, c);
+            acc[i] = _mm256_fmadd_pd(d, d, acc[i]);
+        }
+        j += 4;
+    }
+    for i in 0..G {
+        let mut lanes = [0.0f64; 4];
+        _mm256_storeu_pd(lanes.as_mut_ptr(), acc[i]);
+        out[i] = (lanes[0] + lanes[2]) + (lanes[1] + lanes[3]);
+        for j in full..n {
+            let d = (-2.0f64).mul_add(near[i][j] - base[j], far[i][j] - base[j]);
+            out[i] = d.mul_add(d, out[i]);
+        }
+    }
+    out
+}
+
+fn spread_run_g<const G: usize>(s: &[f64], ms: &[usize], k0: usize, k1: usize, out: &mut [f64]) {
+    let mut m = [0usize; G];
+    m.copy_from_slice(&ms[..G]);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU supports AVX2 and FMA (checked just above); see the function's doc.
+            let r = unsafe { spread_run_avx2::<G>(s, &m, k0, k1) };
+            out.iter_mut().zip(r).for_each(|(o, v)| *o += v);
+            return;
+        }
+    }
+    let r = spread_run_body::<G>(s, &m, k0, k1);
+    out.iter_mut().zip(r).for_each(|(o, v)| *o += v);
+}
+
+/// Adds to `out[i]` the sum over k in `k0..k1` of the squared second difference at `ms[i]`
+/// (`ms.len() == out.len()`, at most [`RUN_MAX`]).
+fn spread_run(s: &[f64], ms: &[usize], k0: usize, k1: usize, out: &mut [f64]) {
+    match out.len() {
+        0 => {}
+        1 => spread_run_g::<1>(s, ms, k0, k1, out),
+        2 => spread_run_g::<2>(s, ms, k0, k1, out),
+        3 => spread_run_g::<3>(s, ms, k0, k1, out),
+        4 => spread_run_g::<4>(s, ms, k0, k1, out),
+        5 => spread_run_g::<5>(s, ms, k0, k1, out),
+        6 => spread_run_g::<6>(s, ms, k0, k1, out),
+        7 => spread_run_g::<7>(s, ms, k0, k1, out),
+        _ => spread_run_g::<RUN_MAX>(s, ms, k0, k1, &mut out[..RUN_MAX]),
+    }
+}
+
+/// Most taus summed in one fused pass (8 vector accumulators, registers to spare).
+const RUN_MAX: usize = 8;
+
 /// Overlapping-Allan sums for many averaging factors at once, cache-blocked over k.
 ///
-/// The k range is cut into blocks of 4096; within a block every m is summed before moving on, so
-/// the three windows s[k..], s[k+m..], s[k+2m..] of consecutive m overlap and stay in cache, and
-/// the record streams from memory a few times instead of once per m. Blocks run in parallel
-/// (rayon); per-block partial sums are added per m.
+/// The sorted factors are cut into runs of at most [`RUN_MAX`] in which each is twice the
+/// previous (an octave list is one long run); a run is summed in one fused pass per block
+/// ([`octave_run_body`]). The k range is cut into blocks of 4096; within a block every run is
+/// summed before moving on, so the windows s[k + 2^i m ..] stay in cache, and the blocks run in
+/// parallel (rayon). A tau whose last term lies inside a block (the staircase n_i = L - 2 m_i)
+/// is fused up to the run's common end and finished alone.
 pub(crate) fn overlapping_allan_sums(s: &[f64], ms: &[usize]) -> Vec<f64> {
     use rayon::prelude::*;
-    const BLOCK: usize = 4096;
+    const BLOCK: usize = 1024;
     let len = s.len();
+    // groups: (first index into ms, count, octave run?)
+    let mut runs: Vec<(usize, usize, bool)> = Vec::new();
+    for (i, &m) in ms.iter().enumerate() {
+        match runs.last_mut() {
+            Some((start, count, octave))
+                if *count < RUN_MAX && ms[*start + *count - 1] * 2 == m && (*octave || *count == 1) =>
+            {
+                *count += 1;
+                *octave = true;
+            }
+            Some((_, count, false)) if *count < RUN_MAX => *count += 1,
+            _ => runs.push((i, 1, false)),
+        }
+    }
     let n_max = ms.iter().map(|&m| len.saturating_sub(2 * m)).max().unwrap_or(0);
     let blocks = n_max.div_ceil(BLOCK);
     let zero = || vec![0.0f64; ms.len()];
@@ -220,13 +481,32 @@ pub(crate) fn overlapping_allan_sums(s: &[f64], ms: &[usize]) -> Vec<f64> {
         .into_par_iter()
         .fold(zero, |mut acc, b| {
             let k0 = b * BLOCK;
-            for (slot, &m) in acc.iter_mut().zip(ms) {
-                let n = len - 2 * m;
-                if k0 >= n {
+            for &(start, count, octave) in &runs {
+                let n_of = |i: usize| len.saturating_sub(2 * ms[i]);
+                // taus of a group sorted by m, so their term counts decrease along it
+                let active = (0..count).take_while(|&i| n_of(start + i) > k0).count();
+                if active == 0 {
                     continue;
                 }
-                let k1 = (k0 + BLOCK).min(n);
-                *slot += second_difference_sq_sum(&s[k0..k1], &s[k0 + m..k1 + m], &s[k0 + 2 * m..k1 + 2 * m]);
+                let common_end = (k0 + BLOCK).min(n_of(start + active - 1));
+                let slots = &mut acc[start..start + active];
+                if octave {
+                    octave_run(s, ms[start], k0, common_end, slots);
+                } else {
+                    spread_run(s, &ms[start..start + active], k0, common_end, slots);
+                }
+                for i in 0..active - 1 {
+                    let end = (k0 + BLOCK).min(n_of(start + i));
+                    if end > common_end {
+                        spread_run(
+                            s,
+                            &ms[start + i..start + i + 1],
+                            common_end,
+                            end,
+                            &mut acc[start + i..start + i + 1],
+                        );
+                    }
+                }
             }
             acc
         })

@@ -205,6 +205,61 @@ fn white_rate_noise_is_identified_and_bounded() {
     }
 }
 
+/// Angle series (sample units) of white, random-walk and flicker-like (sum of AR(1) at octave
+/// time constants) rate noise on top of a 2.5 offset.
+fn test_angles(n: usize, seed: u64) -> Vec<(&'static str, Vec<f64>)> {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut z = move || -> f64 { StandardNormal.sample(&mut rng) };
+    let white: Vec<f64> = (0..n).map(|_| 2.5 + 1e-3 * z()).collect();
+    let mut w = 0.0;
+    let walk: Vec<f64> = (0..n)
+        .map(|_| {
+            w += 1e-5 * z();
+            2.5 + 1e-3 * z() + w
+        })
+        .collect();
+    let mut states = [0.0f64; 16];
+    let flicker: Vec<f64> = (0..n)
+        .map(|_| {
+            let mut sum = 0.0;
+            for (j, st) in states.iter_mut().enumerate() {
+                let a = 1.0 - 0.5f64.powi(j as i32);
+                *st = a * *st + (1.0 - a * a).sqrt() * z();
+                sum += *st;
+            }
+            2.5 + 1e-3 * sum
+        })
+        .collect();
+    [("white", white), ("random walk", walk), ("flicker", flicker)]
+        .into_iter()
+        .map(|(name, mut y)| {
+            rate_to_sample_angle_in_place(&mut y).unwrap();
+            (name, y)
+        })
+        .collect()
+}
+
+#[test]
+fn fft_expansion_matches_direct_sums_within_its_bound() {
+    for (name, s) in test_angles(20_000, 5) {
+        let ms: Vec<usize> = (1..=(s.len() - 1) / 4).collect();
+        let fast = fast::overlapping_allan_sums_fft(&s, &ms).unwrap();
+        let direct = kernels::overlapping_allan_sums(&s, &ms);
+        let mut worst = 0.0f64;
+        for ((&m, f), d) in ms.iter().zip(&fast).zip(&direct) {
+            let err = (f.0 - d).abs();
+            worst = worst.max(err / f.1);
+            assert!(err <= f.1, "{name} m={m}: error {err:e} above bound {:e}", f.1);
+        }
+        eprintln!("{name}: largest error / bound {worst:e}");
+        // the combined result (bound-checked FFT sums, the rest direct) meets 1e-9 everywhere
+        let combined = oadev_sums(&s, &ms);
+        for ((&m, c), d) in ms.iter().zip(&combined).zip(&direct) {
+            assert!((c - d).abs() <= 1e-9 * d, "{name} m={m}: {c} vs {d}");
+        }
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
     #[test]
