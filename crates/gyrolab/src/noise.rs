@@ -115,7 +115,7 @@ pub struct SlopeLineResult {
     pub quantization: Option<SlopeReading>,
     /// Where N was read (slope -1/2, line read at tau = 1 s).
     pub arw: Option<SlopeReading>,
-    /// Where B was read (the curve's interior minimum).
+    /// Where B was read (the median level of the flat region, else an interior minimum).
     pub bias_instability: Option<SlopeReading>,
     /// Where K was read (slope +1/2, line read at tau = 3 s).
     pub rrw: Option<SlopeReading>,
