@@ -7,6 +7,7 @@
 //! - [`calibration`]: calibration files (TOML) written by `gyrolab rate --cal-out`;
 //! - [`raw_log`]: raw rate-table logs (detection, reading, segment files);
 //! - [`apply_csv`]: streaming application of a calibration to a time-series file;
+//! - [`decimal`]: exact fast reading of plain decimal numbers and rows of them;
 //! - [`series`]: streaming reader of time-series files, and the static test of a file;
 //! - [`sim_csv`]: fast CSV writer for simulated static records and rate-table tests;
 //! - [`plan`]: test plans (TOML) for `gyrolab eval`.
@@ -14,6 +15,7 @@
 pub mod apply_csv;
 pub mod atomic;
 pub mod calibration;
+pub mod decimal;
 pub mod error;
 pub mod rate_table;
 pub mod raw_log;

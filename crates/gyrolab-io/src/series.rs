@@ -30,6 +30,8 @@ pub const MAX_LINE_BYTES: usize = 64 << 20;
 /// How many missing cells the reader lists individually (all are counted).
 pub const FIRST_MISSING: usize = 100;
 
+pub use crate::decimal::plain_decimal;
+use crate::decimal::{read_rows, FieldShape, RowLayout, SKIP_COLUMN};
 pub use crate::text::Delimiter;
 
 /// Options of the time-series reader.
@@ -52,6 +54,9 @@ pub struct SeriesOptions {
     pub chunk_bytes: usize,
     /// Rows per block handed to the caller.
     pub block_rows: usize,
+    /// Reads rows of plain decimals by the fast path (same values; on by default, off only to
+    /// compare the two paths in tests and benchmarks).
+    pub fast_rows: bool,
 }
 
 impl Default for SeriesOptions {
@@ -65,6 +70,7 @@ impl Default for SeriesOptions {
             tolerant: false,
             chunk_bytes: DEFAULT_CHUNK_BYTES,
             block_rows: DEFAULT_BLOCK_ROWS,
+            fast_rows: true,
         }
     }
 }
@@ -192,7 +198,7 @@ impl<'a> SeriesBlock<'a> {
     }
 }
 
-const SKIP: u32 = u32::MAX;
+const SKIP: u32 = SKIP_COLUMN;
 
 /// Streaming reader: parse the header with [`SeriesReader::open`], then call
 /// [`SeriesReader::next_block`] until it returns `None`. After an error the reader is spent.
@@ -200,6 +206,7 @@ pub struct SeriesReader<R: Read> {
     src: R,
     header: SeriesHeader,
     tolerant: bool,
+    fast_rows: bool,
     block_rows: usize,
     chunk_bytes: usize,
     buf: Vec<u8>,
@@ -210,6 +217,8 @@ pub struct SeriesReader<R: Read> {
     line_no: u64,
     rows: u64,
     targets: Vec<u32>,
+    shapes: Vec<Option<FieldShape>>,
+    crlf: bool,
     time_slot: Option<usize>,
     temp_slot: Option<usize>,
     rate_slot: Option<usize>,
@@ -252,6 +261,7 @@ impl<R: Read> SeriesReader<R> {
                 table_rate_unit: None,
             },
             tolerant: options.tolerant,
+            fast_rows: options.fast_rows,
             block_rows: options.block_rows.max(1),
             chunk_bytes,
             buf: vec![0; chunk_bytes],
@@ -262,6 +272,8 @@ impl<R: Read> SeriesReader<R> {
             line_no: 0,
             rows: 0,
             targets: Vec::new(),
+            shapes: Vec::new(),
+            crlf: false,
             time_slot: None,
             temp_slot: None,
             rate_slot: None,
@@ -293,6 +305,7 @@ impl<R: Read> SeriesReader<R> {
                 first = false;
             }
             if !is_blank_or_comment(line) {
+                r.crlf = line.ends_with(b"\r");
                 break String::from_utf8_lossy(line).trim().to_string();
             }
         };
@@ -556,11 +569,27 @@ impl<R: Read> SeriesReader<R> {
         let ws = self.header.delimiter == Delimiter::Whitespace;
         let delim = self.header.delimiter.byte();
         let ncols = self.targets.len();
+        let fast = self.fast_rows && !ws;
+        let layout = RowLayout { delim, crlf: self.crlf };
+        if self.shapes.len() != ncols {
+            self.shapes = vec![None; ncols];
+        }
         let mut p = self.pos;
         let mut line_no = self.line_no;
         let result = 'rows: loop {
             if p >= end || self.lines.len() >= self.block_rows {
                 break 'rows Ok(());
+            }
+            if fast {
+                let room = self.block_rows - self.lines.len();
+                let (next, rows) = read_rows(bytes, p, layout, &self.targets, &mut self.shapes, &mut self.cols, room);
+                if rows > 0 {
+                    self.lines.extend((1..=rows as u64).map(|k| line_no + k));
+                    p = next;
+                    line_no += rows as u64;
+                    self.rows += rows as u64;
+                    continue 'rows;
+                }
             }
             line_no += 1;
             let line_start = p;
@@ -890,65 +919,4 @@ pub fn window_means_file(
         acc.push(out, b.temp);
     }
     Ok(acc.finish())
-}
-
-/// Exact powers of ten representable in f64 (10^0 to 10^22).
-const POW10: [f64; 23] = [
-    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20,
-    1e21, 1e22,
-];
-
-/// Fast path for the plain decimals that fill most logs (`-12.3456`, `+0.5`, `7`): at most 15
-/// significant digits, no exponent. The significand w < 10^15 and 10^k (k <= 22) are exact in
-/// f64, so w / 10^k is one correctly rounded operation: the same value every correct parser
-/// returns (Clinger 1990, the fast path). Anything else returns `None` for the full parser.
-/// Returns the value and the bytes used.
-#[inline]
-pub fn plain_decimal(b: &[u8]) -> Option<(f64, usize)> {
-    let mut i = 0;
-    let negative = match b.first() {
-        Some(b'-') => {
-            i = 1;
-            true
-        }
-        Some(b'+') => {
-            i = 1;
-            false
-        }
-        _ => false,
-    };
-    let mut w: u64 = 0;
-    let mut digits = 0usize;
-    while let Some(&c) = b.get(i) {
-        if !c.is_ascii_digit() {
-            break;
-        }
-        w = w * 10 + u64::from(c - b'0');
-        digits += 1;
-        i += 1;
-        if digits > 15 {
-            return None;
-        }
-    }
-    let mut decimals = 0usize;
-    if b.get(i) == Some(&b'.') {
-        i += 1;
-        while let Some(&c) = b.get(i) {
-            if !c.is_ascii_digit() {
-                break;
-            }
-            w = w * 10 + u64::from(c - b'0');
-            digits += 1;
-            decimals += 1;
-            i += 1;
-            if digits > 15 {
-                return None;
-            }
-        }
-    }
-    if digits == 0 || matches!(b.get(i), Some(b'e' | b'E' | b'.')) || decimals >= POW10.len() {
-        return None;
-    }
-    let v = w as f64 / POW10[decimals];
-    Some((if negative { -v } else { v }, i))
 }

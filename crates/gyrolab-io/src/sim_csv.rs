@@ -135,6 +135,74 @@ fn write_digits(out: &mut [u8], v: u64, decimals: usize) -> usize {
     write_padded(out, end, int, width)
 }
 
+/// The eight decimal digits of `n` < 10^8 as ASCII, zero-padded, the first digit in the lowest
+/// byte (SWAR: both four-digit halves, then both digit pairs of each, then both digits of each
+/// pair, are split at once with multiplications by reciprocals that are exact in these ranges).
+#[inline(always)]
+fn eight_digits(n: u64) -> u64 {
+    // Lanes of 32 bits: the first four digits (n / 10^4) in the low lane.
+    let quads = (n / 10_000) | ((n % 10_000) << 32);
+    // In each lane, abcd / 100 = (abcd * 5243) >> 19 for abcd < 10^4; pairs in 16-bit lanes.
+    let hundreds = ((quads * 5243) >> 19) & 0x0000_007f_0000_007f;
+    let pairs = hundreds | ((quads - hundreds * 100) << 16);
+    // In each 16-bit lane, ab / 10 = (ab * 103) >> 10 for ab < 100; digits in bytes.
+    let tens = ((pairs * 103) >> 10) & 0x000f_000f_000f_000f;
+    let digits = tens | ((pairs - tens * 10) << 8);
+    digits + 0x3030_3030_3030_3030
+}
+
+/// Appends `v` / 10^decimals in fixed notation (`decimals` digits after the point, at least one
+/// before it), with a minus sign when `negative`. `v` must be below 10^16, `decimals` at most 15.
+#[inline]
+fn push_fixed(out: &mut Vec<u8>, v: u64, decimals: usize, negative: bool) {
+    // Sixteen digits, the first in the lowest byte.
+    let text = u128::from(eight_digits(v / 100_000_000)) | (u128::from(eight_digits(v % 100_000_000)) << 64);
+    let leading_zeros = ((text - u128::from_le_bytes([b'0'; 16])).trailing_zeros() / 8) as usize;
+    let width = (16 - leading_zeros).max(decimals + 1);
+    if negative {
+        out.push(b'-');
+    }
+    if width >= 16 {
+        // No room for the point in 16 bytes: in two parts.
+        let digits = text.to_le_bytes();
+        let (int, frac) = digits[16 - width..].split_at(width - decimals);
+        out.extend_from_slice(int);
+        if decimals > 0 {
+            out.push(b'.');
+            out.extend_from_slice(frac);
+        }
+        return;
+    }
+    // The `width` significant digits from byte 0, then the point put in after the integer part.
+    let digits = text >> (8 * (16 - width));
+    let int_bytes = 8 * (width - decimals) as u32;
+    let (line, len) = if decimals > 0 {
+        let int_mask = (1u128 << int_bytes) - 1;
+        ((digits & int_mask) | (u128::from(b'.') << int_bytes) | ((digits & !int_mask) << 8), width + 1)
+    } else {
+        (digits, width)
+    };
+    // Sixteen bytes at once, then cut back to the length.
+    let start = out.len();
+    out.extend_from_slice(&line.to_le_bytes());
+    out.truncate(start + len);
+}
+
+/// `x` rounded half away from zero, as `f64::round` (sign of zero included), for |x| < 2^53 (the truncation by an
+/// integer conversion and the difference x - trunc(x) are exact there).
+#[inline(always)]
+fn round_half_away(x: f64) -> f64 {
+    let t = (x as i64 as f64).copysign(x);
+    let d = x - t;
+    if d >= 0.5 {
+        t + 1.0
+    } else if d <= -0.5 {
+        t - 1.0
+    } else {
+        t
+    }
+}
+
 /// Exact integer powers of ten 10^0 ..= 10^19.
 const POW10_INT: [u64; 20] = {
     let mut t = [1u64; 20];
@@ -195,22 +263,19 @@ impl<W: Write> RowWriter<W> {
             NumberFormat::Shortest => self.shortest(v),
             NumberFormat::Fixed { decimals } => {
                 let d = usize::from(decimals);
-                let scaled = (v * POW10[d]).round();
-                if scaled.is_nan() || scaled.abs() >= EXACT_INT_LIMIT {
+                let unrounded = v * POW10[d];
+                if unrounded.is_nan() || unrounded.abs() >= EXACT_INT_LIMIT {
+                    self.shortest(v);
+                    return;
+                }
+                let scaled = round_half_away(unrounded);
+                if scaled.abs() >= EXACT_INT_LIMIT {
                     // Too large for the integer path (or not finite).
                     self.shortest(v);
                     return;
                 }
                 // ok: |scaled| < 2^53, so the conversion to u64 is exact.
-                let int = scaled.abs() as u64;
-                // Sign, up to 16 integer digits, point, up to 15 decimals.
-                let mut text = [0u8; 40];
-                let mut i = write_digits(&mut text, int, d);
-                if scaled < 0.0 {
-                    i -= 1;
-                    text[i] = b'-';
-                }
-                self.buf.extend_from_slice(&text[i..]);
+                push_fixed(&mut self.buf, scaled.abs() as u64, d, scaled < 0.0);
             }
         }
     }
@@ -471,6 +536,51 @@ mod tests {
         let last: Vec<f64> = body[3000].split(',').map(|f| f.parse().unwrap()).collect();
         assert_eq!(last[0], 29.99);
         assert_eq!(last[2], 25.0);
+    }
+
+    proptest::proptest! {
+        /// Fixed notation by SWAR digits equals the plain integer formatting of the same value.
+        #[test]
+        fn push_fixed_equals_integer_formatting(v in 0u64..10_000_000_000_000_000, decimals in 0usize..16, negative: bool) {
+            let mut out = Vec::new();
+            push_fixed(&mut out, v, decimals, negative);
+            let unit = 10u64.pow(decimals as u32);
+            let sign = if negative { "-" } else { "" };
+            let want = if decimals == 0 {
+                format!("{sign}{v}")
+            } else {
+                format!("{sign}{}.{:0decimals$}", v / unit, v % unit)
+            };
+            proptest::prop_assert_eq!(String::from_utf8(out).unwrap(), want);
+        }
+    }
+
+    proptest::proptest! {
+        /// Rounding by truncation equals `f64::round` below 2^53.
+        #[test]
+        fn round_half_away_equals_round(x in -9.0e15f64..9.0e15, k in 0i32..6) {
+            let x = x / 10f64.powi(k * 3);
+            proptest::prop_assert_eq!(round_half_away(x).to_bits(), x.round().to_bits(), "{}", x);
+        }
+    }
+
+    #[test]
+    fn round_half_away_at_halves() {
+        for x in [0.5, -0.5, 1.5, -2.5, 0.49999999999999994, -0.49999999999999994, 4503599627370495.5, 0.0, -0.0] {
+            assert_eq!(round_half_away(x).to_bits(), x.round().to_bits(), "{x}");
+        }
+    }
+
+    #[test]
+    fn eight_digits_of_edge_values() {
+        for n in [0u64, 1, 9, 10, 99, 100, 999, 1_000, 9_999, 10_000, 12_345_678, 99_999_999] {
+            assert_eq!(eight_digits(n).to_le_bytes(), *format!("{n:08}").as_bytes(), "{n}");
+        }
+        // The two four-digit lanes are computed apart (masked): n = k * 10^4 + k gives every
+        // value 0..=9999 in both, so this covers every lane value exhaustively.
+        for n in (0u64..10_000).map(|k| k * 10_000 + k) {
+            assert_eq!(eight_digits(n).to_le_bytes(), *format!("{n:08}").as_bytes(), "{n}");
+        }
     }
 
     #[test]

@@ -258,11 +258,42 @@ proptest! {
         let sign = ["", "-", "+"][sign as usize];
         let frac = format!("{frac:08}");
         let text = if width == 0 { format!("{sign}{int}") } else { format!("{sign}{int}.{}", &frac[..width]) };
-        let fast = gyrolab_io::series::plain_decimal(text.as_bytes());
         let full: f64 = text.trim_start_matches('+').parse().unwrap();
+        // At most 7 + 8 = 15 digits: the fast path must take it, and agree to the bit.
+        let fast = gyrolab_io::series::plain_decimal(text.as_bytes());
+        prop_assert!(fast.is_some(), "{} declined", text);
         if let Some((v, n)) = fast {
             prop_assert_eq!(n, text.len());
             prop_assert_eq!(v.to_bits(), full.to_bits(), "{}", text);
+        }
+        // Followed by a delimiter and more text, the same value and length.
+        let padded = format!("{text},12345678.9\n");
+        prop_assert_eq!(gyrolab_io::series::plain_decimal(padded.as_bytes()), fast);
+    }
+
+    /// On any text made of number characters, whatever the fast path accepts is exactly what
+    /// the full parser reads (value and length).
+    #[test]
+    fn plain_decimal_agrees_with_full_parser_on_any_text(text in "[-+0-9.eE,x]{0,40}") {
+        if let Some((v, n)) = gyrolab_io::series::plain_decimal(text.as_bytes()) {
+            let (full, m) = fast_float2::parse_partial::<f64, _>(text.as_bytes()).unwrap();
+            prop_assert_eq!(n, m, "{}", text);
+            prop_assert_eq!(v.to_bits(), full.to_bits(), "{}", text);
+        }
+    }
+
+    /// Long digit runs (across the eight-byte groups) are read exactly or declined.
+    #[test]
+    fn plain_decimal_long_runs(int in "[0-9]{1,20}", frac in "[0-9]{0,20}") {
+        let text = if frac.is_empty() { int.clone() } else { format!("{int}.{frac}") };
+        let full: f64 = text.parse().unwrap();
+        match gyrolab_io::series::plain_decimal(text.as_bytes()) {
+            Some((v, n)) => {
+                prop_assert!(int.len() + frac.len() <= 15, "{} taken", text);
+                prop_assert_eq!(n, text.len());
+                prop_assert_eq!(v.to_bits(), full.to_bits(), "{}", text);
+            }
+            None => prop_assert!(int.len() + frac.len() > 15, "{} declined", text),
         }
     }
 }

@@ -916,16 +916,18 @@ impl StaticTestAccumulator {
     }
 
     fn process(&mut self, b: &SampleBlock) {
-        self.track_extremes(b);
-        if self.block_is_clean(b) {
+        let clean = self.block_is_clean(b);
+        self.track_extremes(b, clean);
+        if clean {
             self.process_clean(b);
         } else {
             self.process_each(b);
         }
     }
 
-    /// Records the extremes of the block's valid samples, chunk by chunk.
-    fn track_extremes(&mut self, b: &SampleBlock) {
+    /// Records the extremes of the block's valid samples, chunk by chunk (`clean`: every sample
+    /// is valid, see [`Self::block_is_clean`]).
+    fn track_extremes(&mut self, b: &SampleBlock, clean: bool) {
         let fs = self.fs.unwrap_or(1.0); // ok: process runs only once the rate is set
         let i0 = self.samples;
         let n = b.output.len();
@@ -953,6 +955,23 @@ impl StaticTestAccumulator {
             let size = if self.extremes.len() <= EXTREMES_SHORT_CHUNKS { EXTREMES_SHORT_CHUNK } else { EXTREMES_CHUNK };
             let Some(c) = self.extremes.last_mut() else { return };
             let take = ((size - c.samples) as usize).min(n - i);
+            if let (true, Some(ts)) = (clean, b.time_s) {
+                // Every sample valid: the same sums without a test per sample.
+                let slope = c.slope;
+                for (&x, &t) in b.output[i..i + take].iter().zip(&ts[i..i + take]) {
+                    let y = x - slope * t;
+                    c.y_min = c.y_min.min(y);
+                    c.y_max = c.y_max.max(y);
+                    c.t_min = c.t_min.min(t);
+                    c.t_max = c.t_max.max(t);
+                    c.t_sum += t;
+                    c.x_sum += x;
+                }
+                c.valid += take as u64;
+                c.samples += take as u64;
+                i += take;
+                continue;
+            }
             for j in i..i + take {
                 let x = b.output[j];
                 let t = b.time_s.map_or((i0 + j as u64) as f64 / fs, |ts| ts[j]);
@@ -1029,7 +1048,19 @@ impl StaticTestAccumulator {
             let mut prev = self.prev_time.unwrap_or(ts[0]);
             let mut largest = self.quality.largest_interval_s.unwrap_or(f64::NEG_INFINITY);
             let start = usize::from(self.prev_time.is_none());
-            for (i, &t) in ts.iter().enumerate().skip(start) {
+            // The smallest and largest interval first (no branch per sample): only when one is out
+            // of bounds are the intervals looked at one by one.
+            let first = if start == 0 { (ts[0] - prev, ts[0] - prev) } else { (f64::INFINITY, f64::NEG_INFINITY) };
+            let (smallest, widest) = ts.windows(2).fold(first, |(lo, hi), w| {
+                let dt = w[1] - w[0];
+                (lo.min(dt), hi.max(dt))
+            });
+            let all_regular = smallest > 0.0 && widest <= gap_limit;
+            if all_regular {
+                largest = largest.max(widest);
+                prev = ts[n - 1];
+            }
+            for (i, &t) in ts.iter().enumerate().skip(if all_regular { n } else { start }) {
                 let dt = t - prev;
                 if dt <= 0.0 || dt > gap_limit {
                     if dt == 0.0 {
@@ -1053,18 +1084,30 @@ impl StaticTestAccumulator {
         }
         // Min, max and rail runs.
         let (lo, hi) = x.iter().fold((self.min, self.max), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-        for (i, &v) in x.iter().enumerate() {
-            if self.rail.run_len > 0 && v == self.rail.run_value {
-                self.rail.run_len += 1;
-            } else {
-                // The running min/max as of this sample decide whether the ending run is at a rail.
-                self.min = self.min.min(v);
-                self.max = self.max.max(v);
-                self.end_run();
-                self.rail.run_value = v;
-                self.rail.run_len = 1;
-                self.rail.run_start = Some(pos(i));
+        // Runs of equal samples, in pieces of RAIL_PIECE samples. Without two equal neighbours in a
+        // piece every run inside it has one sample, shorter than any rail run
+        // (rail_run_samples >= 2): only its first two samples can end a longer run (the one
+        // carried in), and its last one starts the run carried out.
+        const RAIL_PIECE: usize = 64;
+        let mut start = 0;
+        while start < n {
+            let piece = &x[start..(start + RAIL_PIECE).min(n)];
+            let repeats = piece.windows(2).fold(false, |a, w| a | (w[0] == w[1]));
+            let stepped = if repeats { piece.len() } else { piece.len().min(2) };
+            for (k, &v) in piece.iter().enumerate().take(stepped) {
+                self.rail_step(v, pos(start + k));
             }
+            if stepped < piece.len() {
+                let (lo, hi) =
+                    piece[stepped..].iter().fold((self.min, self.max), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+                self.min = lo;
+                self.max = hi;
+                let last = start + piece.len() - 1;
+                self.rail.run_value = x[last];
+                self.rail.run_len = 1;
+                self.rail.run_start = Some(pos(last));
+            }
+            start += piece.len();
         }
         self.min = lo;
         self.max = hi;
@@ -1162,6 +1205,22 @@ impl StaticTestAccumulator {
         }
         let m = Moments::of(&self.scratch_t, &self.scratch_d);
         self.moments.merge(&m);
+    }
+
+    /// One sample of the rail-run tracking: it continues the current run or ends it (the running
+    /// min and max, as of this sample, decide whether the ending run is at a rail).
+    #[inline]
+    fn rail_step(&mut self, v: f64, p: Position) {
+        if self.rail.run_len > 0 && v == self.rail.run_value {
+            self.rail.run_len += 1;
+        } else {
+            self.min = self.min.min(v);
+            self.max = self.max.max(v);
+            self.end_run();
+            self.rail.run_value = v;
+            self.rail.run_len = 1;
+            self.rail.run_start = Some(p);
+        }
     }
 
     #[inline]
@@ -1484,4 +1543,69 @@ pub fn evaluate_static(block: &SampleBlock, config: &StaticTestConfig) -> Result
     let mut scan = OutlierScan::new(&first, config)?;
     scan.push(block)?;
     scan.finish(first)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Feeds blocks through the sample-by-sample path only (the reference for the block path).
+    fn each_path(config: &StaticTestConfig, blocks: &[SampleBlock]) -> StaticTestResult {
+        let mut acc = StaticTestAccumulator::new(config.clone()).unwrap();
+        for b in blocks {
+            acc.check_block(b).unwrap();
+            acc.track_extremes(b, false);
+            acc.process_each(b);
+        }
+        acc.finish().unwrap()
+    }
+
+    proptest! {
+        /// The block path (slice loops, rail runs by pieces, interval extremes first) finds the same
+        /// quality findings and figures as the sample-by-sample path, on records with long runs at
+        /// the rails, repeated values and irregular time stamps, split into random blocks.
+        #[test]
+        fn block_path_equals_sample_path(
+            runs in prop::collection::vec((0u8..6, 1usize..30), 1..40),
+            stamps in prop::collection::vec((0u8..40, 0usize..2000), 0..6),
+            split in 1usize..300,
+        ) {
+            let x: Vec<f64> = runs.iter().flat_map(|&(v, len)| std::iter::repeat_n(2.0 + 0.25 * f64::from(v), len)).collect();
+            let n = x.len();
+            let mut t: Vec<f64> = (0..n).map(|i| i as f64 * 0.5).collect();
+            for &(kind, at) in &stamps {
+                if at > 0 && at < n {
+                    // A repeated stamp, a decreasing one, a gap; each followed by regular stamps.
+                    let shift = match kind {
+                        0 => -0.5,
+                        1 => -0.6,
+                        2 => 3.0,
+                        _ => 0.0,
+                    };
+                    t.iter_mut().skip(at).for_each(|v| *v += shift);
+                }
+            }
+            let lines: Vec<u64> = (1..=n as u64).collect();
+            let config = StaticTestConfig { sample_rate_hz: Some(2.0), smoothing_times_s: vec![1.0, 3.0], min_windows: 2, rail_run_samples: 4, ..StaticTestConfig::default() };
+            let blocks: Vec<SampleBlock> = x
+                .chunks(split)
+                .zip(t.chunks(split))
+                .zip(lines.chunks(split))
+                .map(|((o, ts), l)| SampleBlock { output: o, time_s: Some(ts), temperature_c: None, lines: Some(l) })
+                .collect();
+            let mut acc = StaticTestAccumulator::new(config.clone()).unwrap();
+            for b in &blocks {
+                acc.push(b).unwrap();
+            }
+            let fast = acc.finish().unwrap();
+            let reference = each_path(&config, &blocks);
+            prop_assert_eq!(&fast.quality, &reference.quality);
+            prop_assert_eq!(fast.valid_samples, reference.valid_samples);
+            prop_assert!((fast.mean_output - reference.mean_output).abs() < 1e-12);
+            for (k, v) in &reference.bias_stability_output {
+                prop_assert!((fast.bias_stability_output[k] - v).abs() < 1e-12 * (1.0 + v.abs()));
+            }
+        }
+    }
 }

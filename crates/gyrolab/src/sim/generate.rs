@@ -71,8 +71,40 @@ struct Engine {
     earth_dps: f64,
     run_bias_dps: f64,
     run_scale_factor: f64,
-    noise: ChaCha8Rng,
+    noise: NormalBatch,
     runs: ChaCha8Rng,
+}
+
+/// Standard normal draws from one stream, made in batches (the same values in the same order as
+/// one draw at a time: only the noise in `Engine::sample` draws from this stream).
+#[derive(Debug, Clone)]
+struct NormalBatch {
+    rng: ChaCha8Rng,
+    values: Vec<f64>,
+    next: usize,
+}
+
+/// Draws per batch.
+const NORMAL_BATCH: usize = 4096;
+
+impl NormalBatch {
+    fn new(rng: ChaCha8Rng) -> NormalBatch {
+        NormalBatch { rng, values: Vec::new(), next: 0 }
+    }
+
+    /// The next standard normal draw.
+    #[inline]
+    fn draw(&mut self) -> f64 {
+        if self.next == self.values.len() {
+            self.values.clear();
+            let rng = &mut self.rng;
+            self.values.extend((0..NORMAL_BATCH).map(|_| -> f64 { StandardNormal.sample(rng) }));
+            self.next = 0;
+        }
+        let z = self.values[self.next];
+        self.next += 1;
+        z
+    }
 }
 
 impl Engine {
@@ -129,7 +161,7 @@ impl Engine {
             earth_dps,
             run_bias_dps: 0.0,
             run_scale_factor: 0.0,
-            noise,
+            noise: NormalBatch::new(noise),
             runs: rng(seed, RUN_STREAM),
         })
     }
@@ -148,15 +180,15 @@ impl Engine {
         // Sensed rate: input + bias terms + noise, deg/s.
         let mut noise = 0.0;
         if self.white_sigma_dps > 0.0 {
-            noise += self.white_sigma_dps * normal(&mut self.noise);
+            noise += self.white_sigma_dps * self.noise.draw();
         }
         for gm in &mut self.gauss_markov {
             noise += gm.state;
-            gm.state = gm.phi * gm.state + gm.drive_sigma * normal(&mut self.noise);
+            gm.state = gm.phi * gm.state + gm.drive_sigma * self.noise.draw();
         }
         if self.rrw_sigma_dps > 0.0 {
             noise += self.rrw_state_dps;
-            self.rrw_state_dps += self.rrw_sigma_dps * normal(&mut self.noise);
+            self.rrw_state_dps += self.rrw_sigma_dps * self.noise.draw();
         }
         let bias = self.bias_dps + self.run_bias_dps + self.bias_tc_dps_per_c * d_temp + self.ramp_dps_per_s * t_s;
         let mut w = table_dps + self.earth_dps + stroke_sign * self.hysteresis_half_dps + bias + noise;

@@ -1,0 +1,497 @@
+//! Fast, exact reading of plain decimal numbers (`-12.3456`, `+0.5`, `7`) from text rows.
+//!
+//! Exactness: a decimal with at most 15 significant digits and no exponent has a significand
+//! w < 10^15 and a power 10^k (k <= 22), both exact in f64, so w / 10^k is one correctly
+//! rounded operation: the value every correct parser returns (Clinger 1990, "How to read
+//! floating point numbers accurately", the fast path). Anything else is left to the full parser
+//! (`fast-float2`) by returning `None`.
+//!
+//! Speed: digits are read eight at a time (SWAR: "SIMD within a register", one `u64` per eight
+//! bytes), and the rows of a long record, which nearly always repeat the layout of the row
+//! before, are read against a remembered [`FieldShape`] per column: the digits and the point
+//! are checked where the shape puts them, so no field waits for the previous one to be scanned.
+//! A row that does not fit is scanned field by field, and a row that does not fit that either is
+//! left to the general reader ([`crate::series`]), which reads or reports it.
+
+/// Exact powers of ten representable in f64 (10^0 to 10^22).
+const POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20,
+    1e21, 1e22,
+];
+
+/// Powers of ten as integers (10^0 to 10^15).
+const POW10_U64: [u64; 16] = {
+    let mut t = [1u64; 16];
+    let mut k = 1;
+    while k < 16 {
+        t[k] = t[k - 1] * 10;
+        k += 1;
+    }
+    t
+};
+
+/// Most significant digits read by the fast paths (w < 10^15 stays exact in f64).
+const MAX_DIGITS: usize = 15;
+
+/// One in every byte of a word.
+const ONES: u64 = 0x0101_0101_0101_0101;
+
+/// Eight bytes from `i` (little-endian, so the first byte is the lowest), zero-padded past the end.
+#[inline(always)]
+fn load8(b: &[u8], i: usize) -> u64 {
+    let mut a = [0u8; 8];
+    match b.get(i..i + 8) {
+        Some(s) => a.copy_from_slice(s),
+        None => {
+            let rest = b.get(i..).unwrap_or(&[]);
+            a[..rest.len()].copy_from_slice(rest);
+        }
+    }
+    u64::from_le_bytes(a)
+}
+
+/// How many of the eight bytes in `v`, from the first, are ASCII digits (0 to 8).
+///
+/// A byte is a digit when neither `b + 0x46` (b > b'9') nor `b - 0x30` (b < b'0') sets its top
+/// bit. Carries and borrows only move towards later bytes, and every byte before the first
+/// non-digit is a digit (no carry, no borrow), so the first non-digit is found exactly.
+#[inline(always)]
+fn leading_digits(v: u64) -> usize {
+    let non_digit = (v.wrapping_add(0x46 * ONES) | v.wrapping_sub(0x30 * ONES)) & (0x80 * ONES);
+    (non_digit.trailing_zeros() / 8) as usize
+}
+
+/// The top bit of every byte of `v` that is not an ASCII digit (exact in every byte: the sums
+/// stay inside their byte).
+#[inline(always)]
+fn non_digit_bytes(v: u64) -> u64 {
+    let x = v ^ (0x30 * ONES); // digits become 0..9
+    ((x & (0x7f * ONES)).wrapping_add(0x76 * ONES) | x) & (0x80 * ONES)
+}
+
+/// The value of the first `n` (0 to 8) bytes of `v`, all ASCII digits, by SWAR: the digits are
+/// moved to the top bytes (zeros below act as leading zeros), then pairs, quads and the two
+/// halves are combined with three multiplications.
+#[inline(always)]
+fn digits_value(v: u64, n: usize) -> u64 {
+    let Some(d) = v.wrapping_sub(0x30 * ONES).checked_shl(64 - 8 * n as u32) else { return 0 };
+    // Bytes hold digits d0..d7 (d0 lowest = most significant). Pairs: 10 d0 + d1 in every
+    // even byte.
+    let pairs = d.wrapping_mul(10).wrapping_add(d >> 8);
+    // Quads in bits 0..32 and 32..64: 100 p0 + p1, then the halves 10^4 q0 + q1.
+    let lo = pairs & 0x0000_00ff_0000_00ff;
+    let hi = (pairs >> 16) & 0x0000_00ff_0000_00ff;
+    (lo.wrapping_mul(100 + (1_000_000 << 32)).wrapping_add(hi.wrapping_mul(1 + (10_000 << 32)))) >> 32
+}
+
+/// Reads a run of digits from `i`, eight at a time, appending them to `w` (the value of the
+/// digits before, w < 10^(15 - limit)): returns (value, digits read, next index), or `None` when
+/// more than `limit` digits follow (leading zeros count), so the value stays below 10^15.
+#[inline(always)]
+fn digit_run(b: &[u8], mut i: usize, mut w: u64, limit: usize) -> Option<(u64, usize, usize)> {
+    let mut digits = 0;
+    loop {
+        let v = load8(b, i);
+        let n = leading_digits(v);
+        digits += n;
+        if digits > limit {
+            return None;
+        }
+        // No overflow: w has at most `limit - n` digits before, so w < 10^limit after.
+        w = w * POW10_U64[n] + digits_value(v, n);
+        i += n;
+        if n < 8 {
+            return Some((w, digits, i));
+        }
+    }
+}
+
+/// The value w / 10^decimals with its sign: one correctly rounded division (w < 10^15).
+#[inline(always)]
+fn exact_quotient(w: u64, decimals: usize, negative: bool) -> f64 {
+    let v = w as f64 / POW10[decimals];
+    if negative {
+        -v
+    } else {
+        v
+    }
+}
+
+/// Fast path for the plain decimals that fill most logs (`-12.3456`, `+0.5`, `7`): at most 15
+/// significant digits, no exponent (see the module notes for why the value is exact). Returns
+/// the value and the bytes used, or `None` for anything else (left to the full parser).
+#[inline]
+pub fn plain_decimal(b: &[u8]) -> Option<(f64, usize)> {
+    let (negative, start) = match b.first() {
+        Some(b'-') => (true, 1),
+        Some(b'+') => (false, 1),
+        _ => (false, 0),
+    };
+    let (mut w, mut digits, mut i) = digit_run(b, start, 0, MAX_DIGITS)?;
+    let mut decimals = 0usize;
+    if b.get(i) == Some(&b'.') {
+        let (fw, fd, fi) = digit_run(b, i + 1, w, MAX_DIGITS - digits)?;
+        w = fw;
+        decimals = fd;
+        digits += fd;
+        i = fi;
+    }
+    if digits == 0 || matches!(b.get(i), Some(b'e' | b'E' | b'.')) {
+        return None;
+    }
+    Some((exact_quotient(w, decimals, negative), i))
+}
+
+/// The layout of a number after its sign: digits before the point, whether there is a point,
+/// digits after it; with the byte masks that check a field against it in two words.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FieldShape {
+    /// Digits before the point.
+    int_digits: u8,
+    /// Digits after the point.
+    frac_digits: u8,
+    /// Whether the number has a point.
+    has_point: bool,
+    /// Bytes from the first digit to the end character (the field's length after its sign).
+    len: u8,
+    /// Which bytes of the two words the shape covers (up to and including the end character).
+    care: [u64; 2],
+    /// The non-digit bytes expected among them: the point and the end character.
+    expected: [u64; 2],
+}
+
+impl FieldShape {
+    /// The shape of `int_digits[.frac_digits]`; `None` when it does not fit the fast path (more
+    /// than 15 digits, or more than 15 bytes before the end character).
+    fn new(int_digits: usize, has_point: bool, frac_digits: usize) -> Option<FieldShape> {
+        let digits = int_digits + frac_digits;
+        let len = digits + usize::from(has_point);
+        if digits == 0 || digits > MAX_DIGITS || len > 15 {
+            return None;
+        }
+        let byte_bit = |k: usize| -> [u64; 2] {
+            let mut m = [0u64; 2];
+            m[k / 8] = 0x80 << (8 * (k % 8));
+            m
+        };
+        let mut care = [0u64; 2];
+        for k in 0..=len {
+            let b = byte_bit(k);
+            care[0] |= b[0];
+            care[1] |= b[1];
+        }
+        let mut expected = byte_bit(len);
+        if has_point {
+            let b = byte_bit(int_digits);
+            expected[0] |= b[0];
+            expected[1] |= b[1];
+        }
+        Some(FieldShape {
+            int_digits: int_digits as u8,
+            frac_digits: frac_digits as u8,
+            has_point,
+            len: len as u8,
+            care,
+            expected,
+        })
+    }
+}
+
+/// What a row's fields end with: `delim` between fields, a line end after the last.
+#[derive(Debug, Clone, Copy)]
+pub struct RowLayout {
+    /// The field separator (not whitespace).
+    pub delim: u8,
+    /// Lines end in `\r\n` (else `\n`).
+    pub crlf: bool,
+}
+
+/// Reads the field at `p` against `shape`, ending in `end_char`: the value and the index of the
+/// end character, or `None` when the field does not have that shape (or 17 bytes from its first
+/// digit are not available).
+#[inline(always)]
+fn shaped_field(b: &[u8], p: usize, shape: &FieldShape, end_char: u8) -> Option<(f64, usize)> {
+    let c0 = *b.get(p)?;
+    let negative = c0 == b'-';
+    let q = p + usize::from(negative || c0 == b'+');
+    let x = u128::from_le_bytes(<[u8; 16]>::try_from(b.get(q..q + 16)?).ok()?);
+    let (w0, w1) = (x as u64, (x >> 64) as u64);
+    let misfit = ((non_digit_bytes(w0) & shape.care[0]) ^ shape.expected[0])
+        | ((non_digit_bytes(w1) & shape.care[1]) ^ shape.expected[1]);
+    let len = usize::from(shape.len);
+    let ni = usize::from(shape.int_digits);
+    let nf = usize::from(shape.frac_digits);
+    // The byte at `len` is inside the 16 (len <= 15); so is the point (ni < len).
+    let byte = |k: usize| (x >> (8 * k)) as u8;
+    if misfit != 0 || byte(len) != end_char || (shape.has_point && byte(ni) != b'.') {
+        return None;
+    }
+    // Digits before the point: bytes 0..ni (ni <= 14); after it: bytes ni + 1 .. len.
+    let int =
+        if ni <= 8 { digits_value(w0, ni) } else { digits_value(w0, 8) * POW10_U64[ni - 8] + digits_value(w1, ni - 8) };
+    let f0 = (x >> (8 * (ni + 1))) as u64;
+    let frac = if nf <= 8 {
+        digits_value(f0, nf)
+    } else {
+        digits_value(f0, 8) * POW10_U64[nf - 8] + digits_value((x >> (8 * (ni + 9))) as u64, nf - 8)
+    };
+    Some((exact_quotient(int * POW10_U64[nf] + frac, nf, negative), q + len))
+}
+
+/// Reads the field at `p` by scanning for `end_char`: the value, the index of the end character
+/// and the field's shape; `None` when it is not a plain decimal of at most 15 digits ending there.
+#[inline(always)]
+fn scanned_field(b: &[u8], p: usize, end_char: u8) -> Option<(f64, usize, Option<FieldShape>)> {
+    let c0 = *b.get(p)?;
+    let negative = c0 == b'-';
+    let q = p + usize::from(negative || c0 == b'+');
+    let (int_w, ni, i) = digit_run(b, q, 0, MAX_DIGITS)?;
+    let (w, nf, i, has_point) = if b.get(i) == Some(&b'.') {
+        let (w, nf, i) = digit_run(b, i + 1, int_w, MAX_DIGITS - ni)?;
+        (w, nf, i, true)
+    } else {
+        (int_w, 0, i, false)
+    };
+    if ni + nf == 0 || b.get(i) != Some(&end_char) {
+        return None;
+    }
+    Some((exact_quotient(w, nf, negative), i, FieldShape::new(ni, has_point, nf)))
+}
+
+/// Reads one row of plain decimals (see [`read_rows`]); `None` leaves `cols` as it was.
+#[inline(always)]
+fn read_row(
+    b: &[u8],
+    start: usize,
+    layout: RowLayout,
+    targets: &[u32],
+    shapes: &mut [Option<FieldShape>],
+    cols: &mut [Vec<f64>],
+) -> Option<usize> {
+    let mut p = start;
+    let last = targets.len().checked_sub(1)?;
+    for (ci, &slot) in targets.iter().enumerate() {
+        let end_char = match (ci == last, layout.crlf) {
+            (false, _) => layout.delim,
+            (true, false) => b'\n',
+            (true, true) => b'\r',
+        };
+        let shape = shapes.get_mut(ci)?;
+        let parsed = match shape.as_ref().and_then(|s| shaped_field(b, p, s, end_char)) {
+            Some(hit) => Some(hit),
+            None => scanned_field(b, p, end_char).map(|(v, e, s)| {
+                *shape = s;
+                (v, e)
+            }),
+        };
+        let parsed = parsed.filter(|&(_, e)| end_char != b'\r' || b.get(e + 1) == Some(&b'\n'));
+        match parsed {
+            Some((v, e)) => {
+                if slot != SKIP_COLUMN {
+                    cols[slot as usize].push(v);
+                }
+                p = e + if end_char == b'\r' { 2 } else { 1 };
+            }
+            None => {
+                // Take back this row's values: the general reader reads the row again.
+                for &s in &targets[..ci] {
+                    if s != SKIP_COLUMN {
+                        cols[s as usize].pop();
+                    }
+                }
+                return None;
+            }
+        }
+    }
+    Some(p)
+}
+
+/// The target slot of a column that is not kept.
+pub const SKIP_COLUMN: u32 = u32::MAX;
+
+/// Reads rows of plain decimals from `start` (each: fields separated by `layout.delim`, the last
+/// ending in `\n` or, with `layout.crlf`, `\r\n`; no spaces, empty cells, exponents; at most 15 digits a
+/// number), pushing field `ci`'s value onto `cols[targets[ci]]` (none for [`SKIP_COLUMN`]), until
+/// a row does not fit, `b` ends, or `room` rows are read. `shapes` (one per field, carried from
+/// call to call) remembers each column's last layout. Returns where it stopped and the rows read.
+pub fn read_rows(
+    b: &[u8],
+    start: usize,
+    layout: RowLayout,
+    targets: &[u32],
+    shapes: &mut [Option<FieldShape>],
+    cols: &mut [Vec<f64>],
+    room: usize,
+) -> (usize, usize) {
+    let mut p = start;
+    let mut rows = 0;
+    while rows < room && p < b.len() {
+        match read_row(b, p, layout, targets, shapes, cols) {
+            Some(next) => {
+                p = next;
+                rows += 1;
+            }
+            None => break,
+        }
+    }
+    (p, rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn non_digit_bytes_marks_exactly_the_non_digits() {
+        for b in 0u8..=255 {
+            let v = u64::from_le_bytes([b'5', b, b'0', 0xff, b, b'9', b'/', b':']);
+            let m = non_digit_bytes(v);
+            let want = |c: u8| if c.is_ascii_digit() { 0 } else { 0x80 };
+            let expect = u64::from_le_bytes([0, want(b), 0, 0x80, want(b), 0, 0x80, 0x80]);
+            assert_eq!(m, expect, "byte {b:#x}");
+        }
+    }
+
+    #[test]
+    fn digits_value_of_every_length() {
+        let text = b"98765432";
+        for n in 0..=8 {
+            let want: u64 = if n == 0 { 0 } else { std::str::from_utf8(&text[..n]).unwrap().parse().unwrap() };
+            assert_eq!(digits_value(load8(text, 0), n), want, "n = {n}");
+        }
+    }
+
+    #[test]
+    fn rows_by_shape_and_by_scan() {
+        // The second row changes the time's width and the sign of the output: scanned, then
+        // the third row fits the new shape.
+        let text = b"9.99,2.5000001\n10.00,-0.0000003\n10.01,-0.0000004\n10.02,1e5\n";
+        let mut shapes = vec![None; 2];
+        let mut cols = vec![Vec::new(), Vec::new()];
+        let (p, rows) =
+            read_rows(text, 0, RowLayout { delim: b',', crlf: false }, &[0, 1], &mut shapes, &mut cols, 100);
+        assert_eq!(rows, 3);
+        assert_eq!(&text[p..], b"10.02,1e5\n");
+        assert_eq!(cols[0], vec![9.99, 10.0, 10.01]);
+        assert_eq!(cols[1], vec![2.5000001, -0.0000003, -0.0000004]);
+        // The rejected row left nothing behind.
+        assert_eq!(cols[0].len(), 3);
+    }
+
+    #[test]
+    fn crlf_rows() {
+        let text = b"1.5,2\r\n-3,4.25\r\n5,6\n";
+        let mut shapes = vec![None; 2];
+        let mut cols = vec![Vec::new(), Vec::new()];
+        let layout = RowLayout { delim: b',', crlf: true };
+        let (p, rows) = read_rows(text, 0, layout, &[0, 1], &mut shapes, &mut cols, 100);
+        assert_eq!((rows, &text[p..]), (2, &b"5,6\n"[..]));
+        assert_eq!(cols, vec![vec![1.5, -3.0], vec![2.0, 4.25]]);
+    }
+
+    /// Whether a field is a plain decimal the fast path must take: `[+-]digits[.digits]` with
+    /// 1 to 15 digits (either side of the point may be empty, not both).
+    fn is_plain(f: &str) -> bool {
+        let body = f.strip_prefix(['-', '+']).unwrap_or(f);
+        let (int, frac) = body.split_once('.').unwrap_or((body, ""));
+        let digits = int.len() + frac.len();
+        int.bytes().all(|c| c.is_ascii_digit())
+            && frac.bytes().all(|c| c.is_ascii_digit())
+            && (1..=15).contains(&digits)
+    }
+
+    /// A number as text: sign, 0 to 8 digits before the point, 0 to 9 after it.
+    fn number_text((sign, int_digits, int, width, frac): (u8, u32, u64, usize, u64)) -> String {
+        let sign = ["", "-", "+"][sign as usize];
+        let int = if int_digits == 0 { String::new() } else { format!("{}", int % 10u64.pow(int_digits)) };
+        let int = if int.is_empty() && width == 0 { "0".to_string() } else { int };
+        let frac = format!("{frac:09}");
+        if width == 0 {
+            format!("{sign}{int}")
+        } else {
+            format!("{sign}{int}.{}", &frac[..width.min(9)])
+        }
+    }
+
+    /// Reads `text` with [`read_rows`] as the reader does (refused rows are skipped here, as the
+    /// general reader would read them) and checks every row: taken rows hold exactly the full
+    /// parser's values, and a row is refused only if one of its fields is not a plain decimal.
+    fn check_rows(text: &str, ncols: usize, targets: &[u32]) -> Result<(), TestCaseError> {
+        let b = text.as_bytes();
+        let mut shapes = vec![None; ncols];
+        let mut cols = vec![Vec::new(); ncols];
+        let mut want: Vec<Vec<f64>> = vec![Vec::new(); ncols];
+        let mut p = 0;
+        while p < b.len() {
+            let (np, rows) =
+                read_rows(b, p, RowLayout { delim: b',', crlf: false }, targets, &mut shapes, &mut cols, 3);
+            for line in std::str::from_utf8(&b[p..np]).unwrap().split_terminator('\n') {
+                let f: Vec<&str> = line.split(',').collect();
+                prop_assert_eq!(f.len(), ncols, "{:?}", line);
+                for c in 0..ncols {
+                    prop_assert!(is_plain(f[c]), "took {:?}", line);
+                    if targets[c] != SKIP_COLUMN {
+                        want[c].push(fast_float2::parse::<f64, _>(f[c]).unwrap());
+                    }
+                }
+            }
+            if rows == 0 {
+                let end = b[p..].iter().position(|&c| c == b'\n').map_or(b.len(), |i| p + i);
+                let line = std::str::from_utf8(&b[p..end]).unwrap();
+                let f: Vec<&str> = line.split(',').collect();
+                prop_assert!(f.len() != ncols || !f.iter().all(|x| is_plain(x)), "refused {:?}", line);
+                p = end + 1;
+            } else {
+                p = np;
+            }
+        }
+        for c in 0..ncols {
+            let got: Vec<u64> = cols[c].iter().map(|v| v.to_bits()).collect();
+            let exp: Vec<u64> = want[c].iter().map(|v| v.to_bits()).collect();
+            prop_assert_eq!(got, exp, "column {}", c);
+        }
+        Ok(())
+    }
+
+    fn number() -> impl Strategy<Value = (u8, u32, u64, usize, u64)> {
+        (0u8..3, 0u32..9, any::<u64>(), 0usize..10, 0u64..1_000_000_000)
+    }
+
+    proptest! {
+        /// Rows of numbers whose widths change (so shapes fit, miss and change), with corrupted
+        /// bytes: every row taken gives exactly the full parser's values, and only rows with a
+        /// field that is not a plain decimal are refused.
+        #[test]
+        fn rows_equal_the_full_parser(
+            fields in prop::collection::vec(number(), 2..80),
+            ncols in 1usize..4,
+            skip in 0usize..4,
+            corrupt in prop::collection::vec((any::<prop::sample::Index>(), prop::sample::select(b"x.-+,e \r\n05".to_vec())), 0..4),
+        ) {
+            let mut text = String::new();
+            for row in fields.chunks_exact(ncols) {
+                for (ci, &f) in row.iter().enumerate() {
+                    text.push_str(&number_text(f));
+                    text.push(if ci + 1 == ncols { '\n' } else { ',' });
+                }
+            }
+            let mut bytes = text.into_bytes();
+            for (at, c) in corrupt {
+                if !bytes.is_empty() {
+                    let i = at.index(bytes.len());
+                    bytes[i] = c;
+                }
+            }
+            let text = String::from_utf8(bytes).unwrap();
+            let targets: Vec<u32> = (0..ncols as u32).map(|c| if c as usize == skip { SKIP_COLUMN } else { c }).collect();
+            check_rows(&text, ncols, &targets)?;
+        }
+
+        /// Any text made of number characters: the same checks.
+        #[test]
+        fn rows_on_any_text(text in "[-+0-9.eE,x \r\n]{0,80}") {
+            check_rows(&text, 2, &[0, 1])?;
+        }
+    }
+}
