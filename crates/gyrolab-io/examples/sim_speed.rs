@@ -1,8 +1,8 @@
 //! Speed of simulating and writing a static record.
 //!
 //! Usage: `cargo run --release -p gyrolab-io --example sim_speed -- [SAMPLES] [PRESET] [MODE] [pipelined] > /dev/null`
-//! SAMPLES defaults to 10 000 000, PRESET to adxrs646; MODE is `shortest` (default), `fixed9`
-//! (9 decimals) or `generate` (simulate only, write nothing); a 4th argument `pipelined` simulates
+//! SAMPLES defaults to 10 000 000, PRESET to adxrs646; MODE is `shortest` (default), `fixedN`
+//! (N decimals, such as `fixed7`) or `generate` (simulate only, write nothing); a 4th argument `pipelined` simulates
 //! on a second thread while the first formats. The record (100 Hz) goes to stdout; the timing goes
 //! to stderr.
 
@@ -31,13 +31,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         std::hint::black_box(acc);
         (n, 0)
     } else {
-        let number_format = match mode {
-            "fixed9" => NumberFormat::Fixed { decimals: 9 },
+        let number_format = match mode.strip_prefix("fixed").map(str::parse::<u8>) {
+            Some(Ok(decimals)) => NumberFormat::Fixed { decimals },
             _ => NumberFormat::Shortest,
         };
         let pipelined = args.get(3).is_some_and(|s| s == "pipelined");
         let options = SimCsvOptions { number_format, comments: vec![format!("preset = {preset_name}")], pipelined };
-        let stdout = std::io::stdout().lock();
+        let stdout = std::io::stdout();
         let sum = write_static_csv(stdout, &model, &spec, 1, &options)?;
         (sum.rows, sum.bytes)
     };

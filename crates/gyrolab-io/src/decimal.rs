@@ -214,7 +214,8 @@ fn shaped_field(b: &[u8], p: usize, shape: &FieldShape, end_char: u8) -> Option<
     let c0 = *b.get(p)?;
     let negative = c0 == b'-';
     let q = p + usize::from(negative || c0 == b'+');
-    let x = u128::from_le_bytes(<[u8; 16]>::try_from(b.get(q..q + 16)?).ok()?);
+    let field: &[u8; 16] = b.get(q..q + 16)?.try_into().ok()?;
+    let x = u128::from_le_bytes(*field);
     let (w0, w1) = (x as u64, (x >> 64) as u64);
     let misfit = ((non_digit_bytes(w0) & shape.care[0]) ^ shape.expected[0])
         | ((non_digit_bytes(w1) & shape.care[1]) ^ shape.expected[1]);
@@ -222,8 +223,8 @@ fn shaped_field(b: &[u8], p: usize, shape: &FieldShape, end_char: u8) -> Option<
     let ni = usize::from(shape.int_digits);
     let nf = usize::from(shape.frac_digits);
     // The byte at `len` is inside the 16 (len <= 15); so is the point (ni < len).
-    let byte = |k: usize| (x >> (8 * k)) as u8;
-    if misfit != 0 || byte(len) != end_char || (shape.has_point && byte(ni) != b'.') {
+    let byte = |k: usize| field.get(k).copied();
+    if misfit != 0 || byte(len) != Some(end_char) || (shape.has_point && byte(ni) != Some(b'.')) {
         return None;
     }
     // Digits before the point: bytes 0..ni (ni <= 14); after it: bytes ni + 1 .. len.

@@ -369,7 +369,9 @@ fn write_preamble<W: Write>(
 }
 
 /// Simulates a static record and writes it in the static layout; returns rows and bytes written.
-pub fn write_static_csv<W: Write>(
+/// With `options.pipelined`, three threads share the work: one simulates, one formats, one
+/// writes (same bytes as with one thread).
+pub fn write_static_csv<W: Write + Send>(
     out: W,
     model: &SensorModel,
     spec: &StaticSpec,
@@ -377,7 +379,66 @@ pub fn write_static_csv<W: Write>(
     options: &SimCsvOptions,
 ) -> Result<WriteSummary, SimCsvError> {
     let generator = StaticGenerator::new(model, spec, seed)?;
-    let mut w = RowWriter::new(out, options.number_format)?;
+    if !options.pipelined {
+        return write_static_rows(RowWriter::new(out, options.number_format)?, generator, seed, model, spec, options);
+    }
+    let (to_output, from_formatter) = std::sync::mpsc::sync_channel::<Vec<u8>>(4);
+    let (to_formatter, spare_buffers) = std::sync::mpsc::channel::<Vec<u8>>();
+    std::thread::scope(|scope| {
+        let output = scope.spawn(move || -> std::io::Result<()> {
+            let mut out = out;
+            for text in from_formatter {
+                out.write_all(&text)?;
+                // The formatter may have finished: a failed return of the buffer is harmless.
+                let _ = to_formatter.send(text);
+            }
+            out.flush()
+        });
+        let sink = ThreadedSink { to_output, spare_buffers };
+        let formatted = RowWriter::new(sink, options.number_format)
+            .map_err(|e| (e, false))
+            .and_then(|w| write_static_rows(w, generator, seed, model, spec, options).map_err(|e| (e, true)));
+        // The sink is dropped by now, so the output thread ends once it has written everything.
+        let written = output.join().unwrap_or_else(|_| Err(std::io::Error::other("the output thread failed")));
+        match (formatted, written) {
+            (Ok(summary), Ok(())) => Ok(summary),
+            // An output error stops the formatter too: report the output's own error.
+            (Err((_, true)), Err(e)) | (Ok(_), Err(e)) => Err(SimCsvError::Io(e)),
+            (Err((e, _)), _) => Err(e),
+        }
+    })
+}
+
+/// A [`Write`] that hands its bytes to the output thread (copies into recycled buffers).
+struct ThreadedSink {
+    to_output: std::sync::mpsc::SyncSender<Vec<u8>>,
+    spare_buffers: std::sync::mpsc::Receiver<Vec<u8>>,
+}
+
+impl Write for ThreadedSink {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        let mut text = self.spare_buffers.try_recv().unwrap_or_default();
+        text.clear();
+        text.extend_from_slice(bytes);
+        self.to_output.send(text).map_err(|_| std::io::Error::other("the output stopped"))?;
+        Ok(bytes.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// The preamble and rows of a static record (simulated on a second thread with
+/// `options.pipelined`).
+fn write_static_rows<W: Write>(
+    mut w: RowWriter<W>,
+    generator: StaticGenerator,
+    seed: u64,
+    model: &SensorModel,
+    spec: &StaticSpec,
+    options: &SimCsvOptions,
+) -> Result<WriteSummary, SimCsvError> {
     let mut truth = vec![format!("truth.earth_rate_dps = {:?}", generator.earth_rate_dps())];
     truth.extend(generator.flicker_design().map(flicker_comment));
     write_preamble(&mut w, "gyrolab simulated static record", seed, options, model, spec.parameter_lines(), truth);
@@ -499,6 +560,39 @@ mod tests {
         assert_eq!(sum.rows, 3000);
         assert_eq!(sum.bytes, out.len() as u64);
         out
+    }
+
+    /// A writer that fails once it has taken `limit` bytes.
+    struct FailingWriter {
+        taken: usize,
+        limit: usize,
+    }
+
+    impl Write for FailingWriter {
+        fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+            if self.taken + bytes.len() > self.limit {
+                return Err(std::io::Error::other("disk full (test)"));
+            }
+            self.taken += bytes.len();
+            Ok(bytes.len())
+        }
+
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn output_errors_are_returned_with_one_or_three_threads() {
+        let model = SensorModel::preset(Preset::Adxrs646);
+        let spec = StaticSpec { sample_rate_hz: 100.0, duration_s: 2000.0, ..StaticSpec::default() };
+        for pipelined in [false, true] {
+            for limit in [0, 100, 300_000] {
+                let o = SimCsvOptions { pipelined, ..SimCsvOptions::default() };
+                let e = write_static_csv(FailingWriter { taken: 0, limit }, &model, &spec, 1, &o).unwrap_err();
+                assert!(e.to_string().contains("disk full (test)"), "pipelined {pipelined}, limit {limit}: {e}");
+            }
+        }
     }
 
     #[test]

@@ -212,7 +212,7 @@ fn sim_error(e: SimCsvError) -> CliError {
     }
 }
 
-fn emit(out: &Option<PathBuf>, write: impl FnOnce(&mut dyn Write) -> Result<(), SimCsvError>) -> CliResult {
+fn emit(out: &Option<PathBuf>, write: impl FnOnce(&mut (dyn Write + Send)) -> Result<(), SimCsvError>) -> CliResult {
     match out {
         Some(path) => {
             let mut failure = None;
@@ -230,9 +230,10 @@ fn emit(out: &Option<PathBuf>, write: impl FnOnce(&mut dyn Write) -> Result<(), 
             }
         }
         None => {
-            let stdout = std::io::stdout();
-            let mut lock = stdout.lock();
-            match write(&mut lock) {
+            // Not locked: the writer may hand the output to a thread of its own (blocks of 64 KiB
+            // or more go out in one write each).
+            let mut stdout = std::io::stdout();
+            match write(&mut stdout) {
                 Err(SimCsvError::Io(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
                 r => r.map_err(sim_error),
             }
