@@ -7,8 +7,11 @@
 //! and the overshoot's margin), so its standard error is 2 mV / sqrt(850) = 69 uV.
 
 mod common;
-use common::rawsim::{csv, generate, noise, sweep, Label, Profile, SimLog};
+use common::rawsim::csv;
 use common::{gyrolab, write};
+use gyrolab::rate_test::Stroke;
+use gyrolab::segment::SegmentKind;
+use gyrolab::sim::{raw_log_setpoints, simulate_raw_log, white_noise, RawLogHold, RawLogProfile, SimulatedRawLog};
 use predicates::str::contains;
 use std::path::{Path, PathBuf};
 
@@ -21,10 +24,10 @@ const SETTLING_S: f64 = 1.0;
 /// First data line of a file written by `csv` (a comment, then the header).
 const FIRST_DATA_LINE: u64 = 3;
 
-fn single_axis_log(dir: &Path, name: &str, seq: &[(f64, Vec<Label>)], seed: u64) -> (PathBuf, SimLog) {
-    let sim = generate(seq, &Profile::default(), seed);
-    let e1 = noise(sim.time.len(), SIGMA_U, seed + 1);
-    let e2 = noise(sim.time.len(), SIGMA_U * 1e3, seed + 2);
+fn single_axis_log(dir: &Path, name: &str, seq: &[(f64, Vec<SegmentKind>)], seed: u64) -> (PathBuf, SimulatedRawLog) {
+    let sim = simulate_raw_log(seq, &RawLogProfile::default(), seed).unwrap();
+    let e1 = white_noise(sim.time.len(), SIGMA_U, seed + 1).unwrap();
+    let e2 = white_noise(sim.time.len(), SIGMA_U * 1e3, seed + 2).unwrap();
     let gx: Vec<f64> = sim.true_rate.iter().zip(&e1).map(|(w, e)| F0 + K * w + e).collect();
     // A second channel in mV with another scale factor and offset.
     let gy: Vec<f64> = sim.true_rate.iter().zip(&e2).map(|(w, e)| 1200.0 + 9.0 * w + e).collect();
@@ -36,11 +39,14 @@ fn json(out: &[u8]) -> serde_json::Value {
     serde_json::from_slice(out).unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(out)))
 }
 
-fn label_of(row: &[&str]) -> Label {
+fn label_of(row: &[&str]) -> SegmentKind {
     match row[1] {
-        "rest_start" => Label::RestStart,
-        "rest_end" => Label::RestEnd,
-        "plateau" => Label::Plateau(row[2].parse().unwrap(), if row[3] == "fwd" { "fwd" } else { "rev" }),
+        "rest_start" => SegmentKind::RestStart,
+        "rest_end" => SegmentKind::RestEnd,
+        "plateau" => SegmentKind::Plateau {
+            run: row[2].parse().unwrap(),
+            stroke: if row[3] == "fwd" { Stroke::Forward } else { Stroke::Reverse },
+        },
         k => panic!("kind {k}"),
     }
 }
@@ -52,7 +58,7 @@ fn label_of(row: &[&str]) -> Label {
 #[test]
 fn raw_log_segmentation_is_exact_and_the_scale_factor_recovered() {
     let dir = tempfile::tempdir().unwrap();
-    let (log, sim) = single_axis_log(dir.path(), "sweep.csv", &sweep(&RATES, 2, true, true), 11);
+    let (log, sim) = single_axis_log(dir.path(), "sweep.csv", &raw_log_setpoints(&RATES, 2, true, true), 11);
     let seg = dir.path().join("seg.csv");
     let out = gyrolab().arg("rate").arg(&log).arg("--segments-out").arg(&seg).arg("--json").assert().success();
     let v = json(&out.get_output().stdout);
@@ -64,7 +70,7 @@ fn raw_log_segmentation_is_exact_and_the_scale_factor_recovered() {
         "index,kind,run,stroke,start_line,end_line,start_time_s,end_time_s,samples,rate_dps"
     );
     let rows: Vec<Vec<&str>> = rows.map(|l| l.split(',').collect()).collect();
-    let truth: Vec<(Label, &common::rawsim::Hold)> =
+    let truth: Vec<(SegmentKind, &RawLogHold)> =
         sim.holds.iter().flat_map(|h| h.labels.iter().map(move |l| (*l, h))).collect();
     assert_eq!(rows.len(), truth.len(), "{text}");
     assert_eq!(rows.len(), 1 + 4 * 7 + 1); // rests + 2 runs x 2 strokes x 7 rates
@@ -136,7 +142,7 @@ fn read_applied(text: &str) -> (Vec<String>, Vec<Vec<String>>) {
 #[test]
 fn apply_on_the_calibration_record_gives_the_table_rates_back() {
     let dir = tempfile::tempdir().unwrap();
-    let (log, sim) = single_axis_log(dir.path(), "cal.csv", &sweep(&RATES, 2, true, true), 31);
+    let (log, sim) = single_axis_log(dir.path(), "cal.csv", &raw_log_setpoints(&RATES, 2, true, true), 31);
     let cal = dir.path().join("cal.toml");
     gyrolab().arg("rate").arg(&log).arg("--cal-out").arg(&cal).assert().success();
     let out = gyrolab()
@@ -241,12 +247,12 @@ fn s_true() -> [[f64; 3]; 3] {
     s
 }
 
-fn triad_log(dir: &Path, axis: usize, seq: &[(f64, Vec<Label>)], seed: u64) -> (PathBuf, SimLog) {
-    let sim = generate(seq, &Profile::default(), seed);
+fn triad_log(dir: &Path, axis: usize, seq: &[(f64, Vec<SegmentKind>)], seed: u64) -> (PathBuf, SimulatedRawLog) {
+    let sim = simulate_raw_log(seq, &RawLogProfile::default(), seed).unwrap();
     let s = s_true();
     let outs: Vec<Vec<f64>> = (0..3)
         .map(|i| {
-            let e = noise(sim.time.len(), SIGMA_U, seed * 10 + i as u64);
+            let e = white_noise(sim.time.len(), SIGMA_U, seed * 10 + i as u64).unwrap();
             sim.true_rate.iter().zip(&e).map(|(w, e)| BT[i] + s[i][axis] * w + e).collect()
         })
         .collect();
@@ -262,8 +268,9 @@ fn triad_log(dir: &Path, axis: usize, seq: &[(f64, Vec<Label>)], seed: u64) -> (
 #[test]
 fn triad_matrix_angles_recovered_and_applied() {
     let dir = tempfile::tempdir().unwrap();
-    let logs: Vec<(PathBuf, SimLog)> =
-        (0..3).map(|a| triad_log(dir.path(), a, &sweep(&TRIAD_RATES, 1, true, true), 40 + a as u64)).collect();
+    let logs: Vec<(PathBuf, SimulatedRawLog)> = (0..3)
+        .map(|a| triad_log(dir.path(), a, &raw_log_setpoints(&TRIAD_RATES, 1, true, true), 40 + a as u64))
+        .collect();
     let cal = dir.path().join("triad.toml");
     let mut cmd = gyrolab();
     cmd.arg("rate").arg("--json").arg("--cal-out").arg(&cal);
@@ -344,19 +351,19 @@ fn bad_raw_logs_exit_2_naming_file_and_line() {
     assert_exit2(gyrolab().arg("rate").arg(&ramp), &["ramp.csv:2501:", "no steady plateau"]);
 
     // Starts at rest, never returns to it.
-    let (p, _) = single_axis_log(d, "norest.csv", &sweep(&RATES, 1, true, false), 5);
+    let (p, _) = single_axis_log(d, "norest.csv", &raw_log_setpoints(&RATES, 1, true, false), 5);
     assert_exit2(gyrolab().arg("rate").arg(&p), &["norest.csv:", "never returns to rest"]);
 
     // The second run stops midway: its reverse stroke has 4 of the 7 rates.
-    let mut seq = sweep(&RATES, 2, true, false);
+    let mut seq = raw_log_setpoints(&RATES, 2, true, false);
     seq.truncate(seq.len() - 3);
-    seq.push((0.0, vec![Label::RestEnd]));
+    seq.push((0.0, vec![SegmentKind::RestEnd]));
     let (p, _) = single_axis_log(d, "midway.csv", &seq, 6);
     assert_exit2(gyrolab().arg("rate").arg(&p), &["midway.csv:", "run 2 rev stroke stops midway"]);
 
     // Manual segments that overlap: out of order in the file (the reader), and sharing a sample
     // (the segmentation).
-    let (p, _) = single_axis_log(d, "ok.csv", &sweep(&RATES, 1, true, true), 7);
+    let (p, _) = single_axis_log(d, "ok.csv", &raw_log_setpoints(&RATES, 1, true, true), 7);
     let seg = write(
         d,
         "seg.csv",
@@ -371,12 +378,12 @@ fn bad_raw_logs_exit_2_naming_file_and_line() {
     assert_exit2(gyrolab().arg("rate").arg(&p).arg("--segments").arg(&seg), &["seg2.csv:4:", "overlaps", "ok.csv:"]);
 
     // A three-axis set without z, and one whose z log turns in one sense only.
-    let (x, _) = triad_log(d, 0, &sweep(&TRIAD_RATES, 1, true, true), 1);
-    let (y, _) = triad_log(d, 1, &sweep(&TRIAD_RATES, 1, true, true), 2);
+    let (x, _) = triad_log(d, 0, &raw_log_setpoints(&TRIAD_RATES, 1, true, true), 1);
+    let (y, _) = triad_log(d, 1, &raw_log_setpoints(&TRIAD_RATES, 1, true, true), 2);
     let mut cmd = gyrolab();
     cmd.arg("rate").arg("--triad").arg(format!("x={}", x.display())).arg("--triad").arg(format!("y={}", y.display()));
     assert_exit2(&mut cmd, &["misses the z axis", "turn_x.csv", "turn_y.csv"]);
-    let (z, _) = triad_log(d, 2, &sweep(&[30.0, 100.0, 300.0], 1, true, true), 3);
+    let (z, _) = triad_log(d, 2, &raw_log_setpoints(&[30.0, 100.0, 300.0], 1, true, true), 3);
     let mut cmd = gyrolab();
     cmd.arg("rate");
     for (a, p) in [("x", &x), ("y", &y), ("z", &z)] {

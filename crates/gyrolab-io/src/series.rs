@@ -570,6 +570,7 @@ impl<R: Read> SeriesReader<R> {
         let delim = self.header.delimiter.byte();
         let ncols = self.targets.len();
         let fast = self.fast_rows && !ws;
+        let mut refused_at = usize::MAX;
         let layout = RowLayout { delim, crlf: self.crlf };
         if self.shapes.len() != ncols {
             self.shapes = vec![None; ncols];
@@ -580,9 +581,14 @@ impl<R: Read> SeriesReader<R> {
             if p >= end || self.lines.len() >= self.block_rows {
                 break 'rows Ok(());
             }
-            if fast {
+            if fast && p != refused_at {
                 let room = self.block_rows - self.lines.len();
                 let (next, rows) = read_rows(bytes, p, layout, &self.targets, &mut self.shapes, &mut self.cols, room);
+                // The row where it stopped short of the room (refused, or the data's end) is the
+                // general path's: no second attempt.
+                if rows < room {
+                    refused_at = next;
+                }
                 if rows > 0 {
                     self.lines.extend((1..=rows as u64).map(|k| line_no + k));
                     p = next;

@@ -244,7 +244,7 @@ mod tests {
     use super::*;
     use crate::rate_test::{evaluate, RateTable, RateTestOptions};
     use crate::segment::{rate_observations, segment_log, PlateauReduction, SegmentKind, SegmentOptions};
-    use crate::testsim::{generate, sweep, Profile};
+    use crate::sim::{raw_log_setpoints, simulate_raw_log, RawLogProfile};
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
     use rand_distr::{Distribution, Normal};
@@ -258,7 +258,7 @@ mod tests {
     #[test]
     fn applying_a_calibration_to_its_own_plateaus_returns_the_table_rates() {
         let (k, f0, c2, sigma) = (0.0075, 2.5, 5e-8, 0.002);
-        let sim = generate(&sweep(&RATES, 2, true, true), &Profile::default(), 21);
+        let sim = simulate_raw_log(&raw_log_setpoints(&RATES, 2, true, true), &RawLogProfile::default(), 21).unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(22);
         let noise = Normal::new(0.0, sigma).unwrap();
         let out: Vec<f64> = sim.true_rate.iter().map(|w| f0 + k * w + c2 * w * w + noise.sample(&mut rng)).collect();

@@ -28,8 +28,6 @@ pub mod rate_test;
 pub mod segment;
 pub mod sim;
 pub mod static_test;
-#[cfg(test)]
-mod testsim;
 pub mod triad;
 pub mod units;
 pub mod window_means;

@@ -871,7 +871,7 @@ pub fn rate_observations(
 mod tests {
     use super::*;
     use crate::rate_test::{evaluate, RateTable, RateTestOptions};
-    use crate::testsim::{generate, gyro_output, sweep, Profile, SimLog};
+    use crate::sim::{gyro_output, raw_log_setpoints, simulate_raw_log, RawLogProfile, SimulatedRawLog};
 
     const RATES: [f64; 7] = [-300.0, -100.0, -30.0, 0.0, 30.0, 100.0, 300.0];
 
@@ -894,8 +894,8 @@ mod tests {
         (t, r)
     }
 
-    fn three_runs() -> SimLog {
-        generate(&sweep(&RATES, 3, true, true), &Profile::default(), 7)
+    fn three_runs() -> SimulatedRawLog {
+        simulate_raw_log(&raw_log_setpoints(&RATES, 3, true, true), &RawLogProfile::default(), 7).unwrap()
     }
 
     /// Segmentation against the simulation's truth. Bounds: the overshoot (0.5 deg/s, tau 0.1 s)
@@ -904,8 +904,8 @@ mod tests {
     /// already within tolerance) and 0.5 s later, and the kept part `settling` after that; a
     /// plateau ends within that ramp margin and a sample or two of the ramp out's start. A
     /// turning plateau splits at the middle of its kept part.
-    fn check_segmentation(p: &Profile, seed: u64) {
-        let sim = generate(&sweep(&RATES, 3, true, true), p, seed);
+    fn check_segmentation(p: &RawLogProfile, seed: u64) {
+        let sim = simulate_raw_log(&raw_log_setpoints(&RATES, 3, true, true), p, seed).unwrap();
         let o = SegmentOptions::default();
         let seg = segment_log(&sim.time, &sim.logged_rate, &o).unwrap();
         let expected: usize = sim.holds.iter().map(|h| h.labels.len()).sum();
@@ -936,23 +936,23 @@ mod tests {
 
     #[test]
     fn segmentation_matches_the_simulated_truth() {
-        check_segmentation(&Profile::default(), 7);
+        check_segmentation(&RawLogProfile::default(), 7);
     }
 
     /// 1 kHz (the top of the range): the ramp moves one tolerance per sample, and the log
     /// has about 600 000 samples (the single pass must stay fast even unoptimised).
     #[test]
     fn segmentation_matches_the_simulated_truth_at_1_khz() {
-        check_segmentation(&Profile { dt: 0.001, ..Profile::default() }, 8);
+        check_segmentation(&RawLogProfile { dt: 0.001, ..RawLogProfile::default() }, 8);
     }
 
     /// K and F0 through `rate_test::evaluate` within 5 standard errors computed from the noise.
     #[test]
     fn scale_factor_and_offset_recovered_through_evaluate() {
-        let p = Profile::default();
+        let p = RawLogProfile::default();
         let sim = three_runs();
         let (k_true, f0_true, sigma) = (0.0075, 2.5, 0.002);
-        let out = gyro_output(&sim.true_rate, k_true, f0_true, sigma, 11);
+        let out = gyro_output(&sim.true_rate, k_true, f0_true, sigma, 11).unwrap();
         let o = SegmentOptions::default();
         let seg = segment_log(&sim.time, &sim.logged_rate, &o).unwrap();
         let (obs, rest) = rate_observations(&seg, &sim.time, &out, PlateauReduction::Mean, o.rest).unwrap();
@@ -1041,15 +1041,15 @@ mod tests {
 
     #[test]
     fn a_rate_that_never_returns_to_rest_is_an_error() {
-        let sim = generate(&sweep(&RATES, 2, true, false), &Profile::default(), 3);
+        let sim = simulate_raw_log(&raw_log_setpoints(&RATES, 2, true, false), &RawLogProfile::default(), 3).unwrap();
         let e = segment_log(&sim.time, &sim.logged_rate, &SegmentOptions::default()).unwrap_err();
         assert!(matches!(e, SegmentError::NoFinalRest { .. }), "{e}");
         assert!(e.to_string().contains("never returns to rest"), "{e}");
         // Without rest at either end: accepted, no rest record.
-        let sim = generate(&sweep(&RATES, 2, false, false), &Profile::default(), 3);
+        let sim = simulate_raw_log(&raw_log_setpoints(&RATES, 2, false, false), &RawLogProfile::default(), 3).unwrap();
         let o = SegmentOptions::default();
         let seg = segment_log(&sim.time, &sim.logged_rate, &o).unwrap();
-        let out = gyro_output(&sim.true_rate, 1.0, 0.0, 0.001, 1);
+        let out = gyro_output(&sim.true_rate, 1.0, 0.0, 0.001, 1).unwrap();
         assert!(rate_observations(&seg, &sim.time, &out, PlateauReduction::Mean, o.rest).unwrap().1.is_none());
         // ... unless rest is required.
         let req = SegmentOptions { rest: RestPolicy::Required, ..o };
@@ -1059,10 +1059,10 @@ mod tests {
     #[test]
     fn a_run_that_stops_midway_is_an_error() {
         // Run 2's reverse stroke stops at -30 deg/s (after 300, 100, 30, 0, -30), then rest.
-        let mut seq = sweep(&RATES, 2, true, false);
+        let mut seq = raw_log_setpoints(&RATES, 2, true, false);
         seq.truncate(seq.len() - 2);
         seq.push((0.0, vec![SegmentKind::RestEnd]));
-        let sim = generate(&seq, &Profile::default(), 5);
+        let sim = simulate_raw_log(&seq, &RawLogProfile::default(), 5).unwrap();
         let e = segment_log(&sim.time, &sim.logged_rate, &SegmentOptions::default()).unwrap_err();
         assert!(
             matches!(e, SegmentError::IncompleteRun { run: 2, stroke: Stroke::Reverse, found: 5, expected: 7, .. }),
@@ -1070,10 +1070,10 @@ mod tests {
         );
         assert!(e.to_string().contains("stops midway"), "{e}");
         // Run 2 without its reverse stroke.
-        let mut seq = sweep(&RATES, 2, true, false);
+        let mut seq = raw_log_setpoints(&RATES, 2, true, false);
         seq.truncate(seq.len() - (RATES.len() - 1));
         seq.push((0.0, vec![SegmentKind::RestEnd]));
-        let sim = generate(&seq, &Profile::default(), 5);
+        let sim = simulate_raw_log(&seq, &RawLogProfile::default(), 5).unwrap();
         let e = segment_log(&sim.time, &sim.logged_rate, &SegmentOptions::default()).unwrap_err();
         assert!(matches!(e, SegmentError::MissingStroke { run: 2, missing: Stroke::Reverse, .. }), "{e}");
     }

@@ -423,7 +423,7 @@ mod tests {
     use super::*;
     use crate::apply::{RangeStatus, TriadApplier};
     use crate::segment::{find_steady_segments, SegmentOptions};
-    use crate::testsim::{generate, sweep, Profile, SimLog};
+    use crate::sim::{raw_log_setpoints, simulate_raw_log, RawLogProfile, SimulatedRawLog};
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
     use rand_distr::{Distribution, Normal};
@@ -447,12 +447,12 @@ mod tests {
     }
 
     struct AxisLog {
-        sim: SimLog,
+        sim: SimulatedRawLog,
         outputs: [Vec<f64>; 3],
     }
 
     fn axis_log(axis: TableAxis, seed: u64) -> AxisLog {
-        let sim = generate(&sweep(&RATES, 1, true, true), &Profile::default(), seed);
+        let sim = simulate_raw_log(&raw_log_setpoints(&RATES, 1, true, true), &RawLogProfile::default(), seed).unwrap();
         let s = true_matrix();
         let mut rng = ChaCha8Rng::seed_from_u64(seed + 100);
         let noise = Normal::new(0.0, SIGMA_U).unwrap();

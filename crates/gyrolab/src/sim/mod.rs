@@ -31,6 +31,7 @@ mod flicker;
 mod generate;
 mod model;
 mod portable;
+mod raw_log;
 #[cfg(test)]
 mod tests;
 
@@ -41,4 +42,7 @@ pub use generate::{
 pub use model::{
     ParameterText, Preset, RateTableSpec, SensorModel, SensorOverrides, SettlingRows, SimConfig, SimError, StaticSpec,
     TemperatureProfile, TemperatureStep, PAPER_RATES_DPS,
+};
+pub use raw_log::{
+    gyro_output, raw_log_setpoints, simulate_raw_log, white_noise, RawLogHold, RawLogProfile, SimulatedRawLog,
 };

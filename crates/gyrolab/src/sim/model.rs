@@ -58,15 +58,15 @@ fn check(parameter: &'static str, value: f64, ok: bool, valid: &str) -> Result<(
     }
 }
 
-fn finite(parameter: &'static str, value: f64) -> Result<(), SimError> {
+pub(crate) fn finite(parameter: &'static str, value: f64) -> Result<(), SimError> {
     check(parameter, value, true, "a finite number")
 }
 
-fn non_negative(parameter: &'static str, value: f64) -> Result<(), SimError> {
+pub(crate) fn non_negative(parameter: &'static str, value: f64) -> Result<(), SimError> {
     check(parameter, value, value >= 0.0, "finite and >= 0")
 }
 
-fn positive(parameter: &'static str, value: f64) -> Result<(), SimError> {
+pub(crate) fn positive(parameter: &'static str, value: f64) -> Result<(), SimError> {
     check(parameter, value, value > 0.0, "finite and > 0")
 }
 
