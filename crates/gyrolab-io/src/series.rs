@@ -569,7 +569,9 @@ impl<R: Read> SeriesReader<R> {
         let ws = self.header.delimiter == Delimiter::Whitespace;
         let delim = self.header.delimiter.byte();
         let ncols = self.targets.len();
-        let fast = self.fast_rows && !ws;
+        // With whitespace, the fast path takes rows with exactly one space between fields (runs of
+        // spaces, tabs and leading spaces go to the general path, which reads them the same).
+        let fast = self.fast_rows;
         let mut refused_at = usize::MAX;
         let layout = RowLayout { delim, crlf: self.crlf };
         if self.shapes.len() != ncols {

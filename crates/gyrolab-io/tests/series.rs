@@ -310,3 +310,58 @@ fn plain_decimal_declines_what_it_cannot_do_exactly() {
     assert_eq!(plain_decimal(b"-0.001\n"), Some((-0.001, 6)));
     assert_eq!(plain_decimal(b".5"), Some((0.5, 2)));
 }
+
+/// A cell of a random row: mostly plain decimals (the fast path's), sometimes what only the
+/// general path reads or reports.
+fn cell() -> impl Strategy<Value = String> {
+    prop_oneof![
+        6 => (0u8..3, 0u64..100_000_000, 0usize..9, 0u64..100_000_000).prop_map(|(s, i, w, f)| {
+            let sign = ["", "-", "+"][s as usize];
+            if w == 0 { format!("{sign}{i}") } else { format!("{sign}{i}.{}", &format!("{f:08}")[..w]) }
+        }),
+        1 => prop::sample::select(vec!["1e3", "", "NaN", " 2.5", "2.5 ", "x", "1234567890.1234567", ".5", "5."])
+            .prop_map(String::from),
+    ]
+}
+
+proptest! {
+    /// The fast row path changes nothing: on random files (every delimiter, CRLF or LF, comments,
+    /// blank lines, odd cells, tolerant or strict) the reader gives the same values (to the bit),
+    /// line numbers and findings, or the same error, with it and without it.
+    #[test]
+    fn fast_rows_change_nothing(
+        rows in prop::collection::vec(prop::collection::vec(cell(), 2..4), 1..40),
+        sep in prop::sample::select(vec![",", "\t", " ", ";"]),
+        crlf in any::<bool>(),
+        comments in any::<bool>(),
+        tolerant in any::<bool>(),
+        chunk in 16usize..300,
+        block_rows in 1usize..30,
+    ) {
+        let eol = if crlf { "\r\n" } else { "\n" };
+        let mut text = format!("time_s{sep}output_v{sep}other_v{eol}");
+        for (i, row) in rows.iter().enumerate() {
+            if comments && i % 5 == 2 {
+                text.push_str(&format!("# note{eol}{eol}"));
+            }
+            text.push_str(&row.join(sep));
+            text.push_str(eol);
+        }
+        let with = SeriesOptions { tolerant, chunk_bytes: chunk, block_rows, ..SeriesOptions::default() };
+        let without = SeriesOptions { fast_rows: false, ..with.clone() };
+        match (read_str(&text, &with), read_str(&text, &without)) {
+            (Ok(a), Ok(b)) => {
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                prop_assert_eq!(&a.lines, &b.lines);
+                prop_assert_eq!(bits(&a.time.unwrap()), bits(&b.time.unwrap()));
+                prop_assert_eq!(a.channels.len(), b.channels.len());
+                for (ca, cb) in a.channels.iter().zip(&b.channels) {
+                    prop_assert_eq!(bits(ca), bits(cb));
+                }
+                prop_assert_eq!(a.quality, b.quality);
+            }
+            (Err(a), Err(b)) => prop_assert_eq!(a.to_string(), b.to_string()),
+            (a, b) => prop_assert!(false, "fast {:?} vs general {:?}\n{:?}", a.map(|d| d.lines), b.map(|d| d.lines), text),
+        }
+    }
+}
