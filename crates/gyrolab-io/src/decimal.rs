@@ -117,29 +117,63 @@ fn exact_quotient(w: u64, decimals: usize, negative: bool) -> f64 {
     }
 }
 
+/// A scanned plain decimal `[+-]digits[.digits]` from `start` (at most 15 digits, at least one).
+struct ScannedDecimal {
+    /// The digits as an integer (< 10^15).
+    significand: u64,
+    /// Digits before the point.
+    int_digits: usize,
+    /// Digits after the point.
+    frac_digits: usize,
+    /// Whether there is a point.
+    has_point: bool,
+    /// Whether the sign is `-`.
+    negative: bool,
+    /// Index of the first byte after the number.
+    end: usize,
+}
+
+impl ScannedDecimal {
+    /// Scans from `start`; `None` when there is no digit or more than 15 of them.
+    #[inline(always)]
+    fn scan(b: &[u8], start: usize) -> Option<ScannedDecimal> {
+        let c0 = b.get(start).copied();
+        let negative = c0 == Some(b'-');
+        let q = start + usize::from(negative || c0 == Some(b'+'));
+        let (int_w, int_digits, i) = digit_run(b, q, 0, MAX_DIGITS)?;
+        let (significand, frac_digits, end, has_point) = if b.get(i) == Some(&b'.') {
+            let (w, nf, i) = digit_run(b, i + 1, int_w, MAX_DIGITS - int_digits)?;
+            (w, nf, i, true)
+        } else {
+            (int_w, 0, i, false)
+        };
+        (int_digits + frac_digits > 0).then_some(ScannedDecimal {
+            significand,
+            int_digits,
+            frac_digits,
+            has_point,
+            negative,
+            end,
+        })
+    }
+
+    /// The value: one correctly rounded division.
+    #[inline(always)]
+    fn value(&self) -> f64 {
+        exact_quotient(self.significand, self.frac_digits, self.negative)
+    }
+}
+
 /// Fast path for the plain decimals that fill most logs (`-12.3456`, `+0.5`, `7`): at most 15
 /// significant digits, no exponent (see the module notes for why the value is exact). Returns
 /// the value and the bytes used, or `None` for anything else (left to the full parser).
 #[inline]
 pub fn plain_decimal(b: &[u8]) -> Option<(f64, usize)> {
-    let (negative, start) = match b.first() {
-        Some(b'-') => (true, 1),
-        Some(b'+') => (false, 1),
-        _ => (false, 0),
-    };
-    let (mut w, mut digits, mut i) = digit_run(b, start, 0, MAX_DIGITS)?;
-    let mut decimals = 0usize;
-    if b.get(i) == Some(&b'.') {
-        let (fw, fd, fi) = digit_run(b, i + 1, w, MAX_DIGITS - digits)?;
-        w = fw;
-        decimals = fd;
-        digits += fd;
-        i = fi;
-    }
-    if digits == 0 || matches!(b.get(i), Some(b'e' | b'E' | b'.')) {
+    let d = ScannedDecimal::scan(b, 0)?;
+    if matches!(b.get(d.end), Some(b'e' | b'E' | b'.')) {
         return None;
     }
-    Some((exact_quotient(w, decimals, negative), i))
+    Some((d.value(), d.end))
 }
 
 /// The layout of a number after its sign: digits before the point, whether there is a point,
@@ -244,20 +278,11 @@ fn shaped_field(b: &[u8], p: usize, shape: &FieldShape, end_char: u8) -> Option<
 /// and the field's shape; `None` when it is not a plain decimal of at most 15 digits ending there.
 #[inline(always)]
 fn scanned_field(b: &[u8], p: usize, end_char: u8) -> Option<(f64, usize, Option<FieldShape>)> {
-    let c0 = *b.get(p)?;
-    let negative = c0 == b'-';
-    let q = p + usize::from(negative || c0 == b'+');
-    let (int_w, ni, i) = digit_run(b, q, 0, MAX_DIGITS)?;
-    let (w, nf, i, has_point) = if b.get(i) == Some(&b'.') {
-        let (w, nf, i) = digit_run(b, i + 1, int_w, MAX_DIGITS - ni)?;
-        (w, nf, i, true)
-    } else {
-        (int_w, 0, i, false)
-    };
-    if ni + nf == 0 || b.get(i) != Some(&end_char) {
+    let d = ScannedDecimal::scan(b, p)?;
+    if b.get(d.end) != Some(&end_char) {
         return None;
     }
-    Some((exact_quotient(w, nf, negative), i, FieldShape::new(ni, has_point, nf)))
+    Some((d.value(), d.end, FieldShape::new(d.int_digits, d.has_point, d.frac_digits)))
 }
 
 /// Reads one row of plain decimals (see [`read_rows`]); `None` leaves `cols` as it was.
@@ -275,13 +300,12 @@ fn read_row(
     if shapes.len() < targets.len() {
         return None;
     }
-    for (ci, &slot) in targets.iter().enumerate() {
+    for (ci, (&slot, shape)) in targets.iter().zip(shapes.iter_mut()).enumerate() {
         let end_char = match (ci == last, layout.crlf) {
             (false, _) => layout.delim,
             (true, false) => b'\n',
             (true, true) => b'\r',
         };
-        let shape = shapes.get_mut(ci)?;
         let parsed = match shape.as_ref().and_then(|s| shaped_field(b, p, s, end_char)) {
             Some(hit) => Some(hit),
             None => scanned_field(b, p, end_char).map(|(v, e, s)| {

@@ -85,56 +85,6 @@ const EXACT_INT_LIMIT: f64 = 9_007_199_254_740_992.0;
 /// Buffer size at which rows are handed to the writer.
 const FLUSH_AT: usize = 1 << 16;
 
-/// Two-digit groups "00".."99", for writing integers two digits at a time.
-const DIGIT_PAIRS: [u8; 200] = {
-    let mut t = [0u8; 200];
-    let mut i = 0;
-    while i < 100 {
-        t[2 * i] = b'0' + (i / 10) as u8;
-        t[2 * i + 1] = b'0' + (i % 10) as u8;
-        i += 1;
-    }
-    t
-};
-
-/// Writes `v` in exactly `width` decimal digits (zero-padded on the left) ending before `end`;
-/// returns the start index. `v` must be below 10^width.
-#[inline]
-fn write_padded(out: &mut [u8], end: usize, mut v: u64, width: usize) -> usize {
-    let start = end - width;
-    let mut i = end;
-    while i >= start + 2 {
-        let pair = (v % 100) as usize * 2;
-        v /= 100;
-        out[i - 2..i].copy_from_slice(&DIGIT_PAIRS[pair..pair + 2]);
-        i -= 2;
-    }
-    if i > start {
-        out[i - 1] = b'0' + (v % 10) as u8;
-    }
-    start
-}
-
-/// Writes `v` as decimal digits ending at the end of `out`, with a decimal point before the last
-/// `decimals` digits (zero-padded: 5 with 3 decimals is `0.005`); returns the start index.
-/// `out` must hold 20 + 1 + decimals bytes.
-#[inline]
-fn write_digits(out: &mut [u8], v: u64, decimals: usize) -> usize {
-    let mut end = out.len();
-    let mut int = v;
-    if decimals > 0 {
-        let unit = POW10_INT[decimals];
-        end = write_padded(out, end, v % unit, decimals) - 1;
-        out[end] = b'.';
-        int = v / unit;
-    }
-    let mut width = 1;
-    while width < 20 && int >= POW10_INT[width] {
-        width += 1;
-    }
-    write_padded(out, end, int, width)
-}
-
 /// The eight decimal digits of `n` < 10^8 as ASCII, zero-padded, the first digit in the lowest
 /// byte (SWAR: both four-digit halves, then both digit pairs of each, then both digits of each
 /// pair, are split at once with multiplications by reciprocals that are exact in these ranges).
@@ -203,17 +153,6 @@ fn round_half_away(x: f64) -> f64 {
     }
 }
 
-/// Exact integer powers of ten 10^0 ..= 10^19.
-const POW10_INT: [u64; 20] = {
-    let mut t = [1u64; 20];
-    let mut i = 1;
-    while i < 20 {
-        t[i] = t[i - 1] * 10;
-        i += 1;
-    }
-    t
-};
-
 /// Row formatter over a block buffer.
 struct RowWriter<W: Write> {
     out: W,
@@ -247,9 +186,11 @@ impl<W: Write> RowWriter<W> {
     }
 
     fn unsigned(&mut self, v: u64) {
-        let mut digits = [0u8; 21];
-        let i = write_digits(&mut digits, v, 0);
-        self.buf.extend_from_slice(&digits[i..]);
+        if v < 10_000_000_000_000_000 {
+            push_fixed(&mut self.buf, v, 0, false);
+        } else {
+            self.buf.extend_from_slice(v.to_string().as_bytes());
+        }
     }
 
     fn shortest(&mut self, v: f64) {
