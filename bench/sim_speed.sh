@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Benchmark of `gyrolab simulate static` on a long record: where the time goes (simulation alone,
 # formatting and writing alone on one thread, both on two threads) and the command itself writing
-# a file, against the disk's own write speed for the same bytes.
+# a file, against the output's own speed: dd copying the same bytes, and dd writing as many bytes
+# from /dev/zero (both flushed to disk, as the command does).
 # Usage: bash bench/sim_speed.sh [SAMPLES (default 100000000)] [WORK_DIR (default /tmp/gyrolab-bench)]
 # The record is `time_s,output_v` at 100 Hz with 7 decimals (ADXRS646 preset), about 25 bytes a line.
 set -euo pipefail
@@ -36,5 +37,9 @@ timed "simulation only (no text)" "$BYTES" "$EX" "$N" adxrs646 generate
 timed "simulate + format + write, one thread, > /dev/null" "$BYTES" "$EX" "$N" adxrs646 fixed7
 timed "simulate + format + write, two threads, > /dev/null" "$BYTES" "$EX" "$N" adxrs646 fixed7 pipelined
 timed "disk: dd the same bytes to a file (fdatasync)" "$BYTES" dd if="$F" of="$DIR/copy.csv" bs=4M conv=fdatasync
+rm -f "$DIR/copy.csv"
+# The output alone: as many zero bytes written from memory (no reading), then flushed to disk.
+timed "disk: dd as many bytes from /dev/zero (fdatasync)" "$BYTES" dd if=/dev/zero of="$DIR/copy.csv" bs=256K \
+    count=$((BYTES / 262144)) conv=fdatasync
 rm -f "$DIR/copy.csv"
 echo "file: $F ($BYTES bytes, $N samples); cores: $(nproc); load average: $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -27,7 +27,7 @@ pub fn write_atomic_with(
         tmp.as_file().set_permissions(std::fs::Permissions::from_mode(0o644))?;
     }
     {
-        let mut w = std::io::BufWriter::with_capacity(1 << 20, tmp.as_file());
+        let mut w = std::io::BufWriter::with_capacity(1 << 16, tmp.as_file());
         fill(&mut w)?;
         w.flush()?;
     }

@@ -1567,7 +1567,7 @@ mod tests {
         /// the rails, repeated values and irregular time stamps, split into random blocks.
         #[test]
         fn block_path_equals_sample_path(
-            runs in prop::collection::vec((0u8..6, 1usize..30), 1..40),
+            runs in prop::collection::vec((0u8..6, 1usize..30), 2..40),
             stamps in prop::collection::vec((0u8..40, 0usize..2000), 0..6),
             split in 1usize..300,
         ) {

@@ -2,7 +2,8 @@
 //!
 //! Sources: IEEE Std 952-1997 annex C (white rate noise from N, rate random walk from K, rate
 //! ramp R, quantization); Brown & Hwang (Gauss-Markov discretisation
-//! x[k+1] = phi x[k] + s sqrt(1 - phi^2) w[k], phi = e^(-dt/T)).
+//! x[k+1] = phi x[k] + s sqrt(1 - phi^2) w[k], phi = e^(-dt/T), applied over the hold of each
+//! flicker process: see `flicker` for the held updates).
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -29,15 +30,58 @@ fn normal(rng: &mut ChaCha8Rng) -> f64 {
     StandardNormal.sample(rng)
 }
 
-/// One first-order Gauss-Markov process of the flicker sum.
+/// One first-order Gauss-Markov process of the flicker sum, advanced every `hold` samples.
 #[derive(Debug, Clone)]
 struct GaussMarkov {
-    /// e^(-dt/T).
+    /// e^(-hold dt / T): the transition over one hold.
     phi: f64,
-    /// Driving standard deviation s sqrt(1 - phi^2), deg/s.
+    /// Driving standard deviation over one hold, s sqrt(1 - phi^2), deg/s.
     drive_sigma: f64,
+    /// Samples between updates.
+    hold: u64,
+    /// Samples until the next update.
+    left: u64,
     /// Current value, deg/s.
     state: f64,
+}
+
+/// The flicker sum: its processes, their current sum and the samples until the next update of
+/// any of them.
+#[derive(Debug, Clone)]
+struct FlickerSum {
+    terms: Vec<GaussMarkov>,
+    /// Sum of the current states, deg/s.
+    sum: f64,
+    /// Samples until the next update (u64::MAX without processes).
+    until_update: u64,
+    /// Samples from the previous update to the next.
+    step: u64,
+}
+
+impl FlickerSum {
+    fn new(terms: Vec<GaussMarkov>) -> FlickerSum {
+        let step = terms.iter().map(|g| g.hold).min().unwrap_or(u64::MAX);
+        let sum = terms.iter().map(|g| g.state).sum();
+        FlickerSum { terms, sum, until_update: step, step }
+    }
+
+    /// Advances every process whose hold has run out (in order), then sums them again.
+    fn update(&mut self, noise: &mut NormalBatch) {
+        let mut next = u64::MAX;
+        let mut sum = 0.0;
+        for gm in &mut self.terms {
+            gm.left -= self.step;
+            if gm.left == 0 {
+                gm.state = gm.phi * gm.state + gm.drive_sigma * noise.draw();
+                gm.left = gm.hold;
+            }
+            next = next.min(gm.left);
+            sum += gm.state;
+        }
+        self.sum = sum;
+        self.until_update = next;
+        self.step = next;
+    }
 }
 
 /// The per-sample sensor model with its noise state.
@@ -58,7 +102,7 @@ struct Engine {
     run_scale_factor_sigma: f64,
     white_sigma_dps: f64,
     flicker: Option<FlickerDesign>,
-    gauss_markov: Vec<GaussMarkov>,
+    flicker_sum: FlickerSum,
     rrw_sigma_dps: f64,
     rrw_state_dps: f64,
     ramp_dps_per_s: f64,
@@ -120,10 +164,12 @@ impl Engine {
             let gm = design
                 .correlation_times_s
                 .iter()
-                .map(|&t| {
-                    let phi = portable::exp(-dt_s / t);
+                .zip(design.hold_samples(dt_s))
+                .map(|(&t, hold)| {
+                    let phi = portable::exp(-(hold as f64) * dt_s / t);
                     // Start in the stationary distribution, so the record is stationary from t = 0.
-                    GaussMarkov { phi, drive_sigma: s * (1.0 - phi * phi).sqrt(), state: s * normal(&mut noise) }
+                    let state = s * normal(&mut noise);
+                    GaussMarkov { phi, drive_sigma: s * (1.0 - phi * phi).sqrt(), hold, left: hold, state }
                 })
                 .collect();
             (Some(design), gm)
@@ -148,7 +194,7 @@ impl Engine {
             run_scale_factor_sigma: units::ppm_to_ratio(model.run_to_run_scale_factor_sigma_ppm),
             white_sigma_dps: units::arw_deg_rt_h_to_sample_sigma_dps(model.arw_deg_rt_h, dt_s),
             flicker,
-            gauss_markov,
+            flicker_sum: FlickerSum::new(gauss_markov),
             rrw_sigma_dps: units::rrw_dph_rt_h_to_increment_sigma_dps(model.rrw_deg_h_rt_h, dt_s),
             rrw_state_dps: 0.0,
             ramp_dps_per_s: units::rate_ramp_dph_per_h_to_dps_per_s(model.rate_ramp_dph_per_h),
@@ -182,9 +228,10 @@ impl Engine {
         if self.white_sigma_dps > 0.0 {
             noise += self.white_sigma_dps * self.noise.draw();
         }
-        for gm in &mut self.gauss_markov {
-            noise += gm.state;
-            gm.state = gm.phi * gm.state + gm.drive_sigma * self.noise.draw();
+        noise += self.flicker_sum.sum;
+        self.flicker_sum.until_update -= 1;
+        if self.flicker_sum.until_update == 0 {
+            self.flicker_sum.update(&mut self.noise);
         }
         if self.rrw_sigma_dps > 0.0 {
             noise += self.rrw_state_dps;

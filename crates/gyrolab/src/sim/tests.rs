@@ -161,24 +161,50 @@ fn saturation_clamps_at_the_rails() {
 
 #[test]
 fn flicker_allan_deviation_is_flat_within_band() {
-    // B = 10 deg/h, flat range 1..100 s at 10 Hz (tau_min = 10 dt, the shortest allowed: the worst
-    // case for point sampling). 1e6 samples (1e5 s).
+    // B = 10 deg/h at 10 Hz, 1e6 samples (1e5 s). First: flat range 1..100 s (tau_min = 10 dt,
+    // the shortest allowed: the worst case for point sampling; holds 1, 1, 3, 33, 333 samples).
+    // Second: 100..1000 s, every process held (3, 33, 333, 3333 samples).
     let b_dps = 10.0 / 3600.0;
-    let model = SensorModel { bias_instability_dph: 10.0, flicker_tau_min_s: 1.0, flicker_tau_max_s: 100.0, ..ideal() };
     let dt = 0.1;
-    let v = outputs(&model, &static_spec(10.0, 100_000.0), 21);
-    let n_phase = (v.len() + 1) as f64;
-    for &m in &[10usize, 30, 100, 300, 1000] {
-        let adev = oadev(&v, dt, m);
-        let ratio = adev / (0.6643 * b_dps);
-        // Statistical error: equivalent degrees of freedom of the overlapping ADEV for flicker FM
-        // (NIST SP 1065, section 5.3.3): edf = 5 N^2 / (4 m (N + 3 m)); relative std of the ADEV
-        // ~ 1 / sqrt(2 edf) (2 % at m = 1000, 0.2 % at m = 10). Tolerance: the stated +-3 % band
-        // plus 3 standard errors.
-        let mf = m as f64;
-        let edf = 5.0 * n_phase * n_phase / (4.0 * mf * (n_phase + 3.0 * mf));
-        let tol = 0.03 + 3.0 / (2.0 * edf).sqrt();
-        assert!((ratio - 1.0).abs() < tol, "tau {} s: ADEV / 0.6643 B = {ratio}, tol {tol}", mf * dt);
+    let cases: [(f64, f64, &[usize], u64); 2] =
+        [(1.0, 100.0, &[10, 30, 100, 300, 1000], 21), (100.0, 1000.0, &[1000, 2000, 4000], 22)];
+    for (tau_min, tau_max, ms, seed) in cases {
+        let model = SensorModel {
+            bias_instability_dph: 10.0,
+            flicker_tau_min_s: tau_min,
+            flicker_tau_max_s: tau_max,
+            ..ideal()
+        };
+        let v = outputs(&model, &static_spec(10.0, 100_000.0), seed);
+        let n_phase = (v.len() + 1) as f64;
+        for &m in ms {
+            let adev = oadev(&v, dt, m);
+            let ratio = adev / (0.6643 * b_dps);
+            // Statistical error: equivalent degrees of freedom of the overlapping ADEV for flicker FM
+            // (NIST SP 1065, section 5.3.3): edf = 5 N^2 / (4 m (N + 3 m)); relative std of the ADEV
+            // ~ 1 / sqrt(2 edf) (2 % at m = 1000, 0.2 % at m = 10). Tolerance: the stated +-3 % band
+            // plus 3 standard errors.
+            let mf = m as f64;
+            let edf = 5.0 * n_phase * n_phase / (4.0 * mf * (n_phase + 3.0 * mf));
+            let tol = 0.03 + 3.0 / (2.0 * edf).sqrt();
+            assert!((ratio - 1.0).abs() < tol, "tau {} s: ADEV / 0.6643 B = {ratio}, tol {tol}", mf * dt);
+        }
+    }
+}
+
+#[test]
+fn held_flicker_processes_change_only_at_their_updates() {
+    // 100 Hz, tau_min 7.5 s: T_i = 0.75, 7.5, 75, 750 s held 2, 25, 250, 2500 samples (floor of
+    // T / 30 dt); holds that are not multiples of each other. Flicker only: the output changes
+    // exactly at multiples of 2 or 25.
+    let model = SensorModel { bias_instability_dph: 10.0, flicker_tau_min_s: 7.5, flicker_tau_max_s: 100.0, ..ideal() };
+    let generator = StaticGenerator::new(&model, &static_spec(100.0, 60.0), 3).unwrap();
+    let design = generator.flicker_design().unwrap().clone();
+    assert_eq!(design.hold_samples(0.01), vec![2, 25, 250, 2500]);
+    let v: Vec<f64> = generator.map(|s| s.output).collect();
+    for n in 1..v.len() {
+        let updated = n % 2 == 0 || n % 25 == 0;
+        assert_eq!(v[n] != v[n - 1], updated, "sample {n}");
     }
 }
 

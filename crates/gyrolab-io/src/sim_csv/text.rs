@@ -1,0 +1,499 @@
+//! Number text for the simulated-record writers: fixed decimals by SWAR digits and the shortest
+//! round-trip form (Ryu), written into a buffer with room to spare.
+//!
+//! Fixed decimals: one correctly rounded multiply by an exact power of ten, round half away from
+//! zero, then integer digits (eight at a time). Both forms are byte-identical on every platform.
+
+/// Exact powers of ten 10^0 ..= 10^15 (all exactly representable in f64).
+const POW10: [f64; 16] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15];
+/// Largest magnitude written through the integer path (2^53).
+const EXACT_INT_LIMIT: f64 = 9_007_199_254_740_992.0;
+/// Room made before each number: the longest number text (a sign, 16 digits, a point, 15
+/// decimals; Ryu's at most 24 bytes) plus the 8 bytes a word store may write past its end.
+const NUMBER_ROOM: usize = 48;
+/// Eight ASCII zeros.
+const ZEROS: u64 = u64::from_le_bytes([b'0'; 8]);
+
+/// The eight decimal digits of `n` < 10^8 as ASCII, zero-padded, the first digit in the lowest
+/// byte (SWAR: both four-digit halves, then both digit pairs of each, then both digits of each
+/// pair, are split at once with multiplications by reciprocals that are exact in these ranges).
+#[inline(always)]
+fn eight_digits(n: u64) -> u64 {
+    // Lanes of 32 bits: the first four digits (n / 10^4) in the low lane.
+    let quads = (n / 10_000) | ((n % 10_000) << 32);
+    // In each lane, abcd / 100 = (abcd * 5243) >> 19 for abcd < 10^4; pairs in 16-bit lanes.
+    let hundreds = ((quads * 5243) >> 19) & 0x0000_007f_0000_007f;
+    let pairs = hundreds | ((quads - hundreds * 100) << 16);
+    // In each 16-bit lane, ab / 10 = (ab * 103) >> 10 for ab < 100; digits in bytes.
+    let tens = ((pairs * 103) >> 10) & 0x000f_000f_000f_000f;
+    let digits = tens | ((pairs - tens * 10) << 8);
+    digits + ZEROS
+}
+
+/// Leading zero digits of eight ASCII digits from [`eight_digits`], at most 7 (one digit stays).
+#[inline(always)]
+fn leading_zero_digits(digits: u64) -> usize {
+    // Each byte minus '0' is the digit itself (no borrow): the zero bytes at the low end are the
+    // leading zeros.
+    (((digits - ZEROS).trailing_zeros() / 8) as usize).min(7)
+}
+
+/// `x` rounded half away from zero, as `f64::round` (sign of zero included), for |x| < 2^53 (the truncation by an
+/// integer conversion and the difference x - trunc(x) are exact there).
+#[inline(always)]
+fn round_half_away(x: f64) -> f64 {
+    let t = (x as i64 as f64).copysign(x);
+    let d = x - t;
+    if d >= 0.5 {
+        t + 1.0
+    } else if d <= -0.5 {
+        t - 1.0
+    } else {
+        t
+    }
+}
+
+/// Row text under construction: numbers are stored a word (8 bytes) at a time and the end moved
+/// on by their length, so the buffer keeps room to spare past its end.
+pub(super) struct TextBuf {
+    /// Text in `bytes[..end]`; the rest is room.
+    pub(super) bytes: Vec<u8>,
+    /// End of the text.
+    pub(super) end: usize,
+    ryu: ryu::Buffer,
+}
+
+impl TextBuf {
+    /// An empty buffer for about `size` bytes of text.
+    pub(super) fn new(size: usize) -> TextBuf {
+        TextBuf { bytes: vec![0; size + 4 * NUMBER_ROOM], end: 0, ryu: ryu::Buffer::new() }
+    }
+
+    /// Makes sure `n` more bytes fit after the end.
+    #[inline(always)]
+    pub(super) fn make_room(&mut self, n: usize) {
+        if self.end + n > self.bytes.len() {
+            self.bytes.resize(self.end + n, 0);
+        }
+    }
+
+    /// Appends one byte.
+    #[inline(always)]
+    pub(super) fn byte(&mut self, b: u8) {
+        self.make_room(1);
+        self.bytes[self.end] = b;
+        self.end += 1;
+    }
+
+    /// Appends bytes.
+    #[inline]
+    pub(super) fn text(&mut self, s: &[u8]) {
+        self.make_room(s.len());
+        self.bytes[self.end..self.end + s.len()].copy_from_slice(s);
+        self.end += s.len();
+    }
+
+    /// Stores the word's eight bytes (lowest first) and keeps the first `len` of them; the caller
+    /// has made room for eight.
+    #[inline(always)]
+    fn word(&mut self, word: u64, len: usize) {
+        self.bytes[self.end..self.end + 8].copy_from_slice(&word.to_le_bytes());
+        self.end += len;
+    }
+
+    /// Appends `n` < 10^16 in decimal, without leading zeros; the caller has made room for 24 bytes.
+    #[inline(always)]
+    fn integer(&mut self, n: u64) {
+        if n < 100_000_000 {
+            let digits = eight_digits(n);
+            let zeros = leading_zero_digits(digits);
+            self.word(digits >> (8 * zeros), 8 - zeros);
+        } else {
+            // n / 10^8 is at least 1 (no zero run of 8) and below 10^8.
+            let high = eight_digits(n / 100_000_000);
+            let zeros = leading_zero_digits(high);
+            self.word(high >> (8 * zeros), 8 - zeros);
+            self.word(eight_digits(n % 100_000_000), 8);
+        }
+    }
+
+    /// Appends any u64 in decimal.
+    pub(super) fn unsigned(&mut self, n: u64) {
+        if n < 10_000_000_000_000_000 {
+            self.make_room(NUMBER_ROOM);
+            self.integer(n);
+        } else {
+            self.text(n.to_string().as_bytes());
+        }
+    }
+
+    /// Appends a `# ` comment line per line of `line` (so that no text can end the comment block
+    /// early).
+    pub(super) fn comment(&mut self, line: &str) {
+        for part in line.split('\n') {
+            self.text(b"# ");
+            self.text(part.trim_end_matches('\r').as_bytes());
+            self.byte(b'\n');
+        }
+    }
+
+    /// Appends the shortest text that reads back to `v` (Ryu).
+    pub(super) fn shortest(&mut self, v: f64) {
+        let s = self.ryu.format(v).as_bytes();
+        if self.end + s.len() > self.bytes.len() {
+            self.bytes.resize(self.end + s.len(), 0);
+        }
+        self.bytes[self.end..self.end + s.len()].copy_from_slice(s);
+        self.end += s.len();
+    }
+}
+
+impl TextBuf {
+    /// Appends `m` / 10^D in fixed notation (D digits after the point, at least one before it),
+    /// with a minus sign when `negative`; `m` < 10^16, D <= 15.
+    #[inline(always)]
+    pub(super) fn fixed<const D: usize>(&mut self, m: u64, negative: bool) {
+        let unit = const { 10u64.pow(D as u32) };
+        self.make_room(NUMBER_ROOM);
+        if negative {
+            self.bytes[self.end] = b'-';
+            self.end += 1;
+        }
+        if D > 0 && D < 8 && m < 100_000_000 {
+            // All digits from one word: the integer part (leading zeros dropped, one kept), the
+            // point, the last D digits.
+            let digits = eight_digits(m);
+            let zeros = leading_zero_digits(digits).min(7 - D.min(7));
+            self.word(digits >> (8 * zeros), 8 - D - zeros);
+            self.bytes[self.end] = b'.';
+            self.end += 1;
+            self.word(digits >> (8 * (8 - D.min(8))), D);
+            return;
+        }
+        self.integer(m / unit);
+        self.fraction::<D>(m % unit);
+    }
+
+    /// As [`TextBuf::fixed`], for a column whose integer part often repeats from one row to the
+    /// next (time stamps: for a whole second): its text is kept in `repeat`.
+    #[inline(always)]
+    pub(super) fn fixed_repeating<const D: usize>(&mut self, m: u64, negative: bool, repeat: &mut IntegerText) {
+        let unit = const { 10u64.pow(D as u32) };
+        self.make_room(NUMBER_ROOM);
+        if negative {
+            self.bytes[self.end] = b'-';
+            self.end += 1;
+        }
+        let integer = m / unit;
+        if integer < 100_000_000 {
+            if integer != repeat.value {
+                let digits = eight_digits(integer);
+                let zeros = leading_zero_digits(digits);
+                *repeat = IntegerText { value: integer, word: digits >> (8 * zeros), len: 8 - zeros };
+            }
+            self.word(repeat.word, repeat.len);
+        } else {
+            self.integer(integer);
+        }
+        self.fraction::<D>(m % unit);
+    }
+
+    /// Appends the point and the D digits of `fraction` < 10^D (nothing for D = 0); the caller
+    /// has made room.
+    #[inline(always)]
+    fn fraction<const D: usize>(&mut self, fraction: u64) {
+        if D == 0 {
+            return;
+        }
+        self.bytes[self.end] = b'.';
+        self.end += 1;
+        if D <= 8 {
+            // The last D of eight zero-padded digits (D >= 1: the shift is below 64).
+            self.word(eight_digits(fraction) >> (8 * (8 - D.min(8))), D);
+        } else {
+            // D - 8 digits (1 to 7), then eight.
+            let high = eight_digits(fraction / 100_000_000);
+            self.word(high >> (8 * (16 - D.clamp(9, 15))), D - 8);
+            self.word(eight_digits(fraction % 100_000_000), 8);
+        }
+    }
+}
+
+/// The text of the integer part last written in a column: its value (u64::MAX: none yet) and its
+/// digits as one word.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct IntegerText {
+    value: u64,
+    word: u64,
+    len: usize,
+}
+
+impl Default for IntegerText {
+    fn default() -> Self {
+        IntegerText { value: u64::MAX, word: 0, len: 0 }
+    }
+}
+
+/// How a number column is written (chosen once per record, so that the row loop is compiled for
+/// it; see [`with_number_text`]).
+pub(super) trait NumberText {
+    /// Appends `v`.
+    fn put(text: &mut TextBuf, v: f64);
+
+    /// Appends `v` of a column whose integer part often repeats (its text kept in `repeat`).
+    #[inline(always)]
+    fn put_repeating(text: &mut TextBuf, v: f64, _repeat: &mut IntegerText) {
+        Self::put(text, v);
+    }
+}
+
+/// Shortest round-trip text (Ryu).
+pub(super) struct Shortest;
+
+impl NumberText for Shortest {
+    #[inline]
+    fn put(text: &mut TextBuf, v: f64) {
+        text.shortest(v);
+    }
+}
+
+/// `D` decimals: v 10^D rounded half away from zero, as integer digits with the point put in;
+/// values too large for that (|v 10^D| >= 2^53) and non-finite ones in the shortest form.
+pub(super) struct Fixed<const D: usize>;
+
+impl<const D: usize> NumberText for Fixed<D> {
+    #[inline(always)]
+    fn put(text: &mut TextBuf, v: f64) {
+        match Self::scaled(v) {
+            Some((m, negative)) => text.fixed::<D>(m, negative),
+            None => text.shortest(v),
+        }
+    }
+
+    #[inline(always)]
+    fn put_repeating(text: &mut TextBuf, v: f64, repeat: &mut IntegerText) {
+        match Self::scaled(v) {
+            Some((m, negative)) => text.fixed_repeating::<D>(m, negative, repeat),
+            None => text.shortest(v),
+        }
+    }
+}
+
+impl<const D: usize> Fixed<D> {
+    /// |v| 10^D rounded half away from zero and whether it is written with a minus sign; none
+    /// when it is not below 2^53 (or not finite): then the shortest form is written.
+    #[inline(always)]
+    fn scaled(v: f64) -> Option<(u64, bool)> {
+        let unrounded = v * POW10[D];
+        if unrounded.is_nan() || unrounded.abs() >= EXACT_INT_LIMIT {
+            return None;
+        }
+        let scaled = round_half_away(unrounded);
+        if scaled.abs() >= EXACT_INT_LIMIT {
+            return None;
+        }
+        // |scaled| < 2^53, so the conversion to u64 is exact. A negative value that rounds to
+        // zero (-0.0) is written without its sign.
+        Some((scaled.abs() as u64, scaled < 0.0))
+    }
+}
+
+/// Calls `$run::<N>($args)` with the [`NumberText`] `N` of a [`NumberFormat`], or returns an
+/// invalid-option error for more than 15 decimals.
+macro_rules! with_number_text {
+    ($format:expr, $run:ident ( $($arg:expr),* $(,)? )) => {
+        match $format {
+            NumberFormat::Shortest => $run::<Shortest, _>($($arg),*),
+            NumberFormat::Fixed { decimals } => match decimals {
+                0 => $run::<Fixed<0>, _>($($arg),*),
+                1 => $run::<Fixed<1>, _>($($arg),*),
+                2 => $run::<Fixed<2>, _>($($arg),*),
+                3 => $run::<Fixed<3>, _>($($arg),*),
+                4 => $run::<Fixed<4>, _>($($arg),*),
+                5 => $run::<Fixed<5>, _>($($arg),*),
+                6 => $run::<Fixed<6>, _>($($arg),*),
+                7 => $run::<Fixed<7>, _>($($arg),*),
+                8 => $run::<Fixed<8>, _>($($arg),*),
+                9 => $run::<Fixed<9>, _>($($arg),*),
+                10 => $run::<Fixed<10>, _>($($arg),*),
+                11 => $run::<Fixed<11>, _>($($arg),*),
+                12 => $run::<Fixed<12>, _>($($arg),*),
+                13 => $run::<Fixed<13>, _>($($arg),*),
+                14 => $run::<Fixed<14>, _>($($arg),*),
+                15 => $run::<Fixed<15>, _>($($arg),*),
+                _ => Err(SimCsvError::InvalidOption(format!("fixed decimals = {decimals}: must be within 0..=15"))),
+            },
+        }
+    };
+}
+pub(super) use with_number_text;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    proptest::proptest! {
+        /// Fixed notation by SWAR digits equals the plain integer formatting of the same value.
+        #[test]
+        fn fixed_equals_integer_formatting(
+            v in 0u64..10_000_000_000_000_000,
+            digits in 1u32..17,
+            decimals in 0usize..16,
+            negative: bool,
+        ) {
+            // Every length of integer, so that the one-word path (below 10^8) is taken often.
+            let v = v % 10u64.pow(digits);
+            let mut text = TextBuf::new(1024);
+            fixed_any(&mut text, v, decimals, negative);
+            let unit = 10u64.pow(decimals as u32);
+            let sign = if negative { "-" } else { "" };
+            let want = if decimals == 0 {
+                format!("{sign}{v}")
+            } else {
+                format!("{sign}{}.{:0decimals$}", v / unit, v % unit)
+            };
+            proptest::prop_assert_eq!(String::from_utf8(text.bytes[..text.end].to_vec()).unwrap(), want);
+        }
+
+        /// Integers by SWAR digits equal the standard formatting, for every length.
+        #[test]
+        fn unsigned_equals_standard_formatting(v: u64, digits in 1u32..21) {
+            let v = if digits < 20 { v % 10u64.pow(digits) } else { v };
+            let mut text = TextBuf::new(1024);
+            text.unsigned(v);
+            proptest::prop_assert_eq!(String::from_utf8(text.bytes[..text.end].to_vec()).unwrap(), v.to_string());
+        }
+    }
+
+    proptest::proptest! {
+        /// A column written with its repeating integer part kept gives the same text as one
+        /// written value by value, whatever the sequence of values.
+        #[test]
+        fn repeating_integer_text_changes_nothing(
+            values in proptest::collection::vec((0u64..10_000_000_000_000_000, 1u32..17, 0u64..3), 1..40),
+            decimals in 0usize..16,
+        ) {
+            let mut repeat = IntegerText::default();
+            let (mut kept, mut each) = (TextBuf::new(16), TextBuf::new(16));
+            let mut previous = 0u64;
+            for &(v, digits, step) in &values {
+                // Runs of values with the same integer part, and jumps.
+                let v = if step < 2 { previous + step } else { v % 10u64.pow(digits) };
+                previous = v;
+                let negative = step == 1 && v % 3 == 0;
+                fixed_repeating_any(&mut kept, v, decimals, negative, &mut repeat);
+                fixed_any(&mut each, v, decimals, negative);
+                kept.byte(b' ');
+                each.byte(b' ');
+            }
+            proptest::prop_assert_eq!(&kept.bytes[..kept.end], &each.bytes[..each.end]);
+        }
+    }
+
+    /// `TextBuf::fixed_repeating` with the number of decimals given at run time.
+    fn fixed_repeating_any(text: &mut TextBuf, v: u64, decimals: usize, negative: bool, repeat: &mut IntegerText) {
+        match decimals {
+            0 => text.fixed_repeating::<0>(v, negative, repeat),
+            1 => text.fixed_repeating::<1>(v, negative, repeat),
+            2 => text.fixed_repeating::<2>(v, negative, repeat),
+            3 => text.fixed_repeating::<3>(v, negative, repeat),
+            4 => text.fixed_repeating::<4>(v, negative, repeat),
+            5 => text.fixed_repeating::<5>(v, negative, repeat),
+            6 => text.fixed_repeating::<6>(v, negative, repeat),
+            7 => text.fixed_repeating::<7>(v, negative, repeat),
+            8 => text.fixed_repeating::<8>(v, negative, repeat),
+            9 => text.fixed_repeating::<9>(v, negative, repeat),
+            10 => text.fixed_repeating::<10>(v, negative, repeat),
+            11 => text.fixed_repeating::<11>(v, negative, repeat),
+            12 => text.fixed_repeating::<12>(v, negative, repeat),
+            13 => text.fixed_repeating::<13>(v, negative, repeat),
+            14 => text.fixed_repeating::<14>(v, negative, repeat),
+            15 => text.fixed_repeating::<15>(v, negative, repeat),
+            _ => panic!("no such test case: {decimals} decimals"),
+        }
+    }
+
+    /// `TextBuf::fixed` with the number of decimals given at run time.
+    fn fixed_any(text: &mut TextBuf, v: u64, decimals: usize, negative: bool) {
+        match decimals {
+            0 => text.fixed::<0>(v, negative),
+            1 => text.fixed::<1>(v, negative),
+            2 => text.fixed::<2>(v, negative),
+            3 => text.fixed::<3>(v, negative),
+            4 => text.fixed::<4>(v, negative),
+            5 => text.fixed::<5>(v, negative),
+            6 => text.fixed::<6>(v, negative),
+            7 => text.fixed::<7>(v, negative),
+            8 => text.fixed::<8>(v, negative),
+            9 => text.fixed::<9>(v, negative),
+            10 => text.fixed::<10>(v, negative),
+            11 => text.fixed::<11>(v, negative),
+            12 => text.fixed::<12>(v, negative),
+            13 => text.fixed::<13>(v, negative),
+            14 => text.fixed::<14>(v, negative),
+            15 => text.fixed::<15>(v, negative),
+            _ => panic!("no such test case: {decimals} decimals"),
+        }
+    }
+
+    proptest::proptest! {
+        /// Rounding by truncation equals `f64::round` below 2^53.
+        #[test]
+        fn round_half_away_equals_round(x in -9.0e15f64..9.0e15, k in 0i32..6) {
+            let x = x / 10f64.powi(k * 3);
+            proptest::prop_assert_eq!(round_half_away(x).to_bits(), x.round().to_bits(), "{}", x);
+        }
+    }
+
+    #[test]
+    fn round_half_away_at_halves() {
+        for x in [0.5, -0.5, 1.5, -2.5, 0.49999999999999994, -0.49999999999999994, 4503599627370495.5, 0.0, -0.0] {
+            assert_eq!(round_half_away(x).to_bits(), x.round().to_bits(), "{x}");
+        }
+    }
+
+    #[test]
+    fn eight_digits_of_edge_values() {
+        for n in [0u64, 1, 9, 10, 99, 100, 999, 1_000, 9_999, 10_000, 12_345_678, 99_999_999] {
+            assert_eq!(eight_digits(n).to_le_bytes(), *format!("{n:08}").as_bytes(), "{n}");
+        }
+        // The two four-digit lanes are computed apart (masked): n = k * 10^4 + k gives every
+        // value 0..=9999 in both, so this covers every lane value exhaustively.
+        for n in (0u64..10_000).map(|k| k * 10_000 + k) {
+            assert_eq!(eight_digits(n).to_le_bytes(), *format!("{n:08}").as_bytes(), "{n}");
+        }
+    }
+
+    #[test]
+    fn fixed_decimals_are_rounded_and_padded() {
+        let mut text = TextBuf::new(1024);
+        for v in [2.5, -0.00004, -0.00006, 1.23456, 0.0, 12345.25, 1e300, f64::NAN, -f64::INFINITY] {
+            Fixed::<4>::put(&mut text, v);
+            text.byte(b' ');
+        }
+        // A negative value that rounds to zero is written without its sign.
+        let want = "2.5000 0.0000 -0.0001 1.2346 0.0000 12345.2500 1e300 NaN -inf ";
+        assert_eq!(String::from_utf8(text.bytes[..text.end].to_vec()).unwrap(), want);
+        let mut text = TextBuf::new(1024);
+        for v in [0.005, -0.005, 9.9996, 1234567.0, 99.0] {
+            Fixed::<3>::put(&mut text, v);
+            text.byte(b' ');
+        }
+        text.unsigned(0);
+        text.byte(b' ');
+        text.unsigned(18_446_744_073_709_551_615);
+        let want = "0.005 -0.005 10.000 1234567.000 99.000 0 18446744073709551615";
+        assert_eq!(String::from_utf8(text.bytes[..text.end].to_vec()).unwrap(), want);
+        // Just below 2^53 after scaling: integer digits; at 2^53: the shortest form.
+        let mut text = TextBuf::new(1024);
+        for v in [9_007_199_254_740_991.0, 9_007_199_254_740_992.0, 900_719_925_474_099.1] {
+            Fixed::<0>::put(&mut text, v);
+            text.byte(b' ');
+            Fixed::<1>::put(&mut text, v);
+            text.byte(b' ');
+        }
+        let want = "9007199254740991 9007199254740991.0 9007199254740992.0 9007199254740992.0 \
+                    900719925474099 900719925474099.1 ";
+        assert_eq!(String::from_utf8(text.bytes[..text.end].to_vec()).unwrap(), want);
+    }
+}
