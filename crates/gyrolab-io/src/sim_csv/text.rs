@@ -344,7 +344,7 @@ mod tests {
             // Every length of integer, so that the one-word path (below 10^8) is taken often.
             let v = v % 10u64.pow(digits);
             let mut text = TextBuf::new(1024);
-            fixed_any(&mut text, v, decimals, negative);
+            fixed_any(&mut text, v, decimals, negative, None);
             let unit = 10u64.pow(decimals as u32);
             let sign = if negative { "-" } else { "" };
             let want = if decimals == 0 {
@@ -381,8 +381,8 @@ mod tests {
                 let v = if step < 2 { previous + step } else { v % 10u64.pow(digits) };
                 previous = v;
                 let negative = step == 1 && v % 3 == 0;
-                fixed_repeating_any(&mut kept, v, decimals, negative, &mut repeat);
-                fixed_any(&mut each, v, decimals, negative);
+                fixed_any(&mut kept, v, decimals, negative, Some(&mut repeat));
+                fixed_any(&mut each, v, decimals, negative, None);
                 kept.byte(b' ');
                 each.byte(b' ');
             }
@@ -390,50 +390,19 @@ mod tests {
         }
     }
 
-    /// `TextBuf::fixed_repeating` with the number of decimals given at run time.
-    fn fixed_repeating_any(text: &mut TextBuf, v: u64, decimals: usize, negative: bool, repeat: &mut IntegerText) {
-        match decimals {
-            0 => text.fixed_repeating::<0>(v, negative, repeat),
-            1 => text.fixed_repeating::<1>(v, negative, repeat),
-            2 => text.fixed_repeating::<2>(v, negative, repeat),
-            3 => text.fixed_repeating::<3>(v, negative, repeat),
-            4 => text.fixed_repeating::<4>(v, negative, repeat),
-            5 => text.fixed_repeating::<5>(v, negative, repeat),
-            6 => text.fixed_repeating::<6>(v, negative, repeat),
-            7 => text.fixed_repeating::<7>(v, negative, repeat),
-            8 => text.fixed_repeating::<8>(v, negative, repeat),
-            9 => text.fixed_repeating::<9>(v, negative, repeat),
-            10 => text.fixed_repeating::<10>(v, negative, repeat),
-            11 => text.fixed_repeating::<11>(v, negative, repeat),
-            12 => text.fixed_repeating::<12>(v, negative, repeat),
-            13 => text.fixed_repeating::<13>(v, negative, repeat),
-            14 => text.fixed_repeating::<14>(v, negative, repeat),
-            15 => text.fixed_repeating::<15>(v, negative, repeat),
-            _ => panic!("no such test case: {decimals} decimals"),
+    /// `TextBuf::fixed` (or `fixed_repeating` with `repeat`) with D given at run time.
+    fn fixed_any(text: &mut TextBuf, v: u64, decimals: usize, negative: bool, repeat: Option<&mut IntegerText>) {
+        fn put<const D: usize>(text: &mut TextBuf, v: u64, negative: bool, repeat: Option<&mut IntegerText>) {
+            match repeat {
+                Some(r) => text.fixed_repeating::<D>(v, negative, r),
+                None => text.fixed::<D>(v, negative),
+            }
         }
-    }
-
-    /// `TextBuf::fixed` with the number of decimals given at run time.
-    fn fixed_any(text: &mut TextBuf, v: u64, decimals: usize, negative: bool) {
-        match decimals {
-            0 => text.fixed::<0>(v, negative),
-            1 => text.fixed::<1>(v, negative),
-            2 => text.fixed::<2>(v, negative),
-            3 => text.fixed::<3>(v, negative),
-            4 => text.fixed::<4>(v, negative),
-            5 => text.fixed::<5>(v, negative),
-            6 => text.fixed::<6>(v, negative),
-            7 => text.fixed::<7>(v, negative),
-            8 => text.fixed::<8>(v, negative),
-            9 => text.fixed::<9>(v, negative),
-            10 => text.fixed::<10>(v, negative),
-            11 => text.fixed::<11>(v, negative),
-            12 => text.fixed::<12>(v, negative),
-            13 => text.fixed::<13>(v, negative),
-            14 => text.fixed::<14>(v, negative),
-            15 => text.fixed::<15>(v, negative),
-            _ => panic!("no such test case: {decimals} decimals"),
-        }
+        let put = [
+            put::<0>, put::<1>, put::<2>, put::<3>, put::<4>, put::<5>, put::<6>, put::<7>, put::<8>, put::<9>,
+            put::<10>, put::<11>, put::<12>, put::<13>, put::<14>, put::<15>,
+        ];
+        put[decimals](text, v, negative, repeat);
     }
 
     proptest::proptest! {
