@@ -9,7 +9,7 @@
 use std::io::Write;
 use std::time::Instant;
 
-use gyrolab::sim::{Preset, SensorModel, StaticGenerator, StaticSpec};
+use gyrolab::sim::{Preset, SensorModel, StaticBlock, StaticGenerator, StaticSpec};
 use gyrolab_io::sim_csv::{write_static_csv, NumberFormat, SimCsvOptions};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -22,13 +22,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let spec = StaticSpec { sample_rate_hz: 100.0, duration_s: samples as f64 / 100.0, ..StaticSpec::default() };
     let start = Instant::now();
     let (rows, bytes) = if mode == "generate" {
-        let mut acc = 0.0;
+        let mut generator = StaticGenerator::new(&model, &spec, 1)?;
+        let mut block = StaticBlock::default();
         let mut n = 0u64;
-        for s in StaticGenerator::new(&model, &spec, 1)? {
-            acc += s.output;
-            n += 1;
+        while generator.next_block(&mut block, 8192) > 0 {
+            std::hint::black_box(&block);
+            n += block.len() as u64;
         }
-        std::hint::black_box(acc);
         (n, 0)
     } else {
         let number_format = match mode.strip_prefix("fixed").map(str::parse::<u8>) {

@@ -14,7 +14,7 @@
 use std::io::Write;
 
 use gyrolab::sim::{
-    FlickerDesign, RateTableGenerator, RateTableSpec, SensorModel, SimError, StaticGenerator, StaticSample, StaticSpec,
+    FlickerDesign, RateTableGenerator, RateTableSpec, SensorModel, SimError, StaticBlock, StaticGenerator, StaticSpec,
     FLICKER_BAND,
 };
 use gyrolab::units::OutputUnit;
@@ -60,7 +60,7 @@ const FLUSH_AT: usize = 1 << 16;
 mod pipeline;
 mod text;
 
-use text::{with_number_text, Fixed, IntegerText, NumberText, Shortest, TextBuf};
+use text::{with_number_text, CountedTime, Cursor, Fixed, IntegerText, NumberText, Shortest, TextBuf, NUMBER_ROOM};
 
 /// Why a simulated record could not be written.
 #[derive(Debug, Error)]
@@ -211,7 +211,7 @@ fn write_static_csv_as<N: NumberText, W: Write + Send>(
     seed: u64,
     options: &SimCsvOptions,
 ) -> Result<WriteSummary, SimCsvError> {
-    let generator = StaticGenerator::new(model, spec, seed)?;
+    let mut generator = StaticGenerator::new(model, spec, seed)?;
     let mut preamble = TextBuf::new(4096);
     let mut truth = vec![format!("truth.earth_rate_dps = {:?}", generator.earth_rate_dps())];
     truth.extend(generator.flicker_design().map(flicker_comment));
@@ -223,29 +223,85 @@ fn write_static_csv_as<N: NumberText, W: Write + Send>(
         return Ok(pipeline::write_static_parallel::<N, W>(out, generator, preamble)?);
     }
     let mut w = RowWriter::with_text(out, preamble);
+    let mut time = TimeColumn::new::<N>(&generator);
+    let mut block = StaticBlock::default();
     let mut rows = 0u64;
-    let mut time_integer = IntegerText::default();
-    for s in generator {
-        static_row::<N>(&mut w.text, &s, &mut time_integer);
+    while generator.next_block(&mut block, BLOCK_SAMPLES) > 0 {
+        static_rows::<N>(&mut w.text, &block, &mut time);
         w.flush_when_full()?;
-        rows += 1;
+        rows += block.len() as u64;
     }
     let bytes = w.finish()?;
     Ok(WriteSummary { rows, bytes })
 }
 
-/// Appends one row of the static layout (with its newline).
-#[inline]
-fn static_row<N: NumberText>(text: &mut TextBuf, s: &StaticSample, time_integer: &mut IntegerText) {
-    N::put_repeating(text, s.time_s, time_integer);
-    text.byte(b',');
-    N::put(text, s.output);
-    if let Some(t) = s.temp_c {
-        text.byte(b',');
-        N::put(text, t);
-    }
-    text.byte(b'\n');
+/// How the time column of a static record is written: from each sample's index when that gives
+/// exactly the text of its time (see [`CountedTime`]), else from the time itself.
+#[derive(Debug, Clone)]
+enum TimeColumn {
+    /// From the sample index.
+    Counted(CountedTime),
+    /// From `time_s`, the text of its integer part kept while it repeats.
+    Converted(IntegerText),
 }
+
+impl TimeColumn {
+    /// The time column of `generator`'s record (before its first sample) written as `N`.
+    fn new<N: NumberText>(generator: &StaticGenerator) -> TimeColumn {
+        match CountedTime::new(generator.sample_rate_hz(), generator.remaining(), N::DECIMALS) {
+            Some(counted) => TimeColumn::Counted(counted),
+            None => TimeColumn::Converted(IntegerText::default()),
+        }
+    }
+}
+
+/// Room a static row needs: three numbers and their separators.
+const STATIC_ROW_ROOM: usize = 3 * (NUMBER_ROOM + 1);
+/// Rows written per room made.
+const ROWS_PER_ROOM: usize = 256;
+
+/// Appends the rows of `block` in the static layout (each with its newline).
+fn static_rows<N: NumberText>(text: &mut TextBuf, block: &StaticBlock, time: &mut TimeColumn) {
+    match time {
+        TimeColumn::Counted(counted) => {
+            let mut position = counted.position(block.first_index);
+            static_rows_with::<N>(text, block, |text, _| counted.put_and_advance(text, &mut position));
+        }
+        TimeColumn::Converted(repeat) => {
+            static_rows_with::<N>(text, block, |text, i| N::put_repeating(text, block.time_s[i], repeat));
+        }
+    }
+}
+
+/// [`static_rows`] with the time column of row i written by `time(text, i)`.
+#[inline(always)]
+fn static_rows_with<N: NumberText>(
+    text: &mut TextBuf,
+    block: &StaticBlock,
+    mut time: impl FnMut(&mut Cursor<'_>, usize),
+) {
+    let mut start = 0;
+    while start < block.len() {
+        let stop = (start + ROWS_PER_ROOM).min(block.len());
+        text.with_room((stop - start) * STATIC_ROW_ROOM, |text| {
+            for (i, &output) in block.output.iter().enumerate().take(stop).skip(start) {
+                time(text, i);
+                text.byte(b',');
+                N::put(text, output);
+                if block.records_temperature {
+                    text.byte(b',');
+                    N::put(text, block.temp_c[i]);
+                }
+                text.byte(b'\n');
+            }
+        });
+        start = stop;
+    }
+}
+
+/// Room a rate-table row needs: three numbers (the run too), the stroke label (at most 10 bytes)
+/// and the separators.
+const RATE_TABLE_ROW_ROOM: usize = 3 * NUMBER_ROOM + 16;
 
 /// Simulates a rate-table test and writes it in the long layout; returns rows and bytes written.
 pub fn write_rate_table_csv<W: Write>(
@@ -278,17 +334,19 @@ fn write_rate_table_csv_as<N: NumberText, W: Write>(
     w.text.byte(b'\n');
     let mut rows = 0u64;
     for s in generator {
-        N::put(&mut w.text, s.rate_dps);
-        w.text.byte(b',');
-        w.text.unsigned(u64::from(s.run));
-        w.text.byte(b',');
-        w.text.text(s.stroke.label().as_bytes());
-        w.text.byte(b',');
-        N::put(&mut w.text, s.output);
-        if flagged {
-            w.text.text(if s.settling { b",1" } else { b",0" });
-        }
-        w.text.byte(b'\n');
+        w.text.with_room(RATE_TABLE_ROW_ROOM, |text| {
+            N::put(text, s.rate_dps);
+            text.byte(b',');
+            text.integer(u64::from(s.run));
+            text.byte(b',');
+            text.text(s.stroke.label().as_bytes());
+            text.byte(b',');
+            N::put(text, s.output);
+            if flagged {
+                text.text(if s.settling { b",1" } else { b",0" });
+            }
+            text.byte(b'\n');
+        });
         w.flush_when_full()?;
         rows += 1;
     }
@@ -486,5 +544,72 @@ mod tests {
             "[static_record]\ntemperature = { kind = \"constant\", temp_c = 1.0, x = 2 }\n"
         )
         .is_err());
+    }
+}
+
+#[cfg(test)]
+mod time_column_tests {
+    use super::*;
+    use gyrolab::sim::Preset;
+
+    /// The rows of a whole record, its time column written as `time` gives.
+    fn rows<N: NumberText>(spec: &StaticSpec, block_samples: usize, counted: bool) -> (String, bool) {
+        let model = SensorModel::preset(Preset::Adxrs646);
+        let mut generator = StaticGenerator::new(&model, spec, 4).unwrap();
+        let mut time = TimeColumn::new::<N>(&generator);
+        let was_counted = matches!(time, TimeColumn::Counted(_));
+        if !counted {
+            time = TimeColumn::Converted(IntegerText::default());
+        }
+        let mut text = TextBuf::new(0);
+        let mut block = StaticBlock::default();
+        while generator.next_block(&mut block, block_samples) > 0 {
+            static_rows::<N>(&mut text, &block, &mut time);
+        }
+        (String::from_utf8(text.bytes[..text.end].to_vec()).unwrap(), was_counted)
+    }
+
+    fn counted_equals_converted<N: NumberText>(sample_rate_hz: f64, duration_s: f64, counts: bool) {
+        let spec = StaticSpec { sample_rate_hz, duration_s, ..StaticSpec::default() };
+        for block_samples in [1, 7, 4096] {
+            let (counted, was_counted) = rows::<N>(&spec, block_samples, true);
+            let (converted, _) = rows::<N>(&spec, block_samples, false);
+            assert_eq!(was_counted, counts, "{sample_rate_hz} Hz, {:?} decimals", N::DECIMALS);
+            assert_eq!(counted, converted, "{sample_rate_hz} Hz, {:?} decimals", N::DECIMALS);
+        }
+    }
+
+    #[test]
+    fn time_counted_from_the_index_has_the_text_of_the_time_itself() {
+        // Rates that divide 10^D: counted; crossing many whole seconds and block ends.
+        counted_equals_converted::<Fixed<7>>(100.0, 130.0, true);
+        counted_equals_converted::<Fixed<2>>(100.0, 130.0, true);
+        counted_equals_converted::<Fixed<3>>(125.0, 100.0, true);
+        counted_equals_converted::<Fixed<4>>(2000.0, 8.0, true);
+        counted_equals_converted::<Fixed<8>>(256.0, 50.0, true);
+        counted_equals_converted::<Fixed<15>>(1000.0, 1.0, true);
+        // 10^15 x 1.2 s is past 2^50: written from the time itself.
+        counted_equals_converted::<Fixed<15>>(1000.0, 1.2, false);
+        counted_equals_converted::<Fixed<0>>(1.0, 5000.0, true);
+        // Rates that do not: the time itself, written as before.
+        counted_equals_converted::<Fixed<1>>(100.0, 50.0, false);
+        counted_equals_converted::<Fixed<3>>(33.0, 50.0, false);
+        counted_equals_converted::<Fixed<6>>(33.3, 50.0, false);
+        counted_equals_converted::<Shortest>(100.0, 50.0, false);
+    }
+
+    #[test]
+    fn time_is_counted_only_where_exactness_is_proven() {
+        // M = k 10^D / f below 2^50 for the last sample k, and under 10^8 whole seconds.
+        let limit = 1u64 << 50;
+        assert!(CountedTime::new(100.0, limit / 10_000_000, Some(9)).is_some());
+        assert!(CountedTime::new(100.0, limit / 10_000_000 + 2, Some(9)).is_none());
+        assert!(CountedTime::new(100.0, 10_000_000_000, Some(2)).is_some());
+        assert!(CountedTime::new(100.0, 10_000_000_001, Some(2)).is_none());
+        assert!(CountedTime::new(1.0, 100_000_000, Some(0)).is_some());
+        assert!(CountedTime::new(1.0, 100_000_001, Some(0)).is_none());
+        assert!(CountedTime::new(200_000.0, 10, Some(7)).is_none());
+        assert!(CountedTime::new(0.5, 10, Some(7)).is_none());
+        assert!(CountedTime::new(100.0, 10, None).is_none());
     }
 }

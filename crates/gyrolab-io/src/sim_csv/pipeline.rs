@@ -23,10 +23,10 @@ use std::collections::BTreeMap;
 use std::io::Write;
 use std::sync::mpsc::{channel, sync_channel, Receiver, Sender, TrySendError};
 
-use gyrolab::sim::{StaticGenerator, StaticSample};
+use gyrolab::sim::{StaticBlock, StaticGenerator};
 
-use super::text::{IntegerText, NumberText, TextBuf};
-use super::{static_row, WriteSummary, BLOCK_SAMPLES};
+use super::text::{NumberText, TextBuf};
+use super::{static_rows, TimeColumn, WriteSummary, BLOCK_SAMPLES};
 
 /// Text buffers each formatting thread owns at most.
 const TEXT_BUFFERS: usize = 3;
@@ -79,16 +79,14 @@ impl BufferPool {
 fn format_block<N: NumberText>(
     text: &mut TextBuf,
     buffer: Vec<u8>,
-    samples: &[StaticSample],
-    time_integer: &mut IntegerText,
+    samples: &StaticBlock,
+    time: &mut TimeColumn,
     seq: u64,
     owner: Owner,
 ) -> TextBlock {
     text.bytes = buffer;
     text.end = 0;
-    for s in samples {
-        static_row::<N>(text, s, time_integer);
-    }
+    static_rows::<N>(text, samples, time);
     TextBlock { seq, bytes: std::mem::take(&mut text.bytes), len: text.end, owner }
 }
 
@@ -99,8 +97,10 @@ pub(super) fn write_static_parallel<N: NumberText, W: Write + Send>(
     mut generator: StaticGenerator,
     preamble: TextBuf,
 ) -> std::io::Result<WriteSummary> {
-    let (to_formatter, queued) = sync_channel::<(u64, Vec<StaticSample>)>(QUEUED_BLOCKS);
-    let (samples_back, spare_samples) = channel::<Vec<StaticSample>>();
+    let (to_formatter, queued) = sync_channel::<(u64, StaticBlock)>(QUEUED_BLOCKS);
+    let (samples_back, spare_samples) = channel::<StaticBlock>();
+    let time = TimeColumn::new::<N>(&generator);
+    let formatter_time = time.clone();
     let (to_output, formatted) = sync_channel::<TextBlock>(2 * TEXT_BUFFERS + 2);
     let (back_to_simulator, simulator_returned) = channel::<Vec<u8>>();
     let (back_to_formatter, formatter_returned) = channel::<Vec<u8>>();
@@ -110,11 +110,11 @@ pub(super) fn write_static_parallel<N: NumberText, W: Write + Send>(
         scope.spawn(move || {
             let mut pool = BufferPool { returned: formatter_returned, created: 0 };
             let mut text = TextBuf::new(0);
-            let mut time_integer = IntegerText::default();
+            let mut time = formatter_time;
             for (seq, samples) in queued {
                 // None: the output thread stopped (it reports why).
                 let Some(buffer) = pool.take() else { break };
-                let block = format_block::<N>(&mut text, buffer, &samples, &mut time_integer, seq, Owner::Formatter);
+                let block = format_block::<N>(&mut text, buffer, &samples, &mut time, seq, Owner::Formatter);
                 if formatter_output.send(block).is_err() {
                     break;
                 }
@@ -124,21 +124,16 @@ pub(super) fn write_static_parallel<N: NumberText, W: Write + Send>(
         });
         let mut pool = BufferPool { returned: simulator_returned, created: 0 };
         let mut text = TextBuf::new(0);
-        let mut time_integer = IntegerText::default();
+        let mut time = time;
         let mut rows = 0u64;
         let first = TextBlock { seq: 0, len: preamble.end, bytes: preamble.bytes, owner: Owner::Simulator };
         let mut sending = to_output.send(first).is_ok();
         let mut seq = 1;
         // A sample block this thread formatted itself, for reuse.
-        let mut own_spare: Option<Vec<StaticSample>> = None;
+        let mut own_spare: Option<StaticBlock> = None;
         while sending {
-            let mut samples = own_spare
-                .take()
-                .or_else(|| spare_samples.try_recv().ok())
-                .unwrap_or_else(|| Vec::with_capacity(BLOCK_SAMPLES));
-            samples.clear();
-            samples.extend(generator.by_ref().take(BLOCK_SAMPLES));
-            if samples.is_empty() {
+            let mut samples = own_spare.take().or_else(|| spare_samples.try_recv().ok()).unwrap_or_default();
+            if generator.next_block(&mut samples, BLOCK_SAMPLES) == 0 {
                 break;
             }
             rows += samples.len() as u64;
@@ -147,8 +142,7 @@ pub(super) fn write_static_parallel<N: NumberText, W: Write + Send>(
                 Err(TrySendError::Full((seq, samples))) => match pool.try_take() {
                     // The formatter is busy and a buffer is free: format here.
                     Some(buffer) => {
-                        let block =
-                            format_block::<N>(&mut text, buffer, &samples, &mut time_integer, seq, Owner::Simulator);
+                        let block = format_block::<N>(&mut text, buffer, &samples, &mut time, seq, Owner::Simulator);
                         own_spare = Some(samples);
                         to_output.send(block).is_ok()
                     }

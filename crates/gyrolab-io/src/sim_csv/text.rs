@@ -8,9 +8,9 @@
 const POW10: [f64; 16] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15];
 /// Largest magnitude written through the integer path (2^53).
 const EXACT_INT_LIMIT: f64 = 9_007_199_254_740_992.0;
-/// Room made before each number: the longest number text (a sign, 16 digits, a point, 15
+/// Room needed for each number: the longest number text (a sign, 16 digits, a point, 15
 /// decimals; Ryu's at most 24 bytes) plus the 8 bytes a word store may write past its end.
-const NUMBER_ROOM: usize = 48;
+pub(super) const NUMBER_ROOM: usize = 48;
 /// Eight ASCII zeros.
 const ZEROS: u64 = u64::from_le_bytes([b'0'; 8]);
 
@@ -38,72 +38,105 @@ fn leading_zero_digits(digits: u64) -> usize {
     (((digits - ZEROS).trailing_zeros() / 8) as usize).min(7)
 }
 
-/// `x` rounded half away from zero, as `f64::round` (sign of zero included), for |x| < 2^53 (the truncation by an
-/// integer conversion and the difference x - trunc(x) are exact there).
-#[inline(always)]
-fn round_half_away(x: f64) -> f64 {
-    let t = (x as i64 as f64).copysign(x);
-    let d = x - t;
-    if d >= 0.5 {
-        t + 1.0
-    } else if d <= -0.5 {
-        t - 1.0
-    } else {
-        t
-    }
-}
-
-/// Row text under construction: numbers are stored a word (8 bytes) at a time and the end moved
-/// on by their length, so the buffer keeps room to spare past its end.
+/// Text under construction: a buffer that grows as needed, with room to spare past the end
+/// (numbers are stored a word at a time through a [`Cursor`]).
 pub(super) struct TextBuf {
     /// Text in `bytes[..end]`; the rest is room.
     pub(super) bytes: Vec<u8>,
     /// End of the text.
     pub(super) end: usize,
-    ryu: ryu::Buffer,
 }
 
 impl TextBuf {
     /// An empty buffer for about `size` bytes of text.
     pub(super) fn new(size: usize) -> TextBuf {
-        TextBuf { bytes: vec![0; size + 4 * NUMBER_ROOM], end: 0, ryu: ryu::Buffer::new() }
+        TextBuf { bytes: vec![0; size + 4 * NUMBER_ROOM], end: 0 }
     }
 
     /// Makes sure `n` more bytes fit after the end.
     #[inline(always)]
     pub(super) fn make_room(&mut self, n: usize) {
         if self.end + n > self.bytes.len() {
-            self.bytes.resize(self.end + n, 0);
+            self.grow(n);
         }
     }
 
-    /// Appends one byte.
-    #[inline(always)]
-    pub(super) fn byte(&mut self, b: u8) {
-        self.make_room(1);
-        self.bytes[self.end] = b;
-        self.end += 1;
+    /// Room for `n` more bytes, and some: the buffer at least doubles.
+    #[cold]
+    #[inline(never)]
+    fn grow(&mut self, n: usize) {
+        let len = (self.end + n).max(2 * self.bytes.len());
+        self.bytes.resize(len, 0);
     }
 
     /// Appends bytes.
-    #[inline]
     pub(super) fn text(&mut self, s: &[u8]) {
         self.make_room(s.len());
         self.bytes[self.end..self.end + s.len()].copy_from_slice(s);
         self.end += s.len();
     }
 
-    /// Stores the word's eight bytes (lowest first) and keeps the first `len` of them; the caller
-    /// has made room for eight.
+    /// Appends one byte.
+    pub(super) fn byte(&mut self, b: u8) {
+        self.text(&[b]);
+    }
+
+    /// Appends a `# ` comment line per line of `line` (so that no text can end the comment block
+    /// early).
+    pub(super) fn comment(&mut self, line: &str) {
+        for part in line.split('\n') {
+            self.text(b"# ");
+            self.text(part.trim_end_matches('\r').as_bytes());
+            self.byte(b'\n');
+        }
+    }
+
+    /// Makes room for `room` bytes and appends through a cursor (see [`Cursor`]); `write` must
+    /// not write more than that.
+    #[inline(always)]
+    pub(super) fn with_room<R>(&mut self, room: usize, write: impl FnOnce(&mut Cursor<'_>) -> R) -> R {
+        self.make_room(room);
+        let mut cursor = Cursor { bytes: &mut self.bytes, end: self.end };
+        let r = write(&mut cursor);
+        self.end = cursor.end;
+        r
+    }
+}
+
+/// Appends text into a buffer with room made beforehand ([`TextBuf::with_room`]), through a
+/// slice and an end of its own: kept in registers, where a store through `TextBuf`'s own fields
+/// would make the compiler load them again after every byte. Numbers need [`NUMBER_ROOM`] bytes
+/// each, since words are stored whole.
+pub(super) struct Cursor<'a> {
+    bytes: &'a mut [u8],
+    end: usize,
+}
+
+impl Cursor<'_> {
+    /// Appends one byte.
+    #[inline(always)]
+    pub(super) fn byte(&mut self, b: u8) {
+        self.bytes[self.end] = b;
+        self.end += 1;
+    }
+
+    /// Appends bytes.
+    #[inline(always)]
+    pub(super) fn text(&mut self, s: &[u8]) {
+        self.bytes[self.end..self.end + s.len()].copy_from_slice(s);
+        self.end += s.len();
+    }
+
+    /// Stores the word's eight bytes (lowest first) and keeps the first `len` of them.
     #[inline(always)]
     fn word(&mut self, word: u64, len: usize) {
         self.bytes[self.end..self.end + 8].copy_from_slice(&word.to_le_bytes());
         self.end += len;
     }
 
-    /// Appends `n` < 10^16 in decimal, without leading zeros; the caller has made room for 24 bytes.
+    /// Appends `n` < 10^16 in decimal, without leading zeros.
     #[inline(always)]
-    fn integer(&mut self, n: u64) {
+    pub(super) fn integer(&mut self, n: u64) {
         if n < 100_000_000 {
             let digits = eight_digits(n);
             let zeros = leading_zero_digits(digits);
@@ -117,47 +150,18 @@ impl TextBuf {
         }
     }
 
-    /// Appends any u64 in decimal.
-    pub(super) fn unsigned(&mut self, n: u64) {
-        if n < 10_000_000_000_000_000 {
-            self.make_room(NUMBER_ROOM);
-            self.integer(n);
-        } else {
-            self.text(n.to_string().as_bytes());
-        }
-    }
-
-    /// Appends a `# ` comment line per line of `line` (so that no text can end the comment block
-    /// early).
-    pub(super) fn comment(&mut self, line: &str) {
-        for part in line.split('\n') {
-            self.text(b"# ");
-            self.text(part.trim_end_matches('\r').as_bytes());
-            self.byte(b'\n');
-        }
-    }
-
     /// Appends the shortest text that reads back to `v` (Ryu).
     pub(super) fn shortest(&mut self, v: f64) {
-        let s = self.ryu.format(v).as_bytes();
-        if self.end + s.len() > self.bytes.len() {
-            self.bytes.resize(self.end + s.len(), 0);
-        }
-        self.bytes[self.end..self.end + s.len()].copy_from_slice(s);
-        self.end += s.len();
+        self.text(ryu::Buffer::new().format(v).as_bytes());
     }
-}
 
-impl TextBuf {
     /// Appends `m` / 10^D in fixed notation (D digits after the point, at least one before it),
     /// with a minus sign when `negative`; `m` < 10^16, D <= 15.
     #[inline(always)]
     pub(super) fn fixed<const D: usize>(&mut self, m: u64, negative: bool) {
         let unit = const { 10u64.pow(D as u32) };
-        self.make_room(NUMBER_ROOM);
         if negative {
-            self.bytes[self.end] = b'-';
-            self.end += 1;
+            self.byte(b'-');
         }
         if D > 0 && D < 8 && m < 100_000_000 {
             // All digits from one word: the integer part (leading zeros dropped, one kept), the
@@ -165,8 +169,7 @@ impl TextBuf {
             let digits = eight_digits(m);
             let zeros = leading_zero_digits(digits).min(7 - D.min(7));
             self.word(digits >> (8 * zeros), 8 - D - zeros);
-            self.bytes[self.end] = b'.';
-            self.end += 1;
+            self.byte(b'.');
             self.word(digits >> (8 * (8 - D.min(8))), D);
             return;
         }
@@ -174,15 +177,13 @@ impl TextBuf {
         self.fraction::<D>(m % unit);
     }
 
-    /// As [`TextBuf::fixed`], for a column whose integer part often repeats from one row to the
+    /// As [`Cursor::fixed`], for a column whose integer part often repeats from one row to the
     /// next (time stamps: for a whole second): its text is kept in `repeat`.
     #[inline(always)]
     pub(super) fn fixed_repeating<const D: usize>(&mut self, m: u64, negative: bool, repeat: &mut IntegerText) {
         let unit = const { 10u64.pow(D as u32) };
-        self.make_room(NUMBER_ROOM);
         if negative {
-            self.bytes[self.end] = b'-';
-            self.end += 1;
+            self.byte(b'-');
         }
         let integer = m / unit;
         if integer < 100_000_000 {
@@ -198,15 +199,13 @@ impl TextBuf {
         self.fraction::<D>(m % unit);
     }
 
-    /// Appends the point and the D digits of `fraction` < 10^D (nothing for D = 0); the caller
-    /// has made room.
+    /// Appends the point and the D digits of `fraction` < 10^D (nothing for D = 0).
     #[inline(always)]
     fn fraction<const D: usize>(&mut self, fraction: u64) {
         if D == 0 {
             return;
         }
-        self.bytes[self.end] = b'.';
-        self.end += 1;
+        self.byte(b'.');
         if D <= 8 {
             // The last D of eight zero-padded digits (D >= 1: the shift is below 64).
             self.word(eight_digits(fraction) >> (8 * (8 - D.min(8))), D);
@@ -234,15 +233,97 @@ impl Default for IntegerText {
     }
 }
 
+/// The time column of a record whose times all have exact D-decimal texts, written from each
+/// sample's index: the integer part (kept while it repeats) and one of `rate` fraction texts.
+///
+/// Exact, hence the same bytes as writing each f64 time: with an integer sample rate f that
+/// divides 10^D, the time of sample k is M / 10^D with M = k 10^D / f an integer; the f64 time k / f
+/// and its product by 10^D each round once, so the product is within M 2^-52 of M, below 1/4 for
+/// M < 2^50, and rounds to M.
+#[derive(Debug, Clone)]
+pub(super) struct CountedTime {
+    /// Samples per second.
+    rate: u64,
+    /// The point and D digits of the fraction of each sample within a second, 16 bytes each.
+    fractions: Vec<[u8; 16]>,
+    /// Bytes of each fraction text (D + 1; 0 for D = 0).
+    fraction_len: usize,
+    /// Text of the current whole second.
+    second: IntegerText,
+}
+
+/// Largest sample rate with a fraction table (16 bytes a sample of one second).
+const COUNTED_TIME_MAX_RATE: f64 = 100_000.0;
+
+impl CountedTime {
+    /// The counted time column for `samples` samples at `sample_rate_hz` written with `decimals`
+    /// decimals (none for the shortest form), when it is exact (see the type) and the record is
+    /// shorter than 10^8 s; none otherwise.
+    pub(super) fn new(sample_rate_hz: f64, samples: u64, decimals: Option<usize>) -> Option<CountedTime> {
+        let d = decimals?;
+        let ok_rate = (1.0..=COUNTED_TIME_MAX_RATE).contains(&sample_rate_hz) && sample_rate_hz.fract() == 0.0;
+        if !ok_rate || d >= POW10.len() {
+            return None;
+        }
+        let rate = sample_rate_hz as u64;
+        let unit = 10u64.pow(d as u32);
+        if !unit.is_multiple_of(rate) {
+            return None;
+        }
+        let step = unit / rate;
+        let last = samples.saturating_sub(1);
+        if last.checked_mul(step)? >= 1 << 50 || last / rate >= 100_000_000 {
+            return None;
+        }
+        let fractions = (0..rate)
+            .map(|r| {
+                let mut entry = [0u8; 16];
+                if d > 0 {
+                    let text = format!(".{:0d$}", r * step);
+                    entry[..text.len()].copy_from_slice(text.as_bytes());
+                }
+                entry
+            })
+            .collect();
+        let fraction_len = if d > 0 { d + 1 } else { 0 };
+        Some(CountedTime { rate, fractions, fraction_len, second: IntegerText::default() })
+    }
+
+    /// The position (whole second, sample within it) of sample `index`.
+    pub(super) fn position(&self, index: u64) -> (u64, u64) {
+        (index / self.rate, index % self.rate)
+    }
+
+    /// Appends the time at `position` (a number: [`NUMBER_ROOM`] bytes) and moves it on by one
+    /// sample.
+    #[inline(always)]
+    pub(super) fn put_and_advance(&mut self, text: &mut Cursor<'_>, position: &mut (u64, u64)) {
+        let (second, within) = *position;
+        if second != self.second.value {
+            let digits = eight_digits(second);
+            let zeros = leading_zero_digits(digits);
+            self.second = IntegerText { value: second, word: digits >> (8 * zeros), len: 8 - zeros };
+        }
+        text.word(self.second.word, self.second.len);
+        let fraction = &self.fractions[within as usize];
+        text.bytes[text.end..text.end + 16].copy_from_slice(fraction);
+        text.end += self.fraction_len;
+        *position = if within + 1 == self.rate { (second + 1, 0) } else { (second, within + 1) };
+    }
+}
+
 /// How a number column is written (chosen once per record, so that the row loop is compiled for
 /// it; see [`with_number_text`]).
 pub(super) trait NumberText {
-    /// Appends `v`.
-    fn put(text: &mut TextBuf, v: f64);
+    /// Decimals written, or none for the shortest form.
+    const DECIMALS: Option<usize>;
+
+    /// Appends `v` (a number: [`NUMBER_ROOM`] bytes).
+    fn put(text: &mut Cursor<'_>, v: f64);
 
     /// Appends `v` of a column whose integer part often repeats (its text kept in `repeat`).
     #[inline(always)]
-    fn put_repeating(text: &mut TextBuf, v: f64, _repeat: &mut IntegerText) {
+    fn put_repeating(text: &mut Cursor<'_>, v: f64, _repeat: &mut IntegerText) {
         Self::put(text, v);
     }
 }
@@ -251,8 +332,10 @@ pub(super) trait NumberText {
 pub(super) struct Shortest;
 
 impl NumberText for Shortest {
+    const DECIMALS: Option<usize> = None;
+
     #[inline]
-    fn put(text: &mut TextBuf, v: f64) {
+    fn put(text: &mut Cursor<'_>, v: f64) {
         text.shortest(v);
     }
 }
@@ -262,8 +345,10 @@ impl NumberText for Shortest {
 pub(super) struct Fixed<const D: usize>;
 
 impl<const D: usize> NumberText for Fixed<D> {
+    const DECIMALS: Option<usize> = Some(D);
+
     #[inline(always)]
-    fn put(text: &mut TextBuf, v: f64) {
+    fn put(text: &mut Cursor<'_>, v: f64) {
         match Self::scaled(v) {
             Some((m, negative)) => text.fixed::<D>(m, negative),
             None => text.shortest(v),
@@ -271,7 +356,7 @@ impl<const D: usize> NumberText for Fixed<D> {
     }
 
     #[inline(always)]
-    fn put_repeating(text: &mut TextBuf, v: f64, repeat: &mut IntegerText) {
+    fn put_repeating(text: &mut Cursor<'_>, v: f64, repeat: &mut IntegerText) {
         match Self::scaled(v) {
             Some((m, negative)) => text.fixed_repeating::<D>(m, negative, repeat),
             None => text.shortest(v),
@@ -285,16 +370,18 @@ impl<const D: usize> Fixed<D> {
     #[inline(always)]
     fn scaled(v: f64) -> Option<(u64, bool)> {
         let unrounded = v * POW10[D];
-        if unrounded.is_nan() || unrounded.abs() >= EXACT_INT_LIMIT {
+        let magnitude = unrounded.abs();
+        if magnitude.is_nan() || magnitude >= EXACT_INT_LIMIT {
             return None;
         }
-        let scaled = round_half_away(unrounded);
-        if scaled.abs() >= EXACT_INT_LIMIT {
-            return None;
-        }
-        // |scaled| < 2^53, so the conversion to u64 is exact. A negative value that rounds to
-        // zero (-0.0) is written without its sign.
-        Some((scaled.abs() as u64, scaled < 0.0))
+        // Round half away from zero, as `f64::round`: below 2^53 the truncation and the
+        // remainder are exact, and the result stays below 2^53 (from 2^52 on every value is an
+        // integer).
+        // (Through i64: the same values below 2^53, converted by single instructions on x86-64.)
+        let whole = magnitude as i64;
+        let m = (whole + i64::from(magnitude - whole as f64 >= 0.5)) as u64;
+        // A negative value that rounds to zero is written without its sign.
+        Some((m, unrounded < 0.0 && m != 0))
     }
 }
 
@@ -357,10 +444,10 @@ mod tests {
 
         /// Integers by SWAR digits equal the standard formatting, for every length.
         #[test]
-        fn unsigned_equals_standard_formatting(v: u64, digits in 1u32..21) {
-            let v = if digits < 20 { v % 10u64.pow(digits) } else { v };
+        fn integer_equals_standard_formatting(v: u64, digits in 1u32..17) {
+            let v = v % 10u64.pow(digits);
             let mut text = TextBuf::new(1024);
-            text.unsigned(v);
+            text.with_room(NUMBER_ROOM, |c| c.integer(v));
             proptest::prop_assert_eq!(String::from_utf8(text.bytes[..text.end].to_vec()).unwrap(), v.to_string());
         }
     }
@@ -390,13 +477,13 @@ mod tests {
         }
     }
 
-    /// `TextBuf::fixed` (or `fixed_repeating` with `repeat`) with D given at run time.
+    /// `Cursor::fixed` (or `fixed_repeating` with `repeat`) with D given at run time.
     fn fixed_any(text: &mut TextBuf, v: u64, decimals: usize, negative: bool, repeat: Option<&mut IntegerText>) {
         fn put<const D: usize>(text: &mut TextBuf, v: u64, negative: bool, repeat: Option<&mut IntegerText>) {
-            match repeat {
-                Some(r) => text.fixed_repeating::<D>(v, negative, r),
-                None => text.fixed::<D>(v, negative),
-            }
+            text.with_room(NUMBER_ROOM, |c| match repeat {
+                Some(r) => c.fixed_repeating::<D>(v, negative, r),
+                None => c.fixed::<D>(v, negative),
+            });
         }
         let put = [
             put::<0>, put::<1>, put::<2>, put::<3>, put::<4>, put::<5>, put::<6>, put::<7>, put::<8>, put::<9>,
@@ -405,20 +492,70 @@ mod tests {
         put[decimals](text, v, negative, repeat);
     }
 
+    /// `Fixed::<D>::scaled` with D given at run time.
+    fn scaled_any(v: f64, decimals: usize) -> Option<(u64, bool)> {
+        let scaled = [
+            Fixed::<0>::scaled,
+            Fixed::<1>::scaled,
+            Fixed::<2>::scaled,
+            Fixed::<3>::scaled,
+            Fixed::<4>::scaled,
+            Fixed::<5>::scaled,
+            Fixed::<6>::scaled,
+            Fixed::<7>::scaled,
+            Fixed::<8>::scaled,
+            Fixed::<9>::scaled,
+            Fixed::<10>::scaled,
+            Fixed::<11>::scaled,
+            Fixed::<12>::scaled,
+            Fixed::<13>::scaled,
+            Fixed::<14>::scaled,
+            Fixed::<15>::scaled,
+        ];
+        scaled[decimals](v)
+    }
+
+    /// The scaled integer by `f64::round` (half away from zero): none at or above 2^53.
+    fn scaled_by_round(v: f64, decimals: usize) -> Option<(u64, bool)> {
+        let unrounded = v * 10f64.powi(decimals as i32);
+        let r = unrounded.round();
+        (unrounded.abs() < EXACT_INT_LIMIT && r.abs() < EXACT_INT_LIMIT).then(|| (r.abs() as u64, r < 0.0))
+    }
+
     proptest::proptest! {
-        /// Rounding by truncation equals `f64::round` below 2^53.
+        /// Rounding by truncation and remainder equals `f64::round` below 2^53.
         #[test]
-        fn round_half_away_equals_round(x in -9.0e15f64..9.0e15, k in 0i32..6) {
-            let x = x / 10f64.powi(k * 3);
-            proptest::prop_assert_eq!(round_half_away(x).to_bits(), x.round().to_bits(), "{}", x);
+        fn scaled_rounds_as_f64_round(x in -9.0e15f64..9.0e15, k in 0i32..6, decimals in 0usize..16) {
+            let v = x / 10f64.powi(k * 3 + decimals as i32);
+            proptest::prop_assert_eq!(scaled_any(v, decimals), scaled_by_round(v, decimals), "{} at {}", v, decimals);
         }
     }
 
     #[test]
-    fn round_half_away_at_halves() {
-        for x in [0.5, -0.5, 1.5, -2.5, 0.49999999999999994, -0.49999999999999994, 4503599627370495.5, 0.0, -0.0] {
-            assert_eq!(round_half_away(x).to_bits(), x.round().to_bits(), "{x}");
+    fn scaled_at_halves_and_limits() {
+        let values = [
+            0.5,
+            -0.5,
+            1.5,
+            -2.5,
+            0.49999999999999994,
+            -0.49999999999999994,
+            4503599627370495.5,
+            4503599627370496.0,
+            9007199254740991.0,
+            9007199254740992.0,
+            0.0,
+            -0.0,
+            f64::NAN,
+            f64::INFINITY,
+        ];
+        for v in values {
+            assert_eq!(scaled_any(v, 0), scaled_by_round(v, 0), "{v}");
         }
+        assert_eq!(scaled_any(-0.0, 3), Some((0, false)));
+        assert_eq!(scaled_any(-0.03125, 1), Some((0, false)));
+        assert_eq!(scaled_any(-0.1875, 1), Some((2, true)));
+        assert_eq!(scaled_any(-0.25, 1), Some((3, true)));
     }
 
     #[test]
@@ -433,36 +570,43 @@ mod tests {
         }
     }
 
+    /// The values written by `put`, each followed by a space.
+    fn written(values: &[f64], put: fn(&mut Cursor<'_>, f64)) -> String {
+        let mut text = TextBuf::new(0);
+        for &v in values {
+            text.with_room(NUMBER_ROOM + 1, |c| {
+                put(c, v);
+                c.byte(b' ');
+            });
+        }
+        String::from_utf8(text.bytes[..text.end].to_vec()).unwrap()
+    }
+
     #[test]
     fn fixed_decimals_are_rounded_and_padded() {
-        let mut text = TextBuf::new(1024);
-        for v in [2.5, -0.00004, -0.00006, 1.23456, 0.0, 12345.25, 1e300, f64::NAN, -f64::INFINITY] {
-            Fixed::<4>::put(&mut text, v);
-            text.byte(b' ');
-        }
+        let values = [2.5, -0.00004, -0.00006, 1.23456, 0.0, 12345.25, 1e300, f64::NAN, -f64::INFINITY];
         // A negative value that rounds to zero is written without its sign.
         let want = "2.5000 0.0000 -0.0001 1.2346 0.0000 12345.2500 1e300 NaN -inf ";
-        assert_eq!(String::from_utf8(text.bytes[..text.end].to_vec()).unwrap(), want);
-        let mut text = TextBuf::new(1024);
-        for v in [0.005, -0.005, 9.9996, 1234567.0, 99.0] {
-            Fixed::<3>::put(&mut text, v);
-            text.byte(b' ');
-        }
-        text.unsigned(0);
-        text.byte(b' ');
-        text.unsigned(18_446_744_073_709_551_615);
-        let want = "0.005 -0.005 10.000 1234567.000 99.000 0 18446744073709551615";
-        assert_eq!(String::from_utf8(text.bytes[..text.end].to_vec()).unwrap(), want);
+        assert_eq!(written(&values, Fixed::<4>::put), want);
+        let want = "0.005 -0.005 10.000 1234567.000 99.000 ";
+        assert_eq!(written(&[0.005, -0.005, 9.9996, 1234567.0, 99.0], Fixed::<3>::put), want);
         // Just below 2^53 after scaling: integer digits; at 2^53: the shortest form.
-        let mut text = TextBuf::new(1024);
-        for v in [9_007_199_254_740_991.0, 9_007_199_254_740_992.0, 900_719_925_474_099.1] {
-            Fixed::<0>::put(&mut text, v);
-            text.byte(b' ');
-            Fixed::<1>::put(&mut text, v);
-            text.byte(b' ');
+        let values = [9_007_199_254_740_991.0, 9_007_199_254_740_992.0, 900_719_925_474_099.1];
+        assert_eq!(written(&values, Fixed::<0>::put), "9007199254740991 9007199254740992.0 900719925474099 ");
+        let want = "9007199254740991.0 9007199254740992.0 900719925474099.1 ";
+        assert_eq!(written(&values, Fixed::<1>::put), want);
+    }
+
+    #[test]
+    fn the_buffer_grows_past_its_first_size() {
+        let mut text = TextBuf::new(0);
+        for i in 0..10_000u64 {
+            text.with_room(NUMBER_ROOM + 1, |c| {
+                c.integer(i);
+                c.byte(b',');
+            });
         }
-        let want = "9007199254740991 9007199254740991.0 9007199254740992.0 9007199254740992.0 \
-                    900719925474099 900719925474099.1 ";
+        let want: String = (0..10_000).map(|i| format!("{i},")).collect();
         assert_eq!(String::from_utf8(text.bytes[..text.end].to_vec()).unwrap(), want);
     }
 }

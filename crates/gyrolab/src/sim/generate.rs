@@ -11,6 +11,7 @@ use rand_distr::{Distribution, StandardNormal};
 
 use super::flicker::FlickerDesign;
 use super::model::{RateTableSpec, SensorModel, SettlingRows, SimError, StaticSpec, TemperatureProfile};
+use super::normal::NormalStream;
 use super::portable;
 use crate::rate_test::{RateObservation, RestRecord, Stroke};
 use crate::units;
@@ -39,48 +40,111 @@ struct GaussMarkov {
     drive_sigma: f64,
     /// Samples between updates.
     hold: u64,
-    /// Samples until the next update.
-    left: u64,
-    /// Current value, deg/s.
-    state: f64,
+    /// Sample count (samples consumed) at which it is next updated.
+    next_at: u64,
 }
 
-/// The flicker sum: its processes, their current sum and the samples until the next update of
-/// any of them.
+impl GaussMarkov {
+    /// Advances `state` by one hold with the draw `z`.
+    #[inline(always)]
+    fn advance(&mut self, state: &mut f64, z: f64) {
+        *state = self.phi * *state + self.drive_sigma * z;
+        self.next_at = self.next_at.saturating_add(self.hold);
+    }
+}
+
+/// The flicker sum: its first-order Gauss-Markov processes (in design order), their current
+/// values and sum, and the samples until the next update of any of them.
+///
+/// The first process (the fastest in the design) is checked on its own; the others share one
+/// "next update" position, so an update of the first looks at no other process.
 #[derive(Debug, Clone)]
 struct FlickerSum {
+    /// The processes.
     terms: Vec<GaussMarkov>,
-    /// Sum of the current states, deg/s.
+    /// Current value of each process, deg/s, padded with zeros to a multiple of 4 (adding +0.0
+    /// to a sum that starts at +0.0 changes no bit), so that the sum runs four at a time.
+    state: Vec<f64>,
+    /// Earliest `next_at` of the processes after the first (u64::MAX without them).
+    next_at_rest: u64,
+    /// Sample count at the last update.
+    now: u64,
+    /// Samples from the last update to the next.
+    step: u64,
+    /// Sum of the current values, deg/s, added in process order.
     sum: f64,
     /// Samples until the next update (u64::MAX without processes).
     until_update: u64,
-    /// Samples from the previous update to the next.
-    step: u64,
 }
 
 impl FlickerSum {
-    fn new(terms: Vec<GaussMarkov>) -> FlickerSum {
-        let step = terms.iter().map(|g| g.hold).min().unwrap_or(u64::MAX);
-        let sum = terms.iter().map(|g| g.state).sum();
-        FlickerSum { terms, sum, until_update: step, step }
+    /// The sum of processes with the given (phi, drive sigma, hold, initial value).
+    fn new(terms: &[(f64, f64, u64, f64)]) -> FlickerSum {
+        let mut state: Vec<f64> = terms.iter().map(|t| t.3).collect();
+        state.resize(terms.len().div_ceil(4) * 4, 0.0);
+        let mut f = FlickerSum {
+            terms: terms
+                .iter()
+                .map(|&(phi, drive_sigma, hold, _)| GaussMarkov { phi, drive_sigma, hold, next_at: hold })
+                .collect(),
+            state,
+            next_at_rest: u64::MAX,
+            now: 0,
+            step: u64::MAX,
+            sum: 0.0,
+            until_update: u64::MAX,
+        };
+        f.next_at_rest = f.terms.iter().skip(1).map(|g| g.next_at).min().unwrap_or(u64::MAX);
+        f.resum();
+        f.step = f.terms.iter().map(|g| g.next_at).min().unwrap_or(u64::MAX);
+        f.until_update = f.step;
+        f
     }
 
-    /// Advances every process whose hold has run out (in order), then sums them again.
-    fn update(&mut self, noise: &mut NormalBatch) {
-        let mut next = u64::MAX;
+    /// Sums the current values in process order.
+    #[inline(always)]
+    fn resum(&mut self) {
         let mut sum = 0.0;
-        for gm in &mut self.terms {
-            gm.left -= self.step;
-            if gm.left == 0 {
-                gm.state = gm.phi * gm.state + gm.drive_sigma * noise.draw();
-                gm.left = gm.hold;
-            }
-            next = next.min(gm.left);
-            sum += gm.state;
+        for four in self.state.chunks_exact(4) {
+            sum = (((sum + four[0]) + four[1]) + four[2]) + four[3];
         }
         self.sum = sum;
-        self.until_update = next;
-        self.step = next;
+    }
+
+    /// Advances every process whose hold has run out (in process order, one draw each), then
+    /// sums them again.
+    #[inline(never)]
+    fn update(&mut self, noise: &mut NormalBatch) {
+        self.now = self.now.saturating_add(self.step);
+        let now = self.now;
+        let (Some(first), Some(first_state)) = (self.terms.first_mut(), self.state.first_mut()) else {
+            return;
+        };
+        if first.next_at == now {
+            first.advance(first_state, noise.draw());
+        }
+        let mut next = first.next_at;
+        if self.next_at_rest == now {
+            self.advance_rest(noise);
+        }
+        next = next.min(self.next_at_rest);
+        self.resum();
+        self.step = next - now;
+        self.until_update = self.step;
+    }
+
+    /// Advances the processes after the first that are due now, in order; finds the next of
+    /// their updates.
+    #[cold]
+    fn advance_rest(&mut self, noise: &mut NormalBatch) {
+        let mut earliest = u64::MAX;
+        for (gm, state) in self.terms.iter_mut().zip(self.state.iter_mut()).skip(1) {
+            if gm.next_at == self.now {
+                gm.advance(state, noise.draw());
+            }
+            earliest = earliest.min(gm.next_at);
+        }
+        self.next_at_rest = earliest;
     }
 }
 
@@ -123,7 +187,7 @@ struct Engine {
 /// one draw at a time: only the noise in `Engine::sample` draws from this stream).
 #[derive(Debug, Clone)]
 struct NormalBatch {
-    rng: ChaCha8Rng,
+    stream: NormalStream,
     values: Vec<f64>,
     next: usize,
 }
@@ -133,21 +197,27 @@ const NORMAL_BATCH: usize = 4096;
 
 impl NormalBatch {
     fn new(rng: ChaCha8Rng) -> NormalBatch {
-        NormalBatch { rng, values: Vec::new(), next: 0 }
+        NormalBatch { stream: NormalStream::new(rng), values: Vec::new(), next: 0 }
     }
 
     /// The next standard normal draw.
-    #[inline]
+    #[inline(always)]
     fn draw(&mut self) -> f64 {
-        if self.next == self.values.len() {
-            self.values.clear();
-            let rng = &mut self.rng;
-            self.values.extend((0..NORMAL_BATCH).map(|_| -> f64 { StandardNormal.sample(rng) }));
-            self.next = 0;
+        if self.next >= self.values.len() {
+            self.refill();
         }
         let z = self.values[self.next];
         self.next += 1;
         z
+    }
+
+    /// Replaces the spent batch with the next `NORMAL_BATCH` draws.
+    #[cold]
+    #[inline(never)]
+    fn refill(&mut self) {
+        self.values.resize(NORMAL_BATCH, 0.0);
+        self.stream.fill(&mut self.values);
+        self.next = 0;
     }
 }
 
@@ -169,9 +239,9 @@ impl Engine {
                     let phi = portable::exp(-(hold as f64) * dt_s / t);
                     // Start in the stationary distribution, so the record is stationary from t = 0.
                     let state = s * normal(&mut noise);
-                    GaussMarkov { phi, drive_sigma: s * (1.0 - phi * phi).sqrt(), hold, left: hold, state }
+                    (phi, s * (1.0 - phi * phi).sqrt(), hold, state)
                 })
-                .collect();
+                .collect::<Vec<_>>();
             (Some(design), gm)
         } else {
             (None, Vec::new())
@@ -194,7 +264,7 @@ impl Engine {
             run_scale_factor_sigma: units::ppm_to_ratio(model.run_to_run_scale_factor_sigma_ppm),
             white_sigma_dps: units::arw_deg_rt_h_to_sample_sigma_dps(model.arw_deg_rt_h, dt_s),
             flicker,
-            flicker_sum: FlickerSum::new(gauss_markov),
+            flicker_sum: FlickerSum::new(&gauss_markov),
             rrw_sigma_dps: units::rrw_dph_rt_h_to_increment_sigma_dps(model.rrw_deg_h_rt_h, dt_s),
             rrw_state_dps: 0.0,
             ramp_dps_per_s: units::rate_ramp_dph_per_h_to_dps_per_s(model.rate_ramp_dph_per_h),
@@ -223,7 +293,51 @@ impl Engine {
     #[inline]
     fn sample(&mut self, t_s: f64, table_dps: f64, stroke_sign: f64, temp_c: f64) -> f64 {
         let d_temp = temp_c - self.reference_temp_c;
-        // Sensed rate: input + bias terms + noise, deg/s.
+        let noise = self.next_noise();
+        let mut w = self.sensed_rate(t_s, table_dps, stroke_sign, d_temp, noise);
+        if self.angle_step_deg > 0.0 {
+            w = self.quantize_angle(w);
+        }
+        self.output_of(w, self.run_scale_factor_at(d_temp))
+    }
+
+    /// Static samples (table still, no stroke) at times `times_s` and temperatures `temps_c`,
+    /// into `outputs` (as long): the same values as [`Engine::sample`] one at a time, computed in
+    /// two passes (the noise, sequential; then the sensor model, independent from sample to
+    /// sample unless the angle is quantized), with the temperature terms computed once when
+    /// `constant_temp_c` says every temperature is that one.
+    fn static_block(&mut self, times_s: &[f64], temps_c: &[f64], constant_temp_c: Option<f64>, outputs: &mut [f64]) {
+        for o in outputs.iter_mut() {
+            *o = self.next_noise();
+        }
+        let input = self.input_offset_dps(0.0, 0.0);
+        if self.angle_step_deg > 0.0 {
+            for ((o, &t_s), &temp_c) in outputs.iter_mut().zip(times_s).zip(temps_c) {
+                let d_temp = temp_c - self.reference_temp_c;
+                let w = self.quantize_angle(input + self.bias_dps_at(t_s, d_temp) + *o);
+                *o = self.output_stage(self.run_scale_factor_at(d_temp)).output(w);
+            }
+        } else if let Some(temp_c) = constant_temp_c {
+            let d_temp = temp_c - self.reference_temp_c;
+            let bias_base = self.temperature_bias_dps(d_temp);
+            let stage = self.output_stage(self.run_scale_factor_at(d_temp));
+            let ramp = self.ramp_dps_per_s;
+            for (o, &t_s) in outputs.iter_mut().zip(times_s) {
+                *o = stage.output(input + (bias_base + ramp * t_s) + *o);
+            }
+        } else {
+            for ((o, &t_s), &temp_c) in outputs.iter_mut().zip(times_s).zip(temps_c) {
+                let d_temp = temp_c - self.reference_temp_c;
+                let w = input + self.bias_dps_at(t_s, d_temp) + *o;
+                *o = self.output_stage(self.run_scale_factor_at(d_temp)).output(w);
+            }
+        }
+    }
+
+    /// The noise of the next sample (white rate noise, flicker sum, rate random walk), deg/s;
+    /// advances the noise state (draws: white, then any flicker updates, then the random walk).
+    #[inline(always)]
+    fn next_noise(&mut self) -> f64 {
         let mut noise = 0.0;
         if self.white_sigma_dps > 0.0 {
             noise += self.white_sigma_dps * self.noise.draw();
@@ -237,24 +351,105 @@ impl Engine {
             noise += self.rrw_state_dps;
             self.rrw_state_dps += self.rrw_sigma_dps * self.noise.draw();
         }
-        let bias = self.bias_dps + self.run_bias_dps + self.bias_tc_dps_per_c * d_temp + self.ramp_dps_per_s * t_s;
-        let mut w = table_dps + self.earth_dps + stroke_sign * self.hysteresis_half_dps + bias + noise;
-        if self.angle_step_deg > 0.0 {
-            // Angle quantization: emit whole angle steps, carry the remainder (bounded).
-            self.angle_residue_deg += w * self.dt_s;
-            let steps = (self.angle_residue_deg / self.angle_step_deg).floor();
-            self.angle_residue_deg -= steps * self.angle_step_deg;
-            w = steps * self.angle_step_deg / self.dt_s;
+        noise
+    }
+
+    /// The sensed rate, deg/s: input, earth rate, hysteresis offset, bias terms (at time t_s and
+    /// temperature offset d_temp from the reference) and `noise`.
+    #[inline(always)]
+    fn sensed_rate(&self, t_s: f64, table_dps: f64, stroke_sign: f64, d_temp: f64, noise: f64) -> f64 {
+        self.input_offset_dps(table_dps, stroke_sign) + self.bias_dps_at(t_s, d_temp) + noise
+    }
+
+    /// Table rate plus earth rate plus the stroke's hysteresis offset, deg/s.
+    #[inline(always)]
+    fn input_offset_dps(&self, table_dps: f64, stroke_sign: f64) -> f64 {
+        table_dps + self.earth_dps + stroke_sign * self.hysteresis_half_dps
+    }
+
+    /// The bias at time t_s and temperature offset d_temp, deg/s.
+    #[inline(always)]
+    fn bias_dps_at(&self, t_s: f64, d_temp: f64) -> f64 {
+        self.temperature_bias_dps(d_temp) + self.ramp_dps_per_s * t_s
+    }
+
+    /// Constant, run-to-run and temperature bias at temperature offset d_temp, deg/s.
+    #[inline(always)]
+    fn temperature_bias_dps(&self, d_temp: f64) -> f64 {
+        self.bias_dps + self.run_bias_dps + self.bias_tc_dps_per_c * d_temp
+    }
+
+    /// The scale factor of this run at temperature offset d_temp (before asymmetry), output
+    /// units per deg/s.
+    #[inline(always)]
+    fn run_scale_factor_at(&self, d_temp: f64) -> f64 {
+        self.scale_factor
+            * (1.0 + self.scale_factor_error + self.run_scale_factor + self.scale_factor_tc_per_c * d_temp)
+    }
+
+    /// Angle quantization: emits whole angle steps of `w` dt and carries the remainder (bounded);
+    /// returns the rate of the steps emitted, deg/s.
+    #[inline(always)]
+    fn quantize_angle(&mut self, w: f64) -> f64 {
+        self.angle_residue_deg += w * self.dt_s;
+        let steps = (self.angle_residue_deg / self.angle_step_deg).floor();
+        self.angle_residue_deg -= steps * self.angle_step_deg;
+        steps * self.angle_step_deg / self.dt_s
+    }
+
+    /// The output for sensed rate `w` with the run's scale factor `k_run`: asymmetry,
+    /// nonlinearity, null, rails, output quantization.
+    #[inline(always)]
+    fn output_of(&self, w: f64, k_run: f64) -> f64 {
+        self.output_stage(k_run).output(w)
+    }
+
+    /// The output stage for the run's scale factor `k_run`.
+    #[inline(always)]
+    fn output_stage(&self, k_run: f64) -> OutputStage {
+        OutputStage {
+            k_positive: k_run * (1.0 + self.asymmetry_half),
+            k_negative: k_run * (1.0 - self.asymmetry_half),
+            k2: self.k2,
+            k3: self.k3,
+            null: self.null,
+            rail_low: self.rail_low,
+            rail_high: self.rail_high,
+            output_step: self.output_step,
         }
-        let k_run = self.scale_factor
-            * (1.0 + self.scale_factor_error + self.run_scale_factor + self.scale_factor_tc_per_c * d_temp);
-        let k = if w >= 0.0 { k_run * (1.0 + self.asymmetry_half) } else { k_run * (1.0 - self.asymmetry_half) };
+    }
+}
+
+/// The sensor's output stage for one scale factor: from the sensed rate to the output (its
+/// values copied out of the engine, so that a loop over samples keeps them in registers).
+#[derive(Debug, Clone, Copy)]
+struct OutputStage {
+    /// Scale factor for w >= 0 and for w < 0 (asymmetry), output units per deg/s.
+    k_positive: f64,
+    k_negative: f64,
+    /// Quadratic and cubic nonlinearity, 1/(deg/s) and 1/(deg/s)^2.
+    k2: f64,
+    k3: f64,
+    /// Null, rails and quantization step, output units.
+    null: f64,
+    rail_low: f64,
+    rail_high: f64,
+    output_step: f64,
+}
+
+impl OutputStage {
+    /// The output for sensed rate `w`, deg/s: asymmetry, nonlinearity, null, rails, output
+    /// quantization.
+    #[inline(always)]
+    fn output(&self, w: f64) -> f64 {
+        let k = if w >= 0.0 { self.k_positive } else { self.k_negative };
         let nonlinear = w * (1.0 + w * (self.k2 + w * self.k3));
-        let mut out = (self.null + k * nonlinear).clamp(self.rail_low, self.rail_high);
+        let out = (self.null + k * nonlinear).clamp(self.rail_low, self.rail_high);
         if self.output_step > 0.0 {
-            out = (out / self.output_step).round() * self.output_step;
+            (out / self.output_step).round() * self.output_step
+        } else {
+            out
         }
-        out
     }
 }
 
@@ -314,6 +509,71 @@ impl StaticGenerator {
     /// Samples still to come.
     pub fn remaining(&self) -> u64 {
         self.count - self.index
+    }
+
+    /// The sample rate, Hz.
+    pub fn sample_rate_hz(&self) -> f64 {
+        self.sample_rate_hz
+    }
+
+    /// Replaces `block` with the next samples, at most `max_samples` of them (the same values as
+    /// the iterator, faster); returns how many (0 at the end of the record).
+    pub fn next_block(&mut self, block: &mut StaticBlock, max_samples: usize) -> usize {
+        let n = usize::try_from(self.remaining()).map_or(max_samples, |r| r.min(max_samples));
+        let first = self.index;
+        block.first_index = first;
+        // (Resized, not cleared: a block of the same length as before is written over in place.)
+        block.time_s.resize(n, 0.0);
+        for (t, i) in block.time_s.iter_mut().zip(first..) {
+            // Sample indices stay far below 2^63: the signed conversion is exact and cheaper.
+            *t = i as i64 as f64 / self.sample_rate_hz;
+        }
+        self.temperature.temps_at(&block.time_s, &mut block.temp_c);
+        let constant_temp_c = match self.temperature {
+            TemperatureProfile::Constant { temp_c } => Some(temp_c),
+            _ => None,
+        };
+        block.output.resize(n, 0.0);
+        self.engine.static_block(&block.time_s, &block.temp_c, constant_temp_c, &mut block.output);
+        block.records_temperature = self.record_temperature;
+        self.index += n as u64;
+        n
+    }
+}
+
+/// A block of consecutive static samples, in columns (see [`StaticGenerator::next_block`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct StaticBlock {
+    /// Index of the first sample in the record (0 for the record's first sample).
+    pub first_index: u64,
+    /// Time from the record start of each sample, s.
+    pub time_s: Vec<f64>,
+    /// Gyro output of each sample, in the model's output unit.
+    pub output: Vec<f64>,
+    /// Sensor temperature at each sample, degC (kept whether or not the record carries it).
+    pub temp_c: Vec<f64>,
+    /// Whether the record carries the temperature (a `temp_c` column).
+    pub records_temperature: bool,
+}
+
+impl StaticBlock {
+    /// Number of samples in the block.
+    pub fn len(&self) -> usize {
+        self.output.len()
+    }
+
+    /// Whether the block holds no samples.
+    pub fn is_empty(&self) -> bool {
+        self.output.is_empty()
+    }
+
+    /// Sample `i` of the block, as the iterator yields it.
+    pub fn sample(&self, i: usize) -> StaticSample {
+        StaticSample {
+            time_s: self.time_s[i],
+            output: self.output[i],
+            temp_c: self.records_temperature.then_some(self.temp_c[i]),
+        }
     }
 }
 

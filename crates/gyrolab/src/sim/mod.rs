@@ -30,6 +30,7 @@
 mod flicker;
 mod generate;
 mod model;
+mod normal;
 mod portable;
 mod raw_log;
 #[cfg(test)]
@@ -37,7 +38,8 @@ mod tests;
 
 pub use flicker::{FlickerDesign, FLICKER_ADEV_FACTOR, FLICKER_BAND, FLICKER_MIN_TAU_SAMPLES};
 pub use generate::{
-    collect_rate_test, RateTableGenerator, RateTableSample, SimStroke, SimulatedRateTest, StaticGenerator, StaticSample,
+    collect_rate_test, RateTableGenerator, RateTableSample, SimStroke, SimulatedRateTest, StaticBlock, StaticGenerator,
+    StaticSample,
 };
 pub use model::{
     ParameterText, Preset, RateTableSpec, SensorModel, SensorOverrides, SettlingRows, SimConfig, SimError, StaticSpec,

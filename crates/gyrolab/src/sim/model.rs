@@ -431,6 +431,16 @@ impl TemperatureProfile {
         }
     }
 
+    /// Replaces `temps_c` with the temperature at each of `times_s` (the values of
+    /// [`TemperatureProfile::temp_at`]), degC.
+    pub fn temps_at(&self, times_s: &[f64], temps_c: &mut Vec<f64>) {
+        temps_c.clear();
+        match self {
+            TemperatureProfile::Constant { temp_c } => temps_c.resize(times_s.len(), *temp_c),
+            _ => temps_c.extend(times_s.iter().map(|&t| self.temp_at(t))),
+        }
+    }
+
     /// Checks the profile's values (finite; steps in strictly increasing time, at or after 0).
     pub fn validate(&self) -> Result<(), SimError> {
         match self {

@@ -364,3 +364,57 @@ fn presets_validate_and_overrides_replace_fields() {
     assert_eq!(cfg.sensor_model().scale_factor_error_ppm, 500.0);
     assert!(m.parameter_lines().iter().any(|(k, v)| *k == "arw_deg_rt_h" && v == "1.5"));
 }
+
+#[test]
+fn blocks_give_the_samples_of_the_iterator() {
+    // Every term of the model that the block path computes in its own passes: all noises, bias
+    // ramp and temperature terms, earth rate, nonlinearity, asymmetry, rails, both quantizations.
+    let full = SensorModel {
+        bias_dph: 30.0,
+        rate_ramp_dph_per_h: 50.0,
+        bias_temp_coeff_dph_per_c: 2.0,
+        scale_factor_temp_coeff_ppm_per_c: 40.0,
+        scale_factor_asymmetry_ppm: 300.0,
+        nonlinearity_quadratic_per_dps: 1e-4,
+        nonlinearity_cubic_per_dps2: -1e-6,
+        rrw_deg_h_rt_h: 20.0,
+        ..SensorModel::preset(Preset::Adxrs646)
+    };
+    let models = [
+        full.clone(),
+        SensorModel { output_quantization_step: 1e-3, ..full.clone() },
+        SensorModel { angle_quantization_deg: 1e-3, ..full.clone() },
+        SensorModel { output_rail_high: Some(2.5004), ..full },
+        SensorModel { arw_deg_rt_h: 0.0, rrw_deg_h_rt_h: 0.0, ..ideal() },
+    ];
+    let temperatures = [
+        TemperatureProfile::default(),
+        TemperatureProfile::Ramp { start_c: 20.0, rate_c_per_h: 30.0 },
+        TemperatureProfile::Steps { start_c: 20.0, steps: vec![TemperatureStep { at_s: 7.3, temp_c: 45.0 }] },
+    ];
+    for (m, model) in models.iter().enumerate() {
+        for (t, temperature) in temperatures.iter().enumerate() {
+            let spec = StaticSpec {
+                temperature: temperature.clone(),
+                latitude_deg: Some(40.0),
+                record_temperature: t > 0,
+                ..static_spec(100.0, 20.0)
+            };
+            let one_by_one: Vec<StaticSample> = StaticGenerator::new(model, &spec, 5).unwrap().collect();
+            for block_size in [1, 7, 256, 5000] {
+                let mut generator = StaticGenerator::new(model, &spec, 5).unwrap();
+                let mut block = StaticBlock::default();
+                let mut from_blocks = Vec::new();
+                while generator.next_block(&mut block, block_size) > 0 {
+                    assert_eq!(block.first_index, from_blocks.len() as u64);
+                    from_blocks.extend((0..block.len()).map(|i| block.sample(i)));
+                }
+                assert_eq!(from_blocks.len(), 2000);
+                for (i, (a, b)) in from_blocks.iter().zip(&one_by_one).enumerate() {
+                    let bits = |s: &StaticSample| (s.time_s.to_bits(), s.output.to_bits(), s.temp_c.map(f64::to_bits));
+                    assert_eq!(bits(a), bits(b), "model {m}, temperature {t}, blocks of {block_size}, sample {i}");
+                }
+            }
+        }
+    }
+}
