@@ -3,43 +3,67 @@
 # formatting and writing alone on one thread, both on two threads) and the command itself writing
 # a file, against the output's own speed: dd copying the same bytes, and dd writing as many bytes
 # from /dev/zero (both flushed to disk, as the command does).
-# Usage: bash bench/sim_speed.sh [SAMPLES (default 100000000)] [WORK_DIR (default /tmp/gyrolab-bench)]
+# Each run is repeated (the rounds alternate between the rows, so that a slow minute of a shared
+# machine does not fall on one row only); the table gives the median and the range of wall times.
+# Usage: bash bench/sim_speed.sh [SAMPLES (default 100000000)] [WORK_DIR (default /tmp/gyrolab-bench)] [ROUNDS (default 3)]
 # The record is `time_s,output_v` at 100 Hz with 7 decimals (ADXRS646 preset), about 25 bytes a line.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 N=${1:-100000000}
 DIR=${2:-/tmp/gyrolab-bench}
+ROUNDS=${3:-3}
 mkdir -p "$DIR"
 cargo build --release -q -p gyrolab-cli
 cargo build --release -q -p gyrolab-io --example sim_speed
 EX=target/release/examples/sim_speed
 F="$DIR/sim_$N.csv"
+COPY="$DIR/copy.csv"
 DUR=$(awk "BEGIN { printf \"%.2f\", $N / 100 }")
-printf '%-52s %9s %9s %9s %12s %9s\n' "run" "wall s" "CPU s" "MB/s" "samples/s" "peak MB"
-row() { # label wall user+sys peak_kb bytes
-    awk -v l="$1" -v w="$2" -v u="$3" -v m="$4" -v b="$5" -v n="$N" \
-        'BEGIN { printf "%-52s %9.2f %9.2f %9.1f %12.3g %9.1f\n", l, w, u, b / w / 1e6, n / w, m / 1024 }'
+LABELS=(
+    "gyrolab simulate static --decimals 7 --out F"
+    "simulation only (no text)"
+    "simulate + format + write, one thread, > /dev/null"
+    "simulate + format + write, two threads, > /dev/null"
+    "disk: dd the same bytes to a file (fdatasync)"
+    "disk: dd as many bytes from /dev/zero (fdatasync)"
+)
+simulate() {
+    rm -f "$F"
+    target/release/gyrolab simulate static --preset adxrs646 --sample-rate-hz 100 --duration-s "$DUR" \
+        --decimals 7 --seed 1 --out "$F"
 }
-timed() { # label bytes command...
-    local label=$1 bytes=$2
-    shift 2
-    /usr/bin/time -f "%e %U %S %M" -o "$DIR/sim.time" "$@" > /dev/null 2> /dev/null
-    read -r w u s m < "$DIR/sim.time"
-    row "$label" "$w" "$(awk -v u="$u" -v s="$s" 'BEGIN { print u + s }')" "$m" "$bytes"
+run_row() { # row index; the file F exists (rows 1 to 5)
+    case $1 in
+        0) simulate ;;
+        1) "$EX" "$N" adxrs646 generate ;;
+        2) "$EX" "$N" adxrs646 fixed7 ;;
+        3) "$EX" "$N" adxrs646 fixed7 pipelined ;;
+        4) dd if="$F" of="$COPY" bs=4M conv=fdatasync ;;
+        5) dd if=/dev/zero of="$COPY" bs=256K count=$((BYTES / 262144)) conv=fdatasync ;;
+    esac
 }
-rm -f "$F"
-/usr/bin/time -f "%e %U %S %M" -o "$DIR/sim.time" target/release/gyrolab simulate static --preset adxrs646 \
-    --sample-rate-hz 100 --duration-s "$DUR" --decimals 7 --seed 1 --out "$F"
+simulate
 BYTES=$(stat -c %s "$F")
-read -r w u s m < "$DIR/sim.time"
-row "gyrolab simulate static --decimals 7 --out F" "$w" "$(awk -v u="$u" -v s="$s" 'BEGIN { print u + s }')" "$m" "$BYTES"
-timed "simulation only (no text)" "$BYTES" "$EX" "$N" adxrs646 generate
-timed "simulate + format + write, one thread, > /dev/null" "$BYTES" "$EX" "$N" adxrs646 fixed7
-timed "simulate + format + write, two threads, > /dev/null" "$BYTES" "$EX" "$N" adxrs646 fixed7 pipelined
-timed "disk: dd the same bytes to a file (fdatasync)" "$BYTES" dd if="$F" of="$DIR/copy.csv" bs=4M conv=fdatasync
-rm -f "$DIR/copy.csv"
-# The output alone: as many zero bytes written from memory (no reading), then flushed to disk.
-timed "disk: dd as many bytes from /dev/zero (fdatasync)" "$BYTES" dd if=/dev/zero of="$DIR/copy.csv" bs=256K \
-    count=$((BYTES / 262144)) conv=fdatasync
-rm -f "$DIR/copy.csv"
-echo "file: $F ($BYTES bytes, $N samples); cores: $(nproc); load average: $(cut -d' ' -f1-3 /proc/loadavg)"
+: > "$DIR/sim.times"
+for round in $(seq "$ROUNDS"); do
+    for row in 0 1 2 3 4 5; do
+        /usr/bin/time -f "$row %e %U %S %M" -a -o "$DIR/sim.times" bash -c "$(declare -f simulate run_row); \
+            F='$F' COPY='$COPY' EX='$EX' N='$N' DUR='$DUR' BYTES='$BYTES'; run_row $row" > /dev/null 2> /dev/null
+        rm -f "$COPY"
+    done
+    echo "round $round of $ROUNDS done" >&2
+done
+printf '%-52s %9s %15s %9s %9s %12s %9s\n' "run" "wall s" "(range)" "CPU s" "MB/s" "samples/s" "peak MB"
+for row in 0 1 2 3 4 5; do
+    awk -v r="$row" -v l="${LABELS[$row]}" -v b="$BYTES" -v n="$N" '
+        $1 == r { w[++k] = $2; c[k] = $3 + $4; m[k] = $5 }
+        END {
+            # Median by wall time (insertion sort of the few rounds), with its own CPU time.
+            for (i = 2; i <= k; i++) for (j = i; j > 1 && w[j - 1] > w[j]; j--) {
+                t = w[j]; w[j] = w[j - 1]; w[j - 1] = t; t = c[j]; c[j] = c[j - 1]; c[j - 1] = t
+            }
+            h = int((k + 1) / 2)
+            printf "%-52s %9.2f %6.2f - %6.2f %9.2f %9.1f %12.3g %9.1f\n", l, w[h], w[1], w[k], c[h], b / w[h] / 1e6, n / w[h], m[1] / 1024
+        }' "$DIR/sim.times"
+done
+echo "file: $F ($BYTES bytes, $N samples); $ROUNDS rounds; cores: $(nproc); load average: $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -18,7 +18,7 @@
 //! by `seed_from_u64`, stream 0 for per-sample noise and stream 1 for run-to-run draws. Gaussian
 //! draws are `rand_distr`'s `StandardNormal` (the core of its `Normal`): a ziggurat whose tables
 //! are compiled-in constants, so a returned value is the product of a uniform and a table entry in
-//! all but the tail case. Remaining risk: the ziggurat's wedge test calls `exp` (a last-bit
+//! all but the tail case (per-sample draws are made in bulk by `normal`, value for value the same). Remaining risk: the ziggurat's wedge test calls `exp` (a last-bit
 //! difference could flip an accept/reject decision only when the uniform falls within about one
 //! ulp of the density, probability ~1e-16 per wedge draw) and its tail (|z| > 3.65, about 3 in
 //! 10 000 draws) computes the value with `ln`, so a platform whose libm `ln` differs in the last
