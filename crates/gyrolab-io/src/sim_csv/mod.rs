@@ -602,7 +602,8 @@ mod time_column_tests {
     fn time_is_counted_only_where_exactness_is_proven() {
         // M = k 10^D / f below 2^50 for the last sample k, and under 10^8 whole seconds.
         let limit = 1u64 << 50;
-        assert!(CountedTime::new(100.0, limit / 10_000_000, Some(9)).is_some());
+        // q = floor(2^50 / 10^7): q samples end at (q - 1) 10^7, q + 1 at q 10^7 < 2^50, q + 2 past it.
+        assert!(CountedTime::new(100.0, limit / 10_000_000 + 1, Some(9)).is_some());
         assert!(CountedTime::new(100.0, limit / 10_000_000 + 2, Some(9)).is_none());
         assert!(CountedTime::new(100.0, 10_000_000_000, Some(2)).is_some());
         assert!(CountedTime::new(100.0, 10_000_000_001, Some(2)).is_none());

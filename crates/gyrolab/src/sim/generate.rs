@@ -517,7 +517,8 @@ impl StaticGenerator {
     }
 
     /// Replaces `block` with the next samples, at most `max_samples` of them (the same values as
-    /// the iterator, faster); returns how many (0 at the end of the record).
+    /// the iterator, faster); returns how many (0 at the end of the record, or when
+    /// `max_samples` is 0).
     pub fn next_block(&mut self, block: &mut StaticBlock, max_samples: usize) -> usize {
         let n = usize::try_from(self.remaining()).map_or(max_samples, |r| r.min(max_samples));
         let first = self.index;

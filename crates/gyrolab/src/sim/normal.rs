@@ -234,6 +234,29 @@ mod tests {
     }
 
     #[test]
+    fn hand_offs_past_the_words_read_ahead_go_on_with_the_stream() {
+        // The last word read ahead is one rand_distr does not accept at once: layer 0 with u
+        // near 1 (the tail: two or more further words) or layer 100 with u near 1 (the wedge
+        // test: one or more further words). Layer 5 with u = 0 is accepted at once (value 0).
+        let near_one = ((1u64 << 52) - 1) << 12;
+        let accepted = ((1u64 << 51) << 12) | 5;
+        for last in [near_one, near_one | 100] {
+            let mut rng = ChaCha8Rng::seed_from_u64(5);
+            let mut bulk = NormalStream::new(rng.clone());
+            bulk.words = vec![accepted, last];
+            bulk.next = 0;
+            let mut drawn = vec![0.0; 50];
+            bulk.fill(&mut drawn);
+            let read_ahead = [accepted, last];
+            let mut reference = WordsThenStream { words: &read_ahead, used: 0, rng: &mut rng };
+            let want: Vec<f64> = (0..50).map(|_| StandardNormal.sample(&mut reference)).collect();
+            assert!(reference.used > 3, "the hand-off took words from the stream");
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+            assert_eq!(bits(&drawn), bits(&want), "last word {last:#x}");
+        }
+    }
+
+    #[test]
     fn layer_widths_are_read_for_every_layer_below_the_top() {
         let layers = layers();
         // X_1 is the ziggurat's tail start r = 3.654152885361008796 (Marsaglia & Tsang, 256 layers).

@@ -209,6 +209,55 @@ fn held_flicker_processes_change_only_at_their_updates() {
 }
 
 #[test]
+fn flicker_sum_follows_the_held_recursion_computed_apart() {
+    // Flicker only, unit scale factor, null 0: each output is the flicker sum itself. Reference:
+    // the documented recursion written out here (METHODS.md section 4): initial states s z from
+    // stream 0 of the seed in process order; after sample count n, every process whose hold
+    // divides n, in process order, x <- phi x + s sqrt(1 - phi^2) z with phi = exp(-k dt / T).
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+    for (tau_min_s, duration_s) in [(7.5, 60.0), (10.0, 4000.0)] {
+        let model = SensorModel {
+            bias_instability_dph: 10.0,
+            flicker_tau_min_s: tau_min_s,
+            flicker_tau_max_s: 100.0 * tau_min_s,
+            ..ideal()
+        };
+        let generator = StaticGenerator::new(&model, &static_spec(100.0, duration_s), 11).unwrap();
+        let design = generator.flicker_design().unwrap().clone();
+        let outputs: Vec<f64> = generator.map(|s| s.output).collect();
+        let holds = design.hold_samples(0.01);
+        let s = design.sigma_each_dps;
+        let phis: Vec<f64> = design
+            .correlation_times_s
+            .iter()
+            .zip(&holds)
+            .map(|(&t, &k)| portable::exp(-(k as f64) * 0.01 / t))
+            .collect();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        rng.set_stream(0);
+        let mut states: Vec<f64> = phis
+            .iter()
+            .map(|_| {
+                let z: f64 = StandardNormal.sample(&mut rng);
+                s * z
+            })
+            .collect();
+        for (n, &out) in outputs.iter().enumerate() {
+            let sum = states.iter().fold(0.0, |acc, &x| acc + x);
+            assert_eq!(out.to_bits(), sum.to_bits(), "tau_min {tau_min_s} s, sample {n}");
+            let count = n as u64 + 1;
+            for ((x, &phi), &k) in states.iter_mut().zip(&phis).zip(&holds) {
+                if count.is_multiple_of(k) {
+                    let z: f64 = StandardNormal.sample(&mut rng);
+                    *x = phi * *x + s * (1.0 - phi * phi).sqrt() * z;
+                }
+            }
+        }
+    }
+}
+
+#[test]
 fn run_to_run_bias_has_the_stated_spread() {
     // Noise-free sensor, one sample per plateau: the 0 deg/s output of each run is its run bias.
     let model = SensorModel { run_to_run_bias_sigma_dph: 36.0, ..ideal() };
