@@ -262,20 +262,31 @@ const ROWS_PER_ROOM: usize = 256;
 
 /// Appends the rows of `block` in the static layout (each with its newline).
 fn static_rows<N: NumberText>(text: &mut TextBuf, block: &StaticBlock, time: &mut TimeColumn) {
-    match time {
-        TimeColumn::Counted(counted) => {
-            let mut position = counted.position(block.first_index);
-            static_rows_with::<N>(text, block, |text, _| counted.put_and_advance(text, &mut position));
+    match (time, block.records_temperature) {
+        (TimeColumn::Counted(counted), temperature) => {
+            counted.start_at(block.first_index);
+            let time = |text: &mut Cursor<'_>, _| counted.put_and_advance(text);
+            if temperature {
+                static_rows_with::<N, true>(text, block, time);
+            } else {
+                static_rows_with::<N, false>(text, block, time);
+            }
         }
-        TimeColumn::Converted(repeat) => {
-            static_rows_with::<N>(text, block, |text, i| N::put_repeating(text, block.time_s[i], repeat));
+        (TimeColumn::Converted(repeat), temperature) => {
+            let time = |text: &mut Cursor<'_>, i: usize| N::put_repeating(text, block.time_s[i], repeat);
+            if temperature {
+                static_rows_with::<N, true>(text, block, time);
+            } else {
+                static_rows_with::<N, false>(text, block, time);
+            }
         }
     }
 }
 
-/// [`static_rows`] with the time column of row i written by `time(text, i)`.
+/// [`static_rows`] with the time column of row i written by `time(text, i)`, and the
+/// temperature column when `TEMPERATURE`.
 #[inline(always)]
-fn static_rows_with<N: NumberText>(
+fn static_rows_with<N: NumberText, const TEMPERATURE: bool>(
     text: &mut TextBuf,
     block: &StaticBlock,
     mut time: impl FnMut(&mut Cursor<'_>, usize),
@@ -288,7 +299,7 @@ fn static_rows_with<N: NumberText>(
                 time(text, i);
                 text.byte(b',');
                 N::put(text, output);
-                if block.records_temperature {
+                if TEMPERATURE {
                     text.byte(b',');
                     N::put(text, block.temp_c[i]);
                 }

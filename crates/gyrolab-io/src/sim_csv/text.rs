@@ -248,8 +248,10 @@ pub(super) struct CountedTime {
     fractions: Vec<[u8; 16]>,
     /// Bytes of each fraction text (D + 1; 0 for D = 0).
     fraction_len: usize,
-    /// Text of the current whole second.
+    /// Text of the current whole second (below 10^8).
     second: IntegerText,
+    /// The current sample within the second.
+    within: usize,
 }
 
 /// Largest sample rate with a fraction table (16 bytes a sample of one second).
@@ -286,29 +288,37 @@ impl CountedTime {
             })
             .collect();
         let fraction_len = if d > 0 { d + 1 } else { 0 };
-        Some(CountedTime { rate, fractions, fraction_len, second: IntegerText::default() })
+        let mut counted = CountedTime { rate, fractions, fraction_len, second: IntegerText::default(), within: 0 };
+        counted.start_at(0);
+        Some(counted)
     }
 
-    /// The position (whole second, sample within it) of sample `index`.
-    pub(super) fn position(&self, index: u64) -> (u64, u64) {
-        (index / self.rate, index % self.rate)
+    /// Moves to sample `index` (the next one written).
+    pub(super) fn start_at(&mut self, index: u64) {
+        self.set_second(index / self.rate);
+        self.within = (index % self.rate) as usize;
     }
 
-    /// Appends the time at `position` (a number: [`NUMBER_ROOM`] bytes) and moves it on by one
-    /// sample.
+    /// Makes `second` the current whole second, with its text.
+    fn set_second(&mut self, second: u64) {
+        let digits = eight_digits(second);
+        let zeros = leading_zero_digits(digits);
+        self.second = IntegerText { value: second, word: digits >> (8 * zeros), len: 8 - zeros };
+    }
+
+    /// Appends the time of the current sample (a number: [`NUMBER_ROOM`] bytes) and moves on to
+    /// the next sample.
     #[inline(always)]
-    pub(super) fn put_and_advance(&mut self, text: &mut Cursor<'_>, position: &mut (u64, u64)) {
-        let (second, within) = *position;
-        if second != self.second.value {
-            let digits = eight_digits(second);
-            let zeros = leading_zero_digits(digits);
-            self.second = IntegerText { value: second, word: digits >> (8 * zeros), len: 8 - zeros };
-        }
+    pub(super) fn put_and_advance(&mut self, text: &mut Cursor<'_>) {
         text.word(self.second.word, self.second.len);
-        let fraction = &self.fractions[within as usize];
+        let fraction = &self.fractions[self.within];
         text.bytes[text.end..text.end + 16].copy_from_slice(fraction);
         text.end += self.fraction_len;
-        *position = if within + 1 == self.rate { (second + 1, 0) } else { (second, within + 1) };
+        self.within += 1;
+        if self.within == self.fractions.len() {
+            self.within = 0;
+            self.set_second(self.second.value + 1);
+        }
     }
 }
 
