@@ -262,29 +262,29 @@ const ROWS_PER_ROOM: usize = 256;
 
 /// Appends the rows of `block` in the static layout (each with its newline).
 fn static_rows<N: NumberText>(text: &mut TextBuf, block: &StaticBlock, time: &mut TimeColumn) {
-    match (time, block.records_temperature) {
-        (TimeColumn::Counted(counted), temperature) => {
+    match time {
+        TimeColumn::Counted(counted) => {
             counted.start_at(block.first_index);
-            let time = |text: &mut Cursor<'_>, _| counted.put_and_advance(text);
-            if temperature {
-                static_rows_with::<N, true>(text, block, time);
-            } else {
-                static_rows_with::<N, false>(text, block, time);
-            }
+            static_rows_timed::<N>(text, block, |text, _| counted.put_and_advance(text));
         }
-        (TimeColumn::Converted(repeat), temperature) => {
-            let time = |text: &mut Cursor<'_>, i: usize| N::put_repeating(text, block.time_s[i], repeat);
-            if temperature {
-                static_rows_with::<N, true>(text, block, time);
-            } else {
-                static_rows_with::<N, false>(text, block, time);
-            }
+        TimeColumn::Converted(repeat) => {
+            static_rows_timed::<N>(text, block, |text, i| N::put_repeating(text, block.time_s[i], repeat));
         }
     }
 }
 
-/// [`static_rows`] with the time column of row i written by `time(text, i)`, and the
-/// temperature column when `TEMPERATURE`.
+/// [`static_rows`] with the time column of row i written by `time(text, i)`: the row loop
+/// compiled with or without the temperature column.
+#[inline(always)]
+fn static_rows_timed<N: NumberText>(text: &mut TextBuf, block: &StaticBlock, time: impl FnMut(&mut Cursor<'_>, usize)) {
+    if block.records_temperature {
+        static_rows_with::<N, true>(text, block, time);
+    } else {
+        static_rows_with::<N, false>(text, block, time);
+    }
+}
+
+/// [`static_rows_timed`] for one layout: the temperature column when `TEMPERATURE`.
 #[inline(always)]
 fn static_rows_with<N: NumberText, const TEMPERATURE: bool>(
     text: &mut TextBuf,

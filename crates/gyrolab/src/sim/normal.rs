@@ -73,6 +73,14 @@ fn layer_width(i: usize) -> f64 {
     }
 }
 
+/// Fills `dest` with the little-endian bytes of `rng`'s next words (as a block generator does).
+fn fill_by_words(rng: &mut impl RngCore, dest: &mut [u8]) {
+    for chunk in dest.chunks_mut(8) {
+        let w = rng.next_u64().to_le_bytes();
+        chunk.copy_from_slice(&w[..chunk.len()]);
+    }
+}
+
 /// A generator that returns one given word, then words accepted at once (layer 0, u = 0: the
 /// value 0), and counts the words taken.
 struct OneWord {
@@ -96,10 +104,7 @@ impl RngCore for OneWord {
     }
 
     fn fill_bytes(&mut self, dest: &mut [u8]) {
-        for chunk in dest.chunks_mut(8) {
-            let w = self.next_u64().to_le_bytes();
-            chunk.copy_from_slice(&w[..chunk.len()]);
-        }
+        fill_by_words(self, dest);
     }
 
     fn try_fill_bytes(&mut self, dest: &mut [u8]) -> Result<(), rand::Error> {
@@ -191,10 +196,7 @@ impl RngCore for WordsThenStream<'_> {
     }
 
     fn fill_bytes(&mut self, dest: &mut [u8]) {
-        for chunk in dest.chunks_mut(8) {
-            let w = self.next_u64().to_le_bytes();
-            chunk.copy_from_slice(&w[..chunk.len()]);
-        }
+        fill_by_words(self, dest);
     }
 
     fn try_fill_bytes(&mut self, dest: &mut [u8]) -> Result<(), rand::Error> {
