@@ -123,13 +123,12 @@ impl FlickerSum {
         if first.next_at == now {
             first.advance(first_state, noise.draw());
         }
-        let mut next = first.next_at;
+        let next_first = first.next_at;
         if self.next_at_rest == now {
             self.advance_rest(noise);
         }
-        next = next.min(self.next_at_rest);
         self.resum();
-        self.step = next - now;
+        self.step = next_first.min(self.next_at_rest) - now;
         self.until_update = self.step;
     }
 
