@@ -1,8 +1,17 @@
 //! Writing output files whole or not at all: write to a temporary file beside the target, then
 //! rename it into place.
+//!
+//! A long output also asks the kernel to start writing each finished 32 MiB to disk while the
+//! program goes on producing the rest (Linux `sync_file_range(2)` with `SYNC_FILE_RANGE_WRITE`, a
+//! hint that does not wait for the data to reach the disk). Without it the whole file waits in
+//! the page cache until the final `fsync`, which then writes it all with nothing left to overlap.
 
+use std::fs::File;
 use std::io::Write;
 use std::path::Path;
+
+/// Bytes written between two requests to start write-back.
+const WRITEBACK_CHUNK: u64 = 32 << 20;
 
 /// Writes `bytes` to `path` atomically (temporary file in the same folder, then rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
@@ -27,7 +36,8 @@ pub fn write_atomic_with(
         tmp.as_file().set_permissions(std::fs::Permissions::from_mode(0o644))?;
     }
     {
-        let mut w = std::io::BufWriter::with_capacity(1 << 16, tmp.as_file());
+        let file = EarlyWriteback::new(tmp.as_file(), WRITEBACK_CHUNK, start_writeback);
+        let mut w = std::io::BufWriter::with_capacity(1 << 16, file);
         fill(&mut w)?;
         w.flush()?;
     }
@@ -36,9 +46,120 @@ pub fn write_atomic_with(
     Ok(())
 }
 
+/// A file written from its start that asks for write-back of every finished `chunk` bytes by
+/// `request(file, offset, len)` (see the module documentation): each request covers the bytes
+/// written since the last one, once they are at least `chunk`.
+struct EarlyWriteback<'a, R: FnMut(&File, u64, u64)> {
+    /// The file, empty when this starts.
+    file: &'a File,
+    /// Bytes between two requests, at the least.
+    chunk: u64,
+    /// Asks for write-back of a range of the file.
+    request: R,
+    /// Bytes written.
+    written: u64,
+    /// Bytes for which write-back has been requested.
+    requested: u64,
+}
+
+impl<'a, R: FnMut(&File, u64, u64)> EarlyWriteback<'a, R> {
+    /// The writer of the empty `file`, asking for write-back every `chunk` bytes by `request`.
+    fn new(file: &'a File, chunk: u64, request: R) -> EarlyWriteback<'a, R> {
+        EarlyWriteback { file, chunk, request, written: 0, requested: 0 }
+    }
+}
+
+impl<R: FnMut(&File, u64, u64)> Write for EarlyWriteback<'_, R> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let n = self.file.write(buf)?;
+        self.written += n as u64;
+        if self.written - self.requested >= self.chunk {
+            (self.request)(self.file, self.requested, self.written - self.requested);
+            self.requested = self.written;
+        }
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.file.flush()
+    }
+}
+
+/// Asks the kernel to start writing `len` bytes from `offset` of `file` to disk, without waiting
+/// for them to get there. A hint: if the file system declines, the final `fsync` does the work
+/// (and reports any write error), so the result is ignored.
+#[cfg(target_os = "linux")]
+fn start_writeback(file: &File, offset: u64, len: u64) {
+    use std::os::fd::AsRawFd;
+    let (Ok(offset), Ok(len)) = (i64::try_from(offset), i64::try_from(len)) else { return };
+    // SAFETY: `file` keeps the descriptor open for the call, which reads no memory of ours.
+    unsafe {
+        libc::sync_file_range(file.as_raw_fd(), offset, len, libc::SYNC_FILE_RANGE_WRITE);
+    }
+}
+
+/// Elsewhere the final `fsync` writes everything.
+#[cfg(not(target_os = "linux"))]
+fn start_writeback(_file: &File, _offset: u64, _len: u64) {}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Writes `pieces` through an [`EarlyWriteback`] asking every `chunk` bytes (through a
+    /// `BufWriter` of `buffer` bytes when given); returns the file's bytes and the requests.
+    fn write_recording(pieces: &[Vec<u8>], chunk: u64, buffer: Option<usize>) -> (Vec<u8>, Vec<(u64, u64)>) {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("out.txt");
+        let file = File::create(&p).unwrap();
+        let mut requests = Vec::new();
+        {
+            let w = EarlyWriteback::new(&file, chunk, |_: &File, offset, len| requests.push((offset, len)));
+            let mut w: Box<dyn Write> = match buffer {
+                Some(b) => Box::new(std::io::BufWriter::with_capacity(b, w)),
+                None => Box::new(w),
+            };
+            for piece in pieces {
+                w.write_all(piece).unwrap();
+            }
+            w.flush().unwrap();
+        }
+        drop(file);
+        (std::fs::read(&p).unwrap(), requests)
+    }
+
+    #[test]
+    fn early_writeback_writes_every_byte_and_asks_for_each_finished_chunk() {
+        // Pieces of 0 to 6 bytes, and (for the buffered case) some longer than the buffer.
+        let pieces: Vec<Vec<u8>> =
+            (0u8..60).map(|i| vec![b'a' + i % 26; usize::from(i % 7) * (1 + usize::from(i % 5 == 4) * 9)]).collect();
+        let want: Vec<u8> = pieces.concat();
+        for buffer in [None, Some(8)] {
+            let (written, requests) = write_recording(&pieces, 10, buffer);
+            assert_eq!(written, want, "buffer {buffer:?}");
+            // The requests follow each other from the start, each at least a chunk long, and
+            // leave less than a chunk unrequested at the end.
+            let mut next = 0;
+            for &(offset, len) in &requests {
+                assert_eq!(offset, next, "{requests:?}");
+                assert!(len >= 10, "{requests:?}");
+                next = offset + len;
+            }
+            assert!(want.len() as u64 - next < 10, "{requests:?} of {}", want.len());
+        }
+        // Without a buffer each request ends at the first piece boundary that completes a chunk.
+        let (_, requests) = write_recording(&pieces, 10, None);
+        let mut ends = Vec::new();
+        let (mut end, mut last) = (0u64, 0u64);
+        for piece in &pieces {
+            end += piece.len() as u64;
+            if end - last >= 10 {
+                ends.push(end);
+                last = end;
+            }
+        }
+        assert_eq!(requests.iter().map(|r| r.0 + r.1).collect::<Vec<_>>(), ends);
+    }
 
     #[test]
     fn failed_write_leaves_no_file() {
