@@ -321,8 +321,16 @@ impl Engine {
             let bias_base = self.temperature_bias_dps(d_temp);
             let stage = self.output_stage(self.run_scale_factor_at(d_temp));
             let ramp = self.ramp_dps_per_s;
-            for (o, &t_s) in outputs.iter_mut().zip(times_s) {
-                *o = stage.output(input + (bias_base + ramp * t_s) + *o);
+            // Two loops, so that the one without output quantization (no rounding call) is
+            // vectorized.
+            if stage.output_step > 0.0 {
+                for (o, &t_s) in outputs.iter_mut().zip(times_s) {
+                    *o = stage.output(input + (bias_base + ramp * t_s) + *o);
+                }
+            } else {
+                for (o, &t_s) in outputs.iter_mut().zip(times_s) {
+                    *o = stage.unquantized(input + (bias_base + ramp * t_s) + *o);
+                }
             }
         } else {
             for ((o, &t_s), &temp_c) in outputs.iter_mut().zip(times_s).zip(temps_c) {
@@ -437,13 +445,20 @@ struct OutputStage {
 }
 
 impl OutputStage {
+    /// The output for sensed rate `w`, deg/s, before output quantization: asymmetry,
+    /// nonlinearity, null, rails.
+    #[inline(always)]
+    fn unquantized(&self, w: f64) -> f64 {
+        let k = if w >= 0.0 { self.k_positive } else { self.k_negative };
+        let nonlinear = w * (1.0 + w * (self.k2 + w * self.k3));
+        (self.null + k * nonlinear).clamp(self.rail_low, self.rail_high)
+    }
+
     /// The output for sensed rate `w`, deg/s: asymmetry, nonlinearity, null, rails, output
     /// quantization.
     #[inline(always)]
     fn output(&self, w: f64) -> f64 {
-        let k = if w >= 0.0 { self.k_positive } else { self.k_negative };
-        let nonlinear = w * (1.0 + w * (self.k2 + w * self.k3));
-        let out = (self.null + k * nonlinear).clamp(self.rail_low, self.rail_high);
+        let out = self.unquantized(w);
         if self.output_step > 0.0 {
             (out / self.output_step).round() * self.output_step
         } else {
