@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Benchmark of `gyrolab simulate static` on a long record: where the time goes (simulation alone,
 # formatting and writing alone on one thread, both on two threads) and the command itself writing
-# a file, against the output's own speed: dd copying the same bytes, and dd writing as many bytes
-# from /dev/zero (both flushed to disk, as the command does).
+# a file, against the output's own speed: gyrolab's file writer alone writing as many bytes from
+# memory (the command's output side with nothing to compute), dd copying the same bytes, and dd
+# writing as many bytes from /dev/zero (all flushed to disk, as the command does).
 # Each run is repeated (the rounds alternate between the rows, so that a slow minute of a shared
 # machine does not fall on one row only); the table gives the median and the range of wall times.
 # Usage: bash bench/sim_speed.sh [SAMPLES (default 100000000)] [WORK_DIR (default /tmp/gyrolab-bench)] [ROUNDS (default 3)]
@@ -14,8 +15,9 @@ DIR=${2:-/tmp/gyrolab-bench}
 ROUNDS=${3:-3}
 mkdir -p "$DIR"
 cargo build --release -q -p gyrolab-cli
-cargo build --release -q -p gyrolab-io --example sim_speed
+cargo build --release -q -p gyrolab-io --example sim_speed --example write_speed
 EX=target/release/examples/sim_speed
+WX=target/release/examples/write_speed
 F="$DIR/sim_$N.csv"
 COPY="$DIR/copy.csv"
 DUR=$(awk "BEGIN { printf \"%.2f\", $N / 100 }")
@@ -24,37 +26,39 @@ LABELS=(
     "simulation only (no text)"
     "simulate + format + write, one thread, > /dev/null"
     "simulate + format + write, two threads, > /dev/null"
-    "disk: dd the same bytes to a file (fdatasync)"
-    "disk: dd as many bytes from /dev/zero (fdatasync)"
+    "output alone: gyrolab's file writer, bytes from memory"
+    "output: dd the same bytes to a file (fdatasync)"
+    "output: dd as many bytes from /dev/zero (fdatasync)"
 )
-simulate() {
-    rm -f "$F"
+simulate() { # the record, into the file $1 (which does not exist)
     target/release/gyrolab simulate static --preset adxrs646 --sample-rate-hz 100 --duration-s "$DUR" \
-        --decimals 7 --seed 1 --out "$F"
+        --decimals 7 --seed 1 --out "$1"
 }
-run_row() { # row index; the file F exists (rows 1 to 5)
+run_row() { # row index; the file F exists and COPY does not (every row writes COPY but 1 to 3)
     case $1 in
-        0) simulate ;;
+        0) simulate "$COPY" ;;
         1) "$EX" "$N" adxrs646 generate ;;
         2) "$EX" "$N" adxrs646 fixed7 ;;
         3) "$EX" "$N" adxrs646 fixed7 pipelined ;;
-        4) dd if="$F" of="$COPY" bs=4M conv=fdatasync ;;
-        5) dd if=/dev/zero of="$COPY" bs=256K count=$((BYTES / 262144)) conv=fdatasync ;;
+        4) "$WX" "$F" "$COPY" "$BYTES" ;;
+        5) dd if="$F" of="$COPY" bs=4M conv=fdatasync ;;
+        6) dd if=/dev/zero of="$COPY" bs=256K count=$((BYTES / 262144)) conv=fdatasync ;;
     esac
 }
-simulate
+rm -f "$F" "$COPY"
+simulate "$F"
 BYTES=$(stat -c %s "$F")
 : > "$DIR/sim.times"
 for round in $(seq "$ROUNDS"); do
-    for row in 0 1 2 3 4 5; do
+    for row in 0 1 2 3 4 5 6; do
         /usr/bin/time -f "$row %e %U %S %M" -a -o "$DIR/sim.times" bash -c "$(declare -f simulate run_row); \
-            F='$F' COPY='$COPY' EX='$EX' N='$N' DUR='$DUR' BYTES='$BYTES'; run_row $row" > /dev/null 2> /dev/null
+            F='$F' COPY='$COPY' EX='$EX' WX='$WX' N='$N' DUR='$DUR' BYTES='$BYTES'; run_row $row" > /dev/null 2> /dev/null
         rm -f "$COPY"
     done
     echo "round $round of $ROUNDS done" >&2
 done
 printf '%-52s %9s %15s %9s %9s %12s %9s\n' "run" "wall s" "(range)" "CPU s" "MB/s" "samples/s" "peak MB"
-for row in 0 1 2 3 4 5; do
+for row in 0 1 2 3 4 5 6; do
     awk -v r="$row" -v l="${LABELS[$row]}" -v b="$BYTES" -v n="$N" '
         $1 == r { w[++k] = $2; c[k] = $3 + $4; m[k] = $5 }
         END {
