@@ -2,20 +2,21 @@
 //! 0 success; 1 an internal or output failure; 2 bad usage or bad data (a plan error included);
 //! 3 a spec limit failed (`gyrolab eval`: every output was written, the report shows FAIL).
 
-use gyrolab_io::DataError;
-use std::fmt;
+use gyrolab_eval::EvalError;
 use std::process::ExitCode;
+use thiserror::Error;
 
 /// A failure that ends the program.
-#[derive(Debug)]
+#[derive(Debug, Error)]
 pub enum CliError {
-    /// Bad input data (exit 2).
-    Data(DataError),
-    /// Bad usage: options that contradict each other or are out of range (exit 2).
-    Usage(String),
+    /// The evaluation failed: bad data or options (exit 2), or an output it could not make (exit 1).
+    #[error("{}", .0.render(&flag))]
+    Eval(#[from] EvalError),
     /// Could not write an output (exit 1).
+    #[error("{0}")]
     Output(String),
     /// The evaluation succeeded and its outputs were written, but a spec limit failed (exit 3).
+    #[error("{0}")]
     LimitFailed(String),
 }
 
@@ -23,27 +24,42 @@ impl CliError {
     /// The process exit code for this error.
     pub fn exit_code(&self) -> ExitCode {
         match self {
-            CliError::Data(_) | CliError::Usage(_) => ExitCode::from(2),
-            CliError::Output(_) => ExitCode::from(1),
+            CliError::Eval(EvalError::Output(_)) | CliError::Output(_) => ExitCode::from(1),
+            CliError::Eval(_) => ExitCode::from(2),
             CliError::LimitFailed(_) => ExitCode::from(3),
         }
     }
 }
 
-impl fmt::Display for CliError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            CliError::Data(e) => write!(f, "{e}"),
-            CliError::Usage(m) => write!(f, "{m}"),
-            CliError::Output(m) => write!(f, "{m}"),
-            CliError::LimitFailed(m) => write!(f, "{m}"),
-        }
+impl From<gyrolab_io::DataError> for CliError {
+    fn from(e: gyrolab_io::DataError) -> Self {
+        CliError::Eval(EvalError::Data(e))
     }
 }
 
-impl From<DataError> for CliError {
-    fn from(e: DataError) -> Self {
-        CliError::Data(e)
+impl From<gyrolab::validate::InvalidOption> for CliError {
+    fn from(e: gyrolab::validate::InvalidOption) -> Self {
+        CliError::Eval(EvalError::Invalid(e))
+    }
+}
+
+/// The command-line spelling of a request field: its flag.
+pub fn flag(field: &str) -> String {
+    match field {
+        "axis_names" => "--axis".into(),
+        "columns" => "--column".into(),
+        "manual_segments" => "--segments".into(),
+        "calibration" => "--cal".into(),
+        "calibration_axis" => "--cal-axis".into(),
+        "latitude_deg" => "--latitude".into(),
+        "smoothing_s" => "--smoothing".into(),
+        "fit_range_s" => "--fit-range".into(),
+        "nonlinearity_limit_pct" => "--nonlinearity-limit".into(),
+        "temperature_quadratic" => "--temp-quadratic".into(),
+        "triad_x" => "--triad x=FILE".into(),
+        "triad_y" => "--triad y=FILE".into(),
+        "triad_z" => "--triad z=FILE".into(),
+        other => format!("--{}", other.replace('_', "-")),
     }
 }
 

@@ -1,10 +1,17 @@
-//! The `gyrolab` command-line program: parses arguments, calls the library crates, prints.
+//! The `gyrolab` command-line program: parses arguments into requests, calls `gyrolab-eval`,
+//! prints, and sets the exit code. No domain logic lives here.
+//!
+//! Layout: `cmd/` one module per subcommand (none imports another); [`args`] argument types
+//! shared by several commands; [`error`] exit codes and the flag of each request field;
+//! [`output`] standard output and atomic files; [`folder`] report folders; [`progress`] the
+//! terminal progress bar.
 
+mod args;
 mod cmd;
 mod error;
+mod folder;
 mod output;
-mod paper_data;
-mod reference;
+mod progress;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -29,7 +36,7 @@ enum Command {
     Apply(Box<cmd::apply::ApplyArgs>),
     /// Plan a test: the record length needed to measure a noise term to a stated precision.
     #[command(subcommand)]
-    Plan(cmd::plan::PlanCommand),
+    Plan(cmd::record_length::PlanCommand),
     /// Simulate records with known truth (static, rate-table) in the layouts gyrolab reads.
     #[command(subcommand)]
     Simulate(cmd::simulate::SimulateCommand),
@@ -49,7 +56,7 @@ fn main() -> ExitCode {
         Command::Allan(a) => cmd::allan::run(a),
         Command::Apply(a) => cmd::apply::run(a),
         Command::Simulate(c) => cmd::simulate::run(c),
-        Command::Plan(c) => cmd::plan::run(c),
+        Command::Plan(c) => cmd::record_length::run(c),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

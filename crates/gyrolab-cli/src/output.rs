@@ -1,8 +1,10 @@
-//! Writing results: to standard output (a closed pipe is not an error) or atomically to a file.
+//! Writing results: to standard output (a closed pipe is not an error) or atomically to a file
+//! or a report folder.
 
 use crate::error::{CliError, CliResult};
+use gyrolab_eval::report_folder::NamedOutput;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Prints text to standard output; a closed pipe (`| head`) ends quietly.
 pub fn print(text: &str) -> CliResult {
@@ -18,6 +20,14 @@ pub fn print(text: &str) -> CliResult {
 pub fn write_file(path: &Path, bytes: &[u8]) -> CliResult {
     gyrolab_io::atomic::write_atomic(path, bytes)
         .map_err(|e| CliError::Output(format!("{}: cannot write the file: {e}", path.display())))
+}
+
+/// Writes a report folder: every output to a temporary file first, then all renamed into place,
+/// so that a failure leaves the folder as it was. Returns the paths written, in order.
+pub fn write_folder(dir: &Path, outputs: &[NamedOutput]) -> CliResult<Vec<PathBuf>> {
+    let files: Vec<(&str, &[u8])> = outputs.iter().map(|o| (o.name.as_str(), &o.bytes[..])).collect();
+    gyrolab_io::atomic::write_folder(dir, &files)
+        .map_err(|(path, e)| CliError::Output(format!("{}: cannot write the file: {e}", path.display())))
 }
 
 /// Serialises a value as pretty JSON with a final newline.

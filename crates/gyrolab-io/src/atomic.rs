@@ -8,7 +8,7 @@
 
 use std::fs::File;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Bytes written between two requests to start write-back.
 const WRITEBACK_CHUNK: u64 = 32 << 20;
@@ -44,6 +44,39 @@ pub fn write_atomic_with(
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
+}
+
+/// Writes a folder of files all or nothing as far as a file system allows: creates `dir`, writes
+/// every file to a temporary file inside it (fsynced), and only when all are written renames
+/// them into place, in order. A failure before the renames leaves the folder as it was (the
+/// temporaries are removed); the error names the file it is about.
+pub fn write_folder(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>, (PathBuf, std::io::Error)> {
+    std::fs::create_dir_all(dir).map_err(|e| (dir.to_path_buf(), e))?;
+    let mut staged = Vec::with_capacity(files.len());
+    for (name, bytes) in files {
+        let path = dir.join(name);
+        if Path::new(name).file_name() != Some(std::ffi::OsStr::new(name)) {
+            return Err((path, std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a plain file name")));
+        }
+        let stage = || -> std::io::Result<tempfile::NamedTempFile> {
+            let mut tmp = tempfile::Builder::new().prefix(".gyrolab-").suffix(".tmp").tempfile_in(dir)?;
+            #[cfg(unix)]
+            {
+                use std::os::unix::fs::PermissionsExt;
+                tmp.as_file().set_permissions(std::fs::Permissions::from_mode(0o644))?;
+            }
+            tmp.write_all(bytes)?;
+            tmp.as_file().sync_all()?;
+            Ok(tmp)
+        };
+        staged.push((stage().map_err(|e| (path.clone(), e))?, path));
+    }
+    let mut written = Vec::with_capacity(staged.len());
+    for (tmp, path) in staged {
+        tmp.persist(&path).map_err(|e| (path.clone(), e.error))?;
+        written.push(path);
+    }
+    Ok(written)
 }
 
 /// A file written from its start that asks for write-back of every finished `chunk` bytes by
@@ -179,5 +212,20 @@ mod tests {
             use std::os::unix::fs::PermissionsExt;
             assert_eq!(std::fs::metadata(&p).unwrap().permissions().mode() & 0o777, 0o644);
         }
+    }
+
+    #[test]
+    fn a_folder_is_written_whole_or_left_as_it_was() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("report");
+        let written = super::write_folder(&out, &[("a.txt", b"one"), ("b.txt", b"two")]).unwrap();
+        assert_eq!(written, [out.join("a.txt"), out.join("b.txt")]);
+        assert_eq!(std::fs::read(out.join("b.txt")).unwrap(), b"two");
+        // A bad name among the files: nothing is replaced, no temporary is left.
+        let e = super::write_folder(&out, &[("a.txt", b"new"), ("x/y.txt", b"bad")]).unwrap_err();
+        assert_eq!(e.0, out.join("x/y.txt"));
+        assert_eq!(std::fs::read(out.join("a.txt")).unwrap(), b"one");
+        let names: Vec<_> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names.len(), 2, "{names:?}");
     }
 }

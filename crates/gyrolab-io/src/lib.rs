@@ -10,7 +10,7 @@
 //! - [`decimal`]: exact fast reading of plain decimal numbers and rows of them;
 //! - [`series`]: streaming reader of time-series files, and the static test of a file;
 //! - [`sim_csv`]: fast CSV writer for simulated static records and rate-table tests;
-//! - [`plan`]: test plans (TOML) for `gyrolab eval`.
+//! - [`test_plan`]: test plans (TOML) for `gyrolab eval`.
 
 pub mod apply_csv;
 pub mod atomic;
@@ -24,4 +24,4 @@ pub mod sim_csv;
 pub mod text;
 
 pub use error::DataError;
-pub mod plan;
+pub mod test_plan;

@@ -11,6 +11,7 @@
 //! - [`segments`]: segmentation summaries of raw rate-table logs;
 //! - [`triad`]: three-axis calibration tables and JSON;
 //! - [`paper`]: the paper's printed tables beside the recomputation, for `gyrolab demo`;
+//! - [`tables_csv`]: the CSV tables of a report folder (points, runs, summary);
 //! - [`format`]: number formatting.
 
 pub mod allan;
@@ -26,4 +27,5 @@ pub mod rate_plots;
 pub mod results;
 pub mod segments;
 pub mod static_report;
+pub mod tables_csv;
 pub mod triad;

@@ -8,12 +8,14 @@
 //! - [`noise`]: IEEE 952 noise terms (ARW, bias instability, RRW, ...) from an Allan curve;
 //! - [`rate_test`]: rate-table (scale-factor) test figures;
 //! - [`static_test`]: static (bias) test figures, accumulated block by block;
-//! - [`plan`]: test planning: record length for a noise term's precision;
+//! - [`record_length`]: test planning: record length for a noise term's precision;
 //! - [`published`]: comparison with figures printed in a publication;
 //! - [`sim`]: gyro simulator with known truth (static records, rate-table tests);
 //! - [`segment`]: plateaus, strokes and runs found in raw rate-table logs;
 //! - [`triad`]: three-axis scale-factor, misalignment and bias calibration (12 parameters);
 //! - [`apply`]: calibrations applied to output samples (output to rate);
+//! - [`sampling`]: the sampling interval of a record from its time stamps (one estimator);
+//! - [`validate`]: validators of option values (errors name the request field);
 //! - [`window_means`]: streaming means of consecutive windows (bias time series).
 //!
 //! Formulas and their sources are listed in `docs/METHODS.md`.
@@ -22,12 +24,14 @@ pub mod allan;
 pub mod apply;
 pub mod fit;
 pub mod noise;
-pub mod plan;
 pub mod published;
 pub mod rate_test;
+pub mod record_length;
+pub mod sampling;
 pub mod segment;
 pub mod sim;
 pub mod static_test;
 pub mod triad;
 pub mod units;
+pub mod validate;
 pub mod window_means;

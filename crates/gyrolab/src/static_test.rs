@@ -20,6 +20,7 @@
 //! sample rate is given).
 
 use crate::fit::{self, FitError};
+use crate::sampling::SampleRateSource;
 use crate::units::{self, OutputUnit};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -358,8 +359,8 @@ pub struct StaticTestResult {
     pub valid_samples: u64,
     /// Sample rate used, Hz.
     pub sample_rate_hz: f64,
-    /// "given" or "estimated from the median time interval".
-    pub sample_rate_source: String,
+    /// Where the sample rate came from.
+    pub sample_rate_source: SampleRateSource,
     /// Span of the record, seconds (last minus first valid time).
     pub duration_s: f64,
     /// Zero-rate output mean F (paper Table 5), output units.
@@ -895,16 +896,13 @@ impl StaticTestAccumulator {
         if p.output.is_empty() {
             return Ok(());
         }
-        let mut dts: Vec<f64> = p.time.windows(2).map(|w| w[1] - w[0]).filter(|d| d.is_finite() && *d > 0.0).collect();
-        if dts.is_empty() {
-            return Err(StaticTestError::SampleRateUnknown(format!(
+        let estimate = crate::sampling::estimate_interval(&p.time).map_err(|_| {
+            StaticTestError::SampleRateUnknown(format!(
                 "no increasing time stamps among the first {} samples; give sample_rate_hz",
                 p.output.len()
-            )));
-        }
-        dts.sort_by(f64::total_cmp);
-        let median = dts[dts.len() / 2];
-        self.set_rate(1.0 / median);
+            ))
+        })?;
+        self.set_rate(estimate.rate_hz());
         let block = SampleBlock {
             output: &p.output,
             time_s: Some(&p.time),
@@ -1395,7 +1393,7 @@ impl StaticTestAccumulator {
             samples: self.samples,
             valid_samples: valid,
             sample_rate_hz: fs,
-            sample_rate_source: if self.fs_given { "given" } else { "estimated from the median time interval" }.into(),
+            sample_rate_source: if self.fs_given { SampleRateSource::Given } else { SampleRateSource::TimeStamps },
             duration_s: self.last_time - t0,
             mean_output,
             std_output,

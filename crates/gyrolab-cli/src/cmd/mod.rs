@@ -1,12 +1,10 @@
-//! One module per subcommand.
+//! One module per subcommand; none imports another (what they share lives beside `cmd`).
 
 pub mod allan;
 pub mod apply;
 pub mod bias;
 pub mod demo;
 pub mod eval;
-pub mod plan;
 pub mod rate;
-pub mod raw;
+pub mod record_length;
 pub mod simulate;
-pub mod static_eval;

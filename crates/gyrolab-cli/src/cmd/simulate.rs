@@ -1,12 +1,12 @@
 //! `gyrolab simulate static|rate-table`: records with known truth, in exactly the layouts that
 //! `gyrolab bias`, `gyrolab allan` and `gyrolab rate` read.
 
-use crate::cmd::rate::parse_output_unit;
 use crate::error::{CliError, CliResult};
 use clap::{Args, Subcommand};
-use gyrolab::sim::{Preset, SensorModel, SimConfig, TemperatureProfile};
+use gyrolab::sim::Preset;
 use gyrolab::units::OutputUnit;
-use gyrolab_io::sim_csv::{read_sim_config, write_rate_table_csv, write_static_csv, SimCsvError, SimCsvOptions};
+use gyrolab_eval::simulate::{csv_options, sim_config, simulate_to, SimOverrides, SimRecord};
+use gyrolab_io::sim_csv::SimCsvError;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -38,7 +38,7 @@ pub struct CommonArgs {
     #[arg(long, value_name = "HZ")]
     pub sample_rate_hz: Option<f64>,
     /// Output unit: dps (default without a preset), v, mv, lsb, rad_s.
-    #[arg(long, value_name = "UNIT", value_parser = parse_output_unit)]
+    #[arg(long, value_name = "UNIT", value_parser = crate::args::parse_output_unit)]
     pub output_unit: Option<OutputUnit>,
     /// Scale factor, output units per deg/s.
     #[arg(long, value_name = "K", allow_hyphen_values = true)]
@@ -135,83 +135,66 @@ fn parse_preset(s: &str) -> Result<Preset, String> {
     })
 }
 
-fn load(common: &CommonArgs) -> CliResult<SimConfig> {
-    let mut cfg = match &common.config {
-        Some(p) => read_sim_config(p)?,
-        None => SimConfig { seed: 1, ..SimConfig::default() },
-    };
-    if let Some(s) = common.seed {
-        cfg.seed = s;
-    }
-    if common.preset.is_some() {
-        cfg.preset = common.preset;
-    }
-    let o = &mut cfg.sensor;
-    macro_rules! set {
-        ($($f:ident),*) => { $( if let Some(v) = common.$f { o.$f = Some(v); } )* };
-    }
-    set!(
-        output_unit,
-        null,
-        bias_dph,
-        arw_deg_rt_h,
-        bias_instability_dph,
-        rrw_deg_h_rt_h,
-        rate_ramp_dph_per_h,
-        output_quantization_step,
-        bias_temp_coeff_dph_per_c
-    );
-    if let Some(k) = common.scale_factor {
-        o.scale_factor_per_dps = Some(k);
-    }
-    if o.output_unit.is_some() && o.scale_factor_per_dps.is_none() && cfg.preset.is_none() {
-        if let Some(OutputUnit::Volt | OutputUnit::Millivolt | OutputUnit::Lsb) = o.output_unit {
-            return Err(CliError::Usage(
-                "an analog or digital output needs --scale-factor (and usually --null), or a --preset".into(),
-            ));
-        }
-    }
-    let temperature = match (common.temp_c, common.temp_ramp_c_per_h) {
-        (None, None) => None,
-        (t, None) => Some(TemperatureProfile::Constant { temp_c: t.unwrap_or(25.0) }),
-        (t, Some(r)) => Some(TemperatureProfile::Ramp { start_c: t.unwrap_or(25.0), rate_c_per_h: r }),
-    };
-    if let Some(t) = temperature {
-        cfg.static_record.temperature = t.clone();
-        cfg.rate_table.temperature = t;
-    }
-    if let Some(l) = common.latitude {
-        cfg.static_record.latitude_deg = Some(l);
-        cfg.rate_table.latitude_deg = Some(l);
-    }
-    if let Some(f) = common.sample_rate_hz {
-        cfg.static_record.sample_rate_hz = f;
-        cfg.rate_table.sample_rate_hz = f;
-    }
-    Ok(cfg)
-}
-
-fn csv_options(common: &CommonArgs) -> CliResult<SimCsvOptions> {
-    // Simulating on a second thread while this one formats gives the same bytes, faster.
-    let pipelined = std::thread::available_parallelism().is_ok_and(|n| n.get() > 1);
-    let mut o = SimCsvOptions { pipelined, ..SimCsvOptions::default() };
-    if let Some(d) = common.decimals {
-        if d > 15 {
-            return Err(CliError::Usage(format!("--decimals must be 0 to 15, got {d}")));
-        }
-        o.number_format = gyrolab_io::sim_csv::NumberFormat::Fixed { decimals: d };
-    }
-    o.comments.push(format!("command: {}", std::env::args().collect::<Vec<_>>().join(" ")));
-    Ok(o)
-}
-
 fn sim_error(e: SimCsvError) -> CliError {
     match e {
         SimCsvError::Io(io) => CliError::Output(format!("cannot write the simulated record: {io}")),
-        other => CliError::Usage(format!("invalid simulation parameters: {other}")),
+        other => gyrolab_eval::EvalError::conflict(format!("invalid simulation parameters: {other}")).into(),
     }
 }
 
+fn overrides(c: &CommonArgs) -> SimOverrides {
+    SimOverrides {
+        config: c.config.clone(),
+        seed: c.seed,
+        preset: c.preset,
+        sample_rate_hz: c.sample_rate_hz,
+        output_unit: c.output_unit,
+        scale_factor: c.scale_factor,
+        null: c.null,
+        bias_dph: c.bias_dph,
+        arw_deg_rt_h: c.arw_deg_rt_h,
+        bias_instability_dph: c.bias_instability_dph,
+        rrw_deg_h_rt_h: c.rrw_deg_h_rt_h,
+        rate_ramp_dph_per_h: c.rate_ramp_dph_per_h,
+        output_quantization_step: c.output_quantization_step,
+        bias_temp_coeff_dph_per_c: c.bias_temp_coeff_dph_per_c,
+        temp_c: c.temp_c,
+        temp_ramp_c_per_h: c.temp_ramp_c_per_h,
+        latitude_deg: c.latitude,
+        ..SimOverrides::default()
+    }
+}
+
+/// Runs `gyrolab simulate`.
+pub fn run(cmd: &SimulateCommand) -> CliResult {
+    let (record, common, o) = match cmd {
+        SimulateCommand::Static(a) => (
+            SimRecord::Static,
+            &a.common,
+            SimOverrides { duration_s: a.duration_s, record_temperature: a.record_temperature, ..overrides(&a.common) },
+        ),
+        SimulateCommand::RateTable(a) => (
+            SimRecord::RateTable,
+            &a.common,
+            SimOverrides {
+                rates_dps: a.rates.clone(),
+                runs: a.runs,
+                samples_per_plateau: a.samples_per_plateau,
+                settling_s: a.settling_s,
+                rest_samples: a.rest_samples,
+                hysteresis_dps: a.hysteresis_dps,
+                nonlinearity_quadratic_per_dps: a.nonlinearity_quadratic_per_dps,
+                scale_factor_asymmetry_ppm: a.scale_factor_asymmetry_ppm,
+                run_to_run_scale_factor_sigma_ppm: a.run_to_run_scale_factor_sigma_ppm,
+                ..overrides(&a.common)
+            },
+        ),
+    };
+    let cfg = sim_config(&o)?;
+    let command = format!("command: {}", std::env::args().collect::<Vec<_>>().join(" "));
+    let opts = csv_options(common.decimals, vec![command])?;
+    emit(&common.out, |w| simulate_to(record, &cfg, &opts, w))
+}
 fn emit(out: &Option<PathBuf>, write: impl FnOnce(&mut (dyn Write + Send)) -> Result<(), SimCsvError>) -> CliResult {
     match out {
         Some(path) => {
@@ -237,63 +220,6 @@ fn emit(out: &Option<PathBuf>, write: impl FnOnce(&mut (dyn Write + Send)) -> Re
                 Err(SimCsvError::Io(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
                 r => r.map_err(sim_error),
             }
-        }
-    }
-}
-
-fn model(cfg: &SimConfig) -> SensorModel {
-    cfg.sensor_model()
-}
-
-/// Runs `gyrolab simulate`.
-pub fn run(cmd: &SimulateCommand) -> CliResult {
-    match cmd {
-        SimulateCommand::Static(a) => {
-            let mut cfg = load(&a.common)?;
-            if let Some(d) = a.duration_s {
-                cfg.static_record.duration_s = d;
-            }
-            if a.record_temperature {
-                cfg.static_record.record_temperature = true;
-            }
-            let m = model(&cfg);
-            let opts = csv_options(&a.common)?;
-            emit(&a.common.out, |w| write_static_csv(w, &m, &cfg.static_record, cfg.seed, &opts).map(|_| ()))
-        }
-        SimulateCommand::RateTable(a) => {
-            let mut cfg = load(&a.common)?;
-            let rt = &mut cfg.rate_table;
-            if !a.rates.is_empty() {
-                rt.rates_dps = a.rates.clone();
-            }
-            if let Some(v) = a.runs {
-                rt.runs = v;
-            }
-            if let Some(v) = a.samples_per_plateau {
-                rt.samples_per_plateau = v;
-            }
-            if let Some(v) = a.settling_s {
-                rt.settling_s = v;
-            }
-            if let Some(v) = a.rest_samples {
-                rt.rest_samples = v;
-            }
-            let o = &mut cfg.sensor;
-            if let Some(v) = a.hysteresis_dps {
-                o.hysteresis_dps = Some(v);
-            }
-            if let Some(v) = a.nonlinearity_quadratic_per_dps {
-                o.nonlinearity_quadratic_per_dps = Some(v);
-            }
-            if let Some(v) = a.scale_factor_asymmetry_ppm {
-                o.scale_factor_asymmetry_ppm = Some(v);
-            }
-            if let Some(v) = a.run_to_run_scale_factor_sigma_ppm {
-                o.run_to_run_scale_factor_sigma_ppm = Some(v);
-            }
-            let m = model(&cfg);
-            let opts = csv_options(&a.common)?;
-            emit(&a.common.out, |w| write_rate_table_csv(w, &m, &cfg.rate_table, cfg.seed, &opts).map(|_| ()))
         }
     }
 }

@@ -1,16 +1,17 @@
-//! The static (bias) and Allan part of `gyrolab eval` and `gyrolab demo --out`: evaluates the
-//! `[static.<axis>]` records of a plan (the same code path for both commands) and returns the
-//! report sections, summary figures, results.json sections and CSV files.
+//! The static (bias) and Allan part of a test plan (and of the paper's report): evaluates the
+//! `[static.<axis>]` records (the same code path for both) and returns the report sections,
+//! summary figures, results.json sections and CSV files.
 
-use crate::cmd::rate::EvaluatedAxis;
-use crate::error::{CliError, CliResult};
+use crate::allan::{analyse_channel, ChannelSetup};
+use crate::error::{EvalError, EvalResult};
+use crate::progress::Progress;
+use crate::rate::EvaluatedAxis;
 use crate::reference::Reference;
 use gyrolab::allan::{AllanOptions, DeviationKind};
-use gyrolab::noise::{fit_noise_model, slope_line_terms};
 use gyrolab::static_test::{bias_repeatability, smoothing_key, StaticTestConfig};
 use gyrolab_io::calibration::read_calibration;
-use gyrolab_io::plan::StaticAxisPlan;
 use gyrolab_io::series::{evaluate_static_file, read_series_all, window_means_file, SeriesOptions};
+use gyrolab_io::test_plan::StaticAxisPlan;
 use gyrolab_io::DataError;
 use gyrolab_report::allan::ChannelAnalysis;
 use gyrolab_report::bias::TestReport;
@@ -21,7 +22,6 @@ use gyrolab_report::static_report::{
     allan_axis_csv, allan_section, bias_tests_csv, bias_windows_csv, static_section, ReferenceJson, StaticAxisReport,
     TestWindows,
 };
-use indicatif::ProgressBar;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -78,7 +78,7 @@ pub fn smoothing_times(limits: &[Limit]) -> Vec<f64> {
 
 /// The output-to-rate reference of an axis: this plan's rate-table K and F0, else the plan's
 /// calibration file, else none (output units only).
-fn reference_of(axis: &str, ctx: &StaticContext<'_>) -> CliResult<(Reference, ReferenceJson)> {
+fn reference_of(axis: &str, ctx: &StaticContext<'_>) -> EvalResult<(Reference, ReferenceJson)> {
     if let Some(r) = ctx.rate_axes.iter().find(|a| a.name == axis) {
         let c = r.calibration();
         return Ok((
@@ -134,17 +134,13 @@ fn reference_of(axis: &str, ctx: &StaticContext<'_>) -> CliResult<(Reference, Re
     ))
 }
 
-fn usage(e: impl std::fmt::Display) -> CliError {
-    CliError::Usage(e.to_string())
-}
-
 /// Evaluates one axis's static records: every test, their repeatability, window means and the
 /// Allan analysis of the Allan record (the plan's `allan_file`, else the longest test).
-fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, bar: &ProgressBar) -> CliResult<StaticAxisReport> {
+fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, progress: &dyn Progress) -> EvalResult<StaticAxisReport> {
     let axis = &s.axis;
     let (reference, reference_json) = reference_of(axis, ctx)?;
     if s.output_unit.is_some() && s.channel.is_none() {
-        return Err(usage(format!(
+        return Err(EvalError::conflict(format!(
             "{}: static.{axis}.output_unit needs static.{axis}.channel (the column it applies to)",
             ctx.base.display()
         )));
@@ -163,7 +159,7 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, bar: &ProgressBar)
     let mut notes = Vec::new();
     let mut samples = Vec::new();
     for path in &s.files {
-        bar.set_message(format!("axis {axis}: static test {}", shown(path, ctx.base)));
+        progress.message(&format!("axis {axis}: static test {}", shown(path, ctx.base)));
         let mut mismatch = None;
         let (results, summary) = evaluate_static_file(path, &options, |ch| {
             let mut cfg = StaticTestConfig {
@@ -177,7 +173,7 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, bar: &ProgressBar)
             cfg
         })?;
         if let Some(m) = mismatch {
-            return Err(usage(format!("{}: {m}", path.display())));
+            return Err(EvalError::conflict(format!("{}: {m}", path.display())));
         }
         if let Some(want) = &s.temperature_channel {
             let found = summary
@@ -186,7 +182,7 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, bar: &ProgressBar)
                 .and_then(|c| summary.header.columns.get(c - 1))
                 .map(|c| c.name.clone());
             if !found.as_deref().is_some_and(|f| f.eq_ignore_ascii_case(want)) {
-                return Err(CliError::Data(DataError::new(
+                return Err(EvalError::Data(DataError::new(
                     path,
                     format!(
                         "static.{axis}.temperature_channel = '{want}': the file's temperature column is {} \
@@ -205,11 +201,11 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, bar: &ProgressBar)
             ));
         }
         let Some(result) = results.into_iter().next() else {
-            return Err(CliError::Data(DataError::new(path, "no output channel to evaluate")));
+            return Err(EvalError::Data(DataError::new(path, "no output channel to evaluate")));
         };
         samples.push(summary.rows);
         tests.push(TestReport { file: shown(path, ctx.base), result });
-        bar.inc(1);
+        progress.advance(1);
     }
     let window_s = tests
         .first()
@@ -218,7 +214,7 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, bar: &ProgressBar)
         .unwrap_or(10.0);
     let mut windows = Vec::new();
     for (path, t) in s.files.iter().zip(&tests) {
-        bar.set_message(format!("axis {axis}: window means of {}", t.file));
+        progress.message(&format!("axis {axis}: window means of {}", t.file));
         windows.push(TestWindows { file: t.file.clone(), windows: window_means_file(path, &options, 0, window_s)? });
     }
     let repeatability = if tests.len() >= 2 {
@@ -235,9 +231,9 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, bar: &ProgressBar)
             s.files[longest].clone() // ok: the plan has at least one file per [static] table
         }
     };
-    bar.set_message(format!("axis {axis}: Allan deviation of {}", shown(&allan_path, ctx.base)));
+    progress.message(&format!("axis {axis}: Allan deviation of {}", shown(&allan_path, ctx.base)));
     let allan = allan_of(&allan_path, &options, &reference, s.sample_rate_hz, ctx.base)?;
-    bar.inc(1);
+    progress.advance(1);
     let simulated = ctx.simulated.map(|f| f(axis));
     Ok(StaticAxisReport {
         axis: axis.clone(),
@@ -260,53 +256,27 @@ fn allan_of(
     reference: &Reference,
     sample_rate_hz: f64,
     base: &Path,
-) -> CliResult<ChannelAnalysis> {
+) -> EvalResult<ChannelAnalysis> {
     let mut data = read_series_all(path, options)?;
     data.time = None;
     data.temperature = None;
     let Some(info) = data.header.channels.first().cloned() else {
-        return Err(CliError::Data(DataError::new(path, "no output channel to analyse")));
+        return Err(EvalError::Data(DataError::new(path, "no output channel to analyse")));
     };
     let lines = std::mem::take(&mut data.lines);
-    let mut values = std::mem::take(&mut data.channels).into_iter().next().unwrap_or_default();
-    let (k, null) = match reference.for_unit(info.unit).map_err(|m| usage(format!("{}: {m}", path.display())))? {
-        Some((k, null)) => (Some(k), null.unwrap_or(0.0)),
-        None => (info.unit.native_scale_factor_per_dps(), 0.0),
-    };
-    if let Some(k) = k {
-        values.iter_mut().for_each(|v| *v = (*v - null) / k);
-    }
-    values.reserve_exact(1);
-    let curve = crate::cmd::allan::channel_curve(
+    let values = std::mem::take(&mut data.channels).into_iter().next().unwrap_or_default();
+    let opts = AllanOptions::new(DeviationKind::Oadev);
+    let setup = ChannelSetup {
         path,
-        &info,
-        values,
-        &lines,
-        1.0 / sample_rate_hz,
-        &AllanOptions::new(DeviationKind::Oadev),
-    )?;
-    let (rate_unit, slope_lines, model_fit, noise_note) = if k.is_some() {
-        ("deg/s".to_string(), slope_line_terms(&curve).ok(), fit_noise_model(&curve, None).ok(), None)
-    } else {
-        (
-            info.unit.symbol().to_string(),
-            None,
-            None,
-            Some(format!(
-                "the data are in {}: give the axis a rate-table record or a calibration file",
-                info.unit.symbol()
-            )),
-        )
+        shown: shown(path, base),
+        lines: &lines,
+        tau0_s: 1.0 / sample_rate_hz,
+        options: &opts,
+        reference,
+        fit_range_s: None,
+        uncalibrated_hint: "give the axis a rate-table record or a calibration file",
     };
-    Ok(ChannelAnalysis {
-        file: shown(path, base),
-        channel: info.name.clone(),
-        rate_unit,
-        curve,
-        slope_lines,
-        model_fit,
-        noise_note,
-    })
+    analyse_channel(&setup, &info, values)
 }
 
 /// Number of progress steps of the static part.
@@ -315,16 +285,20 @@ pub fn progress_steps(plans: &[StaticAxisPlan]) -> u64 {
 }
 
 /// Evaluates every `[static.<axis>]` table and builds the sections, figures, JSON and CSV files.
-pub fn evaluate_static(plans: &[StaticAxisPlan], ctx: &StaticContext<'_>, bar: &ProgressBar) -> CliResult<StaticParts> {
+pub fn evaluate_static(
+    plans: &[StaticAxisPlan],
+    ctx: &StaticContext<'_>,
+    progress: &dyn Progress,
+) -> EvalResult<StaticParts> {
     let mut parts = StaticParts::default();
     if plans.is_empty() {
         return Ok(parts);
     }
     let mut reports = Vec::new();
     for s in plans {
-        reports.push(evaluate_axis(s, ctx, bar)?);
+        reports.push(evaluate_axis(s, ctx, progress)?);
     }
-    let plot_err = |e: gyrolab_report::plot::PlotError| CliError::Output(e.to_string());
+    let plot_err = |e: gyrolab_report::plot::PlotError| EvalError::Output(e.to_string());
     let mut static_json = serde_json::Map::new();
     let mut allan_json = serde_json::Map::new();
     for r in &reports {

@@ -8,7 +8,9 @@
 use crate::calibration::line_col;
 use crate::rate_table::RateColumns;
 use crate::DataError;
+use gyrolab::triad::TableAxis;
 use gyrolab::units::{OutputUnit, RateUnit};
+use gyrolab::validate::{self, InvalidOption};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -26,6 +28,45 @@ struct RawPlan {
     static_tests: BTreeMap<String, Spanned<RawStatic>>,
     #[serde(default)]
     limits: BTreeMap<String, Spanned<RawLimit>>,
+    #[serde(default)]
+    triad: Option<Spanned<RawTriad>>,
+}
+
+/// Raw-log keys, shared by `[rate.<axis>]` and `[triad]` (written out in both, because toml's
+/// spans do not survive serde's `flatten`).
+struct RawSegmentation<'a> {
+    table_rate_column: &'a Option<String>,
+    steady_tolerance_dps: &'a Option<Spanned<f64>>,
+    min_plateau_s: &'a Option<Spanned<f64>>,
+    settling_s: &'a Option<Spanned<f64>>,
+    rest_tolerance_dps: &'a Option<Spanned<f64>>,
+}
+
+macro_rules! raw_segmentation {
+    ($r:expr) => {
+        RawSegmentation {
+            table_rate_column: &$r.table_rate_column,
+            steady_tolerance_dps: &$r.steady_tolerance_dps,
+            min_plateau_s: &$r.min_plateau_s,
+            settling_s: &$r.settling_s,
+            rest_tolerance_dps: &$r.rest_tolerance_dps,
+        }
+    };
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTriad {
+    x: Spanned<String>,
+    y: Spanned<String>,
+    z: Spanned<String>,
+    #[serde(default)]
+    gyro_columns: Option<Spanned<Vec<String>>>,
+    table_rate_column: Option<String>,
+    steady_tolerance_dps: Option<Spanned<f64>>,
+    min_plateau_s: Option<Spanned<f64>>,
+    settling_s: Option<Spanned<f64>>,
+    rest_tolerance_dps: Option<Spanned<f64>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -58,6 +99,13 @@ struct RawRate {
     output_column: Option<String>,
     rate_unit: Option<Spanned<String>>,
     output_unit: Option<Spanned<String>>,
+    raw: Option<bool>,
+    segments: Option<Spanned<String>>,
+    table_rate_column: Option<String>,
+    steady_tolerance_dps: Option<Spanned<f64>>,
+    min_plateau_s: Option<Spanned<f64>>,
+    settling_s: Option<Spanned<f64>>,
+    rest_tolerance_dps: Option<Spanned<f64>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -118,6 +166,41 @@ pub struct RateAxisPlan {
     pub file_as_written: String,
     /// Column names and units, as for `gyrolab rate`.
     pub columns: RateColumns,
+    /// Read the file as a raw log even if its header does not say so (`raw = true`).
+    pub raw: bool,
+    /// Segmentation of a raw log.
+    pub segmentation: SegmentationPlan,
+}
+
+/// How a raw log (time, table rate, outputs) is segmented: the keys of `gyrolab rate`'s
+/// options of the same names; `None` keeps the default.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SegmentationPlan {
+    /// Name of the table-rate column.
+    pub table_rate_column: Option<String>,
+    /// Steadiness tolerance, deg/s.
+    pub steady_tolerance_dps: Option<f64>,
+    /// Shortest plateau, s.
+    pub min_plateau_s: Option<f64>,
+    /// Settling time dropped at each plateau's start, s.
+    pub settling_s: Option<f64>,
+    /// Rest tolerance, deg/s.
+    pub rest_tolerance_dps: Option<f64>,
+    /// A manual segment file (resolved), instead of finding the segments.
+    pub segments: Option<PathBuf>,
+}
+
+/// A three-axis calibration set (`[triad]`): raw logs of rotations about the table's x, y and z.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TriadPlan {
+    /// The logs, resolved, in the order x, y, z.
+    pub files: [PathBuf; 3],
+    /// The paths as written in the plan.
+    pub files_as_written: [String; 3],
+    /// The gyro output columns x, y, z (empty: the files' three outputs).
+    pub gyro_columns: Vec<String>,
+    /// Segmentation.
+    pub segmentation: SegmentationPlan,
 }
 
 /// The static records of one axis (`[static.<axis>]`), evaluated by the static and Allan sections.
@@ -169,6 +252,8 @@ pub struct TestPlan {
     pub static_tests: Vec<StaticAxisPlan>,
     /// Spec limits, by figure name.
     pub limits: Vec<PlanLimit>,
+    /// A three-axis calibration set.
+    pub triad: Option<TriadPlan>,
 }
 
 /// Reads and checks a plan file; `known_figure` tells which `[limits]` names exist.
@@ -204,6 +289,36 @@ impl Ctx<'_> {
                 ),
             ))
         }
+    }
+
+    /// Checks a value with a core validator; the error names `key` and its line.
+    fn check<T>(&self, span: std::ops::Range<usize>, key: &str, r: Result<T, InvalidOption>) -> Result<T, DataError> {
+        r.map_err(|e| self.err(span, key, e.message))
+    }
+
+    fn segmentation(
+        &self,
+        prefix: &str,
+        r: &RawSegmentation<'_>,
+        segments: Option<&Spanned<String>>,
+    ) -> Result<SegmentationPlan, DataError> {
+        let key = |k: &str| format!("{prefix}.{k}");
+        let num = |v: &Option<Spanned<f64>>, k: &'static str, zero_ok: bool| -> Result<Option<f64>, DataError> {
+            v.as_ref()
+                .map(|x| {
+                    let f = if zero_ok { validate::non_negative } else { validate::positive };
+                    self.check(x.span(), &key(k), f(k, *x.get_ref()))
+                })
+                .transpose()
+        };
+        Ok(SegmentationPlan {
+            table_rate_column: r.table_rate_column.clone(),
+            steady_tolerance_dps: num(r.steady_tolerance_dps, "steady_tolerance_dps", false)?,
+            min_plateau_s: num(r.min_plateau_s, "min_plateau_s", false)?,
+            settling_s: num(r.settling_s, "settling_s", true)?,
+            rest_tolerance_dps: num(r.rest_tolerance_dps, "rest_tolerance_dps", true)?,
+            segments: segments.map(|f| self.existing_file(&key("segments"), f)).transpose()?,
+        })
     }
 
     fn output_unit(&self, key: &str, v: &Option<Spanned<String>>) -> Result<Option<OutputUnit>, DataError> {
@@ -265,38 +380,30 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         }
     }
     for a in &axes {
-        if !raw.rate.contains_key(a) && !raw.static_tests.contains_key(a) {
+        if !raw.rate.contains_key(a) && !raw.static_tests.contains_key(a) && raw.triad.is_none() {
             return Err(cx.err(
                 raw.device.axes.span(),
                 "device.axes",
-                format!("axis '{a}' has neither a [rate.{a}] nor a [static.{a}] table"),
+                format!("axis '{a}' has neither a [rate.{a}] nor a [static.{a}] table (nor is there a [triad])"),
             ));
         }
     }
 
     let o = &raw.options;
     let coverage = match &o.coverage {
-        Some(c) if !(c.get_ref().is_finite() && *c.get_ref() > 0.0) => {
-            return Err(cx.err(c.span(), "options.coverage", format!("must be a positive number, got {}", c.get_ref())))
-        }
-        Some(c) => *c.get_ref(),
+        Some(c) => cx.check(c.span(), "options.coverage", validate::positive("coverage", *c.get_ref()))?,
         None => 3.0,
     };
     let order = match &o.order {
-        Some(n) if !(1..=9).contains(n.get_ref()) => {
-            return Err(cx.err(n.span(), "options.order", format!("must be 1 to 9, got {}", n.get_ref())))
-        }
-        Some(n) => *n.get_ref() as usize, // ok: checked to be 1..=9 above
+        Some(n) => cx.check(n.span(), "options.order", validate::polynomial_order("order", *n.get_ref()))?,
         None => 1,
     };
     if let Some(l) = &o.nonlinearity_limit_pct {
-        if !(l.get_ref().is_finite() && *l.get_ref() > 0.0) {
-            return Err(cx.err(
-                l.span(),
-                "options.nonlinearity_limit_pct",
-                format!("must be a positive percentage, got {}", l.get_ref()),
-            ));
-        }
+        cx.check(
+            l.span(),
+            "options.nonlinearity_limit_pct",
+            validate::positive_percentage("nonlinearity_limit_pct", *l.get_ref()),
+        )?;
     }
     let calibration = o.calibration.as_ref().map(|c| cx.existing_file("options.calibration", c)).transpose()?;
     let options = PlanOptions {
@@ -338,6 +445,8 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
                     rate_unit,
                     output_unit: cx.output_unit(&key("output_unit"), &r.output_unit)?,
                 },
+                raw: r.raw.unwrap_or(false),
+                segmentation: cx.segmentation(&format!("rate.{axis}"), &raw_segmentation!(r), r.segments.as_ref())?,
             });
         }
         if let Some(s) = raw.static_tests.get(axis) {
@@ -356,22 +465,13 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
                     cx.existing_file(&format!("{}[{i}]", key("files")), &Spanned::new(s.files.span(), f.clone()))
                 })
                 .collect::<Result<Vec<_>, _>>()?;
-            let fs = *s.sample_rate_hz.get_ref();
-            if !(fs.is_finite() && fs > 0.0) {
-                return Err(cx.err(
-                    s.sample_rate_hz.span(),
-                    &key("sample_rate_hz"),
-                    format!("must be a positive number of Hz, got {fs}"),
-                ));
-            }
+            let fs = cx.check(
+                s.sample_rate_hz.span(),
+                &key("sample_rate_hz"),
+                validate::positive("sample_rate_hz", *s.sample_rate_hz.get_ref()),
+            )?;
             if let Some(l) = &s.latitude_deg {
-                if !(l.get_ref().is_finite() && l.get_ref().abs() <= 90.0) {
-                    return Err(cx.err(
-                        l.span(),
-                        &key("latitude_deg"),
-                        format!("must be within -90..90 degrees, got {}", l.get_ref()),
-                    ));
-                }
+                cx.check(l.span(), &key("latitude_deg"), validate::latitude_deg("latitude_deg", *l.get_ref()))?;
             }
             static_tests.push(StaticAxisPlan {
                 axis: axis.clone(),
@@ -410,6 +510,37 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
     }
     limits.sort_by_key(|l| l.line);
 
+    let triad = match &raw.triad {
+        None => None,
+        Some(t) => {
+            let span = t.span();
+            let t = t.get_ref();
+            let files = [&t.x, &t.y, &t.z];
+            let mut resolved = Vec::with_capacity(3);
+            for (axis, f) in TableAxis::ALL.into_iter().zip(files) {
+                resolved.push(cx.existing_file(&format!("triad.{axis}"), f)?);
+            }
+            let gyro_columns = match &t.gyro_columns {
+                Some(g) if g.get_ref().len() != 3 => {
+                    return Err(cx.err(
+                        g.span(),
+                        "triad.gyro_columns",
+                        format!("expected three names (gyros x, y, z), got {}", g.get_ref().len()),
+                    ))
+                }
+                Some(g) => g.get_ref().clone(),
+                None => Vec::new(),
+            };
+            let _ = span;
+            Some(TriadPlan {
+                files: [resolved[0].clone(), resolved[1].clone(), resolved[2].clone()],
+                files_as_written: files.map(|f| f.get_ref().clone()),
+                gyro_columns,
+                segmentation: cx.segmentation("triad", &raw_segmentation!(t), None)?,
+            })
+        }
+    };
+
     Ok(TestPlan {
         file: path.to_path_buf(),
         device: DevicePlan {
@@ -422,6 +553,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         rate,
         static_tests,
         limits,
+        triad,
     })
 }
 

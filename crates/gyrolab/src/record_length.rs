@@ -16,27 +16,27 @@ use thiserror::Error;
 /// The noise term a static test is planned for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
-pub enum PlannedTerm {
+pub enum NoiseTerm {
     /// Bias instability B, read on the flat (flicker, alpha = -1) part of the curve.
     BiasInstability,
     /// Angle random walk N, read on the white-noise (alpha = 0) part.
     AngleRandomWalk,
 }
 
-impl PlannedTerm {
+impl NoiseTerm {
     /// Noise type alpha (power-law exponent of the rate noise) at which the term is read.
     pub fn alpha(self) -> i32 {
         match self {
-            PlannedTerm::BiasInstability => -1,
-            PlannedTerm::AngleRandomWalk => 0,
+            NoiseTerm::BiasInstability => -1,
+            NoiseTerm::AngleRandomWalk => 0,
         }
     }
 
     /// Parses `bias-instability` / `b` or `arw` / `angle-random-walk` / `n`.
-    pub fn parse(s: &str) -> Option<PlannedTerm> {
+    pub fn parse(s: &str) -> Option<NoiseTerm> {
         match s.trim().to_ascii_lowercase().replace('_', "-").as_str() {
-            "bias-instability" | "b" | "bi" => Some(PlannedTerm::BiasInstability),
-            "arw" | "angle-random-walk" | "n" => Some(PlannedTerm::AngleRandomWalk),
+            "bias-instability" | "b" | "bi" => Some(NoiseTerm::BiasInstability),
+            "arw" | "angle-random-walk" | "n" => Some(NoiseTerm::AngleRandomWalk),
             _ => None,
         }
     }
@@ -44,9 +44,9 @@ impl PlannedTerm {
 
 /// What to plan for.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct PlanRequest {
+pub struct RecordLengthRequest {
     /// The term to measure.
-    pub term: PlannedTerm,
+    pub term: NoiseTerm,
     /// Wanted half-width of the interval relative to the value (0.1 = plus or minus 10 %).
     pub relative_precision: f64,
     /// Two-sided confidence level (0.95).
@@ -59,9 +59,9 @@ pub struct PlanRequest {
 
 /// The plan.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct PlanResult {
+pub struct RecordLength {
     /// The request.
-    pub request: PlanRequest,
+    pub request: RecordLengthRequest,
     /// Noise type alpha assumed at tau.
     pub alpha: i32,
     /// Averaging factor m = tau * f_s.
@@ -80,7 +80,7 @@ pub struct PlanResult {
 
 /// Why a plan cannot be made.
 #[derive(Debug, Clone, PartialEq, Error)]
-pub enum PlanError {
+pub enum RecordLengthError {
     /// A parameter is out of range.
     #[error("{parameter} = {value} is out of range: expected {expected}")]
     OutOfRange {
@@ -112,8 +112,8 @@ fn relative_interval(edf: f64, confidence: f64) -> Option<(f64, f64)> {
 
 /// Plans a static record: the shortest record whose overlapping Allan deviation at tau has a
 /// confidence interval within plus or minus the requested precision.
-pub fn plan_static(req: &PlanRequest) -> Result<PlanResult, PlanError> {
-    let bad = |parameter, value, expected| Err(PlanError::OutOfRange { parameter, value, expected });
+pub fn static_record_length(req: &RecordLengthRequest) -> Result<RecordLength, RecordLengthError> {
+    let bad = |parameter, value, expected| Err(RecordLengthError::OutOfRange { parameter, value, expected });
     if !(req.relative_precision > 0.0 && req.relative_precision < 1.0) {
         return bad("relative precision", req.relative_precision, "between 0 and 1 (0.1 = 10 %)");
     }
@@ -144,7 +144,7 @@ pub fn plan_static(req: &PlanRequest) -> Result<PlanResult, PlanError> {
         lo = hi;
         hi = hi.saturating_mul(2);
         if hi > LIMIT {
-            return Err(PlanError::Unreachable(LIMIT));
+            return Err(RecordLengthError::Unreachable(LIMIT));
         }
     }
     while hi - lo > 1.max(lo / 100_000) {
@@ -158,11 +158,11 @@ pub fn plan_static(req: &PlanRequest) -> Result<PlanResult, PlanError> {
     finish(req, alpha, m, hi)
 }
 
-fn finish(req: &PlanRequest, alpha: i32, m: usize, n: u64) -> Result<PlanResult, PlanError> {
+fn finish(req: &RecordLengthRequest, alpha: i32, m: usize, n: u64) -> Result<RecordLength, RecordLengthError> {
     let edf = equivalent_dof(DeviationKind::Oadev, alpha, m, n as usize + 1);
     let interval = relative_interval(edf, req.confidence).unwrap_or((f64::NAN, f64::NAN));
     let duration_s = n as f64 / req.sample_rate_hz;
-    Ok(PlanResult {
+    Ok(RecordLength {
         request: req.clone(),
         alpha,
         m,
@@ -187,14 +187,14 @@ mod tests {
         // of that length and count how often the measured ADEV(1 s) lies within +-10 % of the
         // true sigma / sqrt(m): the fraction must be close to 90 % (binomial standard error of
         // 300 trials is 1.7 %; allow 6 %).
-        let req = PlanRequest {
-            term: PlannedTerm::AngleRandomWalk,
+        let req = RecordLengthRequest {
+            term: NoiseTerm::AngleRandomWalk,
             relative_precision: 0.10,
             confidence: 0.90,
             sample_rate_hz: 10.0,
             tau_s: 1.0,
         };
-        let plan = plan_static(&req).unwrap();
+        let plan = static_record_length(&req).unwrap();
         assert!(plan.relative_interval.0 >= 0.9 && plan.relative_interval.1 <= 1.1);
         let n = plan.samples as usize;
         assert!(n > 100 && n < 100_000, "{n}");
@@ -220,16 +220,16 @@ mod tests {
 
     #[test]
     fn tighter_precision_needs_a_longer_record() {
-        let mut req = PlanRequest {
-            term: PlannedTerm::BiasInstability,
+        let mut req = RecordLengthRequest {
+            term: NoiseTerm::BiasInstability,
             relative_precision: 0.25,
             confidence: 0.683,
             sample_rate_hz: 100.0,
             tau_s: bias_instability_tau_s(0.6, 12.0),
         };
-        let a = plan_static(&req).unwrap();
+        let a = static_record_length(&req).unwrap();
         req.relative_precision = 0.10;
-        let b = plan_static(&req).unwrap();
+        let b = static_record_length(&req).unwrap();
         assert!(b.duration_s > 3.0 * a.duration_s, "{} vs {}", b.duration_s, a.duration_s);
         // tau for N = 0.6 deg/sqrt(h), B = 12 deg/h: (2 * 0.01 / (0.6643 * 12 / 3600))^2 = 81.6 s.
         assert!((req.tau_s - 81.6).abs() < 0.2, "{}", req.tau_s);
@@ -237,17 +237,17 @@ mod tests {
 
     #[test]
     fn bad_requests() {
-        let ok = PlanRequest {
-            term: PlannedTerm::BiasInstability,
+        let ok = RecordLengthRequest {
+            term: NoiseTerm::BiasInstability,
             relative_precision: 0.2,
             confidence: 0.95,
             sample_rate_hz: 100.0,
             tau_s: 100.0,
         };
-        assert!(plan_static(&PlanRequest { relative_precision: 0.0, ..ok.clone() }).is_err());
-        assert!(plan_static(&PlanRequest { confidence: 1.0, ..ok.clone() }).is_err());
-        assert!(plan_static(&PlanRequest { sample_rate_hz: 0.0, ..ok.clone() }).is_err());
-        assert!(plan_static(&PlanRequest { tau_s: 0.001, ..ok.clone() }).is_err());
-        assert!(plan_static(&PlanRequest { relative_precision: 1e-6, ..ok }).is_err());
+        assert!(static_record_length(&RecordLengthRequest { relative_precision: 0.0, ..ok.clone() }).is_err());
+        assert!(static_record_length(&RecordLengthRequest { confidence: 1.0, ..ok.clone() }).is_err());
+        assert!(static_record_length(&RecordLengthRequest { sample_rate_hz: 0.0, ..ok.clone() }).is_err());
+        assert!(static_record_length(&RecordLengthRequest { tau_s: 0.001, ..ok.clone() }).is_err());
+        assert!(static_record_length(&RecordLengthRequest { relative_precision: 1e-6, ..ok }).is_err());
     }
 }

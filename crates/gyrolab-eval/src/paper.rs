@@ -1,5 +1,6 @@
-//! The paper's data, built into the binary so `gyrolab demo` needs no files
-//! (copies of `data/paper/*.csv`: Tables 1, 3, 4 in the long layout; Tables 2, 5, 6 as printed).
+//! The paper's data (Cheng et al. 2014), built in so that the demo needs no files: the one place
+//! that holds them (`data/paper/*.csv`: Tables 1, 3, 4 in the long layout; Tables 2, 5, 6 as
+//! printed), for the demo, the tests and every front end.
 
 use gyrolab::published::PrintedValue;
 use gyrolab_io::text::parse_text_table;
@@ -7,7 +8,7 @@ use gyrolab_io::DataError;
 use gyrolab_report::paper::{ClaimedTable6, PrintedTable2Row, PrintedTable5Row};
 use std::path::Path;
 
-/// Rate-table records of the three axes: (axis, built-in name, CSV text).
+/// Rate-table records of the three axes (Tables 1, 3, 4): (axis, built-in name, CSV text).
 pub const RATE_TABLES: [(&str, &str, &str); 3] = [
     ("x", "<built-in paper_rate_table_x.csv>", include_str!("../../../data/paper/paper_rate_table_x.csv")),
     ("y", "<built-in paper_rate_table_y.csv>", include_str!("../../../data/paper/paper_rate_table_y.csv")),

@@ -1,10 +1,11 @@
-//! `gyrolab plan static`: how long a static record must be to measure bias instability (or
+//! `gyrolab plan static` (the record-length planner): how long a static record must be to measure bias instability (or
 //! angle random walk) within plus or minus a precision at a confidence, before booking the table.
 
-use crate::error::{CliError, CliResult};
+use crate::error::CliResult;
 use crate::output::{print, to_json};
 use clap::{Args, Subcommand};
-use gyrolab::plan::{bias_instability_tau_s, plan_static, PlanRequest, PlannedTerm};
+use gyrolab::record_length::NoiseTerm;
+use gyrolab_eval::record_length::{plan_record_length, RecordLengthQuery};
 
 /// What to plan.
 #[derive(Debug, Subcommand)]
@@ -18,7 +19,7 @@ pub enum PlanCommand {
 pub struct StaticPlanArgs {
     /// Term to measure: bias-instability or arw.
     #[arg(long, default_value = "bias-instability", value_parser = parse_term)]
-    pub term: PlannedTerm,
+    pub term: NoiseTerm,
     /// Wanted precision: half-width of the interval, percent of the value.
     #[arg(long, value_name = "PCT")]
     pub precision_pct: f64,
@@ -43,38 +44,28 @@ pub struct StaticPlanArgs {
     pub json: bool,
 }
 
-fn parse_term(s: &str) -> Result<PlannedTerm, String> {
-    PlannedTerm::parse(s).ok_or_else(|| format!("unknown term '{s}': expected bias-instability or arw"))
+fn parse_term(s: &str) -> Result<NoiseTerm, String> {
+    NoiseTerm::parse(s).ok_or_else(|| format!("unknown term '{s}': expected bias-instability or arw"))
 }
 
 /// Runs `gyrolab plan`.
 pub fn run(cmd: &PlanCommand) -> CliResult {
     let PlanCommand::Static(a) = cmd;
-    let tau_s = match (a.tau_s, a.term, a.arw_deg_rt_h, a.bias_instability_dph) {
-        (Some(t), _, _, _) => t,
-        (None, PlannedTerm::AngleRandomWalk, _, _) => 1.0,
-        (None, PlannedTerm::BiasInstability, Some(n), Some(b)) if n > 0.0 && b > 0.0 => bias_instability_tau_s(n, b),
-        (None, PlannedTerm::BiasInstability, _, _) => {
-            return Err(CliError::Usage(
-                "bias instability: give --tau-s, or --arw-deg-rt-h and --bias-instability-dph (positive) to place it"
-                    .into(),
-            ))
-        }
-    };
-    let req = PlanRequest {
+    let plan = plan_record_length(&RecordLengthQuery {
         term: a.term,
-        relative_precision: a.precision_pct / 100.0,
+        precision_pct: a.precision_pct,
         confidence: a.confidence,
         sample_rate_hz: a.sample_rate_hz,
-        tau_s,
-    };
-    let plan = plan_static(&req).map_err(|e| CliError::Usage(format!("cannot plan: {e}")))?;
+        tau_s: a.tau_s,
+        arw_deg_rt_h: a.arw_deg_rt_h,
+        bias_instability_dph: a.bias_instability_dph,
+    })?;
     if a.json {
         return print(&to_json(&plan)?);
     }
     let term = match a.term {
-        PlannedTerm::BiasInstability => "bias instability (flicker rate noise, alpha = -1)",
-        PlannedTerm::AngleRandomWalk => "angle random walk (white rate noise, alpha = 0)",
+        NoiseTerm::BiasInstability => "bias instability (flicker rate noise, alpha = -1)",
+        NoiseTerm::AngleRandomWalk => "angle random walk (white rate noise, alpha = 0)",
     };
     print(&format!(
         "To measure {term} from the overlapping Allan deviation at tau = {:.4} s (m = {}, {} Hz)\n\

@@ -1,0 +1,45 @@
+//! Argument types shared by several commands: unit parsers and the output-to-rate reference.
+
+use clap::Args;
+use gyrolab::units::{OutputUnit, RateUnit};
+use gyrolab_eval::reference::ReferenceRequest;
+use std::path::PathBuf;
+
+/// Parses a rate unit option.
+pub fn parse_rate_unit(s: &str) -> Result<RateUnit, String> {
+    RateUnit::parse(s).ok_or_else(|| format!("unknown rate unit '{s}': expected dps, rad_s or dph"))
+}
+
+/// Parses an output unit option.
+pub fn parse_output_unit(s: &str) -> Result<OutputUnit, String> {
+    OutputUnit::parse(s).ok_or_else(|| format!("unknown output unit '{s}': expected v, mv, lsb, dps or rad_s"))
+}
+
+/// Options naming the output-to-rate reference.
+#[derive(Debug, Clone, Args)]
+pub struct ReferenceArgs {
+    /// Calibration file written by `gyrolab rate --cal-out` (scale factor K and null F0).
+    #[arg(long, value_name = "FILE.toml", conflicts_with = "scale_factor")]
+    pub cal: Option<PathBuf>,
+    /// Axis of the calibration file to use (needed when it has several).
+    #[arg(long = "cal-axis", value_name = "NAME", requires = "cal")]
+    pub cal_axis: Option<String>,
+    /// Scale factor K in output units per deg/s (e.g. 0.0075 for V, 7.5 for mV outputs).
+    #[arg(long, value_name = "K", allow_hyphen_values = true)]
+    pub scale_factor: Option<f64>,
+    /// Zero-rate output (null) in output units, with --scale-factor.
+    #[arg(long, value_name = "F", allow_hyphen_values = true, requires = "scale_factor")]
+    pub null: Option<f64>,
+}
+
+impl ReferenceArgs {
+    /// The reference request.
+    pub fn request(&self) -> ReferenceRequest {
+        ReferenceRequest {
+            calibration: self.cal.clone(),
+            calibration_axis: self.cal_axis.clone(),
+            scale_factor: self.scale_factor,
+            null: self.null,
+        }
+    }
+}

@@ -1,0 +1,259 @@
+//! Allan-variance analysis of a time-series file: the deviation family with confidence
+//! intervals per output channel (channels in parallel), converted to deg/s by the reference,
+//! with IEEE 952 noise terms by slope lines and by the five-term fit (docs/METHODS.md section 3).
+
+use crate::error::{EvalError, EvalResult};
+use crate::reference::{Reference, ReferenceRequest};
+use gyrolab::allan::{deviation_from_rate, AllanCurve, AllanError, AllanOptions, DeviationKind, TauList};
+use gyrolab::noise::{fit_noise_model, slope_line_terms};
+use gyrolab::sampling::{estimate_interval, SamplingError};
+use gyrolab::validate::{self, InvalidOption};
+use gyrolab_io::series::{read_series_all, ChannelInfo, SeriesData, SeriesOptions};
+use gyrolab_io::DataError;
+use gyrolab_report::allan::ChannelAnalysis;
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// An Allan analysis of the output channels of one file.
+///
+/// ```
+/// use gyrolab_eval::allan::{analyse_file, AllanRequest};
+/// use gyrolab::allan::{DeviationKind, TauList};
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("rate.csv");
+/// let mut text = String::from("time_s,rate_dps\n");
+/// for i in 0..4000 {
+///     text.push_str(&format!("{},{}\n", i as f64 * 0.01, ((i * 7919) % 13) as f64 * 1e-3));
+/// }
+/// std::fs::write(&path, text).unwrap();
+/// let request = AllanRequest::new(path);
+/// let outcome = analyse_file(&request).unwrap();
+/// assert_eq!(outcome.sample_interval_s, 0.01);
+/// assert_eq!(outcome.analyses[0].curve.points[0].m, 1);
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct AllanRequest {
+    /// The time series.
+    pub file: PathBuf,
+    /// Output columns to analyse (default: every output column).
+    pub columns: Vec<String>,
+    /// Sample rate, Hz (required when the file has no time column).
+    pub sample_rate_hz: Option<f64>,
+    /// Output-to-rate reference.
+    pub reference: ReferenceRequest,
+    /// Deviation kind.
+    pub kind: DeviationKind,
+    /// Averaging times.
+    pub taus: TauList,
+    /// Confidence level of the bounds; `None`: no bounds and no noise identification.
+    pub confidence: Option<f64>,
+    /// Tau range of the five-term fit, s (default: the whole curve).
+    pub fit_range_s: Option<(f64, f64)>,
+}
+
+impl AllanRequest {
+    /// Octave OADEV of every output column with 68.3 % bounds.
+    pub fn new(file: impl Into<PathBuf>) -> Self {
+        AllanRequest {
+            file: file.into(),
+            columns: Vec::new(),
+            sample_rate_hz: None,
+            reference: ReferenceRequest::default(),
+            kind: DeviationKind::Oadev,
+            taus: TauList::Octave,
+            confidence: Some(0.683),
+            fit_range_s: None,
+        }
+    }
+}
+
+/// The analyses of a file.
+#[derive(Debug, Clone)]
+pub struct AllanOutcome {
+    /// One per channel, in column order.
+    pub analyses: Vec<ChannelAnalysis>,
+    /// The sampling interval used, s.
+    pub sample_interval_s: f64,
+}
+
+/// Parses a tau list: `octave`, `decade`, `all`, `N/decade`, or seconds (`0.1,1,10`).
+pub fn parse_taus(text: &str) -> EvalResult<TauList> {
+    let bad = || {
+        InvalidOption::new("taus", format!("'{text}': expected octave, decade, all, N/decade or seconds like 0.1,1,10"))
+    };
+    if text.chars().next().is_some_and(|c| c.is_ascii_digit()) && !text.contains('/') {
+        let v: Result<Vec<f64>, _> = text.split(',').map(|s| s.trim().parse::<f64>()).collect();
+        return Ok(TauList::Seconds(v.map_err(|_| bad())?));
+    }
+    TauList::parse(text).map_err(|e| EvalError::conflict(e.to_string()))
+}
+
+/// Parses a confidence level: a probability, or `none`.
+pub fn parse_confidence(text: &str) -> Result<Option<f64>, InvalidOption> {
+    match text.trim() {
+        "none" => Ok(None),
+        c => match c.parse::<f64>() {
+            Ok(x) if x > 0.0 && x < 1.0 => Ok(Some(x)),
+            _ => Err(InvalidOption::new(
+                "confidence",
+                format!("must lie strictly between 0 and 1, or be 'none'; got '{c}'"),
+            )),
+        },
+    }
+}
+
+/// The sampling interval of a record: the given rate, else the time column's by the one
+/// estimator ([`gyrolab::sampling`]); the Allan variance needs uniform samples, so an irregular
+/// interval is an error naming its line.
+pub fn sample_interval(data: &SeriesData, path: &Path, given_hz: Option<f64>) -> EvalResult<f64> {
+    if let Some(f) = given_hz {
+        return Ok(1.0 / f);
+    }
+    let Some(t) = &data.time else {
+        return Err(DataError::new(path, "no time column (time_s): give --sample-rate-hz").into());
+    };
+    let estimate = estimate_interval(t).map_err(|e| match e {
+        SamplingError::TooShort => DataError::new(path, "fewer than two samples: nothing to analyse"),
+        SamplingError::NotIncreasing => {
+            DataError::new(path, "the time stamps do not increase: expected a uniform time column")
+        }
+    })?;
+    if let Some(g) = estimate.first_irregular {
+        let line = data.lines.get(g.index).copied().unwrap_or(0);
+        return Err(DataError::new(
+            path,
+            format!(
+                "irregular sampling: interval {} s where the record's interval is {} s; the Allan variance needs uniform samples (cut the record at the gap)",
+                g.interval_s, estimate.nominal_s
+            ),
+        )
+        .at_line(line)
+        .into());
+    }
+    Ok(estimate.interval_s)
+}
+
+/// The deviation curve of one channel's rate samples; a non-finite sample is an error naming
+/// its file line and column (`lines[i]` is the line of sample i).
+pub fn channel_curve(
+    path: &Path,
+    info: &ChannelInfo,
+    values: Vec<f64>,
+    lines: &[u64],
+    tau0_s: f64,
+    opts: &AllanOptions,
+) -> EvalResult<AllanCurve> {
+    deviation_from_rate(values, tau0_s, opts).map_err(|e| match e {
+        AllanError::NonFinite { index, value } => EvalError::Data(
+            DataError::new(
+                path,
+                format!("sample {value} is not a finite number: the Allan variance needs a complete record"),
+            )
+            .at_line(lines.get(index).copied().unwrap_or(0))
+            .at_column(info.column, Some(&info.name)),
+        ),
+        other => EvalError::Data(DataError::new(path, format!("channel '{}': {other}", info.name))),
+    })
+}
+
+/// What one channel's analysis needs besides its samples.
+pub struct ChannelSetup<'a> {
+    /// The file, as read.
+    pub path: &'a Path,
+    /// The file as shown in results.
+    pub shown: String,
+    /// Source line of each sample.
+    pub lines: &'a [u64],
+    /// Sampling interval, s.
+    pub tau0_s: f64,
+    /// Deviation options.
+    pub options: &'a AllanOptions,
+    /// Output-to-rate reference.
+    pub reference: &'a Reference,
+    /// Tau range of the five-term fit, s.
+    pub fit_range_s: Option<(f64, f64)>,
+    /// What to tell the user when the data cannot be turned into rates.
+    pub uncalibrated_hint: &'a str,
+}
+
+/// Analyses one channel: converts it to deg/s, computes the curve and, for data in deg/s and an
+/// Allan deviation, the noise terms.
+pub fn analyse_channel(
+    setup: &ChannelSetup<'_>,
+    info: &ChannelInfo,
+    mut values: Vec<f64>,
+) -> EvalResult<ChannelAnalysis> {
+    let calibrated = setup
+        .reference
+        .to_rate(info.unit, &mut values)
+        .map_err(|m| EvalError::conflict(format!("{}: channel '{}': {m}", setup.path.display(), info.name)))?;
+    let rate_unit = if calibrated { "deg/s".to_string() } else { info.unit.symbol().to_string() };
+    values.reserve_exact(1);
+    let curve = channel_curve(setup.path, info, values, setup.lines, setup.tau0_s, setup.options)?;
+    let allan_kind = matches!(setup.options.kind, DeviationKind::Oadev | DeviationKind::Adev);
+    let (slope_lines, model_fit, noise_note) = if !calibrated {
+        (None, None, Some(format!("the data are in {rate_unit}: {}", setup.uncalibrated_hint)))
+    } else if !allan_kind {
+        (None, None, Some("noise terms are read from the Allan deviation (--kind oadev or adev)".to_string()))
+    } else {
+        (slope_line_terms(&curve).ok(), fit_noise_model(&curve, setup.fit_range_s).ok(), None)
+    };
+    Ok(ChannelAnalysis {
+        file: setup.shown.clone(),
+        channel: info.name.clone(),
+        rate_unit,
+        curve,
+        slope_lines,
+        model_fit,
+        noise_note,
+    })
+}
+
+/// Analyses every selected channel of a file, in parallel.
+pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
+    if let Some(f) = request.sample_rate_hz {
+        validate::positive("sample_rate_hz", f)?;
+    }
+    if let Some(c) = request.confidence {
+        validate::confidence("confidence", c)?;
+    }
+    if let Some((a, b)) = request.fit_range_s {
+        validate::increasing_pair("fit_range_s", &[a, b])?;
+    }
+    let reference = request.reference.resolve()?;
+    let path = &request.file;
+    let options = SeriesOptions {
+        sample_rate_hz: request.sample_rate_hz,
+        channels: if request.columns.is_empty() { None } else { Some(request.columns.clone()) },
+        ..SeriesOptions::default()
+    };
+    let mut data = read_series_all(path, &options)?;
+    let tau0 = sample_interval(&data, path, request.sample_rate_hz)?;
+    data.time = None;
+    let opts = AllanOptions {
+        kind: request.kind,
+        taus: request.taus.clone(),
+        confidence: request.confidence,
+        max_factor: None,
+    };
+    let infos = data.header.channels.clone();
+    let lines = std::mem::take(&mut data.lines);
+    let channels = std::mem::take(&mut data.channels);
+    let setup = ChannelSetup {
+        path,
+        shown: path.display().to_string(),
+        lines: &lines,
+        tau0_s: tau0,
+        options: &opts,
+        reference: &reference,
+        fit_range_s: request.fit_range_s,
+        uncalibrated_hint: "give --cal or --scale-factor for noise terms in deg units",
+    };
+    let results: Vec<EvalResult<ChannelAnalysis>> = channels
+        .into_par_iter()
+        .zip(infos.into_par_iter())
+        .map(|(values, info)| analyse_channel(&setup, &info, values))
+        .collect();
+    let analyses = results.into_iter().collect::<Result<Vec<_>, _>>()?;
+    Ok(AllanOutcome { analyses, sample_interval_s: tau0 })
+}

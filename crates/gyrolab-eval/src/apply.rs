@@ -1,0 +1,113 @@
+//! A calibration applied to a time series of outputs, streaming: outputs in, rates out
+//! ([`gyrolab::apply`]: the polynomial model inverted per sample, or the three-axis model).
+
+use crate::error::{EvalError, EvalResult};
+use gyrolab::apply::{SingleAxisCalibration, TriadApplier};
+use gyrolab::units::split_unit_suffix;
+use gyrolab_io::apply_csv::{apply_file, ApplyModel, ApplyPlan, ApplySummary, StreamError};
+use gyrolab_io::calibration::read_calibration;
+use gyrolab_io::raw_log::{detect_raw_log, header_names};
+use gyrolab_io::DataError;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// A calibration to apply to a file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ApplyRequest {
+    /// Calibration file (written by `gyrolab rate --cal-out`).
+    pub calibration: PathBuf,
+    /// Time series of outputs.
+    pub input: PathBuf,
+    /// The `[[axis]]` to apply (default: the `[triad]` when there is one, else the only axis).
+    pub calibration_axis: Option<String>,
+    /// Output column(s): one for an axis, three (x, y, z) for a `[triad]` (default: the file's
+    /// only output, or the columns named after the axes).
+    pub columns: Vec<String>,
+}
+
+/// Chooses the output columns: given, the file's only ones, or those whose base name is an axis name.
+fn choose_columns(input: &Path, given: &[String], axis_names: &[String], skip: &[String]) -> EvalResult<Vec<String>> {
+    let n = axis_names.len();
+    if !given.is_empty() {
+        if given.len() != n {
+            return Err(EvalError::conflict_on(
+                &["columns"],
+                format!("{{columns}} needs {n} name(s) for this calibration, got {}", given.len()),
+            ));
+        }
+        return Ok(given.to_vec());
+    }
+    let names = header_names(input)?;
+    let outputs: Vec<&String> = names
+        .iter()
+        .filter(|c| {
+            let (base, sfx) = split_unit_suffix(c);
+            let special = matches!(base.as_str(), "time" | "t" | "timestamp" | "temp" | "temperature");
+            !special && sfx.is_some() && !skip.iter().any(|s| s.eq_ignore_ascii_case(c))
+        })
+        .collect();
+    if outputs.len() == n {
+        return Ok(outputs.into_iter().cloned().collect());
+    }
+    let by_axis: Option<Vec<String>> = axis_names
+        .iter()
+        .map(|a| outputs.iter().find(|c| split_unit_suffix(c).0.eq_ignore_ascii_case(a)).map(|c| c.to_string()))
+        .collect();
+    by_axis.ok_or_else(|| {
+        EvalError::Data(DataError::new(
+            input,
+            format!(
+                "{} output column(s) ({}) where the calibration needs {n} ({}): choose with --column",
+                outputs.len(),
+                outputs.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", "),
+                axis_names.join(", ")
+            ),
+        ))
+    })
+}
+
+/// The streaming plan of a request: the model, the columns it reads and writes.
+pub fn prepare_apply(request: &ApplyRequest) -> EvalResult<ApplyPlan> {
+    let cal = read_calibration(&request.calibration)?;
+    let cal_err = |msg: String| EvalError::Data(DataError::new(&request.calibration, msg));
+    let names = header_names(&request.input)?;
+    // A raw log's table rate is passed through (as table_rate_dps), beside the calibrated rate.
+    let table_rate = detect_raw_log(&names);
+    let skip: Vec<String> = table_rate.iter().cloned().collect();
+    Ok(match (&cal.triad, &request.calibration_axis) {
+        (Some(t), None) => {
+            let model = TriadApplier::new(&t.calibration()).map_err(|e| cal_err(format!("[triad]: {e}")))?;
+            let axes = t.axes.to_vec();
+            ApplyPlan {
+                model: ApplyModel::Triad(model),
+                output_unit: t.output_unit,
+                columns: choose_columns(&request.input, &request.columns, &axes, &skip)?,
+                rate_names: axes.iter().map(|a| format!("rate_{a}_dps")).collect(),
+                table_rate_column: table_rate,
+            }
+        }
+        (_, name) => {
+            let axis = cal.axis(name.as_deref()).map_err(cal_err)?;
+            let model =
+                SingleAxisCalibration::polynomial(&axis.polynomial.coefficients, axis.rate_min_dps, axis.rate_max_dps)
+                    .map_err(|e| cal_err(format!("axis '{}': {e}", axis.name)))?;
+            ApplyPlan {
+                model: ApplyModel::Single(model),
+                output_unit: axis.output_unit,
+                columns: choose_columns(&request.input, &request.columns, std::slice::from_ref(&axis.name), &skip)?,
+                rate_names: vec!["rate_dps".into()],
+                table_rate_column: table_rate,
+            }
+        }
+    })
+}
+
+/// Streams the input through the plan into `out`; `progress` gets the rows done so far.
+pub fn apply_to(
+    input: &Path,
+    plan: &ApplyPlan,
+    out: &mut dyn Write,
+    progress: &mut dyn FnMut(u64),
+) -> Result<ApplySummary, StreamError> {
+    apply_file(input, plan, out, progress)
+}

@@ -1,0 +1,153 @@
+//! The output-to-rate reference: the scale factor K and null that turn a gyro's outputs into
+//! rates, from a calibration file (written by `gyrolab rate --cal-out`), given numbers, or this
+//! plan's rate-table evaluation. The one place where outputs become deg/s.
+//!
+//! Rate = (output - null) / K (paper eq. 1 inverted); outputs already in deg/s or rad/s are rates
+//! by their unit's native factor ([`OutputUnit::native_scale_factor_per_dps`]).
+
+use crate::error::{EvalError, EvalResult};
+use gyrolab::static_test::StaticTestConfig;
+use gyrolab::units::OutputUnit;
+use gyrolab::validate;
+use gyrolab_io::calibration::read_calibration;
+use std::path::PathBuf;
+
+/// Where the reference comes from: a calibration file, or K (and a null) given.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ReferenceRequest {
+    /// Calibration file (TOML written by `gyrolab rate --cal-out`).
+    pub calibration: Option<PathBuf>,
+    /// Axis of the calibration file (needed when it has several).
+    pub calibration_axis: Option<String>,
+    /// Scale factor K, output units per deg/s (instead of a file).
+    pub scale_factor: Option<f64>,
+    /// Null (zero-rate output), output units, with `scale_factor`.
+    pub null: Option<f64>,
+}
+
+impl ReferenceRequest {
+    /// Resolves the request (reads the calibration file).
+    ///
+    /// ```
+    /// use gyrolab_eval::reference::{Reference, ReferenceRequest};
+    /// use gyrolab::units::OutputUnit;
+    /// let r = ReferenceRequest { scale_factor: Some(0.0075), null: Some(2.5), ..Default::default() };
+    /// let reference = r.resolve().unwrap();
+    /// let mut v = vec![2.5075, 2.5];
+    /// assert!(reference.to_rate(OutputUnit::Volt, &mut v).unwrap());
+    /// assert!((v[0] - 1.0).abs() < 1e-12 && v[1] == 0.0);
+    /// ```
+    pub fn resolve(&self) -> EvalResult<Reference> {
+        if let Some(path) = &self.calibration {
+            if self.scale_factor.is_some() {
+                return Err(EvalError::conflict_on(
+                    &["calibration", "scale_factor"],
+                    "{calibration} and {scale_factor} exclude each other: give one",
+                ));
+            }
+            let cal = read_calibration(path)?;
+            let axis = cal
+                .axis(self.calibration_axis.as_deref())
+                .map_err(|m| EvalError::conflict(format!("{}: {m}", path.display())))?;
+            return Ok(Reference::Calibrated {
+                scale_factor: axis.scale_factor,
+                null: axis.zero_offset,
+                unit: axis.output_unit,
+            });
+        }
+        if self.calibration_axis.is_some() {
+            return Err(EvalError::conflict_on(
+                &["calibration_axis", "calibration"],
+                "{calibration_axis} needs {calibration}",
+            ));
+        }
+        match self.scale_factor {
+            Some(k) => {
+                validate::scale_factor("scale_factor", k)?;
+                if let Some(n) = self.null {
+                    validate::finite("null", n)?;
+                }
+                Ok(Reference::Given { scale_factor: k, null: self.null })
+            }
+            None if self.null.is_some() => {
+                Err(EvalError::conflict_on(&["null", "scale_factor"], "{null} needs {scale_factor}"))
+            }
+            None => Ok(Reference::None),
+        }
+    }
+}
+
+/// A resolved reference.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Reference {
+    /// Nothing given: figures in output units only.
+    None,
+    /// Given numbers, in the unit of whatever output they are applied to.
+    Given {
+        /// K, output units per deg/s.
+        scale_factor: f64,
+        /// Null, output units.
+        null: Option<f64>,
+    },
+    /// From a calibration (a file or this plan's rate-table evaluation), in its output unit.
+    Calibrated {
+        /// K, `unit` per deg/s.
+        scale_factor: f64,
+        /// F0, `unit`.
+        null: f64,
+        /// The calibration's output unit.
+        unit: OutputUnit,
+    },
+}
+
+impl Reference {
+    /// Whether no reference was given.
+    pub fn is_none(&self) -> bool {
+        matches!(self, Reference::None)
+    }
+
+    /// (K, null) in the unit of an output channel; `None` when no reference was given.
+    /// A calibration in V applies to mV channels (and deg/s to rad/s) after conversion; other
+    /// unit pairs are an error.
+    pub fn for_unit(&self, unit: OutputUnit) -> Result<Option<(f64, Option<f64>)>, String> {
+        match *self {
+            Reference::None => Ok(None),
+            Reference::Given { scale_factor, null } => Ok(Some((scale_factor, null))),
+            Reference::Calibrated { scale_factor, null, unit: cal_unit } => match cal_unit.factor_to(unit) {
+                Some(f) => Ok(Some((scale_factor * f, Some(null * f)))),
+                None => Err(format!("the calibration is for {cal_unit} outputs but this channel is in {unit}")),
+            },
+        }
+    }
+
+    /// Sets the scale factor and null of a static-test configuration for a channel in `unit`
+    /// (nothing when no reference was given); the message of an error names the channel.
+    pub fn configure(&self, cfg: &mut StaticTestConfig, channel: &str, unit: OutputUnit) -> Result<(), String> {
+        match self.for_unit(unit) {
+            Ok(Some((k, null))) => {
+                cfg.scale_factor = Some(k);
+                cfg.null_output = null;
+                Ok(())
+            }
+            Ok(None) => Ok(()),
+            Err(m) => Err(format!("channel '{channel}': {m}")),
+        }
+    }
+
+    /// Turns output samples in `unit` into rates in deg/s, in place: `(x - null) / K` with the
+    /// reference (a missing null counts as 0: deviations do not depend on it), else by the
+    /// unit's native factor (deg/s, rad/s). Returns whether the values are now rates; `false`
+    /// leaves them in output units.
+    pub fn to_rate(&self, unit: OutputUnit, values: &mut [f64]) -> Result<bool, String> {
+        let (k, null) = match self.for_unit(unit)? {
+            Some((k, null)) => (Some(k), null.unwrap_or(0.0)),
+            None => (unit.native_scale_factor_per_dps(), 0.0),
+        };
+        match k {
+            Some(k) if null == 0.0 => values.iter_mut().for_each(|v| *v /= k),
+            Some(k) => values.iter_mut().for_each(|v| *v = (*v - null) / k),
+            None => return Ok(false),
+        }
+        Ok(true)
+    }
+}

@@ -1,0 +1,147 @@
+//! A report folder as named outputs: report.html, results.json, calibration.toml, summary and
+//! per-axis CSV tables, assembled from evaluated parts. Nothing is written here: the caller
+//! writes the outputs (the command line with `gyrolab_io::atomic::write_folder`, whole or not
+//! at all).
+
+use crate::error::{EvalError, EvalResult};
+use crate::progress::Progress;
+use crate::rate::{calibration_file, EvaluatedAxis};
+use gyrolab_report::figures::{rate_figures, AxisFigures};
+use gyrolab_report::format::sig;
+use gyrolab_report::html::{rate_section, render_html, Report, ReportHeader, ReportSection, SummaryTable};
+use gyrolab_report::limits::{Limit, Verdict};
+use gyrolab_report::rate::{AxisJson, AxisReport};
+use gyrolab_report::results::{DeviceJson, LimitJson, ResultsJson};
+use gyrolab_report::tables_csv::{points_csv, runs_csv, summary_csv};
+use gyrolab_report::triad::TriadReport;
+use std::collections::BTreeMap;
+
+/// One output of a report folder.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamedOutput {
+    /// File name inside the folder.
+    pub name: String,
+    /// Its content.
+    pub bytes: Vec<u8>,
+}
+
+/// An assembled report folder.
+#[derive(Debug, Clone)]
+pub struct ReportFolder {
+    /// The outputs, in writing order.
+    pub outputs: Vec<NamedOutput>,
+    /// Overall verdict of the limits; `None` without limits.
+    pub verdict: Option<Verdict>,
+    /// One line per failed check.
+    pub failures: Vec<String>,
+}
+
+/// Everything a report folder is assembled from.
+pub struct ReportInputs<'a> {
+    /// Report header (device, date, version, plan).
+    pub header: ReportHeader,
+    /// Device block of results.json.
+    pub device: DeviceJson,
+    /// Evaluated rate-table axes.
+    pub axes: &'a [EvaluatedAxis],
+    /// Spec limits.
+    pub limits: Vec<Limit>,
+    /// Further figures per axis (static bias, Allan), merged into the summary and the limits.
+    pub extra_figures: Vec<AxisFigures>,
+    /// Sections after the rate-table sections (static bias, Allan; demo: the paper comparison).
+    pub extra_sections: Vec<ReportSection>,
+    /// Further results.json sections by key (`static`, `allan`, `paper`, `triad`).
+    pub extra_json: BTreeMap<String, serde_json::Value>,
+    /// Further files (name, content): the static and Allan CSV tables.
+    pub extra_files: Vec<(String, Vec<u8>)>,
+    /// A three-axis calibration, written into calibration.toml's `[triad]`.
+    pub triad: Option<TriadReport<'a>>,
+}
+
+fn json<T: serde::Serialize>(value: &T) -> EvalResult<String> {
+    serde_json::to_string_pretty(value)
+        .map(|s| s + "\n")
+        .map_err(|e| EvalError::Output(format!("cannot serialise JSON: {e}")))
+}
+
+/// Assembles the report folder from evaluated inputs.
+pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> EvalResult<ReportFolder> {
+    let reports: Vec<AxisReport<'_>> = inputs.axes.iter().map(EvaluatedAxis::report).collect();
+    let axis_json: Vec<AxisJson> = reports.iter().map(AxisJson::new).collect();
+    let mut figures: Vec<AxisFigures> = axis_json.iter().map(rate_figures).collect();
+    for extra in inputs.extra_figures {
+        match figures.iter_mut().find(|f| f.axis == extra.axis) {
+            Some(f) => {
+                extra.values.into_iter().for_each(|(k, v)| f.set(k, v));
+                f.simulated.extend(extra.simulated);
+            }
+            None => figures.push(extra),
+        }
+    }
+    let summary = SummaryTable::build(&figures, &inputs.limits);
+    progress.message("drawing plots");
+    let mut sections = Vec::new();
+    for r in &reports {
+        sections.push(rate_section(r, &inputs.limits).map_err(|e| EvalError::Output(e.to_string()))?);
+        progress.advance(1);
+    }
+    sections.extend(inputs.extra_sections);
+    let verdict = if inputs.limits.is_empty() { None } else { Some(summary.overall()) };
+    let failures: Vec<String> = summary
+        .checks
+        .iter()
+        .filter(|c| c.verdict == Verdict::Fail)
+        .map(|c| {
+            let l = Limit { figure: c.figure.clone(), min: c.min, max: c.max };
+            format!(
+                "axis {}: {} = {} {} (limit {})",
+                c.axis,
+                c.figure,
+                sig(c.value.unwrap_or(f64::NAN), 4),
+                c.unit,
+                l.text()
+            )
+        })
+        .collect();
+    let results = ResultsJson {
+        gyrolab_version: inputs.header.gyrolab_version.clone(),
+        created: inputs.header.date.clone(),
+        plan_file: inputs.header.plan_file.clone(),
+        device: inputs.device,
+        rate_axes: axis_json.clone(),
+        sections: inputs.extra_json,
+        limits: inputs.limits.iter().map(|l| LimitJson { figure: l.figure.clone(), min: l.min, max: l.max }).collect(),
+        limit_checks: summary.checks.clone(),
+        verdict,
+    };
+    let html = render_html(&Report { header: inputs.header, summary: summary.clone(), sections });
+    let mut outputs = vec![
+        NamedOutput { name: "report.html".into(), bytes: html.into_bytes() },
+        NamedOutput { name: "results.json".into(), bytes: json(&results)?.into_bytes() },
+    ];
+    if !inputs.axes.is_empty() || inputs.triad.is_some() {
+        let mut cal = calibration_file(inputs.axes);
+        if let Some(t) = &inputs.triad {
+            cal.triad = Some(gyrolab_io::calibration::TriadSection::from_calibration(
+                &t.fit.calibration,
+                ["x".into(), "y".into(), "z".into()],
+                t.files.iter().map(|(_, f)| f.clone()).collect(),
+                t.output_unit,
+            ));
+        }
+        let text = cal.to_toml().map_err(|e| EvalError::Output(format!("cannot serialise the calibration: {e}")))?;
+        outputs.push(NamedOutput { name: "calibration.toml".into(), bytes: text.into_bytes() });
+    }
+    outputs.push(NamedOutput {
+        name: "summary.csv".into(),
+        bytes: summary_csv(&summary, &figures, &inputs.limits).into_bytes(),
+    });
+    for a in &axis_json {
+        outputs.push(NamedOutput { name: format!("points_{}.csv", a.name), bytes: points_csv(a).into_bytes() });
+    }
+    if axis_json.iter().any(|a| !a.scale_factor_per_run.is_empty()) {
+        outputs.push(NamedOutput { name: "scale_factor_runs.csv".into(), bytes: runs_csv(&axis_json).into_bytes() });
+    }
+    outputs.extend(inputs.extra_files.into_iter().map(|(name, bytes)| NamedOutput { name, bytes }));
+    Ok(ReportFolder { outputs, verdict, failures })
+}

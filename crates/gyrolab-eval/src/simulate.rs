@@ -1,0 +1,201 @@
+//! Simulator set-ups: a TOML configuration (optional) with overrides applied, for static
+//! records and rate-table tests with known truth ([`gyrolab::sim`], docs/METHODS.md section 4).
+
+use crate::error::{EvalError, EvalResult};
+use gyrolab::sim::{Preset, SimConfig, TemperatureProfile};
+use gyrolab::units::OutputUnit;
+use gyrolab_io::sim_csv::{
+    read_sim_config, write_rate_table_csv, write_static_csv, NumberFormat, SimCsvError, SimCsvOptions,
+};
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Overrides of a simulator set-up; `None` keeps the configuration's (or the default) value.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SimOverrides {
+    /// A TOML set-up (seed, preset, [sensor], [static_record], [rate_table]).
+    pub config: Option<PathBuf>,
+    /// Seed (default 1).
+    pub seed: Option<u64>,
+    /// Sensor preset.
+    pub preset: Option<Preset>,
+    /// Sample rate, Hz.
+    pub sample_rate_hz: Option<f64>,
+    /// Output unit.
+    pub output_unit: Option<OutputUnit>,
+    /// Scale factor, output units per deg/s.
+    pub scale_factor: Option<f64>,
+    /// Null, output units.
+    pub null: Option<f64>,
+    /// Constant bias, deg/h.
+    pub bias_dph: Option<f64>,
+    /// Angle random walk N, deg/sqrt(h).
+    pub arw_deg_rt_h: Option<f64>,
+    /// Bias instability B, deg/h.
+    pub bias_instability_dph: Option<f64>,
+    /// Rate random walk K, deg/h/sqrt(h).
+    pub rrw_deg_h_rt_h: Option<f64>,
+    /// Rate ramp R, deg/h per hour.
+    pub rate_ramp_dph_per_h: Option<f64>,
+    /// Output quantization step, output units.
+    pub output_quantization_step: Option<f64>,
+    /// Bias temperature coefficient, (deg/h)/degC.
+    pub bias_temp_coeff_dph_per_c: Option<f64>,
+    /// Constant temperature (or the ramp's start), degC.
+    pub temp_c: Option<f64>,
+    /// Temperature ramp, degC per hour.
+    pub temp_ramp_c_per_h: Option<f64>,
+    /// Latitude, degrees.
+    pub latitude_deg: Option<f64>,
+    /// Static record length, s.
+    pub duration_s: Option<f64>,
+    /// Add a temperature column to the static record.
+    pub record_temperature: bool,
+    /// Table rates, deg/s (empty: keep).
+    pub rates_dps: Vec<f64>,
+    /// Runs of the rate-table test.
+    pub runs: Option<u32>,
+    /// Samples per plateau.
+    pub samples_per_plateau: Option<u32>,
+    /// Settling time per plateau, s.
+    pub settling_s: Option<f64>,
+    /// Rest samples at the start and end.
+    pub rest_samples: Option<u32>,
+    /// Hysteresis, deg/s.
+    pub hysteresis_dps: Option<f64>,
+    /// Quadratic nonlinearity, 1/(deg/s).
+    pub nonlinearity_quadratic_per_dps: Option<f64>,
+    /// Scale-factor asymmetry, ppm.
+    pub scale_factor_asymmetry_ppm: Option<f64>,
+    /// Run-to-run scale-factor change (1 sigma), ppm.
+    pub run_to_run_scale_factor_sigma_ppm: Option<f64>,
+}
+
+/// The set-up: the configuration file (if any) with the overrides applied.
+///
+/// ```
+/// use gyrolab_eval::simulate::{sim_config, SimOverrides};
+/// let cfg = sim_config(&SimOverrides { seed: Some(7), duration_s: Some(60.0), ..Default::default() }).unwrap();
+/// assert_eq!((cfg.seed, cfg.static_record.duration_s), (7, 60.0));
+/// ```
+pub fn sim_config(o: &SimOverrides) -> EvalResult<SimConfig> {
+    let mut cfg = match &o.config {
+        Some(p) => read_sim_config(p)?,
+        None => SimConfig { seed: 1, ..SimConfig::default() },
+    };
+    if let Some(s) = o.seed {
+        cfg.seed = s;
+    }
+    if o.preset.is_some() {
+        cfg.preset = o.preset;
+    }
+    let s = &mut cfg.sensor;
+    macro_rules! set {
+        ($($f:ident),*) => { $( if let Some(v) = o.$f { s.$f = Some(v); } )* };
+    }
+    set!(
+        output_unit,
+        null,
+        bias_dph,
+        arw_deg_rt_h,
+        bias_instability_dph,
+        rrw_deg_h_rt_h,
+        rate_ramp_dph_per_h,
+        output_quantization_step,
+        bias_temp_coeff_dph_per_c,
+        hysteresis_dps,
+        nonlinearity_quadratic_per_dps,
+        scale_factor_asymmetry_ppm,
+        run_to_run_scale_factor_sigma_ppm
+    );
+    if let Some(k) = o.scale_factor {
+        s.scale_factor_per_dps = Some(k);
+    }
+    if s.output_unit.is_some() && s.scale_factor_per_dps.is_none() && cfg.preset.is_none() {
+        if let Some(OutputUnit::Volt | OutputUnit::Millivolt | OutputUnit::Lsb) = s.output_unit {
+            return Err(EvalError::conflict_on(
+                &["scale_factor", "null", "preset"],
+                "an analog or digital output needs {scale_factor} (and usually {null}), or a {preset}",
+            ));
+        }
+    }
+    let temperature = match (o.temp_c, o.temp_ramp_c_per_h) {
+        (None, None) => None,
+        (t, None) => Some(TemperatureProfile::Constant { temp_c: t.unwrap_or(25.0) }),
+        (t, Some(r)) => Some(TemperatureProfile::Ramp { start_c: t.unwrap_or(25.0), rate_c_per_h: r }),
+    };
+    if let Some(t) = temperature {
+        cfg.static_record.temperature = t.clone();
+        cfg.rate_table.temperature = t;
+    }
+    if let Some(l) = o.latitude_deg {
+        cfg.static_record.latitude_deg = Some(l);
+        cfg.rate_table.latitude_deg = Some(l);
+    }
+    if let Some(f) = o.sample_rate_hz {
+        cfg.static_record.sample_rate_hz = f;
+        cfg.rate_table.sample_rate_hz = f;
+    }
+    if let Some(d) = o.duration_s {
+        cfg.static_record.duration_s = d;
+    }
+    if o.record_temperature {
+        cfg.static_record.record_temperature = true;
+    }
+    let rt = &mut cfg.rate_table;
+    if !o.rates_dps.is_empty() {
+        rt.rates_dps = o.rates_dps.clone();
+    }
+    if let Some(v) = o.runs {
+        rt.runs = v;
+    }
+    if let Some(v) = o.samples_per_plateau {
+        rt.samples_per_plateau = v;
+    }
+    if let Some(v) = o.settling_s {
+        rt.settling_s = v;
+    }
+    if let Some(v) = o.rest_samples {
+        rt.rest_samples = v;
+    }
+    Ok(cfg)
+}
+
+/// CSV options of a simulated record: `decimals` fixed decimals (0 to 15) or the shortest form;
+/// `comments` are written at the top.
+pub fn csv_options(decimals: Option<u8>, comments: Vec<String>) -> EvalResult<SimCsvOptions> {
+    // Simulating on a second thread while this one formats gives the same bytes, faster.
+    let pipelined = std::thread::available_parallelism().is_ok_and(|n| n.get() > 1);
+    let mut o = SimCsvOptions { pipelined, ..SimCsvOptions::default() };
+    if let Some(d) = decimals {
+        if d > 15 {
+            return Err(gyrolab::validate::InvalidOption::new("decimals", format!("must be 0 to 15, got {d}")).into());
+        }
+        o.number_format = NumberFormat::Fixed { decimals: d };
+    }
+    o.comments.extend(comments);
+    Ok(o)
+}
+
+/// What was simulated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SimRecord {
+    /// A static record.
+    Static,
+    /// A rate-table test.
+    RateTable,
+}
+
+/// Writes the record to `w`.
+pub fn simulate_to(
+    record: SimRecord,
+    cfg: &SimConfig,
+    opts: &SimCsvOptions,
+    w: &mut (dyn Write + Send),
+) -> Result<(), SimCsvError> {
+    let model = cfg.sensor_model();
+    match record {
+        SimRecord::Static => write_static_csv(w, &model, &cfg.static_record, cfg.seed, opts).map(|_| ()),
+        SimRecord::RateTable => write_rate_table_csv(w, &model, &cfg.rate_table, cfg.seed, opts).map(|_| ()),
+    }
+}

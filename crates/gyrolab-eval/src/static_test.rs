@@ -1,0 +1,175 @@
+//! Static tests (the gyro at rest): per file and output channel the bias and its figures
+//! ([`gyrolab::static_test`]: paper eq. 10-12, IEEE 952, GJB 2426A), and the bias repeatability
+//! across the files (docs/METHODS.md section 2). "Static" names the test, "bias" its main figure.
+
+use crate::error::{EvalError, EvalResult};
+use crate::reference::{Reference, ReferenceRequest};
+use gyrolab::static_test::{bias_repeatability, StaticTestConfig};
+use gyrolab::units::OutputUnit;
+use gyrolab::validate;
+use gyrolab_io::series::{evaluate_static_file, ReaderQuality, SeriesOptions};
+use gyrolab_report::bias::{ChannelRepeatability, TestReport};
+use std::path::PathBuf;
+
+/// Static tests, one file per test.
+///
+/// ```
+/// use gyrolab_eval::static_test::{evaluate_static_tests, StaticTestRequest};
+/// let dir = tempfile::tempdir().unwrap();
+/// let mut files = Vec::new();
+/// for (k, level) in [2.5001, 2.5003].into_iter().enumerate() {
+///     let path = dir.path().join(format!("s{k}.csv"));
+///     let mut text = String::from("time_s,output_v\n");
+///     for i in 0..2000 {
+///         text.push_str(&format!("{},{}\n", i as f64 * 0.1, level + if i % 2 == 0 { 1e-4 } else { -1e-4 }));
+///     }
+///     std::fs::write(&path, text).unwrap();
+///     files.push(path);
+/// }
+/// let mut request = StaticTestRequest::new(files);
+/// request.reference.scale_factor = Some(0.0075);
+/// request.reference.null = Some(2.5);
+/// let outcome = evaluate_static_tests(&request).unwrap();
+/// // B0 = (F - F0) / K: 0.0001 V / 0.0075 V/(deg/s) = 0.01333 deg/s = 48 deg/h.
+/// assert!((outcome.tests[0].result.bias_dph.unwrap() - 48.0).abs() < 1e-6);
+/// let r = outcome.repeatability[0].repeatability.bias_repeatability_dph.unwrap();
+/// assert!((r - 96.0 / 2f64.sqrt()).abs() < 1e-6); // std (n-1) of 48 and 144 deg/h
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct StaticTestRequest {
+    /// Records, one file per test.
+    pub files: Vec<PathBuf>,
+    /// Output columns to evaluate (default: every output column).
+    pub columns: Vec<String>,
+    /// Unit of `columns` whose names carry no unit suffix.
+    pub output_unit: Option<OutputUnit>,
+    /// Sample rate, Hz (default: from the time column).
+    pub sample_rate_hz: Option<f64>,
+    /// Output-to-rate reference.
+    pub reference: ReferenceRequest,
+    /// Latitude, degrees (input axis vertical, up): the earth rate is subtracted from the bias.
+    pub latitude_deg: Option<f64>,
+    /// Smoothing times of the bias stability, s (default 1, 10, 100, plus one sample).
+    pub smoothing_s: Vec<f64>,
+    /// Fit a quadratic bias-temperature model as well as the linear one.
+    pub temperature_quadratic: bool,
+    /// Remove outliers (beyond 6 sigma of the drift line) before computing the figures.
+    pub drop_outliers: bool,
+    /// Accept NaN and empty cells (reported, excluded) instead of stopping.
+    pub tolerant: bool,
+}
+
+impl StaticTestRequest {
+    /// The default evaluation of `files`.
+    pub fn new(files: Vec<PathBuf>) -> Self {
+        StaticTestRequest {
+            files,
+            columns: Vec::new(),
+            output_unit: None,
+            sample_rate_hz: None,
+            reference: ReferenceRequest::default(),
+            latitude_deg: None,
+            smoothing_s: Vec::new(),
+            temperature_quadratic: false,
+            drop_outliers: false,
+            tolerant: false,
+        }
+    }
+}
+
+/// What the reader passed on as missing in one file (tolerant mode).
+#[derive(Debug, Clone)]
+pub struct FileQuality {
+    /// The file, as given.
+    pub file: String,
+    /// Its missing cells.
+    pub quality: ReaderQuality,
+}
+
+/// The evaluated static tests.
+#[derive(Debug, Clone)]
+pub struct StaticOutcome {
+    /// One per file and channel, in file order.
+    pub tests: Vec<TestReport>,
+    /// Bias repeatability per channel present in two or more files.
+    pub repeatability: Vec<ChannelRepeatability>,
+    /// Missing cells per file (tolerant mode).
+    pub files: Vec<FileQuality>,
+    /// The reference used.
+    pub reference: Reference,
+}
+
+/// Evaluates every file of the request and the repeatability across them.
+pub fn evaluate_static_tests(request: &StaticTestRequest) -> EvalResult<StaticOutcome> {
+    if let Some(f) = request.sample_rate_hz {
+        validate::positive("sample_rate_hz", f)?;
+    }
+    if let Some(l) = request.latitude_deg {
+        validate::latitude_deg("latitude_deg", l)?;
+    }
+    validate::smoothing_times("smoothing_s", &request.smoothing_s)?;
+    if request.output_unit.is_some() && request.columns.is_empty() {
+        return Err(EvalError::conflict_on(&["output_unit", "columns"], "{output_unit} needs {columns}"));
+    }
+    let reference = request.reference.resolve()?;
+    let options = SeriesOptions {
+        sample_rate_hz: request.sample_rate_hz,
+        channels: if request.columns.is_empty() { None } else { Some(request.columns.clone()) },
+        column_units: request
+            .output_unit
+            .map(|u| request.columns.iter().map(|c| (c.clone(), u)).collect())
+            .unwrap_or_default(),
+        tolerant: request.tolerant,
+        ..SeriesOptions::default()
+    };
+    let mut tests: Vec<TestReport> = Vec::new();
+    let mut files = Vec::new();
+    for path in &request.files {
+        let mut mismatch = None;
+        let (results, summary) = evaluate_static_file(path, &options, |ch| {
+            let mut cfg = StaticTestConfig {
+                latitude_deg: request.latitude_deg,
+                temperature_quadratic: request.temperature_quadratic,
+                drop_outliers: request.drop_outliers,
+                ..StaticTestConfig::default()
+            };
+            if !request.smoothing_s.is_empty() {
+                cfg.smoothing_times_s = request.smoothing_s.clone();
+            }
+            if let Err(m) = reference.configure(&mut cfg, &ch.name, ch.unit) {
+                mismatch = Some(m);
+            }
+            cfg
+        })?;
+        if let Some(m) = mismatch {
+            return Err(EvalError::conflict(format!("{}: {m}", path.display())));
+        }
+        files.push(FileQuality { file: path.display().to_string(), quality: summary.quality });
+        for result in results {
+            tests.push(TestReport { file: path.display().to_string(), result });
+        }
+    }
+    let repeatability = repeatability_by_channel(&tests);
+    Ok(StaticOutcome { tests, repeatability, files, reference })
+}
+
+/// Bias repeatability of each channel present in two or more tests (paper eq. 12), in order of
+/// first appearance.
+pub fn repeatability_by_channel(tests: &[TestReport]) -> Vec<ChannelRepeatability> {
+    let mut channels: Vec<&str> = Vec::new();
+    for t in tests {
+        if !channels.contains(&t.result.channel.as_str()) {
+            channels.push(&t.result.channel);
+        }
+    }
+    let mut out = Vec::new();
+    for ch in channels {
+        let of: Vec<_> = tests.iter().filter(|t| t.result.channel == ch).map(|t| t.result.clone()).collect();
+        if of.len() >= 2 {
+            if let Ok(r) = bias_repeatability(&of) {
+                out.push(ChannelRepeatability { channel: ch.to_string(), repeatability: r });
+            }
+        }
+    }
+    out
+}

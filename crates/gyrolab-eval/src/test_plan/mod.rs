@@ -1,0 +1,205 @@
+//! Evaluation of a TOML test plan ([`gyrolab_io::test_plan`], keys in docs/PLAN.md) into a
+//! report folder: the rate-table records per axis (long, wide or raw logs), a three-axis set,
+//! then the static (bias) and Allan part of every `[static.<axis>]` table.
+
+pub mod static_part;
+
+use crate::error::EvalResult;
+use crate::progress::Progress;
+use crate::rate::{evaluate_record, is_raw_log, EvaluatedAxis, RateSettings};
+use crate::raw_log::{evaluate_channels, segment_file, SegmentationRequest};
+use crate::report_folder::{assemble_report, ReportFolder, ReportInputs};
+use crate::triad::{evaluate_triad, TriadRequest};
+use crate::EvalError;
+use gyrolab::triad::TableAxis;
+use gyrolab_io::rate_table::read_rate_table;
+use gyrolab_io::test_plan::{read_plan, SegmentationPlan, TestPlan};
+use gyrolab_io::DataError;
+use gyrolab_report::figures::known_figure;
+use gyrolab_report::format::sig;
+use gyrolab_report::html::{DataTable, ReportHeader, ReportSection};
+use gyrolab_report::limits::Limit;
+use gyrolab_report::results::DeviceJson;
+use gyrolab_report::triad::triad_json;
+use std::path::{Path, PathBuf};
+
+/// Reads and checks a plan file (limit names are checked against the figure catalogue).
+pub fn read_test_plan(path: &Path) -> EvalResult<TestPlan> {
+    Ok(read_plan(path, &|n| known_figure(n).is_some())?)
+}
+
+/// Rate-test settings of a plan.
+pub fn plan_settings(plan: &TestPlan) -> RateSettings {
+    RateSettings {
+        coverage: plan.options.coverage,
+        half_hysteresis: plan.options.half_hysteresis,
+        order: plan.options.order as i64,
+        nonlinearity_limit_pct: plan.options.nonlinearity_limit_pct,
+    }
+}
+
+/// The segmentation request of a plan's raw-log keys.
+pub fn segmentation_request(p: &SegmentationPlan) -> SegmentationRequest {
+    SegmentationRequest {
+        table_rate_column: p.table_rate_column.clone(),
+        steady_tolerance_dps: p.steady_tolerance_dps,
+        min_plateau_s: p.min_plateau_s,
+        settling_s: p.settling_s,
+        rest_tolerance_dps: p.rest_tolerance_dps,
+        manual_segments: p.segments.clone(),
+    }
+}
+
+/// Number of progress steps of a plan's evaluation.
+pub fn progress_steps(plan: &TestPlan) -> u64 {
+    2 * plan.rate.len() as u64 + 6 + 2 * static_part::progress_steps(&plan.static_tests) + plan.triad.is_some() as u64
+}
+
+/// Evaluates the `[rate.<axis>]` records of a plan, in device axis order.
+pub fn evaluate_plan_rates(plan: &TestPlan, progress: &dyn Progress) -> EvalResult<Vec<EvaluatedAxis>> {
+    let options = plan_settings(plan).options()?;
+    let mut axes = Vec::new();
+    for r in &plan.rate {
+        progress.message(&format!("evaluating axis {}", r.axis));
+        if is_raw_log(&r.file, r.raw)? {
+            let request = segmentation_request(&r.segmentation);
+            let seg_options = request.options()?;
+            let log = segment_file(&r.file, &request, &seg_options, r.columns.output.as_deref())?;
+            if log.log.header.channels.len() != 1 {
+                let names: Vec<&str> = log.log.header.channels.iter().map(|c| c.name.as_str()).collect();
+                return Err(EvalError::Data(DataError::new(
+                    &r.file,
+                    format!(
+                        "rate.{}: the raw log has {} output columns ({}): name the one of this axis with \
+                         rate.{}.output_column",
+                        r.axis,
+                        names.len(),
+                        names.join(", "),
+                        r.axis
+                    ),
+                )));
+            }
+            let mut name = Some(r.axis.clone());
+            let mut evaluated = evaluate_channels(&log, &options, &seg_options, &mut || name.take())?;
+            for a in &mut evaluated {
+                a.file = r.file_as_written.clone();
+            }
+            axes.extend(evaluated);
+        } else {
+            let record = read_rate_table(&r.file, &r.columns)?;
+            axes.push(evaluate_record(r.axis.clone(), r.file_as_written.clone(), record, &options)?);
+        }
+        progress.advance(1);
+    }
+    Ok(axes)
+}
+
+/// The HTML section of a three-axis calibration.
+fn triad_section(t: &gyrolab_report::triad::TriadReport<'_>) -> ReportSection {
+    let c = &t.fit.calibration;
+    let u = t.output_unit.symbol();
+    let mut rows = Vec::new();
+    for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+        let mut row = vec![axis.to_string()];
+        row.extend((0..3).map(|j| sig(c.matrix[i][j], 7)));
+        row.push(sig(c.bias[i], 7));
+        rows.push(row);
+    }
+    ReportSection {
+        title: "Three-axis calibration (scale factors, misalignments, biases)".into(),
+        paragraphs: vec![format!(
+            "Output = M · rate + b, fitted by least squares over the steady plateaus of the rotations about the \
+             table axes ({}). M in {u}/(deg/s), b in {u}; docs/METHODS.md, three-axis calibration.",
+            t.files.iter().map(|(a, f)| format!("{a}: {f}")).collect::<Vec<_>>().join(", ")
+        )],
+        tables: vec![DataTable {
+            caption: format!("Scale-factor and misalignment matrix M ({u}/(deg/s)) and bias b ({u})"),
+            header: ["gyro", "M · x", "M · y", "M · z", "b"].map(String::from).to_vec(),
+            rows,
+        }],
+        ..Default::default()
+    }
+}
+
+/// Evaluates a plan into a report folder (nothing is written).
+///
+/// ```
+/// use gyrolab_eval::{progress::Silent, test_plan::{read_test_plan, evaluate_test_plan}};
+/// let plan = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper_plan.toml");
+/// let folder = evaluate_test_plan(&read_test_plan(&plan).unwrap(), &plan.display().to_string(), &Silent).unwrap();
+/// assert!(folder.outputs.iter().any(|o| o.name == "results.json"));
+/// assert_eq!(folder.verdict, Some(gyrolab_report::limits::Verdict::Fail)); // the paper's own claims fail
+/// ```
+pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progress) -> EvalResult<ReportFolder> {
+    progress.begin(progress_steps(plan));
+    let axes = evaluate_plan_rates(plan, progress)?;
+    let triad = match &plan.triad {
+        None => None,
+        Some(t) => {
+            progress.message("three-axis calibration");
+            let request = TriadRequest {
+                files: TableAxis::ALL.into_iter().zip(t.files.iter().cloned()).collect(),
+                gyro_columns: t.gyro_columns.clone(),
+                segmentation: segmentation_request(&t.segmentation),
+            };
+            let mut result = evaluate_triad(&request)?;
+            for ((_, shown), written) in result.files.iter_mut().zip(&t.files_as_written) {
+                *shown = written.clone();
+            }
+            progress.advance(1);
+            Some(result)
+        }
+    };
+    let mut notes = Vec::new();
+    if let Some(l) = plan.options.nonlinearity_limit_pct {
+        notes.push(format!("Linear input range searched with a nonlinearity limit of {} %.", sig(l, 4)));
+    }
+    let limits: Vec<Limit> =
+        plan.limits.iter().map(|l| Limit { figure: l.figure.clone(), min: l.min, max: l.max }).collect();
+    let base = match plan.file.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let ctx = static_part::StaticContext {
+        rate_axes: &axes,
+        calibration: plan.options.calibration.as_deref(),
+        limits: &limits,
+        base: &base,
+        simulated: None,
+    };
+    let mut parts = static_part::evaluate_static(&plan.static_tests, &ctx, progress)?;
+    let triad_report = triad.as_ref().map(|t| t.report());
+    if let Some(t) = &triad_report {
+        parts.sections.insert(0, triad_section(t));
+        let value = serde_json::to_value(triad_json(t)).map_err(|e| EvalError::Output(e.to_string()))?;
+        parts.json.insert("triad".into(), value);
+    }
+    let created = humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string();
+    let header = ReportHeader {
+        title: format!("Gyro test report: {} {}", plan.device.model, plan.device.serial),
+        model: plan.device.model.clone(),
+        serial: plan.device.serial.clone(),
+        axes: plan.device.axes.clone(),
+        date: created,
+        gyrolab_version: env!("CARGO_PKG_VERSION").into(),
+        plan_file: plan_file.to_string(),
+        notes,
+    };
+    let inputs = ReportInputs {
+        header,
+        device: DeviceJson {
+            model: plan.device.model.clone(),
+            serial: plan.device.serial.clone(),
+            axes: plan.device.axes.clone(),
+            description: plan.device.description.clone(),
+        },
+        axes: &axes,
+        limits,
+        extra_figures: parts.figures,
+        extra_sections: parts.sections,
+        extra_json: parts.json,
+        extra_files: parts.files,
+        triad: triad_report,
+    };
+    assemble_report(inputs, progress)
+}
