@@ -11,9 +11,10 @@
 //!   allantools' `edf_greenhall` implements. Case 4 (white PM, unmodified) is evaluated here by
 //!   its exact finite sum, which equals the paper's a0 - a1/r when ceil(r) > d.
 //! - NIST SP 1065 section 5.2.11 table 11 (recalled as `b T/tau - c`) for TOTDEV's EDF.
-//! - NIST SP 1065 eq. (45): chi-squared bounds var*edf/chi2(p, edf).
+//! - NIST SP 1065 eq. (45): chi-squared bounds var*edf/chi2(p, edf), quantiles from `chi2`
+//!   (valid at every edf; statrs' `ChiSquared::inverse_cdf` fails above edf ~ 3e5).
 
-use statrs::distribution::{ChiSquared, ContinuousCDF};
+use super::chi2::chi_squared_quantile;
 
 /// Fewest decimated phase points for which the lag-1 autocorrelation is trusted (Riley & Greenhall).
 pub(crate) const LAG1_MIN_POINTS: usize = 30;
@@ -406,10 +407,12 @@ pub(crate) fn chi2_bounds(dev: f64, edf: f64, confidence: f64) -> Option<(f64, f
     if dev == 0.0 {
         return Some((0.0, 0.0));
     }
-    let chi2 = ChiSquared::new(edf).ok()?;
     let tail = (1.0 - confidence) / 2.0;
-    let hi_q = chi2.inverse_cdf(1.0 - tail);
-    let lo_q = chi2.inverse_cdf(tail);
+    let hi_q = chi_squared_quantile(1.0 - tail, edf)?;
+    let lo_q = chi_squared_quantile(tail, edf)?;
+    if !(lo_q > 0.0 && hi_q.is_finite()) {
+        return None;
+    }
     let var = dev * dev;
     let lo = (edf * var / hi_q).sqrt();
     let hi = (edf * var / lo_q).sqrt();

@@ -26,10 +26,12 @@
 //! the FFT path of long OADEV tau lists (a few copies of the record) and the B1 fallback's N/m
 //! averages (m > N/30 in practice). TOTDEV builds a reflected copy of 3N values.
 
+mod chi2;
 mod confidence;
 mod fast;
 mod kernels;
 
+pub use chi2::{chi_squared_cdf, chi_squared_quantile};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
