@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
-# Installs what the tests need beyond the Rust toolchain: Python's allantools (from PyPI, into
-# .venv) for the equality check of the Allan deviations, and Chromium for the browser test of
+# Installs what the tests need beyond the Rust toolchain: Python's allantools and scipy (from PyPI,
+# into .venv) for the equality checks of the Allan deviations and the chi-squared quantiles
+# (scripts/check_chi2_scipy.py), and Chromium for the browser test of
 # the HTML report (crates/gyrolab-cli/tests/browser.rs). Does nothing that is already done.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-if ! .venv/bin/python -c "import allantools" 2>/dev/null; then
-    echo "install-test-deps: installing allantools (PyPI) into .venv" >&2
+if ! .venv/bin/python -c "import allantools, scipy" 2>/dev/null; then
+    echo "install-test-deps: installing allantools and scipy (PyPI) into .venv" >&2
     python3 -m venv .venv
-    .venv/bin/pip install --quiet --disable-pip-version-check "allantools==2024.6" "numpy<3"
+    .venv/bin/pip install --quiet --disable-pip-version-check "allantools==2024.6" "numpy<3" "scipy"
 fi
 if [ -x /usr/bin/chromium ]; then
     exit 0

@@ -2,25 +2,31 @@
 //!
 //! Sources:
 //! - W. J. Riley, C. A. Greenhall, "Power law noise identification using the lag 1
-//!   autocorrelation", EFTF 2004 (lag-1 ACF of the decimated, detrended phase; differencing
-//!   until delta = r1/(1+r1) < 0.25; alpha = -round(2 delta) - 2d + 2 for phase data).
-//! - NIST SP 1065 section 5.6 (B1 ratio of Barnes, R(n) = Mod AVAR / AVAR) for the largest
-//!   averaging factors where fewer than 30 decimated points are left (Stable32's fallback).
+//!   autocorrelation", EFTF 2004: lag-1 ACF r1, differencing until delta = r1/(1+r1) < 0.25,
+//!   alpha = -round(2 delta) - 2d for frequency data. Applied, as Stable32 does (read off its
+//!   result files, see `docs/METHODS.md`), to the m-sample frequency averages with a linear trend
+//!   removed, when there are at least 30 of them; alpha capped at 2.
+//! - NIST SP 1065 section 5.6 (B1 ratio of Barnes, R(n) = Mod AVAR / AVAR) for the larger
+//!   averaging factors (Stable32's fallback), with Barnes' B1(N, mu) evaluated at N = the
+//!   estimator's number of terms, as Stable32's results require.
 //! - C. A. Greenhall, W. J. Riley, "Uncertainty of stability variances based on finite
 //!   differences", 35th PTTI, 2003/2004: EDF algorithm (eq. 7-10 and tables 1-3), the same one
 //!   allantools' `edf_greenhall` implements. Case 4 (white PM, unmodified) is evaluated here by
 //!   its exact finite sum, which equals the paper's a0 - a1/r when ceil(r) > d.
 //! - NIST SP 1065 section 5.2.11 table 11 (recalled as `b T/tau - c`) for TOTDEV's EDF.
-//! - NIST SP 1065 eq. (45): chi-squared bounds var*edf/chi2(p, edf).
+//! - NIST SP 1065 eq. (45): chi-squared bounds var*edf/chi2(p, edf), quantiles from `chi2`
+//!   (valid at every edf; statrs' `ChiSquared::inverse_cdf` fails above edf ~ 3e5).
 
-use statrs::distribution::{ChiSquared, ContinuousCDF};
+use super::chi2::chi_squared_quantile;
 
-/// Fewest decimated phase points for which the lag-1 autocorrelation is trusted (Riley & Greenhall).
-pub(crate) const LAG1_MIN_POINTS: usize = 30;
+/// Fewest m-sample frequency averages for which the lag-1 autocorrelation is used (Riley &
+/// Greenhall's 30; Stable32 counts averages: on Cs5071A it switches to B1 between 30 and 29).
+pub(crate) const LAG1_MIN_AVERAGES: usize = 30;
 
-/// Fewest m-sample averages for the B1 fallback. Stable32's result files show B1 used with 9 and
-/// more averages and the previous tau's alpha kept with 7 or fewer; 8 is not pinned down by them.
-pub(crate) const B1_MIN_AVERAGES: usize = 8;
+/// Fewest "independent terms" for the B1 fallback: the number of terms of a non-overlapping
+/// estimator, terms / m of an overlapping one. Below it the previous tau's alpha is kept.
+/// Read off Stable32's result files (phasedat, Keysight, gps, Cs5071A; see `docs/METHODS.md`).
+pub(crate) const B1_MIN_TERMS: f64 = 8.0;
 
 /// Lag-1 autocorrelation r1 of a series (Riley & Greenhall eq. 2); `None` if it has no spread.
 #[cfg(test)]
@@ -37,66 +43,61 @@ fn lag1_acf(z: &[f64]) -> Option<f64> {
     Some(num / den)
 }
 
-/// Removes the least-squares polynomial of degree <= 2 from equally spaced values, in place,
-/// by projection on discrete orthogonal (Gram) polynomials: no matrix, exact to rounding.
+/// Removes the least-squares straight line from equally spaced values, in place, by projection
+/// on the orthogonal polynomials 1 and t - c: no matrix, exact to rounding.
 #[cfg(test)]
-fn detrend_quadratic(z: &mut [f64]) {
+fn detrend_linear(z: &mut [f64]) {
     let n = z.len();
-    if n < 3 {
+    if n < 2 {
         return;
     }
     let c = (n as f64 - 1.0) / 2.0;
-    let q = (n as f64 * n as f64 - 1.0) / 12.0;
-    let p1 = |t: usize| t as f64 - c;
-    let p2 = |t: usize| (t as f64 - c).powi(2) - q;
-    let (mut s0, mut s1, mut s2, mut n1, mut n2) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let (mut s0, mut s1, mut n1) = (0.0, 0.0, 0.0);
     for (t, &v) in z.iter().enumerate() {
         s0 += v;
-        s1 += v * p1(t);
-        s2 += v * p2(t);
-        n1 += p1(t) * p1(t);
-        n2 += p2(t) * p2(t);
+        s1 += v * (t as f64 - c);
+        n1 += (t as f64 - c) * (t as f64 - c);
     }
-    let (a0, a1, a2) = (s0 / n as f64, s1 / n1, if n2 > 0.0 { s2 / n2 } else { 0.0 });
+    let (a0, a1) = (s0 / n as f64, s1 / n1);
     for (t, v) in z.iter_mut().enumerate() {
-        *v -= a0 + a1 * p1(t) + a2 * p2(t);
+        *v -= a0 + a1 * (t as f64 - c);
     }
 }
 
-/// Lag-1 autocorrelation noise identification on phase `s` (sample units) at averaging factor m.
+/// Lag-1 autocorrelation noise identification at averaging factor m, on the phase `s` (sample
+/// units), as Stable32 does it: the n = (L-1)/m non-overlapping m-sample frequency averages
+/// w_j = s[(j+1) m] - s[j m] (the factor 1/m does not change r1), linear trend removed, then
+/// differenced (at most `dmax` - 1 times, `dmax` the estimator's difference order) until
+/// delta = r1/(1+r1) < 0.25; alpha = -round(2 delta) - 2d, capped at 2 (white PM).
 ///
-/// Returns the integer power-law exponent alpha of the rate (frequency) PSD, or `None` when fewer
-/// than [`LAG1_MIN_POINTS`] decimated points remain or the series is constant.
+/// Returns `None` when fewer than [`LAG1_MIN_AVERAGES`] averages exist or the series is constant.
 ///
-/// Streaming, without a copy of the decimated series: one pass over z_t = s[t m] gives the
-/// quadratic's coefficients (orthogonal polynomials, as [`detrend_quadratic`]), a second pass
-/// forms the residual r_t and its differences of every order up to `dmax` on the fly and sums,
-/// per order, w, w^2 and w_t w_{t+1}; r1 = (S11 - mu (S1 - w_last + S1 - w_first) + (n-1) mu^2)
-/// / (S2 - n mu^2). The residual has zero mean and its differences a mean of order
-/// (spread) / n, so the expanded sums lose nothing against the centred ones.
+/// Streaming, without a copy of the averages: one pass gives the line's coefficients
+/// (orthogonal polynomials, as [`detrend_linear`]), a second pass forms the residual r_j and its
+/// differences of every order up to `dmax` - 1 on the fly and sums, per order, w, w^2 and
+/// w_t w_{t+1}; r1 = (S11 - mu (S1 - w_last + S1 - w_first) + (n-1) mu^2) / (S2 - n mu^2).
+/// The residual has zero mean and its differences a mean of order (spread) / n, so the expanded
+/// sums lose nothing against the centred ones.
 pub(crate) fn lag1_noise_id(s: &[f64], m: usize, dmax: usize) -> Option<i32> {
-    const ORDERS: usize = 4;
-    if s.is_empty() || m == 0 {
+    const ORDERS: usize = 3;
+    if s.len() < 2 || m == 0 {
         return None;
     }
-    let n = (s.len() - 1) / m + 1;
-    if n < LAG1_MIN_POINTS {
+    let n = (s.len() - 1) / m;
+    if n < LAG1_MIN_AVERAGES {
         return None;
     }
-    let dmax = dmax.min(ORDERS - 1);
+    let dmax = dmax.saturating_sub(1).min(ORDERS - 1);
+    let averages = || (0..n).map(|j| s[(j + 1) * m] - s[j * m]);
     let c = (n as f64 - 1.0) / 2.0;
-    let q = (n as f64 * n as f64 - 1.0) / 12.0;
-    let p1 = |t: usize| t as f64 - c;
-    let p2 = |t: usize| (t as f64 - c).powi(2) - q;
-    let (mut s0, mut s1, mut s2, mut n1, mut n2) = (0.0, 0.0, 0.0, 0.0, 0.0);
-    for (t, &v) in s.iter().step_by(m).enumerate() {
+    let (mut s0, mut s1, mut n1) = (0.0, 0.0, 0.0);
+    for (t, v) in averages().enumerate() {
+        let p1 = t as f64 - c;
         s0 += v;
-        s1 += v * p1(t);
-        s2 += v * p2(t);
-        n1 += p1(t) * p1(t);
-        n2 += p2(t) * p2(t);
+        s1 += v * p1;
+        n1 += p1 * p1;
     }
-    let (a0, a1, a2) = (s0 / n as f64, s1 / n1, if n2 > 0.0 { s2 / n2 } else { 0.0 });
+    let (a0, a1) = (s0 / n as f64, s1 / n1);
     // per order d: sum w, sum w^2, sum w_t w_{t+1}, first w, last w
     let mut sum1 = [0.0f64; ORDERS];
     let mut sum2 = [0.0f64; ORDERS];
@@ -105,9 +106,9 @@ pub(crate) fn lag1_noise_id(s: &[f64], m: usize, dmax: usize) -> Option<i32> {
     let mut last = [0.0f64; ORDERS];
     // prev[d]: the order-d value at t - 1 (defined once t - 1 >= d)
     let mut prev = [0.0f64; ORDERS];
-    for (t, &v) in s.iter().step_by(m).enumerate() {
+    for (t, v) in averages().enumerate() {
         let mut cur = [0.0f64; ORDERS];
-        cur[0] = v - (a0 + a1 * p1(t) + a2 * p2(t));
+        cur[0] = v - (a0 + a1 * (t as f64 - c));
         let top = dmax.min(t);
         for d in 1..=top {
             cur[d] = cur[d - 1] - prev[d - 1];
@@ -140,11 +141,16 @@ pub(crate) fn lag1_noise_id(s: &[f64], m: usize, dmax: usize) -> Option<i32> {
         let r1 = num / den;
         let delta = r1 / (1.0 + r1);
         if delta < 0.25 || d >= dmax {
-            let alpha = -(2.0 * delta).round() as i32 - 2 * d as i32 + 2;
-            return Some(alpha);
+            return Some(lag1_alpha(delta, d));
         }
         d += 1;
     }
+}
+
+/// alpha = -round(2 delta) - 2d for frequency data, capped at 2 (Stable32 never reports more;
+/// r1 < -5/9 on a short white-PM series would otherwise give 3).
+fn lag1_alpha(delta: f64, d: usize) -> i32 {
+    (-(2.0 * delta).round() as i32 - 2 * d as i32).min(2)
 }
 
 /// Allan-variance tau exponent mu for a power-law alpha (SP1065 table 4): mu = -alpha - 1, capped at -2.
@@ -182,11 +188,19 @@ fn rn_theory(m: f64, alpha: i32) -> f64 {
 
 /// B1-ratio noise identification (with R(n) to split white from flicker PM), SP1065 section 5.6.
 ///
-/// `averages` are the non-overlapping m-sample means of the rate; `mod_over_allan` the measured
-/// ratio Mod AVAR / AVAR at this m (used only when B1 points to PM noise).
-pub(crate) fn b1_noise_id(averages: &[f64], m: usize, mod_over_allan: impl FnOnce() -> Option<f64>) -> Option<i32> {
+/// `averages` are the non-overlapping m-sample means of the rate (the measured B1 is their sample
+/// variance over their Allan variance); `terms` is the estimator's number of terms, the N at
+/// which Barnes' B1(N, mu) is evaluated (Stable32 does so: with N = the number of averages the
+/// overlapping estimators of Cs5071A would get alpha -1 where Stable32 has 0); `mod_over_allan`
+/// the measured ratio Mod AVAR / AVAR at this m (used only when B1 points to PM noise).
+pub(crate) fn b1_noise_id(
+    averages: &[f64],
+    m: usize,
+    terms: usize,
+    mod_over_allan: impl FnOnce() -> Option<f64>,
+) -> Option<i32> {
     let n = averages.len();
-    if n < B1_MIN_AVERAGES {
+    if n < 3 || terms < 2 {
         return None;
     }
     let mean = averages.iter().sum::<f64>() / n as f64;
@@ -196,7 +210,7 @@ pub(crate) fn b1_noise_id(averages: &[f64], m: usize, mod_over_allan: impl FnOnc
         return None;
     }
     let b1 = var / avar;
-    let nf = n as f64;
+    let nf = terms as f64;
     // candidate alphas from random-walk FM up to PM; boundaries are geometric means
     let mut alpha = -2;
     for candidate in [-1, 0, 1] {
@@ -406,35 +420,39 @@ pub(crate) fn chi2_bounds(dev: f64, edf: f64, confidence: f64) -> Option<(f64, f
     if dev == 0.0 {
         return Some((0.0, 0.0));
     }
-    let chi2 = ChiSquared::new(edf).ok()?;
     let tail = (1.0 - confidence) / 2.0;
-    let hi_q = chi2.inverse_cdf(1.0 - tail);
-    let lo_q = chi2.inverse_cdf(tail);
+    let hi_q = chi_squared_quantile(1.0 - tail, edf)?;
+    let lo_q = chi_squared_quantile(tail, edf)?;
+    if !(lo_q > 0.0 && hi_q.is_finite()) {
+        return None;
+    }
     let var = dev * dev;
     let lo = (edf * var / hi_q).sqrt();
     let hi = (edf * var / lo_q).sqrt();
     (lo.is_finite() && hi.is_finite()).then_some((lo, hi))
 }
 
-/// The copying reference implementation of [`lag1_noise_id`] (decimate, detrend, difference).
+/// The copying reference implementation of [`lag1_noise_id`] (average, detrend, difference).
 #[cfg(test)]
 fn lag1_noise_id_copy(s: &[f64], m: usize, dmax: usize) -> Option<i32> {
-    let mut z: Vec<f64> = s.iter().step_by(m).copied().collect();
-    if z.len() < LAG1_MIN_POINTS {
+    let z: Vec<f64> = s.iter().step_by(m).copied().collect();
+    let mut w: Vec<f64> = z.windows(2).map(|p| (p[1] - p[0]) / m as f64).collect();
+    if w.len() < LAG1_MIN_AVERAGES {
         return None;
     }
-    detrend_quadratic(&mut z);
+    detrend_linear(&mut w);
+    let dmax = dmax - 1;
     let mut d = 0usize;
     loop {
-        let r1 = lag1_acf(&z)?;
+        let r1 = lag1_acf(&w)?;
         let delta = r1 / (1.0 + r1);
         if delta < 0.25 || d >= dmax {
-            return Some(-(2.0 * delta).round() as i32 - 2 * d as i32 + 2);
+            return Some(lag1_alpha(delta, d));
         }
-        for i in 0..z.len() - 1 {
-            z[i] = z[i + 1] - z[i];
+        for i in 0..w.len() - 1 {
+            w[i] = w[i + 1] - w[i];
         }
-        z.pop();
+        w.pop();
         d += 1;
     }
 }

@@ -455,7 +455,8 @@ const RUN_MAX: usize = 8;
 /// ([`octave_run_body`]). The k range is cut into blocks of 4096; within a block every run is
 /// summed before moving on, so the windows s[k + 2^i m ..] stay in cache, and the blocks run in
 /// parallel (rayon). A tau whose last term lies inside a block (the staircase n_i = L - 2 m_i)
-/// is fused up to the run's common end and finished alone.
+/// is fused up to the run's common end and finished alone. Blocks are grouped and combined in a
+/// fixed order, so the sums do not depend on the number of threads.
 pub(crate) fn overlapping_allan_sums(s: &[f64], ms: &[usize]) -> Vec<f64> {
     use rayon::prelude::*;
     const BLOCK: usize = 1024;
@@ -476,42 +477,53 @@ pub(crate) fn overlapping_allan_sums(s: &[f64], ms: &[usize]) -> Vec<f64> {
     }
     let n_max = ms.iter().map(|&m| len.saturating_sub(2 * m)).max().unwrap_or(0);
     let blocks = n_max.div_ceil(BLOCK);
-    let zero = || vec![0.0f64; ms.len()];
-    (0..blocks)
+    // Fixed partition, independent of the thread count: the blocks are cut into at most
+    // GROUPS_MAX consecutive groups (fewer for long tau lists, so that the per-group sums stay
+    // within GROUP_BUDGET values); each group sums its blocks in order, and the groups' sums are
+    // added in group order. The result is bit-identical whatever rayon's schedule.
+    const GROUPS_MAX: usize = 64;
+    const GROUP_BUDGET: usize = 1 << 22;
+    let groups = (GROUP_BUDGET / ms.len().max(1)).clamp(1, GROUPS_MAX).min(blocks.max(1));
+    let per_group = blocks.div_ceil(groups).max(1);
+    let partial: Vec<Vec<f64>> = (0..groups)
         .into_par_iter()
-        .fold(zero, |mut acc, b| {
-            let k0 = b * BLOCK;
-            for &(start, count, octave) in &runs {
-                let n_of = |i: usize| len.saturating_sub(2 * ms[i]);
-                // taus of a group sorted by m, so their term counts decrease along it
-                let active = (0..count).take_while(|&i| n_of(start + i) > k0).count();
-                if active == 0 {
-                    continue;
-                }
-                let common_end = (k0 + BLOCK).min(n_of(start + active - 1));
-                let slots = &mut acc[start..start + active];
-                if octave {
-                    octave_run(s, ms[start], k0, common_end, slots);
-                } else {
-                    spread_run(s, &ms[start..start + active], k0, common_end, slots);
-                }
-                for i in 0..active - 1 {
-                    let end = (k0 + BLOCK).min(n_of(start + i));
-                    if end > common_end {
-                        spread_run(
-                            s,
-                            &ms[start + i..start + i + 1],
-                            common_end,
-                            end,
-                            &mut acc[start + i..start + i + 1],
-                        );
-                    }
-                }
+        .map(|g| {
+            let mut acc = vec![0.0f64; ms.len()];
+            for b in g * per_group..((g + 1) * per_group).min(blocks) {
+                sum_block(s, ms, &runs, b * BLOCK, BLOCK, &mut acc);
             }
             acc
         })
-        .reduce(zero, |mut a, b| {
-            a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
-            a
-        })
+        .collect();
+    let mut total = vec![0.0f64; ms.len()];
+    for acc in &partial {
+        total.iter_mut().zip(acc).for_each(|(t, v)| *t += v);
+    }
+    total
+}
+
+/// Adds to `acc` the sums of every run over k in `k0..k0 + block` (see [`overlapping_allan_sums`]).
+fn sum_block(s: &[f64], ms: &[usize], runs: &[(usize, usize, bool)], k0: usize, block: usize, acc: &mut [f64]) {
+    let len = s.len();
+    for &(start, count, octave) in runs {
+        let n_of = |i: usize| len.saturating_sub(2 * ms[i]);
+        // taus of a group sorted by m, so their term counts decrease along it
+        let active = (0..count).take_while(|&i| n_of(start + i) > k0).count();
+        if active == 0 {
+            continue;
+        }
+        let common_end = (k0 + block).min(n_of(start + active - 1));
+        let slots = &mut acc[start..start + active];
+        if octave {
+            octave_run(s, ms[start], k0, common_end, slots);
+        } else {
+            spread_run(s, &ms[start..start + active], k0, common_end, slots);
+        }
+        for i in 0..active - 1 {
+            let end = (k0 + block).min(n_of(start + i));
+            if end > common_end {
+                spread_run(s, &ms[start + i..start + i + 1], common_end, end, &mut acc[start + i..start + i + 1]);
+            }
+        }
+    }
 }

@@ -26,10 +26,12 @@
 //! the FFT path of long OADEV tau lists (a few copies of the record) and the B1 fallback's N/m
 //! averages (m > N/30 in practice). TOTDEV builds a reflected copy of 3N values.
 
+mod chi2;
 mod confidence;
 mod fast;
 mod kernels;
 
+pub use chi2::{chi_squared_cdf, chi_squared_quantile};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
@@ -207,11 +209,11 @@ impl AllanOptions {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum NoiseIdMethod {
-    /// Lag-1 autocorrelation (Riley & Greenhall), >= 30 decimated points.
+    /// Lag-1 autocorrelation (Riley & Greenhall) of the frequency averages, >= 30 of them.
     Lag1Autocorrelation,
-    /// B1 ratio with R(n) (SP1065 5.6), used where fewer than 30 decimated points remain.
+    /// B1 ratio with R(n) (SP1065 5.6), used where fewer than 30 averages remain.
     B1Ratio,
-    /// Taken over from the next smaller averaging factor (B1 not computable either).
+    /// Taken over from the next smaller averaging factor (too few terms for B1 either).
     Previous,
 }
 
@@ -606,7 +608,7 @@ fn compute(s: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve,
         .collect();
     if let Some(confidence) = options.confidence {
         let ids: Vec<Option<(i32, NoiseIdMethod)>> =
-            points.par_iter().map(|p| identify_noise(s, p.m, kind.difference_order() as usize)).collect();
+            points.par_iter().map(|p| identify_noise(s, p.m, kind, p.terms)).collect();
         let mut previous: Option<i32> = None;
         for (p, id) in points.iter_mut().zip(ids) {
             match id {
@@ -700,10 +702,20 @@ fn variance_at(s: &[f64], extended: Option<&[f64]>, kind: DeviationKind, m: usiz
     }
 }
 
-/// Noise identification at m: lag-1 ACF when >= 30 decimated points, else B1 ratio with R(n).
-fn identify_noise(s: &[f64], m: usize, dmax: usize) -> Option<(i32, NoiseIdMethod)> {
-    if let Some(a) = confidence::lag1_noise_id(s, m, dmax) {
+/// Noise identification at m, Stable32's rule: lag-1 ACF of the frequency averages when there
+/// are >= 30 of them; else the B1 ratio with R(n) (B1 theory at N = `terms`) when the estimator
+/// has at least [`confidence::B1_MIN_TERMS`] independent terms (its terms, divided by m for the
+/// overlapping ones); else `None` (the caller keeps the previous tau's alpha).
+fn identify_noise(s: &[f64], m: usize, kind: DeviationKind, terms: usize) -> Option<(i32, NoiseIdMethod)> {
+    if let Some(a) = confidence::lag1_noise_id(s, m, kind.difference_order() as usize) {
         return Some((a, NoiseIdMethod::Lag1Autocorrelation));
+    }
+    let independent = match kind {
+        DeviationKind::Adev | DeviationKind::Hdev => terms as f64,
+        _ => terms as f64 / m as f64,
+    };
+    if independent < confidence::B1_MIN_TERMS {
+        return None;
     }
     let averages: Vec<f64> =
         s.iter().step_by(m).collect::<Vec<_>>().windows(2).map(|w| (w[1] - w[0]) / m as f64).collect();
@@ -717,7 +729,7 @@ fn identify_noise(s: &[f64], m: usize, dmax: usize) -> Option<(i32, NoiseIdMetho
         let avar = asum / (2.0 * (m as f64).powi(2) * an as f64);
         (avar > 0.0).then(|| mvar / avar)
     };
-    confidence::b1_noise_id(&averages, m, rn).map(|a| (a, NoiseIdMethod::B1Ratio))
+    confidence::b1_noise_id(&averages, m, terms, rn).map(|a| (a, NoiseIdMethod::B1Ratio))
 }
 
 /// Equivalent degrees of freedom of a deviation of `kind` at averaging factor `m` for noise

@@ -279,3 +279,26 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn bounds_exist_at_every_tau_of_a_long_white_record() {
+    // Issue 15: statrs' chi-squared quantile failed at edf ~ 2.7e5 (500 000 white samples, m = 2):
+    // the upper bound came out -0. Every point with an EDF must have finite bounds around sigma.
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(15);
+    let y: Vec<f64> = (0..500_000).map(|_| StandardNormal.sample(&mut rng)).collect();
+    for kind in DeviationKind::ALL {
+        let curve = deviation_from_rate_slice(&y, 0.01, &AllanOptions::new(kind)).unwrap();
+        for p in &curve.points {
+            let Some(edf) = p.edf else { continue };
+            let (lo, hi) = (p.lower.unwrap(), p.upper.unwrap());
+            assert!(lo.is_finite() && hi.is_finite() && lo > 0.0, "{kind:?} m={} edf {edf}: [{lo}, {hi}]", p.m);
+            assert!(lo < p.deviation && p.deviation < hi, "{kind:?} m={} edf {edf}: {lo} {} {hi}", p.m, p.deviation);
+        }
+        let m2 = curve.points.iter().find(|p| p.m == 2).unwrap();
+        assert!(m2.edf.unwrap() > 1e5, "{kind:?} edf at m = 2: {:?}", m2.edf);
+        // 68.3 % bounds of a variance with edf degrees of freedom: sigma (1 +- 1/sqrt(2 edf)) to first order
+        let half = 1.0 / (2.0 * m2.edf.unwrap()).sqrt();
+        let up = m2.upper.unwrap() / m2.deviation - 1.0;
+        assert!((up / half - 1.0).abs() < 0.05, "{kind:?} upper {up:e} vs {half:e}");
+    }
+}
