@@ -9,3 +9,7 @@ cargo test --workspace --all-targets
 # Allan deviations equal to Python allantools (rate data = data_type 'freq') at relative 1e-9.
 cargo build --quiet -p gyrolab-cli
 .venv/bin/python scripts/check_allantools.py target/debug/gyrolab
+# Chi-squared quantiles (the confidence bounds) equal to scipy's chi2.ppf from 1 to 1e9 degrees
+# of freedom at relative 1e-9.
+cargo build --quiet -p gyrolab --example chi2_quantiles
+.venv/bin/python scripts/check_chi2_scipy.py target/debug/examples/chi2_quantiles

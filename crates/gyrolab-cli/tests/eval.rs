@@ -349,3 +349,50 @@ fn rounded(v: serde_json::Value) -> serde_json::Value {
         other => other,
     }
 }
+
+/// Least-squares slope of y on x, written out (independent of gyrolab's fit).
+fn lsq_slope(x: &[f64], y: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let sxx: f64 = x.iter().map(|a| (a - mx) * (a - mx)).sum();
+    sxy / sxx
+}
+
+#[test]
+fn raw_log_plan_is_segmented_and_recovers_the_simulated_scale_factor() {
+    let plan = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/raw_log_plan.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("report");
+    gyrolab().arg("eval").arg(&plan).arg("--out").arg(&out).arg("--quiet").assert().code(0);
+    let v: serde_json::Value = serde_json::from_str(&read(&out.join("results.json"))).unwrap();
+    let axis = &v["rate_axes"][0];
+    assert_eq!(axis["layout"], "raw");
+    // The example log was simulated with K = 0.0075 V/(deg/s) and 0.5 mV white noise; each of
+    // the 24 plateau means averages >= 250 samples, so K is known to ~1e-6 relative of the
+    // truth; 1e-4 leaves room and still fails on a wrong segmentation (a lost plateau edge
+    // moves K by more).
+    let k = axis["scale_factor"].as_f64().unwrap();
+    assert!((k / 0.0075 - 1.0).abs() < 1e-4, "K = {k}");
+    // The same slope, by a least-squares line through the plateau means the test computes from
+    // the segments file and the log itself.
+    let log = read(&plan.parent().unwrap().join("data/raw_log_x.csv"));
+    // Line number (1-based) -> output, for the data rows.
+    let outputs: Vec<Option<f64>> = log
+        .lines()
+        .map(|l| (!l.starts_with('#') && !l.starts_with("time")).then(|| l.split(',').nth(2).unwrap().parse().unwrap()))
+        .collect();
+    let segs = read(&out.join("segments_x.csv"));
+    let (mut rates, mut means) = (Vec::new(), Vec::new());
+    for l in segs.lines().filter(|l| l.contains(",plateau,")) {
+        let f: Vec<&str> = l.split(',').collect();
+        let (l0, l1): (usize, usize) = (f[4].parse().unwrap(), f[5].parse().unwrap());
+        let v: Vec<f64> = (l0..=l1).filter_map(|line| outputs[line - 1]).collect();
+        rates.push(f[9].parse::<f64>().unwrap());
+        means.push(v.iter().sum::<f64>() / v.len() as f64);
+    }
+    assert_eq!(rates.len(), 24, "2 runs x 2 strokes x 6 rates");
+    let slope = lsq_slope(&rates, &means);
+    assert!((slope / k - 1.0).abs() < 1e-6, "slope {slope} against K {k}");
+    assert!(v["sections"]["segmentation"]["x"].is_object());
+}

@@ -7,7 +7,7 @@ pub mod static_part;
 use crate::error::EvalResult;
 use crate::progress::Progress;
 use crate::rate::{evaluate_record, is_raw_log, EvaluatedAxis, RateSettings};
-use crate::raw_log::{evaluate_channels, segment_file, SegmentationRequest};
+use crate::raw_log::{evaluate_channels, segment_file, SegmentationRequest, SegmentedLog};
 use crate::report_folder::{assemble_report, ReportFolder, ReportInputs};
 use crate::triad::{evaluate_triad, TriadRequest};
 use crate::EvalError;
@@ -20,6 +20,7 @@ use gyrolab_report::format::sig;
 use gyrolab_report::html::{DataTable, ReportHeader, ReportSection};
 use gyrolab_report::limits::Limit;
 use gyrolab_report::results::DeviceJson;
+use gyrolab_report::segments::SegmentationJson;
 use gyrolab_report::triad::triad_json;
 use std::path::{Path, PathBuf};
 
@@ -55,10 +56,15 @@ pub fn progress_steps(plan: &TestPlan) -> u64 {
     2 * plan.rate.len() as u64 + 6 + 2 * static_part::progress_steps(&plan.static_tests) + plan.triad.is_some() as u64
 }
 
-/// Evaluates the `[rate.<axis>]` records of a plan, in device axis order.
-pub fn evaluate_plan_rates(plan: &TestPlan, progress: &dyn Progress) -> EvalResult<Vec<EvaluatedAxis>> {
+/// Evaluates the `[rate.<axis>]` records of a plan, in device axis order; raw logs come back
+/// with their segmentation, (axis, log).
+pub fn evaluate_plan_rates(
+    plan: &TestPlan,
+    progress: &dyn Progress,
+) -> EvalResult<(Vec<EvaluatedAxis>, Vec<(String, SegmentedLog)>)> {
     let options = plan_settings(plan).options()?;
     let mut axes = Vec::new();
+    let mut logs = Vec::new();
     for r in &plan.rate {
         progress.message(&format!("evaluating axis {}", r.axis));
         if is_raw_log(&r.file, r.raw)? {
@@ -85,13 +91,14 @@ pub fn evaluate_plan_rates(plan: &TestPlan, progress: &dyn Progress) -> EvalResu
                 a.file = r.file_as_written.clone();
             }
             axes.extend(evaluated);
+            logs.push((r.axis.clone(), log));
         } else {
             let record = read_rate_table(&r.file, &r.columns)?;
             axes.push(evaluate_record(r.axis.clone(), r.file_as_written.clone(), record, &options)?);
         }
         progress.advance(1);
     }
-    Ok(axes)
+    Ok((axes, logs))
 }
 
 /// The HTML section of a three-axis calibration.
@@ -132,7 +139,7 @@ fn triad_section(t: &gyrolab_report::triad::TriadReport<'_>) -> ReportSection {
 /// ```
 pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progress) -> EvalResult<ReportFolder> {
     progress.begin(progress_steps(plan));
-    let axes = evaluate_plan_rates(plan, progress)?;
+    let (axes, logs) = evaluate_plan_rates(plan, progress)?;
     let triad = match &plan.triad {
         None => None,
         Some(t) => {
@@ -168,6 +175,16 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         simulated: None,
     };
     let mut parts = static_part::evaluate_static(&plan.static_tests, &ctx, progress)?;
+    if !logs.is_empty() {
+        let mut seg = serde_json::Map::new();
+        for (axis, log) in &logs {
+            let value = serde_json::to_value(SegmentationJson::new(&log.report()))
+                .map_err(|e| EvalError::Output(e.to_string()))?;
+            seg.insert(axis.clone(), value);
+            parts.files.push((format!("segments_{axis}.csv"), log.segments_csv().into_bytes()));
+        }
+        parts.json.insert("segmentation".into(), serde_json::Value::Object(seg));
+    }
     let triad_report = triad.as_ref().map(|t| t.report());
     if let Some(t) = &triad_report {
         parts.sections.insert(0, triad_section(t));
