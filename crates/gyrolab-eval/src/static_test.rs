@@ -4,12 +4,12 @@
 
 use crate::error::{EvalError, EvalResult};
 use crate::reference::{Reference, ReferenceRequest};
-use gyrolab::static_test::{bias_repeatability, StaticTestConfig};
+use gyrolab::static_test::{bias_repeatability, StaticTestConfig, StaticTestResult};
 use gyrolab::units::OutputUnit;
 use gyrolab::validate;
-use gyrolab_io::series::{evaluate_static_file, ReaderQuality, SeriesOptions};
+use gyrolab_io::series::{evaluate_static_file, ReaderQuality, SeriesOptions, SeriesSummary};
 use gyrolab_report::bias::{ChannelRepeatability, TestReport};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Static tests, one file per test.
 ///
@@ -125,25 +125,16 @@ pub fn evaluate_static_tests(request: &StaticTestRequest) -> EvalResult<StaticOu
     let mut tests: Vec<TestReport> = Vec::new();
     let mut files = Vec::new();
     for path in &request.files {
-        let mut mismatch = None;
-        let (results, summary) = evaluate_static_file(path, &options, |ch| {
-            let mut cfg = StaticTestConfig {
-                latitude_deg: request.latitude_deg,
-                temperature_quadratic: request.temperature_quadratic,
-                drop_outliers: request.drop_outliers,
-                ..StaticTestConfig::default()
-            };
-            if !request.smoothing_s.is_empty() {
-                cfg.smoothing_times_s = request.smoothing_s.clone();
-            }
-            if let Err(m) = reference.configure(&mut cfg, &ch.name, ch.unit) {
-                mismatch = Some(m);
-            }
-            cfg
-        })?;
-        if let Some(m) = mismatch {
-            return Err(EvalError::conflict(format!("{}: {m}", path.display())));
+        let mut config = StaticTestConfig {
+            latitude_deg: request.latitude_deg,
+            temperature_quadratic: request.temperature_quadratic,
+            drop_outliers: request.drop_outliers,
+            ..StaticTestConfig::default()
+        };
+        if !request.smoothing_s.is_empty() {
+            config.smoothing_times_s = request.smoothing_s.clone();
         }
+        let (results, summary) = evaluate_file(path, &options, &reference, &config)?;
         files.push(FileQuality { file: path.display().to_string(), quality: summary.quality });
         for result in results {
             tests.push(TestReport { file: path.display().to_string(), result });
@@ -151,6 +142,28 @@ pub fn evaluate_static_tests(request: &StaticTestRequest) -> EvalResult<StaticOu
     }
     let repeatability = repeatability_by_channel(&tests);
     Ok(StaticOutcome { tests, repeatability, files, reference })
+}
+
+/// Evaluates every channel of one file with `config`, its scale factor and null set from the
+/// reference for each channel's unit (a unit the reference cannot convert is a conflict).
+pub fn evaluate_file(
+    path: &Path,
+    options: &SeriesOptions,
+    reference: &Reference,
+    config: &StaticTestConfig,
+) -> EvalResult<(Vec<StaticTestResult>, SeriesSummary)> {
+    let mut mismatch = None;
+    let evaluated = evaluate_static_file(path, options, |ch| {
+        let mut cfg = config.clone();
+        if let Err(m) = reference.configure(&mut cfg, &ch.name, ch.unit) {
+            mismatch = Some(m);
+        }
+        cfg
+    })?;
+    match mismatch {
+        Some(m) => Err(EvalError::conflict(format!("{}: {m}", path.display()))),
+        None => Ok(evaluated),
+    }
 }
 
 /// Bias repeatability of each channel present in two or more tests (paper eq. 12), in order of

@@ -7,10 +7,11 @@ use crate::error::{EvalError, EvalResult};
 use crate::progress::Progress;
 use crate::rate::EvaluatedAxis;
 use crate::reference::Reference;
+use crate::static_test::evaluate_file;
 use gyrolab::allan::{AllanOptions, DeviationKind};
 use gyrolab::static_test::{bias_repeatability, smoothing_key, StaticTestConfig};
 use gyrolab_io::calibration::read_calibration;
-use gyrolab_io::series::{evaluate_static_file, read_series_all, window_means_file, SeriesOptions};
+use gyrolab_io::series::{read_series_all, window_means_file, SeriesOptions};
 use gyrolab_io::test_plan::StaticAxisPlan;
 use gyrolab_io::DataError;
 use gyrolab_report::allan::ChannelAnalysis;
@@ -160,21 +161,12 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, progress: &dyn Pro
     let mut samples = Vec::new();
     for path in &s.files {
         progress.message(&format!("axis {axis}: static test {}", shown(path, ctx.base)));
-        let mut mismatch = None;
-        let (results, summary) = evaluate_static_file(path, &options, |ch| {
-            let mut cfg = StaticTestConfig {
-                latitude_deg: s.latitude_deg,
-                smoothing_times_s: smoothing.clone(),
-                ..StaticTestConfig::default()
-            };
-            if let Err(m) = reference.configure(&mut cfg, &ch.name, ch.unit) {
-                mismatch = Some(m);
-            }
-            cfg
-        })?;
-        if let Some(m) = mismatch {
-            return Err(EvalError::conflict(format!("{}: {m}", path.display())));
-        }
+        let config = StaticTestConfig {
+            latitude_deg: s.latitude_deg,
+            smoothing_times_s: smoothing.clone(),
+            ..StaticTestConfig::default()
+        };
+        let (results, summary) = evaluate_file(path, &options, &reference, &config)?;
         if let Some(want) = &s.temperature_channel {
             let found = summary
                 .header
