@@ -48,8 +48,8 @@ fn table2_rows_11_and_14_disagree_and_all_others_agree() {
         }
         // The demo's computed means are the same stroke means.
         let row = demo.table2.iter().find(|r| r.point == point).unwrap();
-        for k in 0..3 {
-            assert!((row.computed_v[k] - computed[k]).abs() < 1e-12, "point {point} column {k}");
+        for (k, (got, want)) in row.computed_v.iter().zip(&computed).enumerate() {
+            assert!((got - want).abs() < 1e-12, "point {point} column {k}");
         }
         count += 1;
     }

@@ -42,8 +42,7 @@ fn raw_log_plateaus_and_runs_match_the_simulation_and_k_is_recovered() {
     let plateaus = found.iter().filter(|k| matches!(k, SegmentKind::Plateau { .. })).count();
     assert_eq!(plateaus, 2 * 2 * RATES.len());
     // Each segment's mean table rate is its hold's setpoint (table noise 0.01 deg/s averaged).
-    let holds: Vec<f64> =
-        sim.holds.iter().flat_map(|h| std::iter::repeat_n(h.rate, h.labels.len())).collect();
+    let holds: Vec<f64> = sim.holds.iter().flat_map(|h| std::iter::repeat_n(h.rate, h.labels.len())).collect();
     for (s, rate) in log.segments.iter().zip(&holds) {
         assert!((s.rate_dps - rate).abs() < 0.01, "{s:?} vs {rate}");
     }

@@ -142,8 +142,11 @@ fn raw_log_with_two_outputs_needs_output_column() {
     let d = dir.path();
     single_axis_log(&d.join("two.csv"), &[-30.0, 30.0], 1, 5, true);
     let plan_path = d.join("plan.toml");
-    std::fs::write(&plan_path, "[device]\nmodel = \"m\"\nserial = \"s\"\naxes = [\"x\"]\n\n[rate.x]\nfile = \"two.csv\"\n")
-        .unwrap();
+    std::fs::write(
+        &plan_path,
+        "[device]\nmodel = \"m\"\nserial = \"s\"\naxes = [\"x\"]\n\n[rate.x]\nfile = \"two.csv\"\n",
+    )
+    .unwrap();
     let plan = read_test_plan(&plan_path).unwrap();
     let e = evaluate_test_plan(&plan, "plan.toml", &Silent).unwrap_err();
     let text = e.to_string();
@@ -172,11 +175,7 @@ fn paper_plan_verdict_is_fail() {
     let plan = read_test_plan(&plan_path).unwrap();
     let folder = evaluate_test_plan(&plan, &plan_path.display().to_string(), &Silent).unwrap();
     assert_eq!(folder.verdict, Some(Verdict::Fail));
-    assert!(
-        folder.failures.iter().any(|f| f.starts_with("axis x: linearity_pct")),
-        "failures: {:?}",
-        folder.failures
-    );
+    assert!(folder.failures.iter().any(|f| f.starts_with("axis x: linearity_pct")), "failures: {:?}", folder.failures);
     let v: serde_json::Value = serde_json::from_slice(output(&folder, "results.json")).unwrap();
     assert_eq!(v["verdict"], "FAIL");
     let m = common::rate_means(&common::read_long(&common::paper_file("paper_rate_table_x.csv")));

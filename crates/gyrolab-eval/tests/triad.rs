@@ -17,8 +17,11 @@ use gyrolab_eval::EvalError;
 #[test]
 fn triad_matrix_angles_and_biases_recovered() {
     let dir = tempfile::tempdir().unwrap();
-    let files: Vec<(TableAxis, std::path::PathBuf)> =
-        TableAxis::ALL.into_iter().enumerate().map(|(a, axis)| (axis, triad_log(dir.path(), a, 40 + a as u64))).collect();
+    let files: Vec<(TableAxis, std::path::PathBuf)> = TableAxis::ALL
+        .into_iter()
+        .enumerate()
+        .map(|(a, axis)| (axis, triad_log(dir.path(), a, 40 + a as u64)))
+        .collect();
     let request = TriadRequest { files, ..Default::default() };
     let result = evaluate_triad(&request).unwrap();
     let fit = &result.fit;
