@@ -12,6 +12,31 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// A calibration to apply to a file.
+///
+/// ```
+/// use gyrolab_eval::apply::{apply_to, prepare_apply, ApplyRequest};
+/// use gyrolab_eval::rate::{calibration_file, evaluate_rates, RateRequest};
+/// // A calibration of the paper's axis x (K about 7.3 mV/(deg/s)), written as `rate --cal-out` does.
+/// let paper = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/paper/paper_rate_table_x.csv");
+/// let rate = RateRequest { files: vec![paper], axis_names: vec!["x".into()], ..Default::default() };
+/// let axes = evaluate_rates(&rate).unwrap().axes;
+/// let (k, f0) = (axes[0].evaluation.scale_factor(), axes[0].evaluation.zero_offset());
+/// let dir = tempfile::tempdir().unwrap();
+/// let cal = dir.path().join("cal.toml");
+/// std::fs::write(&cal, calibration_file(&axes).to_toml().unwrap()).unwrap();
+/// // Outputs at 0 and 100 deg/s by that line.
+/// let input = dir.path().join("outputs.csv");
+/// std::fs::write(&input, format!("time_s,output_v\n0,{f0}\n0.01,{}\n", f0 + 100.0 * k)).unwrap();
+/// let request = ApplyRequest { calibration: cal, input: input.clone(), calibration_axis: None, columns: vec![] };
+/// let plan = prepare_apply(&request).unwrap();
+/// assert_eq!(plan.columns, ["output_v"]);
+/// let mut out = Vec::new();
+/// let summary = apply_to(&input, &plan, &mut out, &mut |_| {}).unwrap();
+/// assert_eq!(summary.rows, 2);
+/// let text = String::from_utf8(out).unwrap();
+/// let rates: Vec<f64> = text.lines().skip(1).map(|l| l.split(',').nth(1).unwrap().parse().unwrap()).collect();
+/// assert!(rates[0].abs() < 1e-9 && (rates[1] - 100.0).abs() < 1e-9, "{text}");
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct ApplyRequest {
     /// Calibration file (written by `gyrolab rate --cal-out`).

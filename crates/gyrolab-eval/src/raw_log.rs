@@ -17,6 +17,22 @@ use gyrolab_report::segments::SegmentationReport;
 use std::path::{Path, PathBuf};
 
 /// How raw logs are segmented; `None` keeps the default of [`SegmentOptions`].
+///
+/// ```
+/// use gyrolab_eval::{raw_log::SegmentationRequest, EvalError};
+/// let request = SegmentationRequest { settling_s: Some(2.0), min_plateau_s: Some(5.0), ..Default::default() };
+/// let o = request.options().unwrap();
+/// assert_eq!((o.settling_s, o.min_duration_s), (2.0, 5.0));
+/// // Unset fields keep the defaults.
+/// let d = gyrolab::segment::SegmentOptions::default();
+/// assert_eq!(o.tolerance_abs_dps, d.tolerance_abs_dps);
+/// // A value outside its domain names its field.
+/// let bad = SegmentationRequest { steady_tolerance_dps: Some(0.0), ..Default::default() };
+/// match bad.options() {
+///     Err(EvalError::Invalid(e)) => assert_eq!(e.field, "steady_tolerance_dps"),
+///     other => panic!("{other:?}"),
+/// }
+/// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SegmentationRequest {
     /// Name of the table-rate column (default: `table_rate_<unit>` or `rate_<unit>`).

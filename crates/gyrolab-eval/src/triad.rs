@@ -13,6 +13,26 @@ use gyrolab_report::triad::TriadReport;
 use std::path::PathBuf;
 
 /// A three-axis calibration set.
+///
+/// Each table axis needs a log; a missing one is a conflict naming its field (`triad_x`,
+/// `triad_y`, `triad_z`), which the front end spells its own way:
+///
+/// ```
+/// use gyrolab::triad::TableAxis;
+/// use gyrolab_eval::triad::{evaluate_triad, TriadRequest};
+/// let request = TriadRequest {
+///     files: vec![(TableAxis::X, "turn_x.csv".into()), (TableAxis::Y, "turn_y.csv".into())],
+///     ..Default::default()
+/// };
+/// let e = evaluate_triad(&request).unwrap_err();
+/// let text = e.render(&|f| format!("--{}", f.replace('_', "-")));
+/// assert!(text.contains("misses the z axis") && text.contains("give --triad-z"), "{text}");
+/// // Gyro columns, when named, are three.
+/// let request = TriadRequest { gyro_columns: vec!["gx_v".into()], ..request };
+/// let files = vec![(TableAxis::Z, "turn_z.csv".into())];
+/// let e = evaluate_triad(&TriadRequest { files: [request.files.clone(), files].concat(), ..request }).unwrap_err();
+/// assert!(e.render(&|f| f.to_string()).contains("gyro_columns needs three names"), "{e}");
+/// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TriadRequest {
     /// The logs, (table axis, file); x, y and z each at least once.

@@ -1,0 +1,89 @@
+//! `analyse_file` on white rate noise written here from a seeded normal generator: the OADEV and
+//! the slope-line ARW against the generating N, a gap in the time column, and the deviation at
+//! m = 1 against a direct computation.
+
+use gyrolab::allan::TauList;
+use gyrolab_eval::allan::{analyse_file, AllanRequest};
+use gyrolab_eval::EvalError;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Normal};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Writes `values` as `time_s,rate_dps` at 100 Hz (`{:?}`: the shortest text that reads back
+/// to the same number); `gap_after` shifts every time stamp after that sample by 10 s.
+fn write_rates(path: &Path, values: &[f64], gap_after: Option<usize>) {
+    let mut s = String::from("time_s,rate_dps\n");
+    for (i, v) in values.iter().enumerate() {
+        let shift = if gap_after.is_some_and(|g| i > g) { 10.0 } else { 0.0 };
+        writeln!(s, "{:?},{v:?}", i as f64 * 0.01 + shift).unwrap();
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+fn white(n: usize, sigma: f64, seed: u64) -> Vec<f64> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let d = Normal::new(0.0, sigma).unwrap();
+    (0..n).map(|_| d.sample(&mut rng)).collect()
+}
+
+/// One hour at 100 Hz of white rate noise with ARW N = 0.5 deg/sqrt(h): per-sample sigma
+/// (N / 60) / sqrt(0.01 s) deg/s, so the Allan deviation is (N / 60) / sqrt(tau), N/60 deg/s at
+/// tau = 1 s. The OADEV at tau = 1 s (m = 100 of 360 000 samples) has about
+/// 3 x 360 000 / (2 x 100) = 5400 degrees of freedom, a relative standard error of
+/// 1 / sqrt(2 x 5400) = 1 %: 5 % is 5 sigma. The slope-line N reads the -1/2 line at 1 s, fitted
+/// over several such points: 3 % is at least 3 sigma.
+#[test]
+fn white_noise_oadev_and_arw_match_the_generating_n() {
+    const N_DEG_RT_H: f64 = 0.5;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("white.csv");
+    let sigma = N_DEG_RT_H / 60.0 / 0.01f64.sqrt();
+    write_rates(&path, &white(360_000, sigma, 2024), None);
+    let request = AllanRequest { taus: TauList::Decade, ..AllanRequest::new(&path) };
+    let outcome = analyse_file(&request).unwrap();
+    assert_eq!(outcome.sample_interval_s, 0.01);
+    let a = &outcome.analyses[0];
+    assert_eq!(a.rate_unit, "deg/s");
+    let p = a.curve.points.iter().find(|p| p.m == 100).expect("decade taus include m = 100");
+    assert!((p.tau_s - 1.0).abs() < 1e-12);
+    let want = N_DEG_RT_H / 60.0;
+    assert!((p.deviation / want - 1.0).abs() < 0.05, "OADEV(1 s) = {}, N/60 = {want}", p.deviation);
+    let n = a.slope_lines.as_ref().expect("slope lines for deg/s data").coefficients.arw_deg_rt_h.unwrap();
+    assert!((n / N_DEG_RT_H - 1.0).abs() < 0.03, "slope-line N = {n}, truth {N_DEG_RT_H}");
+}
+
+/// A 10 s gap in the time column: a data error naming the line of the first sample after the
+/// gap (the header is line 1, sample i is on line i + 2).
+#[test]
+fn a_gap_is_a_data_error_naming_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("gap.csv");
+    write_rates(&path, &white(2000, 0.1, 1), Some(999));
+    let e = analyse_file(&AllanRequest::new(&path)).unwrap_err();
+    match &e {
+        EvalError::Data(d) => {
+            assert_eq!(d.line, Some(1000 + 2), "{e}");
+            assert!(d.message.contains("irregular sampling"), "{e}");
+        }
+        other => panic!("expected a data error, got {other:?}"),
+    }
+    assert!(e.to_string().contains("1002"), "{e}");
+}
+
+/// The deviation at m = 1 is sqrt(0.5 mean((y[i+1] - y[i])^2)), computed here from the
+/// generated values (read back exactly), to 1e-12 relative.
+#[test]
+fn deviation_at_m1_is_the_direct_computation() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("short.csv");
+    let y = white(20_000, 0.05, 77);
+    write_rates(&path, &y, None);
+    let outcome = analyse_file(&AllanRequest::new(&path)).unwrap();
+    let p = &outcome.analyses[0].curve.points[0];
+    assert_eq!(p.m, 1);
+    let d2: f64 = y.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum::<f64>() / (y.len() - 1) as f64;
+    let direct = (0.5 * d2).sqrt();
+    assert!((p.deviation - direct).abs() <= 1e-12 * direct, "{} vs {direct}", p.deviation);
+}
