@@ -23,7 +23,6 @@ use crate::fit::{self, FitError};
 use crate::sampling::SampleRateSource;
 use crate::units::{self, OutputUnit};
 use serde::{Deserialize, Serialize};
-use std::collections::BTreeMap;
 use thiserror::Error;
 
 /// How many first positions each data-quality finding keeps.
@@ -379,14 +378,15 @@ pub struct StaticTestResult {
     pub earth_rate_component_dph: Option<f64>,
     /// Whether the earth-rate component was subtracted from the bias.
     pub earth_rate_subtracted: bool,
-    /// Bias stability std(window means, n-1) in output units, keyed by smoothing seconds.
-    pub bias_stability_output: BTreeMap<String, f64>,
-    /// Bias stability in deg/h (when calibrated), keyed by smoothing seconds.
-    pub bias_stability_dph: BTreeMap<String, f64>,
-    /// Whole windows used per smoothing time.
-    pub bias_stability_windows: BTreeMap<String, u64>,
-    /// The smoothing time quoted as "the" bias stability (10 s, else 1 s, else one sample).
-    pub bias_stability_quoted_s: Option<String>,
+    /// Bias stability per reported smoothing time, in increasing smoothing time (one entry per
+    /// [`smoothing_key`]). In JSON: three objects keyed by [`smoothing_key`]
+    /// (`bias_stability_output`, `bias_stability_dph`, `bias_stability_windows`).
+    #[serde(flatten, with = "stability_json")]
+    pub bias_stability: Vec<BiasStability>,
+    /// The smoothing time quoted as "the" bias stability (10 s, else 1 s, else one sample), s;
+    /// always one of `bias_stability`'s. In JSON: its [`smoothing_key`] string.
+    #[serde(with = "quoted_json")]
+    pub bias_stability_quoted_s: Option<f64>,
     /// Smoothing times not reported, with reasons.
     pub bias_stability_skipped: Vec<SkippedSmoothing>,
     /// Drift: least-squares slope of output vs time, output units per hour.
@@ -401,9 +401,131 @@ pub struct StaticTestResult {
     pub quality: DataQuality,
     /// Notes: figures not computed and why.
     pub notes: Vec<String>,
+}
+
+/// Bias stability at one smoothing time T (paper eq. 11).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct BiasStability {
+    /// Smoothing time T, seconds.
+    pub smoothing_s: f64,
+    /// Std (n-1) of the consecutive T-second window means, output units.
+    pub output: f64,
+    /// The same in deg/h (when calibrated).
+    pub dph: Option<f64>,
+    /// Whole windows used.
+    pub windows: u64,
+}
+
+impl BiasStability {
+    /// The smoothing time as the JSON and report key ([`smoothing_key`]: "0.01", "10").
+    pub fn key(&self) -> String {
+        smoothing_key(self.smoothing_s)
+    }
+}
+
+impl StaticTestResult {
+    /// The bias stability at a smoothing time, matched by [`smoothing_key`] (to 9 decimals).
+    pub fn stability_at(&self, smoothing_s: f64) -> Option<&BiasStability> {
+        let key = smoothing_key(smoothing_s);
+        self.bias_stability.iter().find(|b| b.key() == key)
+    }
+
+    /// The bias stability quoted as "the" figure (at `bias_stability_quoted_s`).
+    pub fn quoted_stability(&self) -> Option<&BiasStability> {
+        self.bias_stability_quoted_s.and_then(|t| self.stability_at(t))
+    }
+}
+
+/// The smoothing times reported by any of the results (one per [`smoothing_key`], the first
+/// seen), in increasing order: the columns of a table of several tests.
+pub fn reported_smoothing_times<'a>(results: impl IntoIterator<Item = &'a StaticTestResult>) -> Vec<f64> {
+    let mut times: Vec<f64> = Vec::new();
+    for r in results {
+        for b in &r.bias_stability {
+            let key = b.key();
+            if !times.iter().any(|t| smoothing_key(*t) == key) {
+                times.push(b.smoothing_s);
+            }
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    times
+}
+
+/// JSON form of [`StaticTestResult::bias_stability`]: three objects keyed by [`smoothing_key`],
+/// keys in string order (as the earlier `BTreeMap<String, _>` fields wrote them).
+mod stability_json {
+    use super::{smoothing_key, BiasStability};
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+    use std::collections::BTreeMap;
+
+    #[derive(Serialize, Deserialize)]
+    struct Maps {
+        bias_stability_output: BTreeMap<String, f64>,
+        bias_stability_dph: BTreeMap<String, f64>,
+        bias_stability_windows: BTreeMap<String, u64>,
+    }
+
+    pub fn serialize<S: Serializer>(v: &[BiasStability], s: S) -> Result<S::Ok, S::Error> {
+        let mut m = Maps {
+            bias_stability_output: BTreeMap::new(),
+            bias_stability_dph: BTreeMap::new(),
+            bias_stability_windows: BTreeMap::new(),
+        };
+        for b in v {
+            let key = smoothing_key(b.smoothing_s);
+            m.bias_stability_output.insert(key.clone(), b.output);
+            if let Some(d) = b.dph {
+                m.bias_stability_dph.insert(key.clone(), d);
+            }
+            m.bias_stability_windows.insert(key, b.windows);
+        }
+        m.serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<BiasStability>, D::Error> {
+        let m = Maps::deserialize(d)?;
+        let mut v = Vec::with_capacity(m.bias_stability_output.len());
+        for (key, output) in m.bias_stability_output {
+            let smoothing_s = key
+                .parse::<f64>()
+                .map_err(|_| serde::de::Error::custom(format!("smoothing time '{key}' is not a number")))?;
+            let windows = m.bias_stability_windows.get(&key).copied().ok_or_else(|| {
+                serde::de::Error::custom(format!("bias_stability_windows has no entry for smoothing time '{key}'"))
+            })?;
+            v.push(BiasStability { smoothing_s, output, dph: m.bias_stability_dph.get(&key).copied(), windows });
+        }
+        v.sort_by(|a, b| a.smoothing_s.total_cmp(&b.smoothing_s));
+        Ok(v)
+    }
+}
+
+/// JSON form of [`StaticTestResult::bias_stability_quoted_s`]: its [`smoothing_key`] string.
+mod quoted_json {
+    use super::smoothing_key;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+        v.map(smoothing_key).serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+        Option::<String>::deserialize(d)?
+            .map(|k| {
+                k.parse::<f64>().map_err(|_| serde::de::Error::custom(format!("smoothing time '{k}' is not a number")))
+            })
+            .transpose()
+    }
+}
+
+/// The first pass's figures, before the outlier pass ([`StaticTestAccumulator::finish`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FirstPass {
+    /// The figures, without an outlier report.
+    pub result: StaticTestResult,
     /// Whether the outlier pass could find anything: `false` when the first pass's per-chunk
-    /// extremes prove that no sample lies beyond the rule (the pass can then be skipped).
-    #[serde(skip)]
+    /// extremes prove that no sample lies beyond the rule (the pass can then be skipped, see
+    /// [`FirstPass::with_no_outliers`]).
     pub outlier_scan_needed: bool,
 }
 
@@ -1269,7 +1391,7 @@ impl StaticTestAccumulator {
     }
 
     /// Finishes the record and computes the figures (no outlier pass; see [`OutlierScan`]).
-    pub fn finish(mut self) -> Result<StaticTestResult, StaticTestError> {
+    pub fn finish(mut self) -> Result<FirstPass, StaticTestError> {
         if self.probe.is_some() {
             if self.has_time == Some(false) {
                 return Err(StaticTestError::NoSampleRate);
@@ -1310,12 +1432,9 @@ impl StaticTestAccumulator {
         }
         let to_dph = |v_out: f64| k.map(|k| units::dps_to_dph(v_out / k.abs()));
 
-        let mut stab_out = BTreeMap::new();
-        let mut stab_dph = BTreeMap::new();
-        let mut stab_n = BTreeMap::new();
+        let mut stability: Vec<BiasStability> = Vec::new();
         let mut skipped = self.skipped.clone();
         for w in &self.windows {
-            let key = smoothing_key(w.smoothing_s);
             let (n, std) = if w.m == 1 { (valid, Some(std_output)) } else { (w.means.n, w.means.std()) };
             if n < cfg.min_windows {
                 skipped.push(SkippedSmoothing {
@@ -1326,11 +1445,13 @@ impl StaticTestAccumulator {
                 continue;
             }
             let Some(std) = std else { continue };
-            stab_out.insert(key.clone(), std);
-            if let Some(v) = to_dph(std) {
-                stab_dph.insert(key.clone(), v);
+            let entry = BiasStability { smoothing_s: w.smoothing_s, output: std, dph: to_dph(std), windows: n };
+            // One entry per key: a later smoothing time with the same key replaces the earlier one.
+            let key = entry.key();
+            match stability.iter_mut().find(|b| b.key() == key) {
+                Some(b) => *b = entry,
+                None => stability.push(entry),
             }
-            stab_n.insert(key, n);
             if w.with_missing > 0 || w.empty > 0 {
                 notes.push(format!(
                     "smoothing {} s: {} windows had missing samples (mean over the valid ones), {} had none and were dropped",
@@ -1338,12 +1459,15 @@ impl StaticTestAccumulator {
                 ));
             }
         }
-        let quoted = ["10", "1"]
-            .iter()
-            .map(|s| s.to_string())
-            .find(|s| stab_out.contains_key(s))
-            .or_else(|| self.config.include_one_sample.then(|| smoothing_key(1.0 / fs)))
-            .filter(|s| stab_out.contains_key(s));
+        stability.sort_by(|a, b| a.smoothing_s.total_cmp(&b.smoothing_s));
+        let find = |t: f64| stability.iter().find(|b| b.key() == smoothing_key(t)).map(|b| b.smoothing_s);
+        let quoted = find(10.0).or_else(|| find(1.0)).or_else(|| {
+            if self.config.include_one_sample {
+                find(1.0 / fs)
+            } else {
+                None
+            }
+        });
 
         let (drift_out, drift_dph, drift_line) = if mo.ctt > 0.0 {
             let slope = mo.ctd / mo.ctt;
@@ -1386,8 +1510,7 @@ impl StaticTestAccumulator {
             if self.rail.at_min.value == Some(self.min) { self.rail.at_min } else { RailRuns::default() };
         quality.stuck_at_max =
             if self.rail.at_max.value == Some(self.max) { self.rail.at_max } else { RailRuns::default() };
-        Ok(StaticTestResult {
-            outlier_scan_needed,
+        let result = StaticTestResult {
             channel: self.config.channel.clone(),
             output_unit: self.config.output_unit,
             samples: self.samples,
@@ -1403,9 +1526,7 @@ impl StaticTestAccumulator {
             bias_dph,
             earth_rate_component_dph: earth,
             earth_rate_subtracted: earth_done,
-            bias_stability_output: stab_out,
-            bias_stability_dph: stab_dph,
-            bias_stability_windows: stab_n,
+            bias_stability: stability,
             bias_stability_quoted_s: quoted,
             bias_stability_skipped: skipped,
             drift_output_per_h: drift_out,
@@ -1414,7 +1535,8 @@ impl StaticTestAccumulator {
             temperature,
             quality,
             notes,
-        })
+        };
+        Ok(FirstPass { result, outlier_scan_needed })
     }
 }
 
@@ -1475,7 +1597,8 @@ pub struct OutlierScan {
 
 impl OutlierScan {
     /// Prepares the second pass from the first pass's result.
-    pub fn new(first: &StaticTestResult, config: &StaticTestConfig) -> Result<Self, StaticTestError> {
+    pub fn new(first: &FirstPass, config: &StaticTestConfig) -> Result<Self, StaticTestError> {
+        let first = &first.result;
         let mut cfg = config.clone();
         // The second pass reuses the rate the first pass used, so windows line up.
         cfg.sample_rate_hz = Some(first.sample_rate_hz);
@@ -1501,7 +1624,7 @@ impl OutlierScan {
 
     /// The final result: the first pass's figures with the outlier report, or, with
     /// `drop_outliers`, the figures recomputed without the outliers.
-    pub fn finish(mut self, first: StaticTestResult) -> Result<StaticTestResult, StaticTestError> {
+    pub fn finish(mut self, first: FirstPass) -> Result<StaticTestResult, StaticTestError> {
         let drop = self.inner.config.drop_outliers;
         let report = OutlierReport {
             k_sigma: self.inner.config.outlier_k_sigma,
@@ -1509,24 +1632,25 @@ impl OutlierScan {
             outliers: std::mem::take(&mut self.inner.outliers),
             dropped: drop,
         };
-        let mut out = if drop && report.outliers.count > 0 { self.inner.finish()? } else { first };
+        let mut out = if drop && report.outliers.count > 0 { self.inner.finish()?.result } else { first.result };
         out.quality.outliers = Some(report);
         Ok(out)
     }
 }
 
-impl StaticTestResult {
+impl FirstPass {
     /// The result of an outlier pass that found nothing, for a first pass whose extremes prove
     /// that none exists (`outlier_scan_needed` is false): the same report the pass would give.
-    pub fn with_no_outliers(mut self, config: &StaticTestConfig) -> StaticTestResult {
-        let sigma = self.drift_line.map_or(self.std_output, |l| l.residual_std_output);
-        self.quality.outliers = Some(OutlierReport {
+    pub fn with_no_outliers(self, config: &StaticTestConfig) -> StaticTestResult {
+        let mut out = self.result;
+        let sigma = out.drift_line.map_or(out.std_output, |l| l.residual_std_output);
+        out.quality.outliers = Some(OutlierReport {
             k_sigma: config.outlier_k_sigma,
             residual_std_output: sigma,
             outliers: QualityIssue::default(),
             dropped: config.drop_outliers,
         });
-        self
+        out
     }
 }
 
@@ -1556,7 +1680,7 @@ mod tests {
             acc.track_extremes(b, false);
             acc.process_each(b);
         }
-        acc.finish().unwrap()
+        acc.finish().unwrap().result
     }
 
     proptest! {
@@ -1596,13 +1720,15 @@ mod tests {
             for b in &blocks {
                 acc.push(b).unwrap();
             }
-            let fast = acc.finish().unwrap();
+            let fast = acc.finish().unwrap().result;
             let reference = each_path(&config, &blocks);
             prop_assert_eq!(&fast.quality, &reference.quality);
             prop_assert_eq!(fast.valid_samples, reference.valid_samples);
             prop_assert!((fast.mean_output - reference.mean_output).abs() < 1e-12);
-            for (k, v) in &reference.bias_stability_output {
-                prop_assert!((fast.bias_stability_output[k] - v).abs() < 1e-12 * (1.0 + v.abs()));
+            prop_assert_eq!(fast.bias_stability.len(), reference.bias_stability.len());
+            for (f, r) in fast.bias_stability.iter().zip(&reference.bias_stability) {
+                prop_assert_eq!(f.smoothing_s, r.smoothing_s);
+                prop_assert!((f.output - r.output).abs() < 1e-12 * (1.0 + r.output.abs()));
             }
         }
     }
