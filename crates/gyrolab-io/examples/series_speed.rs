@@ -61,7 +61,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         bytes / 1e6 / s,
         summary.rows as f64 / 1e6 / s,
         results[0].mean_output,
-        results[0].bias_stability_output.get("1")
+        results[0].stability_at(1.0).map(|b| b.output)
     );
     Ok(())
 }

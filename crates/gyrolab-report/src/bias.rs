@@ -3,7 +3,9 @@
 
 use crate::format::{short, sig, sig_opt};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Cell, CellAlignment, Table};
-use gyrolab::static_test::{BiasRepeatability, QualityIssue, StaticTestResult};
+use gyrolab::static_test::{
+    reported_smoothing_times, smoothing_key, BiasRepeatability, QualityIssue, StaticTestResult,
+};
 use serde::Serialize;
 
 /// One evaluated test (one channel of one file).
@@ -129,27 +131,16 @@ pub fn bias_table(tests: &[TestReport], repeatability: &[ChannelRepeatability]) 
     if tests.iter().any(|r| r.result.earth_rate_component_dph.is_some()) {
         row("earth rate (subtracted)".into(), "deg/h".into(), &|r| sig_opt(r.earth_rate_component_dph, 5));
     }
-    let mut keys: Vec<(f64, String)> = Vec::new();
-    for r in tests {
-        for k in r.result.bias_stability_output.keys() {
-            if let Ok(v) = k.parse::<f64>() {
-                if !keys.iter().any(|(_, s)| s == k) {
-                    keys.push((v, k.clone()));
-                }
-            }
-        }
-    }
-    keys.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let calibrated = tests.iter().any(|r| !r.result.bias_stability_dph.is_empty());
-    for (_, k) in &keys {
+    let times = reported_smoothing_times(tests.iter().map(|r| &r.result));
+    let calibrated = tests.iter().any(|r| r.result.bias_stability.iter().any(|b| b.dph.is_some()));
+    for &t in &times {
+        let k = smoothing_key(t);
         if calibrated {
             row(format!("bias stability ({k} s)"), "deg/h".into(), &|r| {
-                sig_opt(r.bias_stability_dph.get(k.as_str()).copied(), 4)
+                sig_opt(r.stability_at(t).and_then(|b| b.dph), 4)
             });
         } else {
-            row(format!("bias stability ({k} s)"), ou.clone(), &|r| {
-                sig_opt(r.bias_stability_output.get(k.as_str()).copied(), 4)
-            });
+            row(format!("bias stability ({k} s)"), ou.clone(), &|r| sig_opt(r.stability_at(t).map(|b| b.output), 4));
         }
     }
     if calibrated {
@@ -191,7 +182,7 @@ pub fn bias_table(tests: &[TestReport], repeatability: &[ChannelRepeatability]) 
             s.push_str(&format!("; mean bias {} deg/h, bias repeatability {} deg/h", sig(m, 5), sig(b, 4)));
         }
     }
-    if let Some(q) = tests.first().and_then(|r| r.result.bias_stability_quoted_s.clone()) {
+    if let Some(q) = tests.first().and_then(|r| r.result.bias_stability_quoted_s).map(smoothing_key) {
         s.push_str(&format!("\nbias stability is quoted at a smoothing time of {q} s (window means, n-1)."));
     }
     s

@@ -12,7 +12,7 @@ use crate::plot::{
     scatter_fit_plot, Annotation, Axis, Figure, LegendCorner, Orientation, Panel, PlotError, RefLine, Series,
     SeriesStyle,
 };
-use gyrolab::static_test::BiasRepeatability;
+use gyrolab::static_test::{reported_smoothing_times, smoothing_key, BiasRepeatability};
 use gyrolab::window_means::WindowMean;
 use serde::Serialize;
 
@@ -97,20 +97,10 @@ impl StaticAxisReport {
         }
     }
 
-    /// The smoothing times (keys as in the results, e.g. "10", "0.01") of any test, in increasing order.
-    pub fn smoothing_keys(&self) -> Vec<String> {
-        let mut keys: Vec<(f64, String)> = Vec::new();
-        for t in &self.tests {
-            for k in t.result.bias_stability_output.keys() {
-                if let Ok(v) = k.parse::<f64>() {
-                    if !keys.iter().any(|(_, s)| s == k) {
-                        keys.push((v, k.clone()));
-                    }
-                }
-            }
-        }
-        keys.sort_by(|a, b| a.0.total_cmp(&b.0));
-        keys.into_iter().map(|k| k.1).collect()
+    /// The smoothing times (s) reported by any test, in increasing order (one per
+    /// [`smoothing_key`], which names them in figures and tables: "10", "0.01").
+    pub fn smoothing_times(&self) -> Vec<f64> {
+        reported_smoothing_times(self.tests.iter().map(|t| &t.result))
     }
 
     /// The axis's summary figures: bias (mean over the tests), bias stability and drift (the
@@ -122,10 +112,10 @@ impl StaticAxisReport {
         if let Some(m) = biases.as_deref().and_then(gyrolab::fit::mean) {
             f.set("bias_dph", m);
         }
-        for k in self.smoothing_keys() {
+        for t in self.smoothing_times() {
             let worst =
-                self.tests.iter().filter_map(|t| t.result.bias_stability_dph.get(&k).copied()).fold(f64::NAN, f64::max);
-            f.set(format!("bias_stability_dph_{k}s"), worst);
+                self.tests.iter().filter_map(|r| r.result.stability_at(t).and_then(|b| b.dph)).fold(f64::NAN, f64::max);
+            f.set(format!("bias_stability_dph_{}s", smoothing_key(t)), worst);
         }
         if let Some(b) = self.repeatability.as_ref().and_then(|r| r.bias_repeatability_dph) {
             f.set("bias_repeatability_dph", b);
@@ -205,24 +195,14 @@ fn csv_field(s: &str) -> String {
 
 /// `bias_tests.csv`: one row per static test of every axis.
 pub fn bias_tests_csv(axes: &[StaticAxisReport]) -> String {
-    let mut keys: Vec<(f64, String)> = Vec::new();
-    for a in axes {
-        for k in a.smoothing_keys() {
-            if let Ok(v) = k.parse::<f64>() {
-                if !keys.iter().any(|(_, s)| *s == k) {
-                    keys.push((v, k));
-                }
-            }
-        }
-    }
-    keys.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let times = reported_smoothing_times(axes.iter().flat_map(|a| a.tests.iter().map(|t| &t.result)));
     let mut s = String::from("# gyrolab: static (bias) tests; mean_output in output_unit, figures in deg/h\n");
     for a in axes.iter().filter(|a| a.simulated.is_some()) {
         s.push_str(&format!("# axis {}: {}", a.axis, simulated_comment(a).trim_start_matches("# ")));
     }
     s.push_str("axis,test,file,channel,samples,duration_s,sample_rate_hz,mean_output,std_output,output_unit,bias_dph");
-    for (_, k) in &keys {
-        s.push_str(&format!(",bias_stability_dph_{k}s"));
+    for &t in &times {
+        s.push_str(&format!(",bias_stability_dph_{}s", smoothing_key(t)));
     }
     s.push_str(",drift_dph_per_h,temp_sensitivity_dph_per_c,simulated\n");
     let opt = |v: Option<f64>| v.map_or_else(String::new, |x| x.to_string());
@@ -243,8 +223,8 @@ pub fn bias_tests_csv(axes: &[StaticAxisReport]) -> String {
                 r.output_unit.symbol(),
                 opt(r.bias_dph)
             ));
-            for (_, k) in &keys {
-                s.push_str(&format!(",{}", opt(r.bias_stability_dph.get(k).copied())));
+            for &t in &times {
+                s.push_str(&format!(",{}", opt(r.stability_at(t).and_then(|b| b.dph))));
             }
             s.push_str(&format!(
                 ",{},{},{}\n",
@@ -467,7 +447,7 @@ fn simulated_paragraph(a: &StaticAxisReport) -> Vec<String> {
 pub fn static_section(a: &StaticAxisReport, limits: &[Limit]) -> Result<ReportSection, PlotError> {
     let figs = a.figures();
     let mut keys: Vec<(String, String)> = vec![("bias_dph".into(), "bias B0 (mean over the tests)".into())];
-    for k in a.smoothing_keys() {
+    for k in a.smoothing_times().into_iter().map(smoothing_key) {
         keys.push((format!("bias_stability_dph_{k}s"), format!("bias stability, T = {k} s (worst test)")));
     }
     keys.push(("bias_repeatability_dph".into(), format!("bias repeatability over {} tests", a.tests.len())));
@@ -482,7 +462,7 @@ pub fn static_section(a: &StaticAxisReport, limits: &[Limit]) -> Result<ReportSe
         a.tests.iter().map(|t| t.file.as_str()).collect::<Vec<_>>().join(", "),
         a.reference.text
     ));
-    if let Some(q) = a.tests.first().and_then(|t| t.result.bias_stability_quoted_s.clone()) {
+    if let Some(q) = a.tests.first().and_then(|t| t.result.bias_stability_quoted_s).map(smoothing_key) {
         paragraphs.push(format!(
             "Bias stability is the standard deviation (n − 1) of consecutive T-second window means; the bias time series \
              shows the {q}-s window means. Across the tests the summary quotes the mean bias and the worst stability and drift."
@@ -508,7 +488,7 @@ pub fn static_section(a: &StaticAxisReport, limits: &[Limit]) -> Result<ReportSe
             svg: svg?,
         });
     }
-    let skeys = a.smoothing_keys();
+    let times = a.smoothing_times();
     let u = a.bias_unit();
     let mut header = vec![
         "test".to_string(),
@@ -518,7 +498,7 @@ pub fn static_section(a: &StaticAxisReport, limits: &[Limit]) -> Result<ReportSe
         format!("mean output ({ou})"),
         format!("bias B0 ({u})"),
     ];
-    header.extend(skeys.iter().map(|k| format!("B_s({k} s) ({u})")));
+    header.extend(times.iter().map(|&t| format!("B_s({} s) ({u})", smoothing_key(t))));
     header.push(format!("drift ({u}/h)"));
     let mut table_rows: Vec<Vec<String>> = a
         .tests
@@ -535,9 +515,9 @@ pub fn static_section(a: &StaticAxisReport, limits: &[Limit]) -> Result<ReportSe
                 sig(r.mean_output, 8),
                 if cal { sig_opt(r.bias_dph, 5) } else { sig(r.mean_output, 8) },
             ];
-            for k in &skeys {
-                let v = if cal { r.bias_stability_dph.get(k) } else { r.bias_stability_output.get(k) };
-                row.push(sig_opt(v.copied(), 4));
+            for &t in &times {
+                let b = r.stability_at(t);
+                row.push(sig_opt(if cal { b.and_then(|b| b.dph) } else { b.map(|b| b.output) }, 4));
             }
             row.push(sig_opt(if cal { r.drift_dph_per_h } else { r.drift_output_per_h }, 4));
             row
@@ -552,7 +532,7 @@ pub fn static_section(a: &StaticAxisReport, limits: &[Limit]) -> Result<ReportSe
             sig(rep.output_repeatability, 4),
             sig_opt(rep.bias_repeatability_dph, 4),
         ];
-        row.extend(skeys.iter().map(|_| String::new()));
+        row.extend(times.iter().map(|_| String::new()));
         row.push(String::new());
         table_rows.push(row);
     }

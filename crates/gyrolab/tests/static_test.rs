@@ -16,6 +16,11 @@ fn run(x: &[f64], c: &StaticTestConfig) -> StaticTestResult {
     evaluate_static(&SampleBlock::output_only(x), c).unwrap()
 }
 
+/// The bias stability at smoothing time `t` (panics when not reported).
+fn at(r: &StaticTestResult, t: f64) -> BiasStability {
+    *r.stability_at(t).unwrap_or_else(|| panic!("no bias stability at {t} s"))
+}
+
 /// x = 1 3 2 4 6 5 7 9 8 10 at 1 Hz.
 const HAND: [f64; 10] = [1.0, 3.0, 2.0, 4.0, 6.0, 5.0, 7.0, 9.0, 8.0, 10.0];
 
@@ -37,19 +42,22 @@ fn hand_record_mean_bias_stability_drift() {
     assert_relative_eq!(r.bias_dps.unwrap(), 2.5, epsilon = 1e-15);
     assert_relative_eq!(r.bias_dph.unwrap(), 9000.0, epsilon = 1e-10);
     // One sample: squares of deviations from 5.5 sum to 82.5; std = sqrt(82.5 / 9).
-    assert_relative_eq!(r.bias_stability_output["1"], (82.5f64 / 9.0).sqrt(), epsilon = 1e-14);
+    assert_relative_eq!(at(&r, 1.0).output, (82.5f64 / 9.0).sqrt(), epsilon = 1e-14);
     // T = 2 s: window means 2 3 5.5 8 9, deviations -3.5 -2.5 0 2.5 3.5, sum of squares 37, std sqrt(37/4).
-    assert_relative_eq!(r.bias_stability_output["2"], (37.0f64 / 4.0).sqrt(), epsilon = 1e-14);
-    assert_eq!(r.bias_stability_windows["2"], 5);
+    assert_relative_eq!(at(&r, 2.0).output, (37.0f64 / 4.0).sqrt(), epsilon = 1e-14);
+    assert_eq!(at(&r, 2.0).windows, 5);
     // T = 3 s: windows 2 5 8 (the 10th sample is a partial window, dropped): std 3; / K * 3600 = 5400 deg/h.
-    assert_relative_eq!(r.bias_stability_output["3"], 3.0, epsilon = 1e-14);
-    assert_eq!(r.bias_stability_windows["3"], 3);
-    assert_relative_eq!(r.bias_stability_dph["3"], 5400.0, epsilon = 1e-9);
+    assert_relative_eq!(at(&r, 3.0).output, 3.0, epsilon = 1e-14);
+    assert_eq!(at(&r, 3.0).windows, 3);
+    assert_relative_eq!(at(&r, 3.0).dph.unwrap(), 5400.0, epsilon = 1e-9);
+    let times: Vec<f64> = r.bias_stability.iter().map(|b| b.smoothing_s).collect();
+    assert_eq!(times, vec![1.0, 2.0, 3.0], "increasing smoothing time");
     // Drift: sum (t-4.5)(x-5.5) = 79.5, sum (t-4.5)^2 = 82.5 -> 0.963636 V/s = 3469.0909 V/h;
     // / K = 0.4818 (deg/s)/s * 3600 * 3600 = 6 244 363.6 (deg/h)/h.
     assert_relative_eq!(r.drift_output_per_h.unwrap(), 79.5 / 82.5 * 3600.0, epsilon = 1e-9);
     assert_relative_eq!(r.drift_dph_per_h.unwrap(), 79.5 / 82.5 / 2.0 * 3600.0 * 3600.0, epsilon = 1e-5);
-    assert_eq!(r.bias_stability_quoted_s.as_deref(), Some("1")); // one sample is 1 s at 1 Hz
+    assert_eq!(r.bias_stability_quoted_s, Some(1.0)); // one sample is 1 s at 1 Hz
+    assert_eq!(r.quoted_stability(), r.stability_at(1.0));
     assert!(!r.earth_rate_subtracted);
 }
 
@@ -68,10 +76,12 @@ fn blocks_and_time_column_do_not_change_results() {
                 let b = SampleBlock { output: xs, time_s: with_time.then_some(ts), temperature_c: None, lines: None };
                 acc.push(&b).unwrap();
             }
-            let r = acc.finish().unwrap();
+            let r = acc.finish().unwrap().result;
             assert_relative_eq!(r.mean_output, whole.mean_output, epsilon = 1e-14);
-            for (k, v) in &whole.bias_stability_output {
-                assert_relative_eq!(r.bias_stability_output[k], *v, epsilon = 1e-13);
+            assert_eq!(r.bias_stability.len(), whole.bias_stability.len());
+            for (b, w) in r.bias_stability.iter().zip(&whole.bias_stability) {
+                assert_eq!(b.smoothing_s, w.smoothing_s);
+                assert_relative_eq!(b.output, w.output, epsilon = 1e-13);
             }
             assert_relative_eq!(r.drift_output_per_h.unwrap(), whole.drift_output_per_h.unwrap(), epsilon = 1e-9);
         }
@@ -88,16 +98,18 @@ proptest! {
         let mut x = xs.clone();
         for i in nan_at { if i < x.len() { x[i] = f64::NAN; } }
         let c = StaticTestConfig { smoothing_times_s: vec![2.0, 5.0], min_windows: 2, ..cfg(1.0) };
-        let whole = StaticTestAccumulator::new(c.clone()).and_then(|mut a| { a.push(&SampleBlock::output_only(&x))?; a.finish() });
+        let whole = StaticTestAccumulator::new(c.clone()).and_then(|mut a| { a.push(&SampleBlock::output_only(&x))?; a.finish() }).map(|f| f.result);
         let mut acc = StaticTestAccumulator::new(c).unwrap();
         for part in x.chunks(split) { acc.push(&SampleBlock::output_only(part)).unwrap(); }
-        let parts = acc.finish();
+        let parts = acc.finish().map(|f| f.result);
         let (w, p) = (whole.unwrap(), parts.unwrap());
         prop_assert_eq!(w.valid_samples, p.valid_samples);
         prop_assert_eq!(&w.quality, &p.quality);
         prop_assert!((w.mean_output - p.mean_output).abs() < 1e-12);
-        for (k, v) in &w.bias_stability_output {
-            prop_assert!((p.bias_stability_output[k] - v).abs() < 1e-12 * (1.0 + v.abs()));
+        prop_assert_eq!(w.bias_stability.len(), p.bias_stability.len());
+        for (a, b) in w.bias_stability.iter().zip(&p.bias_stability) {
+            prop_assert_eq!(a.smoothing_s, b.smoothing_s);
+            prop_assert!((b.output - a.output).abs() < 1e-12 * (1.0 + a.output.abs()));
         }
     }
 }
@@ -113,16 +125,16 @@ fn white_noise_stability_matches_sigma_over_sqrt_m() {
     let x: Vec<f64> = (0..n).map(|_| 2.5 + noise.sample(&mut rng)).collect();
     let c = StaticTestConfig { scale_factor: Some(k), null_output: Some(2.5), ..cfg(fs) };
     let r = run(&x, &c);
-    for (key, t) in [("0.01", 0.01), ("1", 1.0), ("10", 10.0), ("100", 100.0)] {
+    for t in [0.01, 1.0, 10.0, 100.0] {
         let m = t * fs;
         let windows = (n as f64 / m).floor();
-        assert_eq!(r.bias_stability_windows[key] as f64, windows);
+        assert_eq!(at(&r, t).windows as f64, windows);
         let expected = sigma / m.sqrt() / k * 3600.0;
         let tol = 4.0 / (2.0 * (windows - 1.0)).sqrt();
-        let got = r.bias_stability_dph[key];
+        let got = at(&r, t).dph.unwrap();
         assert!((got / expected - 1.0).abs() < tol, "T = {t}: {got} vs {expected} (tol {tol})");
     }
-    assert_eq!(r.bias_stability_quoted_s.as_deref(), Some("10"));
+    assert_eq!(r.bias_stability_quoted_s, Some(10.0));
     // The mean of 1e6 samples is within 4 sigma / sqrt(n) of the null: bias within 4e-6 / 0.01 deg/s.
     assert!(r.bias_dps.unwrap().abs() < 4.0 * sigma / (n as f64).sqrt() / k);
     // 1000 s of white noise: drift consistent with zero (slope SE = sigma / sqrt(sum (t - tbar)^2)).
@@ -142,7 +154,7 @@ fn mean_and_std_keep_precision_on_a_large_offset() {
     let expected = 1e-4 * (n as f64 / (n as f64 - 1.0)).sqrt();
     assert_relative_eq!(r.std_output, expected, max_relative = 1e-9);
     // Windows of 1 s = 1000 samples (an even count): every window mean is 2.5, std below 1e-15.
-    assert!(r.bias_stability_output["1"] < 1e-14);
+    assert!(at(&r, 1.0).output < 1e-14);
 }
 
 fn constant_record(v: f64, n: usize) -> Vec<f64> {
@@ -311,11 +323,11 @@ fn dropping_outliers_recomputes_the_mean() {
 fn short_record_skips_smoothing_times_with_reasons() {
     // 50 samples at 1 Hz: 50 one-sample windows, 50 of 1 s, 5 of 10 s, 0 of 100 s.
     let r = run(&constant_record(1.0, 50), &cfg(1.0));
-    assert!(r.bias_stability_output.contains_key("1"));
+    assert!(r.stability_at(1.0).is_some());
     let skipped: Vec<(f64, u64)> = r.bias_stability_skipped.iter().map(|s| (s.smoothing_s, s.windows)).collect();
     assert_eq!(skipped, vec![(10.0, 5), (100.0, 0)]);
     assert!(r.bias_stability_skipped[0].reason.contains("at least 10"));
-    assert_eq!(r.bias_stability_quoted_s.as_deref(), Some("1"));
+    assert_eq!(r.bias_stability_quoted_s, Some(1.0));
 }
 
 #[test]
@@ -377,4 +389,43 @@ fn skipping_the_outlier_pass_changes_nothing() {
     assert_eq!(o.outliers.first[0].sample, 123_456);
     let block = SampleBlock { output: &x, time_s: None, temperature_c: None, lines: None };
     assert_eq!(evaluate_static(&block, &cfg).unwrap(), full);
+}
+
+/// The JSON form keeps the earlier string-keyed objects: keys in string order ("0.01" < "1" <
+/// "10" < "100" < "2"), the quoted smoothing time as its key string; it reads back to the same
+/// typed entries.
+#[test]
+fn json_keeps_string_keyed_stability_objects() {
+    let x: Vec<f64> = (0..4000).map(|i| 2.5 + 1e-3 * ((i * 7919) % 13) as f64).collect();
+    let c = StaticTestConfig {
+        smoothing_times_s: vec![2.0, 10.0, 1.0, 100.0],
+        min_windows: 2,
+        scale_factor: Some(0.01),
+        null_output: Some(2.5),
+        ..cfg(100.0)
+    };
+    let r = run(&x, &c);
+    let times: Vec<f64> = r.bias_stability.iter().map(|b| b.smoothing_s).collect();
+    assert_eq!(times, vec![0.01, 1.0, 2.0, 10.0]);
+    let j = serde_json::to_string(&r).unwrap();
+    let keys = |name: &str| {
+        let v: serde_json::Value = serde_json::from_str(&j).unwrap();
+        v[name].as_object().unwrap().keys().cloned().collect::<Vec<_>>()
+    };
+    for name in ["bias_stability_output", "bias_stability_dph", "bias_stability_windows"] {
+        assert_eq!(keys(name), vec!["0.01", "1", "10", "2"], "{name}");
+    }
+    let order = ["\"bias_stability_output\":{\"0.01\":", "\"bias_stability_dph\":{\"0.01\":", "\"bias_stability_windows\":{\"0.01\":4000,\"1\":40,\"10\":4,\"2\":20},\"bias_stability_quoted_s\":\"10\",\"bias_stability_skipped\""];
+    let pos: Vec<usize> = order.iter().map(|s| j.find(s).unwrap_or_else(|| panic!("{s} in {j}"))).collect();
+    assert!(pos.windows(2).all(|w| w[0] < w[1]), "{j}");
+    assert!(!j.contains("outlier_scan_needed"));
+    let back: StaticTestResult = serde_json::from_str(&j).unwrap();
+    // serde_json without its float_roundtrip feature may read a number back 1 ulp off.
+    assert_eq!(back.bias_stability.len(), r.bias_stability.len());
+    for (b, a) in back.bias_stability.iter().zip(&r.bias_stability) {
+        assert_eq!((b.smoothing_s, b.windows), (a.smoothing_s, a.windows));
+        assert_relative_eq!(b.output, a.output, max_relative = 1e-15);
+        assert_relative_eq!(b.dph.unwrap(), a.dph.unwrap(), max_relative = 1e-15);
+    }
+    assert_eq!(back.bias_stability_quoted_s, Some(10.0));
 }

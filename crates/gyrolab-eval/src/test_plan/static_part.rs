@@ -199,11 +199,7 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, progress: &dyn Pro
         tests.push(TestReport { file: shown(path, ctx.base), result });
         progress.advance(1);
     }
-    let window_s = tests
-        .first()
-        .and_then(|t| t.result.bias_stability_quoted_s.as_deref())
-        .and_then(|q| q.parse::<f64>().ok())
-        .unwrap_or(10.0);
+    let window_s = tests.first().and_then(|t| t.result.bias_stability_quoted_s).unwrap_or(10.0);
     let mut windows = Vec::new();
     for (path, t) in s.files.iter().zip(&tests) {
         progress.message(&format!("axis {axis}: window means of {}", t.file));
