@@ -187,3 +187,56 @@ fn paper_plan_verdict_is_fail() {
     assert_eq!(v["rate_axes"][0]["name"], "x");
     assert!((reported - linearity_pct).abs() <= 1e-9 * linearity_pct, "{reported} vs {linearity_pct}");
 }
+
+/// The static null of an axis with a rate test is its rest reference F_r (here the paper's
+/// 0 deg/s point, the mean of its eight outputs, computed in this test), measured at rest on the
+/// same mounting: it already holds the earth rate of a vertical axis, so `latitude_deg` does not
+/// subtract it again. Static records simulated with null = F_r, K = the paper's K and a bias of
+/// 50 deg/h give back 50 deg/h within the noise (a subtraction would move it by
+/// Omega_e sin 40 deg = 9.67 deg/h, 8 standard errors).
+#[test]
+fn static_null_is_the_rest_reference_and_keeps_its_earth_rate() {
+    let dir = tempfile::tempdir().unwrap();
+    let x = common::paper_file("paper_rate_table_x.csv");
+    let rows = common::read_long(&x);
+    let zero: Vec<f64> = rows.iter().filter(|r| r.0 == 0.0).map(|r| r.3).collect();
+    let f_r = zero.iter().sum::<f64>() / zero.len() as f64;
+    let means = common::rate_means(&rows);
+    let (k, _) = common::lsq_line(&means.rates, &means.mean);
+    let (arw, duration_s, bias) = (0.3, 1200.0, 50.0);
+    for j in 0..2 {
+        let model = SensorModel {
+            scale_factor_per_dps: k,
+            null: f_r,
+            arw_deg_rt_h: arw,
+            bias_dph: bias,
+            ..SensorModel::default()
+        };
+        let model = SensorModel { output_unit: OutputUnit::Volt, ..model };
+        let spec = StaticSpec { sample_rate_hz: 100.0, duration_s, ..StaticSpec::default() };
+        let f = std::fs::File::create(dir.path().join(format!("s{j}.csv"))).unwrap();
+        write_static_csv(std::io::BufWriter::new(f), &model, &spec, 40 + j, &SimCsvOptions::default()).unwrap();
+    }
+    let plan = dir.path().join("plan.toml");
+    std::fs::write(
+        &plan,
+        format!(
+            "[device]\nmodel = \"m\"\nserial = \"s\"\naxes = [\"x\"]\n[rate.x]\nfile = \"{}\"\n[static.x]\n\
+             files = [\"s0.csv\", \"s1.csv\"]\nsample_rate_hz = 100.0\nlatitude_deg = 40.0\n",
+            x.display()
+        ),
+    )
+    .unwrap();
+    let folder = evaluate_test_plan(&read_test_plan(&plan).unwrap(), "plan.toml", &Silent).unwrap();
+    let v: serde_json::Value = serde_json::from_slice(output(&folder, "results.json")).unwrap();
+    let s = &v["sections"]["static"]["x"];
+    assert_eq!(s["reference"]["null_source"], "zero_rate_point");
+    assert_eq!(s["reference"]["null_contains_earth_rate"], true);
+    assert!((s["reference"]["null_output"].as_f64().unwrap() - f_r).abs() < 1e-12);
+    let se_dph = arw / 60.0 / duration_s.sqrt() * 3600.0;
+    for t in s["tests"].as_array().unwrap() {
+        assert_eq!(t["earth_rate_subtracted"], false);
+        let b = t["bias_dph"].as_f64().unwrap();
+        assert!((b - bias).abs() < 5.0 * se_dph, "bias {b} deg/h, truth {bias}, tolerance {}", 5.0 * se_dph);
+    }
+}

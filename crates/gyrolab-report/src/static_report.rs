@@ -26,8 +26,14 @@ pub struct ReferenceJson {
     pub source: String,
     /// Scale factor K, output units per deg/s (null for `none`).
     pub scale_factor: Option<f64>,
-    /// Null F0, output units (null for `none`).
+    /// The static null F_null used, output units (null for `none`).
     pub null_output: Option<f64>,
+    /// Which zero-rate output the null is: `rest_records`, `zero_rate_point`, `rest_reference`
+    /// (a calibration file's F_r), `line_intercept` (F0); null for `none`.
+    pub null_source: Option<String>,
+    /// Whether the null already contains the earth-rate component (measured at rest on the same
+    /// mounting): a latitude then does not subtract it again.
+    pub null_contains_earth_rate: bool,
     /// Output unit of K and F0.
     pub output_unit: Option<String>,
     /// The reference in words (as in the report).

@@ -181,6 +181,45 @@ fn repeatability_of_known_bias_offsets() {
 }
 
 #[test]
+fn repeatability_needs_the_scale_factor_only() {
+    // The same biases with K given and no null: B0_i = (F_i - F_null) / K, the null cancels in
+    // the spread, so the repeatability is still sqrt(10/3) deg/h; the mean bias needs the null.
+    let (k, null) = (0.0075, 2.5);
+    let results: Vec<StaticTestResult> = [10.0, 12.0, 9.0, 13.0]
+        .iter()
+        .map(|b_dph| {
+            run(
+                &constant_record(null + k * b_dph / 3600.0, 1200),
+                &StaticTestConfig { scale_factor: Some(k), ..cfg(1.0) },
+            )
+        })
+        .collect();
+    assert!(results.iter().all(|r| r.bias_dph.is_none()));
+    let rep = bias_repeatability(&results).unwrap();
+    assert_relative_eq!(rep.bias_repeatability_dph.unwrap(), (10.0f64 / 3.0).sqrt(), epsilon = 1e-6);
+    assert!(rep.mean_bias_dph.is_none());
+}
+
+#[test]
+fn a_null_measured_on_the_mounting_keeps_its_earth_rate() {
+    // Output = null + K (bias + earth): with a null measured at rest on the same mounting the
+    // earth rate is already in it; the bias is (F - null) / K with nothing subtracted, and the
+    // component is still reported (Omega_e sin 40 deg = 9.668 deg/h).
+    let (k, null) = (0.0075, 2.5);
+    let x = constant_record(null + k * 20.0 / 3600.0, 1200);
+    let base =
+        StaticTestConfig { scale_factor: Some(k), null_output: Some(null), latitude_deg: Some(40.0), ..cfg(1.0) };
+    let kept = run(&x, &StaticTestConfig { null_contains_earth_rate: true, ..base.clone() });
+    assert_relative_eq!(kept.bias_dph.unwrap(), 20.0, epsilon = 1e-6);
+    assert!(!kept.earth_rate_subtracted);
+    let earth = 15.041_067_178_669_1 * 40f64.to_radians().sin();
+    assert_relative_eq!(kept.earth_rate_component_dph.unwrap(), earth, epsilon = 1e-3);
+    assert!(kept.notes.iter().any(|n| n.contains("already contains")));
+    let subtracted = run(&x, &base);
+    assert_relative_eq!(subtracted.bias_dph.unwrap(), 20.0 - earth, epsilon = 1e-3);
+}
+
+#[test]
 fn paper_table5_x_mean_reproduces() {
     // Paper Table 5, axis x: 2.513789 2.529938 2.518372 2.528373, printed mean 2.522618.
     let results: Vec<StaticTestResult> =

@@ -9,6 +9,7 @@ use crate::rate::EvaluatedAxis;
 use crate::reference::Reference;
 use crate::static_test::evaluate_file;
 use gyrolab::allan::{AllanOptions, DeviationKind};
+use gyrolab::rate_test::RestReferenceSource;
 use gyrolab::static_test::{bias_repeatability, smoothing_key, StaticTestConfig};
 use gyrolab_io::calibration::read_calibration;
 use gyrolab_io::series::{read_series_all, window_means_file, SeriesOptions};
@@ -77,59 +78,99 @@ pub fn smoothing_times(limits: &[Limit]) -> Vec<f64> {
     t
 }
 
-/// The output-to-rate reference of an axis: this plan's rate-table K and F0, else the plan's
-/// calibration file, else none (output units only).
+/// The static null of an axis: the best measured zero-rate output of its rate test, the rest
+/// reference F_r (rest records at start and end, else the 0 deg/s point, paper eq. 5); the
+/// fitted intercept F0 only where neither was recorded (it is pulled by saturated end points).
+/// Both were measured on the table at rest on the same mounting, so they contain the earth-rate
+/// component a vertical input axis sees.
+fn static_null(
+    rest_reference: f64,
+    source: Option<RestReferenceSource>,
+    zero_offset: f64,
+) -> (f64, &'static str, &'static str) {
+    match source {
+        Some(RestReferenceSource::RestRecords) => {
+            (rest_reference, "rest_records", "the rest reference F_r (rest records)")
+        }
+        Some(RestReferenceSource::ZeroRatePoint) => {
+            (rest_reference, "zero_rate_point", "the rest reference F_r (the 0 deg/s point)")
+        }
+        Some(RestReferenceSource::FitZeroOffset) => (zero_offset, "line_intercept", "the fitted zero offset F0"),
+        // A calibration file stores F_r but not where it came from.
+        None => (rest_reference, "rest_reference", "the rest reference F_r"),
+    }
+}
+
+/// The static null of an evaluated rate-table axis (see [`static_null`]).
+pub fn static_null_of(axis: &EvaluatedAxis) -> f64 {
+    let c = axis.calibration();
+    static_null(c.rest_reference, Some(axis.evaluation.rest_reference_source), c.zero_offset).0
+}
+
+/// The output-to-rate reference of an axis: this plan's rate-table K and static null, else the
+/// plan's calibration file, else none (output units only).
 fn reference_of(axis: &str, ctx: &StaticContext<'_>) -> EvalResult<(Reference, ReferenceJson)> {
-    if let Some(r) = ctx.rate_axes.iter().find(|a| a.name == axis) {
-        let c = r.calibration();
+    let sig = gyrolab_report::format::sig;
+    let found = match ctx.rate_axes.iter().find(|a| a.name == axis) {
+        Some(r) => {
+            let c = r.calibration();
+            let (null, key, words) =
+                static_null(c.rest_reference, Some(r.evaluation.rest_reference_source), c.zero_offset);
+            Some((
+                c,
+                null,
+                key,
+                words,
+                "rate_table",
+                format!("this plan's rate-table evaluation of axis {axis} ({})", r.file),
+            ))
+        }
+        None => match ctx.calibration {
+            Some(path) => {
+                let cal = read_calibration(path)?;
+                cal.axis(Some(axis)).ok().map(|c| {
+                    let (null, key, words) = static_null(c.rest_reference, None, c.zero_offset);
+                    let from = format!("the calibration file {} (axis {axis})", shown(path, ctx.base));
+                    (c.clone(), null, key, words, "calibration_file", from)
+                })
+            }
+            None => None,
+        },
+    };
+    let Some((c, null, key, words, source, from)) = found else {
         return Ok((
-            Reference::Calibrated { scale_factor: c.scale_factor, null: c.zero_offset, unit: c.output_unit },
+            Reference::None,
             ReferenceJson {
-                source: "rate_table".into(),
-                scale_factor: Some(c.scale_factor),
-                null_output: Some(c.zero_offset),
-                output_unit: Some(c.output_unit.symbol().into()),
+                source: "none".into(),
+                scale_factor: None,
+                null_output: None,
+                null_source: None,
+                null_contains_earth_rate: false,
+                output_unit: None,
                 text: format!(
-                    "K = {} {u}/(deg/s) and F0 = {} {u} from this plan's rate-table evaluation of axis {axis} ({}).",
-                    gyrolab_report::format::sig(c.scale_factor, 6),
-                    gyrolab_report::format::sig(c.zero_offset, 7),
-                    r.file,
-                    u = c.output_unit.symbol()
+                    "none: axis {axis} has no rate-table record in this plan and no entry in a calibration file, so \
+                     figures are in output units only (outputs already in deg/s or rad/s are rates)."
                 ),
             },
         ));
-    }
-    if let Some(path) = ctx.calibration {
-        let cal = read_calibration(path)?;
-        if let Ok(c) = cal.axis(Some(axis)) {
-            return Ok((
-                Reference::Calibrated { scale_factor: c.scale_factor, null: c.zero_offset, unit: c.output_unit },
-                ReferenceJson {
-                    source: "calibration_file".into(),
-                    scale_factor: Some(c.scale_factor),
-                    null_output: Some(c.zero_offset),
-                    output_unit: Some(c.output_unit.symbol().into()),
-                    text: format!(
-                        "K = {} {u}/(deg/s) and F0 = {} {u} from the calibration file {} (axis {axis}).",
-                        gyrolab_report::format::sig(c.scale_factor, 6),
-                        gyrolab_report::format::sig(c.zero_offset, 7),
-                        shown(path, ctx.base),
-                        u = c.output_unit.symbol()
-                    ),
-                },
-            ));
-        }
-    }
+    };
+    let u = c.output_unit.symbol();
     Ok((
-        Reference::None,
+        Reference::Calibrated { scale_factor: c.scale_factor, null, unit: c.output_unit },
         ReferenceJson {
-            source: "none".into(),
-            scale_factor: None,
-            null_output: None,
-            output_unit: None,
+            source: source.into(),
+            scale_factor: Some(c.scale_factor),
+            null_output: Some(null),
+            null_source: Some(key.into()),
+            null_contains_earth_rate: true,
+            output_unit: Some(u.into()),
             text: format!(
-                "none: axis {axis} has no rate-table record in this plan and no entry in a calibration file, so figures \
-                 are in output units only (outputs already in deg/s or rad/s are rates)."
+                "K = {} {u}/(deg/s) and null = {} {u} ({words}; F0 = {} {u}) from {from}. The null was measured at \
+                 rest on the rate table, so it already contains the earth-rate component of a vertical input axis: \
+                 a latitude does not subtract it again.",
+                sig(c.scale_factor, 6),
+                sig(null, 7),
+                sig(c.zero_offset, 7),
             ),
         },
     ))
@@ -163,6 +204,7 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, progress: &dyn Pro
         progress.message(&format!("axis {axis}: static test {}", shown(path, ctx.base)));
         let config = StaticTestConfig {
             latitude_deg: s.latitude_deg,
+            null_contains_earth_rate: reference_json.null_contains_earth_rate,
             smoothing_times_s: smoothing.clone(),
             ..StaticTestConfig::default()
         };

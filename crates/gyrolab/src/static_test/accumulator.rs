@@ -662,11 +662,18 @@ impl StaticTestAccumulator {
         let k = cfg.effective_scale_factor();
         let null = cfg.effective_null_output();
         let earth = cfg.latitude_deg.map(units::earth_rate_vertical_dph);
+        let subtract = earth.filter(|_| !cfg.null_contains_earth_rate);
+        if earth.is_some() && cfg.null_contains_earth_rate {
+            notes.push(
+                "earth rate not subtracted: the null was measured at rest on the same mounting and already contains it"
+                    .into(),
+            );
+        }
         let (bias_dps, bias_dph, earth_done) = match (k, null) {
             (Some(k), Some(f0)) => {
                 let raw_dph = units::dps_to_dph((mean_output - f0) / k);
-                let dph = raw_dph - earth.unwrap_or(0.0);
-                (Some(units::dph_to_dps(dph)), Some(dph), earth.is_some())
+                let dph = raw_dph - subtract.unwrap_or(0.0);
+                (Some(units::dph_to_dps(dph)), Some(dph), subtract.is_some())
             }
             _ => {
                 notes.push(match k {
@@ -676,7 +683,7 @@ impl StaticTestAccumulator {
                 (None, None, false)
             }
         };
-        if earth.is_some() && !earth_done {
+        if subtract.is_some() && !earth_done {
             notes.push("earth rate not subtracted: the bias could not be computed".into());
         }
         let to_dph = |v_out: f64| k.map(|k| units::dps_to_dph(v_out / k.abs()));

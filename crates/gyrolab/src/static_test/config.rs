@@ -90,8 +90,13 @@ pub struct StaticTestConfig {
     pub scale_factor: Option<f64>,
     /// Zero-rate output reference F_null in output units (defaults to 0 for rate outputs).
     pub null_output: Option<f64>,
-    /// Latitude in degrees (input axis vertical, pointing up): subtract the earth rate when given.
+    /// Latitude in degrees (input axis vertical, pointing up): subtract the earth rate when given
+    /// (unless `null_contains_earth_rate`).
     pub latitude_deg: Option<f64>,
+    /// The null was measured at rest on the same mounting (a rate test's rest reference or
+    /// intercept), so it already contains the earth-rate component: it is reported, not
+    /// subtracted again.
+    pub null_contains_earth_rate: bool,
     /// Report the bias stability of raw samples (smoothing time one sample interval).
     pub include_one_sample: bool,
     /// Smoothing times T in seconds for the bias stability.
@@ -121,6 +126,7 @@ impl Default for StaticTestConfig {
             scale_factor: None,
             null_output: None,
             latitude_deg: None,
+            null_contains_earth_rate: false,
             include_one_sample: true,
             smoothing_times_s: vec![1.0, 10.0, 100.0],
             min_windows: 10,

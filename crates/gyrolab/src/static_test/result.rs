@@ -4,7 +4,7 @@
 use super::config::{StaticTestError, FIRST_POSITIONS};
 use crate::fit;
 use crate::sampling::SampleRateSource;
-use crate::units::OutputUnit;
+use crate::units::{self, OutputUnit};
 use serde::{Deserialize, Serialize};
 
 /// Where a sample is: 0-based sample index in the record, and its source line when known.
@@ -339,7 +339,8 @@ pub struct BiasRepeatability {
     pub output_repeatability: f64,
     /// Mean bias, deg/h (when every test is calibrated).
     pub mean_bias_dph: Option<f64>,
-    /// Bias repeatability std(B0_i, n-1), deg/h (when every test is calibrated).
+    /// Bias repeatability std(B0_i, n-1), deg/h, whenever every test has a scale factor: the
+    /// null cancels (B0_i = F_i / K - F_null / K), so it is std(F_i / K_i) without a null.
     pub bias_repeatability_dph: Option<f64>,
 }
 
@@ -355,7 +356,23 @@ pub fn bias_repeatability(results: &[StaticTestResult]) -> Result<BiasRepeatabil
         mean_output: fit::mean(&means).unwrap_or(f64::NAN), // ok: len >= 2
         output_repeatability: fit::sample_std(&means).unwrap_or(f64::NAN), // ok: len >= 2
         mean_bias_dph: biases.as_deref().and_then(fit::mean),
-        bias_repeatability_dph: biases.as_deref().and_then(fit::sample_std),
+        bias_repeatability_dph: match biases {
+            Some(b) => fit::sample_std(&b),
+            None => {
+                // B0_i = (F_i - F_null) / K_i: with one K and one null for every test the null
+                // cancels in the spread, so the repeatability needs K only.
+                let k: Option<Vec<f64>> = results.iter().map(|r| r.scale_factor_output_per_dps).collect();
+                let same_k = k.as_ref().is_some_and(|k| k.iter().all(|x| *x == k[0]));
+                let nulls_agree = results.windows(2).all(|w| w[0].null_output == w[1].null_output);
+                match k {
+                    Some(k) if same_k && nulls_agree => {
+                        let b0: Vec<f64> = means.iter().map(|f| units::dps_to_dph(f / k[0])).collect();
+                        fit::sample_std(&b0)
+                    }
+                    _ => None,
+                }
+            }
+        },
     })
 }
 
