@@ -13,3 +13,7 @@ cargo build --quiet -p gyrolab-cli
 # of freedom at relative 1e-9.
 cargo build --quiet -p gyrolab --example chi2_quantiles
 .venv/bin/python scripts/check_chi2_scipy.py target/debug/examples/chi2_quantiles
+# The Python package: built with maturin and installed into .venv, then its pytest suite
+# (equality with allantools and with the command line, simulated truth, malformed inputs).
+PATH="$PWD/.venv/bin:$PATH" .venv/bin/pip install --quiet --disable-pip-version-check --no-build-isolation ./python
+GYROLAB_BIN=target/debug/gyrolab .venv/bin/python -m pytest -q -rs python/tests

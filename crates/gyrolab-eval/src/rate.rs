@@ -219,3 +219,40 @@ pub fn evaluate_rates(request: &RateRequest) -> EvalResult<RateOutcome> {
     }
     Ok(RateOutcome { axes, logs })
 }
+
+/// Evaluates observations held in memory (one per plateau mean or sample: rate in deg/s, run,
+/// stroke, output in `output_unit`) as the axis `name`, the way a file's records are.
+///
+/// ```
+/// use gyrolab::rate_test::{RateObservation, Stroke};
+/// use gyrolab::units::OutputUnit;
+/// use gyrolab_eval::rate::{evaluate_observations, RateSettings};
+/// let mut obs = Vec::new();
+/// for run in 1..=2 {
+///     for (stroke, rates) in [(Stroke::Forward, [-10.0, 0.0, 10.0]), (Stroke::Reverse, [10.0, 0.0, -10.0])] {
+///         for r in rates {
+///             obs.push(RateObservation { rate_dps: r, run, stroke, output: 2.5 + 0.0075 * r });
+///         }
+///     }
+/// }
+/// let axis = evaluate_observations("x", &obs, OutputUnit::Volt, &RateSettings::default()).unwrap();
+/// assert!((axis.evaluation.scale_factor() - 0.0075).abs() < 1e-15);
+/// ```
+pub fn evaluate_observations(
+    name: &str,
+    observations: &[gyrolab::rate_test::RateObservation],
+    output_unit: gyrolab::units::OutputUnit,
+    settings: &RateSettings,
+) -> EvalResult<EvaluatedAxis> {
+    let options = settings.options()?;
+    let table = gyrolab::rate_test::RateTable::from_observations(observations, None)
+        .map_err(|e| EvalError::Data(gyrolab_io::DataError::new(name, format!("cannot read the observations: {e}"))))?;
+    let record = RateTableFile {
+        table,
+        output_unit,
+        rate_unit: gyrolab::units::RateUnit::DegPerSec,
+        layout: RateLayout::Long,
+        samples: observations.len(),
+    };
+    evaluate_record(name.into(), name.into(), record, &options)
+}

@@ -199,3 +199,34 @@ pub fn simulate_to(
         SimRecord::RateTable => write_rate_table_csv(w, &model, &cfg.rate_table, cfg.seed, opts).map(|_| ()),
     }
 }
+
+/// A simulated static record in memory: time from the start (s), the output in the model's
+/// output unit, and the temperature (degC) when the set-up records it.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct StaticSamples {
+    /// Time of each sample, s.
+    pub time_s: Vec<f64>,
+    /// Output of each sample.
+    pub output: Vec<f64>,
+    /// Temperature of each sample, degC (empty unless recorded).
+    pub temp_c: Vec<f64>,
+}
+
+/// Simulates the static record of a set-up into memory (the same samples `simulate static`
+/// writes for the same seed, before formatting).
+pub fn simulate_static_samples(cfg: &SimConfig) -> EvalResult<StaticSamples> {
+    let model = cfg.sensor_model();
+    let mut generator = gyrolab::sim::StaticGenerator::new(&model, &cfg.static_record, cfg.seed)
+        .map_err(|e| EvalError::conflict(format!("invalid simulation parameters: {e}")))?;
+    let n = usize::try_from(generator.remaining()).unwrap_or(usize::MAX);
+    let mut out = StaticSamples { time_s: Vec::with_capacity(n), output: Vec::with_capacity(n), temp_c: Vec::new() };
+    let mut block = gyrolab::sim::StaticBlock::default();
+    while generator.next_block(&mut block, 1 << 16) > 0 {
+        out.time_s.extend_from_slice(&block.time_s);
+        out.output.extend_from_slice(&block.output);
+        if block.records_temperature {
+            out.temp_c.extend_from_slice(&block.temp_c);
+        }
+    }
+    Ok(out)
+}

@@ -186,3 +186,16 @@ pub fn repeatability_by_channel(tests: &[TestReport]) -> Vec<ChannelRepeatabilit
     }
     out
 }
+
+/// Evaluates one static test held in memory (output samples, optional time stamps and
+/// temperatures) with `config`, its scale factor and null set from the reference.
+pub fn evaluate_samples(
+    block: &gyrolab::static_test::SampleBlock<'_>,
+    config: &StaticTestConfig,
+    reference: &Reference,
+) -> EvalResult<StaticTestResult> {
+    let mut cfg = config.clone();
+    reference.configure(&mut cfg, &config.channel, config.output_unit).map_err(EvalError::conflict)?;
+    gyrolab::static_test::evaluate_static(block, &cfg)
+        .map_err(|e| EvalError::Data(gyrolab_io::DataError::new(&config.channel, e.to_string())))
+}
