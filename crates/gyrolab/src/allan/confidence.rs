@@ -98,6 +98,38 @@ pub(crate) fn lag1_noise_id(s: &[f64], m: usize, dmax: usize) -> Option<i32> {
         n1 += p1 * p1;
     }
     let (a0, a1) = (s0 / n as f64, s1 / n1);
+    // Order 0 alone first: most series stop there (delta < 0.25), and this loop has no
+    // per-order branches. Its sums are the ones the general loop below forms for d = 0, in the
+    // same order, so the result does not depend on which loop ran.
+    {
+        let (mut sum1, mut sum2, mut sum11, mut first, mut prev) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        for (t, v) in averages().enumerate() {
+            let cur = v - (a0 + a1 * (t as f64 - c));
+            if t == 0 {
+                first = cur;
+            } else {
+                sum11 += prev * cur;
+            }
+            sum1 += cur;
+            sum2 += cur * cur;
+            prev = cur;
+        }
+        let lf = n as f64;
+        if n < 3 {
+            return None;
+        }
+        let mu = sum1 / lf;
+        let den = sum2 - lf * mu * mu;
+        if den <= 0.0 || !den.is_finite() {
+            return None;
+        }
+        let num = sum11 - mu * ((sum1 - prev) + (sum1 - first)) + (lf - 1.0) * mu * mu;
+        let r1 = num / den;
+        let delta = r1 / (1.0 + r1);
+        if delta < 0.25 || dmax == 0 {
+            return Some(lag1_alpha(delta, 0));
+        }
+    }
     // per order d: sum w, sum w^2, sum w_t w_{t+1}, first w, last w
     let mut sum1 = [0.0f64; ORDERS];
     let mut sum2 = [0.0f64; ORDERS];
