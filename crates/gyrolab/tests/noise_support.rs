@@ -172,3 +172,35 @@ fn equal_first_two_deviations_are_not_quantization() {
     let got = s.quantization.value().expect("Q resolved");
     assert!(rel(got, q) < 0.01, "Q {got}");
 }
+
+/// The five-term fit is flagged poor when its weighted RMS residual exceeds FIT_RMS_LIMIT: a
+/// white-noise curve with a bump of +30 % at three taus (edf 1000, so each point's relative
+/// variance uncertainty is sqrt(2/1000) = 4.5 %) cannot be fitted; the bump-free curve can.
+#[test]
+fn a_poor_five_term_fit_is_flagged() {
+    use gyrolab::noise::{fit_noise_model, FitQuality, FIT_RMS_LIMIT};
+    let mut devs: Vec<f64> = (0..12).map(|k| 1e-3 / (0.01 * f64::from(1u32 << k)).sqrt()).collect();
+    let fit = fit_noise_model(&hand_curve(&devs), None).unwrap();
+    assert_eq!(fit.quality, FitQuality::Acceptable, "{fit:?}");
+    for d in &mut devs[5..8] {
+        *d *= 1.3;
+    }
+    let fit = fit_noise_model(&hand_curve(&devs), None).unwrap();
+    assert!(fit.weighted_rms_residual > FIT_RMS_LIMIT, "{fit:?}");
+    assert_eq!(fit.quality, FitQuality::Poor);
+}
+
+/// The readings do not depend on the number of threads (bit-identical for 1 and 2).
+#[test]
+fn readings_are_identical_for_one_and_two_threads() {
+    let model =
+        SensorModel { arw_deg_rt_h: 0.25, bias_instability_dph: 4.0, rrw_deg_h_rt_h: 6.0, ..SensorModel::default() };
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| format!("{:?}", slope_line_terms(&simulated_curve(&model, 100.0, 7200.0, 2)).unwrap()))
+    };
+    assert_eq!(run(1), run(2));
+}
