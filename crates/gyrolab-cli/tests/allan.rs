@@ -22,9 +22,8 @@ fn rel(a: f64, b: f64) -> f64 {
 #[test]
 fn recovers_known_noise_terms_of_simulated_records() {
     // 10 h at 10 Hz. Tolerances: N within 5 % (thousands of degrees of freedom at short tau);
-    // B and K within 25 % (few degrees of freedom at long tau; spread over seeds 1-8 was
-    // B 11.7-12.3 by the fit, 10.0-13.1 by slope lines; K 54-62 for 60 by the fit, 45-73 by
-    // slope lines: docs/METHODS.md).
+    // B and K within 25 % (few degrees of freedom at long tau; the support rules and their
+    // checks over seeds are in docs/METHODS.md section 3).
     let dir = tempfile::tempdir().unwrap();
     let nb = simulate(
         dir.path(),

@@ -489,3 +489,61 @@ pub fn kalibr_yaml(channels: &[ChannelAnalysis], update_rate_hz: f64) -> Option<
 pub fn has_terms(c: &NoiseCoefficients) -> bool {
     c.arw_deg_rt_h.is_some() || c.bias_instability_dph.is_some() || c.rrw_deg_h_rt_h.is_some()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gyrolab::allan::{AllanPoint, DeviationKind};
+    use gyrolab::noise::{fit_noise_model, slope_line_terms};
+
+    /// A hand-made white-noise curve (sigma = 1e-3 / sqrt(tau), edf 1000), optionally with a 30 %
+    /// bump at three taus.
+    fn analysis(bump: bool) -> ChannelAnalysis {
+        let points = (0..12)
+            .map(|k| {
+                let tau_s = 0.01 * f64::from(1u32 << k);
+                let f = if bump && (5..8).contains(&k) { 1.3 } else { 1.0 };
+                AllanPoint {
+                    m: 1 << k,
+                    tau_s,
+                    deviation: f * 1e-3 / tau_s.sqrt(),
+                    terms: 1000,
+                    alpha: None,
+                    noise_id: None,
+                    edf: Some(1000.0),
+                    lower: None,
+                    upper: None,
+                }
+            })
+            .collect();
+        let curve = AllanCurve { kind: DeviationKind::Oadev, tau0_s: 0.01, n_rate: 1 << 20, confidence: None, points };
+        ChannelAnalysis {
+            file: "hand.csv".into(),
+            channel: "rate_dps".into(),
+            rate_unit: "deg/s".into(),
+            slope_lines: slope_line_terms(&curve).ok(),
+            model_fit: fit_noise_model(&curve, None).ok(),
+            curve,
+            noise_note: None,
+        }
+    }
+
+    #[test]
+    fn text_and_json_show_bounds_and_flag_a_poor_fit() {
+        let good = analysis(false);
+        let text = allan_text(&good);
+        // B is not resolved on white noise: printed as '< x' with its reason, never as a value.
+        let b_row = text.lines().find(|l| l.contains("bias instability B")).unwrap();
+        assert!(b_row.contains("< ") && b_row.contains("record too short"), "{b_row}");
+        assert!(!text.contains("POOR FIT"), "{text}");
+        // N = 1e-3 deg/sqrt(s) = 0.06 deg/sqrt(h) by hand.
+        let j = allan_json(&good);
+        let noise = j.noise.unwrap();
+        assert!((noise.arw_deg_rt_h.unwrap() - 0.06).abs() < 1e-12);
+        assert!(noise.bias_instability_dph.is_none() && noise.allan_minimum_dph.is_none());
+        let b = noise.readings.iter().find(|r| r.term == "bias_instability").unwrap();
+        assert_eq!((b.basis, b.reason), ("upper_bound", Some("record_too_short")));
+        let text = allan_text(&analysis(true));
+        assert!(text.contains("POOR FIT"), "{text}");
+    }
+}
