@@ -4,7 +4,14 @@
 use crate::format::{short, sig, sig_opt};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Cell, CellAlignment, Table};
 use gyrolab::allan::AllanCurve;
-use gyrolab::noise::{KalibrGyroscope, ModelFitResult, NoiseCoefficients, SlopeLineResult, SlopeReading};
+use gyrolab::noise::{
+    combine_kalibr, kalibr_from_readings, FitQuality, KalibrBasis, KalibrGyroscope, ModelFitResult, NoiseCoefficients,
+    Reading, SlopeLineResult, Unresolved, FIT_RMS_LIMIT,
+};
+use gyrolab::units;
+
+/// sqrt(2 ln 2 / pi): Allan minimum per unit IEEE bias instability.
+const BIAS_FACTOR: f64 = gyrolab::noise::BIAS_INSTABILITY_FACTOR;
 use serde::Serialize;
 
 /// One analysed channel.
@@ -31,8 +38,14 @@ pub struct ChannelAnalysis {
 pub struct NoiseJson {
     /// Angle random walk N, deg/sqrt(h).
     pub arw_deg_rt_h: Option<f64>,
-    /// Bias instability B, deg/h (ADEV flat value / 0.6643).
+    /// Bias instability B in the IEEE 952 convention, deg/h (Allan minimum of the flat region
+    /// / 0.6643); null unless resolved.
     pub bias_instability_dph: Option<f64>,
+    /// The Allan deviation minimum of the flat region, deg/h (the ADI / Sensonor datasheet
+    /// convention; 0.6643 x `bias_instability_dph`); null unless resolved.
+    pub allan_minimum_dph: Option<f64>,
+    /// Tau of the Allan minimum, s; null unless resolved.
+    pub allan_minimum_tau_s: Option<f64>,
     /// Rate random walk K, deg/h/sqrt(h).
     pub rrw_deg_h_rt_h: Option<f64>,
     /// Quantization noise Q, deg.
@@ -43,25 +56,39 @@ pub struct NoiseJson {
     pub arw_deg_rt_s: Option<f64>,
     /// K, deg/s/sqrt(s).
     pub rrw_deg_s_rt_s: Option<f64>,
-    /// Where each slope-line term was read: tau and the tau range of its slope region.
+    /// Every slope-line term with its basis (`value`, `upper_bound`, `absent`), where it was
+    /// read or bounded, and why it is not a value.
     pub readings: Vec<ReadingJson>,
     /// The weighted least-squares fit of the five-term model.
     pub fit: Option<FitJson>,
-    /// Kalibr imu.yaml gyroscope entries (rad units).
+    /// Kalibr imu.yaml gyroscope entries (rad units) with their basis (`value`, `upper_bound`,
+    /// `fit_value`).
     pub kalibr: KalibrGyroscope,
 }
 
-/// Where a term was read.
+/// One slope-line term: its basis and support.
 #[derive(Debug, Clone, Serialize)]
 pub struct ReadingJson {
-    /// Term: `quantization`, `arw`, `bias_instability`, `rrw`, `rate_ramp`.
+    /// Term: `quantization`, `arw`, `bias_instability`, `allan_minimum`, `rrw`, `rate_ramp`.
     pub term: &'static str,
-    /// Tau of the reading, s.
-    pub tau_s: f64,
-    /// Tau range of the slope region, s.
-    pub tau_range_s: [f64; 2],
-    /// Local log-log slope there.
-    pub local_slope: f64,
+    /// `value`, `upper_bound` or `absent`.
+    pub basis: &'static str,
+    /// The value or the upper bound, in `unit`; null when absent.
+    pub value: Option<f64>,
+    /// Unit of `value` (that of the term's top-level key).
+    pub unit: &'static str,
+    /// Tau of the reading or of the bound, s.
+    pub tau_s: Option<f64>,
+    /// Tau range of the supported region, s (values only).
+    pub tau_range_s: Option<[f64; 2]>,
+    /// Log-log slope of the region (values only; for rrw the slope of the excess over the other
+    /// terms).
+    pub local_slope: Option<f64>,
+    /// Why the term is not a value: `no_supported_region`, `not_above_other_terms`,
+    /// `record_too_short`, `no_points`.
+    pub reason: Option<&'static str>,
+    /// For `record_too_short`: the record length below which the term cannot be resolved, s.
+    pub needed_record_s: Option<f64>,
 }
 
 /// The five-term fit in JSON.
@@ -83,6 +110,10 @@ pub struct FitJson {
     pub points_used: usize,
     /// Weighted RMS residual (relative).
     pub weighted_rms_residual: f64,
+    /// `acceptable`, or `poor` when the weighted RMS residual exceeds `quality_limit`.
+    pub quality: FitQuality,
+    /// The residual limit of `quality`.
+    pub quality_limit: f64,
 }
 
 /// JSON of one channel.
@@ -136,24 +167,41 @@ pub struct AllanDocument {
     pub channels: Vec<AllanJson>,
 }
 
+/// The terms in report order: key, label, unit, reading in that unit.
+pub fn terms_in_units(s: &SlopeLineResult) -> [(&'static str, &'static str, &'static str, Reading); 6] {
+    [
+        ("arw", "angle random walk N", "deg/sqrt(h)", s.arw.scaled(units::arw_deg_rt_s_to_deg_rt_h(1.0))),
+        (
+            "bias_instability",
+            "bias instability B (IEEE 952)",
+            "deg/h",
+            s.bias_instability.scaled(units::bias_dps_to_dph(1.0)),
+        ),
+        ("allan_minimum", "Allan minimum (datasheet)", "deg/h", s.allan_minimum.scaled(units::bias_dps_to_dph(1.0))),
+        ("rrw", "rate random walk K", "deg/h/sqrt(h)", s.rrw.scaled(units::rrw_dps_rt_s_to_dph_rt_h(1.0))),
+        ("quantization", "quantization Q", "deg", s.quantization),
+        ("rate_ramp", "rate ramp R", "deg/h/h", s.rate_ramp.scaled(units::rate_ramp_dps_per_s_to_dph_per_h(1.0))),
+    ]
+}
+
 fn readings(s: &SlopeLineResult) -> Vec<ReadingJson> {
-    let mut v = Vec::new();
-    let mut push = |term, r: &Option<SlopeReading>| {
-        if let Some(r) = r {
-            v.push(ReadingJson {
-                term,
-                tau_s: r.tau_s,
-                tau_range_s: [r.tau_range_s.0, r.tau_range_s.1],
-                local_slope: r.local_slope,
-            });
-        }
-    };
-    push("quantization", &s.quantization);
-    push("arw", &s.arw);
-    push("bias_instability", &s.bias_instability);
-    push("rrw", &s.rrw);
-    push("rate_ramp", &s.rate_ramp);
-    v
+    terms_in_units(s)
+        .into_iter()
+        .map(|(term, _, unit, r)| ReadingJson {
+            term,
+            basis: r.basis().name(),
+            value: r.value().or(r.bound()),
+            unit,
+            tau_s: r.tau_s(),
+            tau_range_s: r.site().map(|x| [x.tau_range_s.0, x.tau_range_s.1]),
+            local_slope: r.site().map(|x| x.local_slope),
+            reason: r.reason().map(|x| x.name()),
+            needed_record_s: match r.reason() {
+                Some(Unresolved::RecordTooShort { needed_record_s }) => Some(needed_record_s),
+                _ => None,
+            },
+        })
+        .collect()
 }
 
 /// Builds the JSON of one channel.
@@ -164,6 +212,8 @@ pub fn allan_json(a: &ChannelAnalysis) -> AllanJson {
         NoiseJson {
             arw_deg_rt_h: k.arw_deg_rt_h,
             bias_instability_dph: k.bias_instability_dph,
+            allan_minimum_dph: s.allan_minimum.value().map(units::bias_dps_to_dph),
+            allan_minimum_tau_s: s.allan_minimum.site().map(|x| x.tau_s),
             rrw_deg_h_rt_h: k.rrw_deg_h_rt_h,
             quantization_deg: k.quantization_deg,
             rate_ramp_dph_per_h: k.rate_ramp_dph_per_h,
@@ -179,8 +229,10 @@ pub fn allan_json(a: &ChannelAnalysis) -> AllanJson {
                 tau_range_s: [f.tau_range_s.0, f.tau_range_s.1],
                 points_used: f.points_used,
                 weighted_rms_residual: f.weighted_rms_residual,
+                quality: f.quality,
+                quality_limit: FIT_RMS_LIMIT,
             }),
-            kalibr: gyrolab::noise::kalibr_gyroscope(k),
+            kalibr: kalibr_from_readings(s, a.model_fit.as_ref()),
         }
     });
     AllanJson {
@@ -237,8 +289,31 @@ pub fn allan_csv(channels: &[ChannelAnalysis]) -> String {
     s
 }
 
-/// A row of the noise-term table: name, unit, slope-line value, reading, five-term fit value.
-type NoiseRow<'a> = (&'a str, &'a str, Option<f64>, &'a Option<SlopeReading>, Option<f64>);
+/// A reading as text: the value, `< bound`, or `absent`.
+pub fn reading_text(r: &Reading, digits: usize) -> String {
+    match r {
+        Reading::Value { value, .. } => sig(*value, digits),
+        Reading::UpperBound { value, .. } => format!("< {}", sig(*value, digits)),
+        Reading::Absent { .. } => "absent".into(),
+    }
+}
+
+/// Where a reading was read or bounded, and why it is not a value.
+pub fn support_text(r: &Reading) -> String {
+    match r {
+        Reading::Value { site, .. } => format!(
+            "tau {} s on slope {} over {}..{} s",
+            short(site.tau_s, 4),
+            short(site.local_slope, 2),
+            short(site.tau_range_s.0, 4),
+            short(site.tau_range_s.1, 4)
+        ),
+        Reading::UpperBound { tau_s, reason, .. } => {
+            format!("upper bound at tau {} s: {}", short(*tau_s, 4), reason.describe())
+        }
+        Reading::Absent { reason } => reason.describe(),
+    }
+}
 
 /// The deviation table and noise summary of one channel, as text.
 pub fn allan_text(a: &ChannelAnalysis) -> String {
@@ -286,29 +361,24 @@ pub fn allan_text(a: &ChannelAnalysis) -> String {
         (Some(sl), _) => {
             let mut n = Table::new();
             n.load_preset(UTF8_FULL_CONDENSED);
-            n.set_header(vec!["noise term", "unit", "slope lines", "read at tau s (slope region)", "five-term fit"]);
-            let k = &sl.coefficients;
+            n.set_header(vec!["noise term", "unit", "slope lines", "support", "five-term fit"]);
             let f = a.model_fit.as_ref().map(|f| f.coefficients);
-            let at = |r: &Option<SlopeReading>| {
-                r.map_or("not present".to_string(), |r| {
-                    format!("{} ({}..{})", short(r.tau_s, 4), short(r.tau_range_s.0, 4), short(r.tau_range_s.1, 4))
-                })
-            };
-            let rows: [NoiseRow<'_>; 5] = [
-                ("angle random walk N", "deg/sqrt(h)", k.arw_deg_rt_h, &sl.arw, f.and_then(|f| f.arw_deg_rt_h)),
-                (
-                    "bias instability B",
-                    "deg/h",
-                    k.bias_instability_dph,
-                    &sl.bias_instability,
-                    f.and_then(|f| f.bias_instability_dph),
-                ),
-                ("rate random walk K", "deg/h/sqrt(h)", k.rrw_deg_h_rt_h, &sl.rrw, f.and_then(|f| f.rrw_deg_h_rt_h)),
-                ("quantization Q", "deg", k.quantization_deg, &sl.quantization, f.and_then(|f| f.quantization_deg)),
-                ("rate ramp R", "deg/h/h", k.rate_ramp_dph_per_h, &sl.rate_ramp, f.and_then(|f| f.rate_ramp_dph_per_h)),
-            ];
-            for (name, unit, v, r, fv) in rows {
-                n.add_row(vec![name.to_string(), unit.to_string(), sig_opt(v, 4), at(r), sig_opt(fv, 4)]);
+            for (term, label, unit, r) in terms_in_units(sl) {
+                let fv = f.and_then(|f| match term {
+                    "arw" => f.arw_deg_rt_h,
+                    "bias_instability" => f.bias_instability_dph,
+                    "allan_minimum" => f.bias_instability_dph.map(|b| b * BIAS_FACTOR),
+                    "rrw" => f.rrw_deg_h_rt_h,
+                    "quantization" => f.quantization_deg,
+                    _ => f.rate_ramp_dph_per_h,
+                });
+                n.add_row(vec![
+                    label.to_string(),
+                    unit.to_string(),
+                    reading_text(&r, 4),
+                    support_text(&r),
+                    sig_opt(fv, 4),
+                ]);
             }
             s.push_str(&n.to_string());
             if let Some(fit) = &a.model_fit {
@@ -319,8 +389,17 @@ pub fn allan_text(a: &ChannelAnalysis) -> String {
                     fit.points_used,
                     sig(fit.weighted_rms_residual, 3)
                 ));
+                if fit.quality == FitQuality::Poor {
+                    s.push_str(&format!(
+                        "\nwarning: POOR FIT: the weighted RMS residual exceeds {}: the five-term model does not describe this curve; do not use its values",
+                        short(FIT_RMS_LIMIT, 3)
+                    ));
+                }
             }
-            s.push_str("\nB is the flat ADEV value divided by 0.6643 (IEEE 952); N is read at tau = 1 s, K at tau = 3 s on their slope lines.\n");
+            s.push_str(
+                "\nEach term is a value only where the curve supports its slope at the bounds' confidence; '< x' is an upper bound (docs/METHODS.md section 3). \
+                 B (IEEE 952) = Allan minimum / 0.6643; datasheets (ADI, Sensonor) quote the Allan minimum itself. N is read at the tau nearest 1 s on its -1/2 region.\n",
+            );
         }
         (None, Some(note)) => s.push_str(&format!("noise terms: {note}\n")),
         (None, None) => {}
@@ -328,28 +407,143 @@ pub fn allan_text(a: &ChannelAnalysis) -> String {
     s
 }
 
-/// Kalibr imu.yaml gyroscope entries for one channel.
-pub fn kalibr_yaml(a: &ChannelAnalysis, update_rate_hz: f64) -> Option<String> {
-    let k = a.slope_lines.as_ref().map(|s| gyrolab::noise::kalibr_gyroscope(&s.coefficients))?;
-    let n = k.gyroscope_noise_density?;
-    let r = k.gyroscope_random_walk;
-    Some(format!(
-        "# Kalibr imu.yaml gyroscope entries written by gyrolab {} from {} ({})\n\
+/// Kalibr's entries for several gyro channels, as written to imu.yaml.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KalibrFile {
+    /// The YAML text.
+    pub text: String,
+    /// The combined entries.
+    pub entries: KalibrGyroscope,
+    /// One line per entry that is not a resolved value (to print as `warning:` on stderr).
+    pub warnings: Vec<String>,
+}
+
+fn basis_comment(b: Option<KalibrBasis>) -> &'static str {
+    match b {
+        Some(KalibrBasis::Value) => "resolved slope-line value",
+        Some(KalibrBasis::UpperBound) => {
+            "UPPER BOUND: the term is not resolved by the record; the curve's upper confidence bound limits it"
+        }
+        Some(KalibrBasis::FitValue) => "FIVE-TERM FIT VALUE: the term is neither resolved nor bounded by slope lines",
+        None => "",
+    }
+}
+
+/// Kalibr imu.yaml gyroscope entries for the analysed channels: each entry is the largest over
+/// the channels (as ethz-asl allan_variance_ros combines its axes), with its basis in a comment
+/// and a warning for every entry that is an upper bound or a fit value. `None` when no channel
+/// has noise terms or the noise density cannot be given at all.
+pub fn kalibr_yaml(channels: &[ChannelAnalysis], update_rate_hz: f64) -> Option<KalibrFile> {
+    let per: Vec<(usize, KalibrGyroscope)> = channels
+        .iter()
+        .enumerate()
+        .filter_map(|(i, a)| a.slope_lines.as_ref().map(|s| (i, kalibr_from_readings(s, a.model_fit.as_ref()))))
+        .collect();
+    let list: Vec<KalibrGyroscope> = per.iter().map(|x| x.1).collect();
+    let mut e = combine_kalibr(&list);
+    let n = e.gyroscope_noise_density?;
+    let k = e.gyroscope_random_walk?;
+    e.channel_index = (per[e.channel_index.0].0, per[e.channel_index.1].0);
+    let name = |i: usize| format!("{} ({})", channels[i].file, channels[i].channel);
+    let mut text = format!(
+        "# Kalibr imu.yaml gyroscope entries written by gyrolab {}\n\
          # gyroscope_noise_density = angle random walk N in rad/s/sqrt(Hz);\n\
-         # gyroscope_random_walk = rate random walk K in rad/s^2/sqrt(Hz){}\n\
-         gyroscope_noise_density: {n:e}\n\
-         gyroscope_random_walk: {}\n\
-         update_rate: {}\n",
+         # gyroscope_random_walk = rate random walk K in rad/s^2/sqrt(Hz).\n\
+         # Channels combined by the largest value per entry (as allan_variance_ros): {}\n",
         env!("CARGO_PKG_VERSION"),
-        a.file,
-        a.channel,
-        if r.is_none() { " (not present in the record: 0 written; choose a value from the datasheet)" } else { "" },
-        r.map_or("0.0".to_string(), |x| format!("{x:e}")),
+        per.iter().map(|x| name(x.0)).collect::<Vec<_>>().join(", ")
+    );
+    for (i, g) in &per {
+        text.push_str(&format!(
+            "#   {}: noise density {} ({}), random walk {} ({})\n",
+            name(*i),
+            g.gyroscope_noise_density.map_or("none".into(), |x| format!("{x:e}")),
+            g.gyroscope_noise_density_basis.map_or("none", |b| b.name()),
+            g.gyroscope_random_walk.map_or("none".into(), |x| format!("{x:e}")),
+            g.gyroscope_random_walk_basis.map_or("none", |b| b.name()),
+        ));
+    }
+    let mut warnings = Vec::new();
+    for (key, basis, ch) in [
+        ("gyroscope_noise_density", e.gyroscope_noise_density_basis, e.channel_index.0),
+        ("gyroscope_random_walk", e.gyroscope_random_walk_basis, e.channel_index.1),
+    ] {
+        text.push_str(&format!("# {key}: from {}; {}\n", name(ch), basis_comment(basis)));
+        if basis != Some(KalibrBasis::Value) {
+            warnings.push(format!(
+                "Kalibr {key} is {} ({}), not a resolved value: {}",
+                basis.map_or("none", |b| b.name()),
+                name(ch),
+                basis_comment(basis)
+            ));
+        }
+    }
+    text.push_str(&format!(
+        "gyroscope_noise_density: {n:e}\ngyroscope_random_walk: {k:e}\nupdate_rate: {}\n",
         short(update_rate_hz, 9)
-    ))
+    ));
+    Some(KalibrFile { text, entries: e, warnings })
 }
 
 /// A noise-coefficient set has at least one term.
 pub fn has_terms(c: &NoiseCoefficients) -> bool {
     c.arw_deg_rt_h.is_some() || c.bias_instability_dph.is_some() || c.rrw_deg_h_rt_h.is_some()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gyrolab::allan::{AllanPoint, DeviationKind};
+    use gyrolab::noise::{fit_noise_model, slope_line_terms};
+
+    /// A hand-made white-noise curve (sigma = 1e-3 / sqrt(tau), edf 1000), optionally with a 30 %
+    /// bump at three taus.
+    fn analysis(bump: bool) -> ChannelAnalysis {
+        let points = (0..12)
+            .map(|k| {
+                let tau_s = 0.01 * f64::from(1u32 << k);
+                let f = if bump && (5..8).contains(&k) { 1.3 } else { 1.0 };
+                AllanPoint {
+                    m: 1 << k,
+                    tau_s,
+                    deviation: f * 1e-3 / tau_s.sqrt(),
+                    terms: 1000,
+                    alpha: None,
+                    noise_id: None,
+                    edf: Some(1000.0),
+                    lower: None,
+                    upper: None,
+                }
+            })
+            .collect();
+        let curve = AllanCurve { kind: DeviationKind::Oadev, tau0_s: 0.01, n_rate: 1 << 20, confidence: None, points };
+        ChannelAnalysis {
+            file: "hand.csv".into(),
+            channel: "rate_dps".into(),
+            rate_unit: "deg/s".into(),
+            slope_lines: slope_line_terms(&curve).ok(),
+            model_fit: fit_noise_model(&curve, None).ok(),
+            curve,
+            noise_note: None,
+        }
+    }
+
+    #[test]
+    fn text_and_json_show_bounds_and_flag_a_poor_fit() {
+        let good = analysis(false);
+        let text = allan_text(&good);
+        // B is not resolved on white noise: printed as '< x' with its reason, never as a value.
+        let b_row = text.lines().find(|l| l.contains("bias instability B")).unwrap();
+        assert!(b_row.contains("< ") && b_row.contains("record too short"), "{b_row}");
+        assert!(!text.contains("POOR FIT"), "{text}");
+        // N = 1e-3 deg/sqrt(s) = 0.06 deg/sqrt(h) by hand.
+        let j = allan_json(&good);
+        let noise = j.noise.unwrap();
+        assert!((noise.arw_deg_rt_h.unwrap() - 0.06).abs() < 1e-12);
+        assert!(noise.bias_instability_dph.is_none() && noise.allan_minimum_dph.is_none());
+        let b = noise.readings.iter().find(|r| r.term == "bias_instability").unwrap();
+        assert_eq!((b.basis, b.reason), ("upper_bound", Some("record_too_short")));
+        let text = allan_text(&analysis(true));
+        assert!(text.contains("POOR FIT"), "{text}");
+    }
 }

@@ -142,6 +142,8 @@ impl StaticAxisReport {
                 ("rrw_deg_h_rt_h", c.rrw_deg_h_rt_h),
                 ("quantization_deg", c.quantization_deg),
                 ("rate_ramp_dph_per_h", c.rate_ramp_dph_per_h),
+                ("allan_minimum_dph", s.allan_minimum.value().map(gyrolab::units::bias_dps_to_dph)),
+                ("allan_minimum_tau_s", s.allan_minimum.site().map(|r| r.tau_s)),
             ] {
                 if let Some(v) = v {
                     f.set(k, v);
@@ -383,7 +385,7 @@ pub fn allan_plot(a: &StaticAxisReport) -> Option<Result<String, PlotError>> {
     };
     if let Some(s) = &c.slope_lines {
         let k = &s.coefficients;
-        let t_min = s.bias_instability.map_or((t_lo * t_hi).sqrt(), |r| r.tau_s);
+        let t_min = s.bias_instability.site().map_or((t_lo * t_hi).sqrt(), |r| r.tau_s);
         if let Some(n) = k.arw_deg_rt_s {
             let line: Vec<(f64, f64)> =
                 grid(t_lo.min(1.0), (t_min * 2.0).max(1.0)).into_iter().map(|t| (t, n / t.sqrt() * f)).collect();
@@ -576,6 +578,8 @@ pub fn allan_section(a: &StaticAxisReport, limits: &[Limit]) -> Option<Result<Re
         ("rrw_deg_h_rt_h", "rate random walk K"),
         ("quantization_deg", "quantization noise Q"),
         ("rate_ramp_dph_per_h", "rate ramp R"),
+        ("allan_minimum_dph", "Allan minimum (datasheet convention)"),
+        ("allan_minimum_tau_s", "τ of the Allan minimum"),
     ]
     .iter()
     .map(|(k, l)| (k.to_string(), l.to_string()))
@@ -585,7 +589,10 @@ pub fn allan_section(a: &StaticAxisReport, limits: &[Limit]) -> Option<Result<Re
     paragraphs.push(format!(
         "Record {} ({} samples at τ0 = {} s, {} s long), rate in {}. Overlapping Allan deviation at octave taus with \
          {} confidence bounds (NIST SP 1065). Noise terms by the slope-line method (IEEE 952): N read on the slope −1/2 \
-         line at τ = 1 s, B = flat minimum / 0.6643, K on the slope +1/2 line at τ = 3 s.",
+         line at the τ nearest 1 s, B (IEEE 952) = Allan minimum of the flat region / 0.6643 (datasheets such as ADI's and \
+         Sensonor's quote the Allan minimum itself), K from the curve's excess over the other terms on the rising side. \
+         A term is given as a value only where the curve supports its slope at the bounds' confidence (docs/METHODS.md \
+         section 3).",
         c.file,
         c.curve.n_rate,
         short(c.curve.tau0_s, 6),
@@ -594,12 +601,14 @@ pub fn allan_section(a: &StaticAxisReport, limits: &[Limit]) -> Option<Result<Re
         c.curve.confidence.map_or("no".into(), |x| format!("{} %", short(100.0 * x, 4)))
     ));
     if let Some(s) = &c.slope_lines {
-        if s.bias_instability.is_none() {
-            paragraphs.push(
-                "B is not read: the curve has no interior minimum (it still falls at the longest tau; a longer record \
-                 is needed)."
-                    .into(),
-            );
+        for (_, label, unit, r) in crate::allan::terms_in_units(s) {
+            if r.value().is_none() {
+                paragraphs.push(format!(
+                    "{label} is not resolved: {} {unit} ({}).",
+                    crate::allan::reading_text(&r, 3),
+                    crate::allan::support_text(&r)
+                ));
+            }
         }
     }
     if let Some(n) = &c.noise_note {
@@ -616,6 +625,13 @@ pub fn allan_section(a: &StaticAxisReport, limits: &[Limit]) -> Option<Result<Re
             sig_opt(k.bias_instability_dph, 4),
             sig_opt(k.rrw_deg_h_rt_h, 4)
         ));
+        if fit.quality == gyrolab::noise::FitQuality::Poor {
+            paragraphs.push(format!(
+                "POOR FIT: the weighted RMS residual {} exceeds {}; the five-term model does not describe this curve.",
+                sig(fit.weighted_rms_residual, 3),
+                gyrolab::noise::FIT_RMS_LIMIT
+            ));
+        }
     }
     let calibrated = c.rate_unit == "deg/s";
     let (f, u) = if calibrated { (3600.0, "deg/h".to_string()) } else { (1.0, c.rate_unit.clone()) };

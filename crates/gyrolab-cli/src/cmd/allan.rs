@@ -46,7 +46,9 @@ pub struct AllanArgs {
     /// Print JSON (keys in docs/JSON.md).
     #[arg(long)]
     pub json: bool,
-    /// Write Kalibr imu.yaml gyroscope entries (first channel) to this file.
+    /// Write Kalibr imu.yaml gyroscope entries to this file: every analysed channel combined by
+    /// the largest value per entry; unresolved terms hold their upper bound (or the five-term fit
+    /// value), named in a comment and in a `warning:` on stderr.
     #[arg(long, value_name = "FILE.yaml")]
     pub kalibr_yaml: Option<PathBuf>,
 }
@@ -76,11 +78,13 @@ pub fn run(args: &AllanArgs) -> CliResult {
     let outcome = outcome?;
     let analyses = &outcome.analyses;
     if let Some(yaml) = &args.kalibr_yaml {
-        let first = analyses.first().ok_or_else(|| EvalError::conflict("no channel to analyse"))?;
-        let text = kalibr_yaml(first, 1.0 / outcome.sample_interval_s).ok_or_else(|| {
-            EvalError::conflict("no angle random walk could be read from the curve (calibrate the data with --cal or --scale-factor and use --kind oadev)")
+        let file = kalibr_yaml(analyses, 1.0 / outcome.sample_interval_s).ok_or_else(|| {
+            EvalError::conflict("no gyro noise terms could be read from the curve (calibrate the data with --cal or --scale-factor and use --kind oadev)")
         })?;
-        write_file(yaml, text.as_bytes())?;
+        write_file(yaml, file.text.as_bytes())?;
+        for w in &file.warnings {
+            eprintln!("warning: {w}");
+        }
     }
     if args.json {
         let doc = allan_document(analyses).ok_or_else(|| EvalError::conflict("no channel to analyse"))?;

@@ -242,19 +242,37 @@ impl Preset {
         Preset::ALL.into_iter().find(|p| p.name() == t)
     }
 
+    /// The convention of the datasheet's bias-instability figure: every preset's datasheet
+    /// (ADI, Sensonor) quotes the Allan deviation minimum; the preset takes that number as the
+    /// IEEE 952 B, so its simulated Allan minimum is 0.6643 times the datasheet figure. To
+    /// simulate the datasheet's minimum itself, set `bias_instability_dph` to figure / 0.6643.
+    pub fn bias_instability_convention(self) -> &'static str {
+        match self {
+            Preset::Adxrs646 | Preset::Adis16470 => {
+                "datasheet figure: Allan minimum (ADI); preset value used as IEEE 952 B (Allan minimum = 0.6643 B)"
+            }
+            Preset::Stim300 => {
+                "datasheet figure: Allan minimum (Sensonor); preset value used as IEEE 952 B (Allan minimum = 0.6643 B)"
+            }
+        }
+    }
+
     /// Where the preset's figures come from, for a record's comment lines.
     pub fn source(self) -> &'static str {
         match self {
             Preset::Adxrs646 => {
-                "ADXRS646 datasheet class (methods notes s.5): ARW 0.6 deg/sqrt(h), bias drift 12 deg/h; \
+                "ADXRS646 datasheet class (methods notes s.5): ARW 0.6 deg/sqrt(h), bias drift 12 deg/h (ADI quotes the \
+                 Allan minimum; simulated as IEEE 952 B = 12, i.e. Allan minimum 0.6643 x 12 = 8.0 deg/h); \
                  K 7.5 mV/(deg/s) as measured in the paper; null 2.5 V; rails 0.25/4.75 V"
             }
             Preset::Adis16470 => {
-                "ADIS16470 datasheet class (methods notes s.5): ARW 0.34 deg/sqrt(h), BI 8 deg/h, +-2000 deg/s, \
+                "ADIS16470 datasheet class (methods notes s.5): ARW 0.34 deg/sqrt(h), BI 8 deg/h (ADI's in-run bias \
+                 stability, an Allan minimum; simulated as IEEE 952 B = 8, i.e. Allan minimum 5.3 deg/h), +-2000 deg/s, \
                  32-bit output LSB 0.1/65536 deg/s"
             }
             Preset::Stim300 => {
-                "STIM300 datasheet class (methods notes s.5): ARW 0.15 deg/sqrt(h), BI 0.5 deg/h, SF 500 ppm, \
+                "STIM300 datasheet class (methods notes s.5): ARW 0.15 deg/sqrt(h), BI 0.5 deg/h (Sensonor quotes the \
+                 Allan minimum; simulated as IEEE 952 B = 0.5, i.e. Allan minimum 0.33 deg/h), SF 500 ppm, \
                  nonlinearity 25 ppm at +-200 deg/s, range +-400 deg/s"
             }
         }
