@@ -109,13 +109,15 @@ class AllanResult:
         ax.errorbar(t, d, yerr=[lo, hi], fmt="o-", ms=3, capsize=2, label=label or self.kind.upper())
         n = self.noise.get("arw_deg_rt_s")
         b = self.noise.get("bias_instability_dph")
+        b_min = self.noise.get("allan_minimum_dph")
         k = self.noise.get("rrw_deg_s_rt_s")
         if self.unit == "deg/s":
             tt = np.geomspace(t[0], t[-1], 50)
             if n:
                 ax.plot(tt, n / np.sqrt(tt), "--", lw=1, label=f"N = {self.noise['arw_deg_rt_h']:.3g} deg/√h")
-            if b:
-                ax.plot(tt, np.full_like(tt, 0.6643 * b / 3600.0), ":", lw=1, label=f"B = {b:.3g} deg/h")
+            if b and b_min:
+                # The flat level is the Allan minimum (0.6643 B, IEEE 952), given by gyrolab.
+                ax.plot(tt, np.full_like(tt, b_min / 3600.0), ":", lw=1, label=f"B = {b:.3g} deg/h (minimum {b_min:.3g})")
             if k:
                 ax.plot(tt, k * np.sqrt(tt / 3.0), "-.", lw=1, label=f"K = {self.noise['rrw_deg_h_rt_h']:.3g} deg/h/√h")
         ax.set_xscale("log")

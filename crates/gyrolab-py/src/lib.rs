@@ -78,7 +78,15 @@ fn allan<'py>(
     let taus = parse_taus(taus).map_err(err)?;
     let reference = reference(scale_factor, null)?;
     let (unit, per_hour) = if unit == "dph" { (OutputUnit::DegPerSec, true) } else { (output_unit(unit)?, false) };
-    let mut values = x.as_array().to_vec();
+    // The one copy: the working buffer the deviation integrates into the angle series in place
+    // (with room for its extra point, so it is never copied again); a contiguous array is copied
+    // as one block.
+    let view = x.as_array();
+    let mut values = Vec::with_capacity(view.len() + 1);
+    match x.as_slice() {
+        Ok(s) => values.extend_from_slice(s),
+        Err(_) => values.extend(view.iter().copied()),
+    }
     if per_hour {
         values.iter_mut().for_each(|v| *v = gyrolab::units::dph_to_dps(*v));
     }

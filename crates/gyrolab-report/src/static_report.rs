@@ -16,8 +16,8 @@ use gyrolab::static_test::{reported_smoothing_times, smoothing_key, BiasRepeatab
 use gyrolab::window_means::WindowMean;
 use serde::Serialize;
 
-/// The ADEV flat level of bias instability: sigma_min = 0.6643 B (IEEE 952).
-const FLAT_FACTOR: f64 = 0.6643;
+/// The ADEV flat level of bias instability: sigma_min = 0.6643 B (IEEE 952; the one constant).
+const FLAT_FACTOR: f64 = gyrolab::noise::BIAS_INSTABILITY_FACTOR;
 
 /// Which output-to-rate reference the static figures used.
 #[derive(Debug, Clone, PartialEq, Serialize)]
