@@ -34,6 +34,7 @@ __all__ = [
     "read",
     "read_with_units",
     "evaluate_plan",
+    "apply",
     "__version__",
 ]
 
@@ -331,3 +332,20 @@ def evaluate_plan(plan: PathLike, out: PathLike) -> Dict[str, Any]:
     [...], "failures": [...]}``."""
     verdict, files, failures = _gyrolab.evaluate_plan(str(plan), str(out))
     return {"verdict": verdict, "files": [str(f) for f in files], "failures": list(failures)}
+
+
+def apply(outputs: Any, calibration: PathLike, axis: Optional[str] = None) -> Dict[str, np.ndarray]:
+    """Applies a calibration file (from ``gyrolab rate --cal-out``) to outputs in its output unit:
+    one array for an ``[[axis]]`` (``axis`` names it when the file has several) -> ``rate_dps``;
+    three arrays x, y, z for a ``[triad]`` -> ``rate_x_dps``, ``rate_y_dps``, ``rate_z_dps``.
+    ``status`` says per sample ``inside``, ``below``/``above`` the calibrated range (continued
+    along the end tangent) or ``not_finite``."""
+    arrays = [np.asarray(o, dtype=np.float64) for o in (outputs if isinstance(outputs, (list, tuple)) else [outputs])]
+    for i, a in enumerate(arrays):
+        if a.ndim != 1:
+            raise Error(f"outputs[{i}]: expected a 1-D array, got shape {a.shape}")
+    rates, status = _gyrolab.apply(str(calibration), arrays, axis)
+    names = ["rate_dps"] if len(rates) == 1 else ["rate_x_dps", "rate_y_dps", "rate_z_dps"]
+    out: Dict[str, np.ndarray] = dict(zip(names, rates))
+    out["status"] = np.array(status)
+    return out

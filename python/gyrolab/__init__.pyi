@@ -102,3 +102,6 @@ def read_with_units(path: PathLike) -> Tuple[Dict[str, np.ndarray], Dict[str, st
 
 def evaluate_plan(plan: PathLike, out: PathLike) -> Dict[str, Any]:
     """Evaluates a test plan into a report folder: verdict, files, failures."""
+
+def apply(outputs: Any, calibration: PathLike, axis: Optional[str] = ...) -> Dict[str, np.ndarray]:
+    """Applies a calibration file to outputs: rate_dps (or rate_x/y/z_dps) and status arrays."""

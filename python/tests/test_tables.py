@@ -62,3 +62,15 @@ def test_evaluate_plan_writes_the_report(root, tmp_path):
     r = gyrolab.evaluate_plan(root / "examples" / "paper_plan.toml", out)
     assert r["verdict"] == "FAIL" and r["failures"]
     assert (out / "report.html").exists() and (out / "results.json").exists()
+
+
+def test_apply_inverts_the_calibration(cli, root, tmp_path):
+    cal = tmp_path / "cal.toml"
+    subprocess.run([cli, "rate", str(paper(root, "x")), "--axis", "x", "--cal-out", str(cal)], check=True,
+                   capture_output=True)
+    f = gyrolab.rate_table(files=[paper(root, "x")], axis_names=["x"])["axes"][0]
+    k, f0 = f["scale_factor"], f["zero_offset"]
+    rates = np.array([-100.0, 0.0, 50.0, 1000.0])
+    out = gyrolab.apply(f0 + k * rates, cal)
+    np.testing.assert_allclose(out["rate_dps"][:3], rates[:3], rtol=1e-9, atol=1e-9)
+    assert list(out["status"]) == ["inside", "inside", "inside", "above"]

@@ -91,40 +91,81 @@ fn choose_columns(input: &Path, given: &[String], axis_names: &[String], skip: &
     })
 }
 
+/// The model of a calibration file: its `[triad]` (unless an axis is named) or the named (or
+/// only) `[[axis]]`, with its output unit and the names of the axes it gives rates for.
+fn model_of(
+    calibration: &Path,
+    axis: Option<&str>,
+) -> EvalResult<(ApplyModel, gyrolab::units::OutputUnit, Vec<String>)> {
+    let cal = read_calibration(calibration)?;
+    let cal_err = |msg: String| EvalError::Data(DataError::new(calibration, msg));
+    Ok(match (&cal.triad, axis) {
+        (Some(t), None) => {
+            let model = TriadApplier::new(&t.calibration()).map_err(|e| cal_err(format!("[triad]: {e}")))?;
+            (ApplyModel::Triad(model), t.output_unit, t.axes.to_vec())
+        }
+        (_, name) => {
+            let axis = cal.axis(name).map_err(cal_err)?;
+            let model =
+                SingleAxisCalibration::polynomial(&axis.polynomial.coefficients, axis.rate_min_dps, axis.rate_max_dps)
+                    .map_err(|e| cal_err(format!("axis '{}': {e}", axis.name)))?;
+            (ApplyModel::Single(model), axis.output_unit, vec![axis.name.clone()])
+        }
+    })
+}
+
 /// The streaming plan of a request: the model, the columns it reads and writes.
 pub fn prepare_apply(request: &ApplyRequest) -> EvalResult<ApplyPlan> {
-    let cal = read_calibration(&request.calibration)?;
-    let cal_err = |msg: String| EvalError::Data(DataError::new(&request.calibration, msg));
+    let (model, output_unit, axes) = model_of(&request.calibration, request.calibration_axis.as_deref())?;
     let names = header_names(&request.input)?;
     // A raw log's table rate is passed through (as table_rate_dps), beside the calibrated rate.
     let table_rate = detect_raw_log(&names);
     let skip: Vec<String> = table_rate.iter().cloned().collect();
-    Ok(match (&cal.triad, &request.calibration_axis) {
-        (Some(t), None) => {
-            let model = TriadApplier::new(&t.calibration()).map_err(|e| cal_err(format!("[triad]: {e}")))?;
-            let axes = t.axes.to_vec();
-            ApplyPlan {
-                model: ApplyModel::Triad(model),
-                output_unit: t.output_unit,
-                columns: choose_columns(&request.input, &request.columns, &axes, &skip)?,
-                rate_names: axes.iter().map(|a| format!("rate_{a}_dps")).collect(),
-                table_rate_column: table_rate,
-            }
-        }
-        (_, name) => {
-            let axis = cal.axis(name.as_deref()).map_err(cal_err)?;
-            let model =
-                SingleAxisCalibration::polynomial(&axis.polynomial.coefficients, axis.rate_min_dps, axis.rate_max_dps)
-                    .map_err(|e| cal_err(format!("axis '{}': {e}", axis.name)))?;
-            ApplyPlan {
-                model: ApplyModel::Single(model),
-                output_unit: axis.output_unit,
-                columns: choose_columns(&request.input, &request.columns, std::slice::from_ref(&axis.name), &skip)?,
-                rate_names: vec!["rate_dps".into()],
-                table_rate_column: table_rate,
-            }
-        }
+    let rate_names = match model {
+        ApplyModel::Triad(_) => axes.iter().map(|a| format!("rate_{a}_dps")).collect(),
+        ApplyModel::Single(_) => vec!["rate_dps".into()],
+    };
+    Ok(ApplyPlan {
+        model,
+        output_unit,
+        columns: choose_columns(&request.input, &request.columns, &axes, &skip)?,
+        rate_names,
+        table_rate_column: table_rate,
     })
+}
+
+/// Rates from outputs held in memory (one array for an axis, three x, y, z for a `[triad]`, in
+/// the calibration's output unit): the rates (deg/s, one array per axis) and each sample's range
+/// status.
+pub fn apply_arrays(
+    calibration: &Path,
+    axis: Option<&str>,
+    outputs: &[&[f64]],
+) -> EvalResult<(Vec<Vec<f64>>, Vec<gyrolab::apply::RangeStatus>)> {
+    let (model, _, axes) = model_of(calibration, axis)?;
+    let n = outputs.first().map_or(0, |o| o.len());
+    if outputs.len() != axes.len() || outputs.iter().any(|o| o.len() != n) {
+        return Err(EvalError::conflict(format!(
+            "the calibration needs {} output array(s) of one length ({}), got {}",
+            axes.len(),
+            axes.join(", "),
+            outputs.len()
+        )));
+    }
+    match model {
+        ApplyModel::Single(m) => {
+            let mut out = Vec::with_capacity(n);
+            m.apply_block(outputs[0], &mut out);
+            Ok((vec![out.iter().map(|r| r.rate_dps).collect()], out.iter().map(|r| r.status).collect()))
+        }
+        ApplyModel::Triad(m) => {
+            let mut out = Vec::with_capacity(n);
+            m.apply_block(outputs[0], outputs[1], outputs[2], &mut out)
+                .map_err(|e| EvalError::Data(DataError::new(calibration, format!("[triad]: {e}"))))?;
+            let rates = (0..3).map(|k| out.iter().map(|r| r.rates_dps[k]).collect()).collect();
+            Ok((rates, out.iter().map(|r| r.status).collect()))
+        }
+    }
 }
 
 /// Streams the input through the plan into `out`; `progress` gets the rows done so far.

@@ -319,6 +319,32 @@ fn evaluate_plan(py: Python<'_>, plan: PathBuf, out: PathBuf) -> PyResult<(Optio
     Ok((folder.verdict.map(|v| v.text().to_string()), written, folder.failures))
 }
 
+/// Applies a calibration file to outputs in memory: (rates per axis, status per sample:
+/// `inside`, `below`, `above`, `not_finite`).
+#[pyfunction]
+#[pyo3(signature = (calibration, outputs, axis=None))]
+#[allow(clippy::type_complexity)]
+fn apply<'py>(
+    py: Python<'py>,
+    calibration: PathBuf,
+    outputs: Vec<PyReadonlyArray1<'py, f64>>,
+    axis: Option<&str>,
+) -> PyResult<(Vec<Bound<'py, PyArray1<f64>>>, Vec<&'static str>)> {
+    let owned: Vec<Vec<f64>> = outputs.iter().map(|o| o.as_array().to_vec()).collect();
+    let slices: Vec<&[f64]> = owned.iter().map(Vec::as_slice).collect();
+    let (rates, status) = py.detach(|| gyrolab_eval::apply::apply_arrays(&calibration, axis, &slices)).map_err(err)?;
+    let status = status
+        .into_iter()
+        .map(|s| match s {
+            gyrolab::apply::RangeStatus::Inside => "inside",
+            gyrolab::apply::RangeStatus::Below => "below",
+            gyrolab::apply::RangeStatus::Above => "above",
+            gyrolab::apply::RangeStatus::NotFinite => "not_finite",
+        })
+        .collect();
+    Ok((rates.into_iter().map(|r| PyArray1::from_vec(py, r)).collect(), status))
+}
+
 /// The native module.
 #[pymodule]
 fn _gyrolab(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -331,5 +357,6 @@ fn _gyrolab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate_static, m)?)?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(apply, m)?)?;
     Ok(())
 }
