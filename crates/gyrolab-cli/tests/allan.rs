@@ -200,3 +200,18 @@ fn kalibr_yaml_combines_three_channels_and_writes_bounds_not_zero() {
     assert_eq!(rrw["basis"], "upper_bound", "{rrw}");
     assert!(rrw["reason"].is_string() && rrw["tau_s"].as_f64().is_some(), "{rrw}");
 }
+
+#[test]
+fn fit_range_takes_low_comma_high_as_the_readme_writes_it() {
+    // `--fit-range 0.1,1000` (one argument) and `--fit-range 0.1 1000` (two) are the same range;
+    // the fit then covers only taus inside it.
+    let dir = tempfile::tempdir().unwrap();
+    let f = simulate(dir.path(), "w.csv", &["--duration-s", "600", "--arw-deg-rt-h", "0.5", "--seed", "3"]);
+    let a = json(&["--fit-range", "0.1,10"], &f);
+    let b = json(&["--fit-range", "0.1", "10"], &f);
+    assert_eq!(a["noise"]["fit"], b["noise"]["fit"]);
+    let range = a["noise"]["fit"]["tau_range_s"].as_array().unwrap();
+    assert!(range[0].as_f64().unwrap() >= 0.1 && range[1].as_f64().unwrap() <= 10.0, "{range:?}");
+    let e = allan_error("time_s,rate_dps\n0,1\n0.1,2\n0.2,1\n0.3,2\n", &["--fit-range", "10,1"]);
+    assert!(e.contains("--fit-range needs two increasing positive taus"), "{e}");
+}

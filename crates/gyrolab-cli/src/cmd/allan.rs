@@ -38,7 +38,7 @@ pub struct AllanArgs {
     #[arg(long, default_value = "0.683", value_name = "C")]
     pub confidence: String,
     /// Fit the five-term noise model over this tau range only, seconds: LOW,HIGH.
-    #[arg(long, value_name = "LOW,HIGH", value_delimiter = ',', num_args = 1..=2, allow_hyphen_values = true)]
+    #[arg(long, value_name = "LOW,HIGH", value_delimiter = ',', num_args = 1..=2)]
     pub fit_range: Vec<f64>,
     /// Print CSV (file, channel, tau_s, m, dev, ci_low, ci_high, n_terms, alpha).
     #[arg(long, conflicts_with = "json")]
