@@ -96,3 +96,89 @@ fn missing_file_and_bad_options() {
     gyrolab().args(["nonsense"]).assert().code(2);
     gyrolab().args(["rate"]).assert().code(2);
 }
+
+// ---- Issue 15: bounded memory and time ----
+
+/// Runs `gyrolab ARGS` and returns stderr, asserting exit code 2 and no panic.
+fn error_of(args: &[&std::ffi::OsStr]) -> String {
+    let out = gyrolab().args(args).timeout(std::time::Duration::from_secs(60)).assert().code(2).get_output().clone();
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(err.starts_with("error: "), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
+#[test]
+fn dev_zero_ends_quickly_as_binary_data() {
+    let z = std::ffi::OsStr::new("/dev/zero");
+    for cmd in ["rate", "bias", "allan"] {
+        let e = error_of(&[cmd.as_ref(), z]);
+        assert!(e.contains("/dev/zero:1: binary data"), "{cmd}: {e}");
+    }
+}
+
+#[test]
+fn nul_file_and_overlong_line_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let nul = dir.path().join("nul.csv");
+    std::fs::write(&nul, vec![0u8; 3 << 20]).unwrap();
+    for cmd in ["rate", "bias"] {
+        let e = error_of(&[cmd.as_ref(), nul.as_os_str()]);
+        assert!(e.contains("nul.csv:1: binary data"), "{e}");
+        assert!(e.len() < 300, "{e}");
+    }
+    let long = dir.path().join("long.csv");
+    let mut text = b"rate_dps,run,stroke,output_v\n".to_vec();
+    text.extend(std::iter::repeat_n(b'7', 2 << 20));
+    std::fs::write(&long, &text).unwrap();
+    for cmd in ["rate", "bias"] {
+        let e = error_of(&[cmd.as_ref(), long.as_os_str()]);
+        assert!(e.contains("line 2 is longer than 1 MiB: expected text lines (is this a binary file?)"), "{cmd}: {e}");
+        assert!(e.len() < 300, "{e}");
+    }
+}
+
+#[test]
+fn many_distinct_rates_and_runs_are_refused() {
+    let mut text = String::from("rate_dps,run,stroke,output_v\n");
+    for i in 0..8000 {
+        text.push_str(&format!("{i},{i},fwd,1\n"));
+    }
+    let e = rate_error(&text);
+    assert!(e.contains("more than 1000 runs"), "{e}");
+    let mut text = String::from("rate_dps,run,stroke,output_v\n");
+    for i in 0..2000 {
+        text.push_str(&format!("{i},{},fwd,1\n", i % 900 + 1));
+    }
+    let e = rate_error(&text);
+    assert!(e.contains("more than 1000000 rate-run cells"), "{e}");
+}
+
+#[test]
+fn huge_simulations_are_refused_up_front_with_their_size() {
+    for args in [
+        &["simulate", "static", "--duration-s", "1e10"][..],
+        &["simulate", "static", "--sample-rate-hz", "1e12"][..],
+        &["simulate", "rate-table", "--samples-per-plateau", "4294967295", "--runs", "1000"][..],
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("o.csv");
+        let out_arg = out.as_os_str();
+        let mut all: Vec<&std::ffi::OsStr> = args.iter().map(|s| s.as_ref()).collect();
+        all.extend(["--out".as_ref(), out_arg]);
+        let e = error_of(&all);
+        assert!(e.contains("samples (about") && e.contains("--max-samples"), "{e}");
+        assert!(!out.exists());
+    }
+    // The bound is explicit and can be lowered (or raised).
+    let e = error_of(&[
+        "simulate".as_ref(),
+        "static".as_ref(),
+        "--duration-s".as_ref(),
+        "10".as_ref(),
+        "--max-samples".as_ref(),
+        "100".as_ref(),
+    ]);
+    assert!(e.contains("1e3 samples"), "{e}");
+    gyrolab().args(["simulate", "static", "--duration-s", "10", "--max-samples", "1000"]).assert().success();
+}

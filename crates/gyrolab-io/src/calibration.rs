@@ -138,7 +138,7 @@ impl CalibrationFile {
 
 /// Reads a calibration file; errors name the line and column of a TOML problem.
 pub fn read_calibration(path: &Path) -> Result<CalibrationFile, DataError> {
-    let text = std::fs::read_to_string(path).map_err(|e| DataError::io(path, &e))?;
+    let text = crate::text::read_text_file(path, crate::text::MAX_CONFIG_BYTES, "a calibration file (TOML)")?;
     parse_calibration(path, &text)
 }
 

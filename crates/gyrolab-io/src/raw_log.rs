@@ -10,7 +10,7 @@ use gyrolab::rate_test::Stroke;
 use gyrolab::segment::{ManualSegment, Segment, SegmentError, SegmentKind};
 use gyrolab::units::{split_unit_suffix, RateUnit};
 use std::fmt::Write as _;
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
 /// Base names (before the unit suffix) of a table-rate column, in order of preference.
@@ -21,9 +21,15 @@ pub fn header_names(path: &Path) -> Result<Vec<String>, DataError> {
     let f = std::fs::File::open(path).map_err(|e| DataError::io(path, &e))?;
     let mut r = BufReader::new(f);
     let mut buf = Vec::new();
+    let mut guard = crate::text::TextGuard::default();
     loop {
         buf.clear();
-        let n = r.read_until(b'\n', &mut buf).map_err(|e| DataError::io(path, &e))?;
+        // At most one line over the limit is read: the guard ends an endless line (`/dev/zero`).
+        let n = (&mut r)
+            .take(crate::text::MAX_LINE_BYTES as u64 + 2)
+            .read_until(b'\n', &mut buf)
+            .map_err(|e| DataError::io(path, &e))?;
+        guard.check(path, &buf)?;
         if n == 0 {
             return Err(DataError::new(path, "the file is empty: expected a header row such as 'time_s,output_v'"));
         }
@@ -132,7 +138,7 @@ pub struct ManualSegmentRow {
 /// `rest_end`, `plateau`) and, for plateaus, `run` and `stroke` (`fwd`/`rev`); other columns
 /// (as in a `--segments-out` file) are ignored. Rows must be in time order.
 pub fn read_manual_segments(path: &Path) -> Result<Vec<ManualSegmentRow>, DataError> {
-    let text = std::fs::read_to_string(path).map_err(|e| DataError::io(path, &e))?;
+    let text = crate::text::read_text_file(path, crate::text::MAX_CONFIG_BYTES, "a segment file (CSV)")?;
     let t = parse_text_table(path, &text)?;
     let col = |name: &str| {
         t.column(name).ok_or_else(|| {

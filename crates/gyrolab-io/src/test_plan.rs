@@ -258,7 +258,7 @@ pub struct TestPlan {
 
 /// Reads and checks a plan file; `known_figure` tells which `[limits]` names exist.
 pub fn read_plan(path: &Path, known_figure: &dyn Fn(&str) -> bool) -> Result<TestPlan, DataError> {
-    let text = std::fs::read_to_string(path).map_err(|e| DataError::io(path, &e))?;
+    let text = crate::text::read_text_file(path, crate::text::MAX_CONFIG_BYTES, "a test plan (TOML)")?;
     parse_plan(path, &text, known_figure)
 }
 

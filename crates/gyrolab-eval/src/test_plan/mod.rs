@@ -56,12 +56,12 @@ pub fn progress_steps(plan: &TestPlan) -> u64 {
     2 * plan.rate.len() as u64 + 6 + 2 * static_part::progress_steps(&plan.static_tests) + plan.triad.is_some() as u64
 }
 
+/// The evaluated rate axes of a plan and its segmented raw logs, (axis, log).
+pub type PlanRates = (Vec<EvaluatedAxis>, Vec<(String, SegmentedLog)>);
+
 /// Evaluates the `[rate.<axis>]` records of a plan, in device axis order; raw logs come back
 /// with their segmentation, (axis, log).
-pub fn evaluate_plan_rates(
-    plan: &TestPlan,
-    progress: &dyn Progress,
-) -> EvalResult<(Vec<EvaluatedAxis>, Vec<(String, SegmentedLog)>)> {
+pub fn evaluate_plan_rates(plan: &TestPlan, progress: &dyn Progress) -> EvalResult<PlanRates> {
     let options = plan_settings(plan).options()?;
     let mut axes = Vec::new();
     let mut logs = Vec::new();

@@ -368,7 +368,7 @@ fn write_rate_table_csv_as<N: NumberText, W: Write>(
 /// Reads a simulation set-up (TOML: `seed`, `preset`, `[sensor]`, `[static_record]`,
 /// `[rate_table]`); errors name the line and column.
 pub fn read_sim_config(path: &std::path::Path) -> Result<gyrolab::sim::SimConfig, crate::DataError> {
-    let text = std::fs::read_to_string(path).map_err(|e| crate::DataError::io(path, &e))?;
+    let text = crate::text::read_text_file(path, crate::text::MAX_CONFIG_BYTES, "a simulation set-up (TOML)")?;
     toml::from_str(&text).map_err(|e| {
         let mut d = crate::DataError::new(path, format!("not a valid simulation set-up: {}", e.message()));
         if let Some(span) = e.span() {
