@@ -182,3 +182,110 @@ fn huge_simulations_are_refused_up_front_with_their_size() {
     assert!(e.contains("1e3 samples"), "{e}");
     gyrolab().args(["simulate", "static", "--duration-s", "10", "--max-samples", "1000"]).assert().success();
 }
+
+// ---- Issue 15: no silent NaN, inf or zero figure ----
+
+#[test]
+fn constant_output_is_no_scale_factor_and_writes_no_calibration() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(
+        dir.path(),
+        "flat.csv",
+        "rate_dps,run,stroke,output_v\n-10,1,fwd,2.5\n10,1,fwd,2.5\n-10,1,rev,2.5\n10,1,rev,2.5\n",
+    );
+    let cal = dir.path().join("cal.toml");
+    let e = error_of(&["rate".as_ref(), p.as_os_str(), "--cal-out".as_ref(), cal.as_os_str()]);
+    assert!(e.contains("flat.csv: cannot evaluate: the output does not change with the rate: no scale factor"), "{e}");
+    assert!(!cal.exists());
+}
+
+#[test]
+fn overflowing_samples_are_refused_where_they_are() {
+    let e = rate_error("rate_dps,run,stroke,output_v\n-10,1,fwd,1e308\n");
+    assert!(e.contains("bad.csv:2:4: column 'output_v': found 1e308, a magnitude above 1e150"), "{e}");
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "s.csv", "time_s,output_dps\n0,1\n0.01,1e308\n0.02,1\n");
+    for cmd in ["bias", "allan"] {
+        let e = error_of(&[cmd.as_ref(), p.as_os_str()]);
+        assert!(e.contains("s.csv:3:2: column 'output_dps': found 1e308, a magnitude above 1e150"), "{cmd}: {e}");
+    }
+}
+
+#[test]
+fn two_signs_are_not_a_number() {
+    let e = rate_error("rate_dps,run,stroke,output_v\n-10,1,fwd,+-2.5\n");
+    assert!(
+        e.contains("bad.csv:2:4: column 'output_v': found '+-2.5', expected a number with one sign at most"),
+        "{e}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "s.csv", "time_s,output_dps\n0,1\n0.01,+-2.5\n0.02,1\n");
+    let e = error_of(&["bias".as_ref(), p.as_os_str()]);
+    assert!(e.contains("s.csv:3:2: column 'output_dps': found '+-2.5', expected a number"), "{e}");
+}
+
+#[test]
+fn absurd_option_magnitudes_are_refused_with_the_flag() {
+    let x = paper("paper_rate_table_x.csv");
+    let e = error_of(&["rate".as_ref(), "--coverage".as_ref(), "1e308".as_ref(), x.as_os_str()]);
+    assert!(e.contains("--coverage must have a magnitude from 1e-100 to 1e100"), "{e}");
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "v.csv", "time_s,output_v\n0,1\n0.01,2\n0.02,1\n0.03,1\n");
+    let e = error_of(&["bias".as_ref(), "--scale-factor".as_ref(), "1e-320".as_ref(), p.as_os_str()]);
+    assert!(e.contains("--scale-factor must have a magnitude") && e.contains("1e-320"), "{e}");
+}
+
+/// A calibration of the paper's axis x written by `gyrolab rate --cal-out`, edited by `edit`.
+fn edited_calibration(dir: &std::path::Path, edit: impl Fn(&str) -> String) -> std::path::PathBuf {
+    let cal = dir.join("cal.toml");
+    gyrolab().arg("rate").arg(paper("paper_rate_table_x.csv")).arg("--cal-out").arg(&cal).assert().success();
+    let text = edit(&std::fs::read_to_string(&cal).unwrap());
+    std::fs::write(&cal, text).unwrap();
+    cal
+}
+
+/// Replaces the value of `key = ...` by `value`.
+fn set_key(text: &str, key: &str, value: &str) -> String {
+    text.lines()
+        .map(|l| if l.starts_with(&format!("{key} =")) { format!("{key} = {value}") } else { l.to_string() })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+#[test]
+fn bad_calibration_values_name_the_calibration_file_line_and_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = write(dir.path(), "data.csv", "time_s,output_v\n0,2.5\n0.01,2.6\n0.02,2.5\n0.03,2.4\n");
+    for (key, value) in [("zero_offset", "nan"), ("zero_offset", "1e308"), ("scale_factor", "1.0")] {
+        let cal = edited_calibration(dir.path(), |t| set_key(t, key, value));
+        let text = std::fs::read_to_string(&cal).unwrap();
+        let line = text.lines().position(|l| l.starts_with(&format!("{key} ="))).unwrap() + 1;
+        for cmd in ["bias", "apply"] {
+            let mut args: Vec<&std::ffi::OsStr> =
+                vec![cmd.as_ref(), data.as_os_str(), "--cal".as_ref(), cal.as_os_str()];
+            let out = dir.path().join("out.csv");
+            if cmd == "apply" {
+                args.extend(["--out".as_ref(), out.as_os_str()]);
+            }
+            let e = error_of(&args);
+            assert!(
+                e.contains(&format!("cal.toml:{line}: axis 'paper_rate_table_x', {key}")),
+                "{cmd} {key}={value}: {e}"
+            );
+            assert!(!e.contains("data.csv"), "{e}");
+        }
+    }
+}
+
+#[test]
+fn a_time_jump_inside_a_raw_log_plateau_is_reported_at_its_line() {
+    let mut text = String::from("time_s,table_rate_dps,output_v\n");
+    for i in 0..3000 {
+        let t = i as f64 * 0.01 + if i >= 1500 { 1e6 } else { 0.0 };
+        text.push_str(&format!("{t:.2},0,2.5\n"));
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "raw.csv", &text);
+    let e = error_of(&["rate".as_ref(), p.as_os_str()]);
+    assert!(e.contains("raw.csv:1502: sample 1500") && e.contains("time jumps by"), "{e}");
+}
