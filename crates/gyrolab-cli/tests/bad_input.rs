@@ -289,3 +289,45 @@ fn a_time_jump_inside_a_raw_log_plateau_is_reported_at_its_line() {
     let e = error_of(&["rate".as_ref(), p.as_os_str()]);
     assert!(e.contains("raw.csv:1502: sample 1500") && e.contains("time jumps by"), "{e}");
 }
+
+// ---- Issue 15: contradictions ----
+
+/// A 100 Hz static record of `n` samples (rate_dps, a small deterministic wobble).
+fn record_100hz(n: usize) -> String {
+    let mut text = String::from("time_s,rate_dps\n");
+    for i in 0..n {
+        text.push_str(&format!("{:.2},{:.6}\n", i as f64 * 0.01, ((i * 7919) % 1000) as f64 * 1e-4));
+    }
+    text
+}
+
+#[test]
+fn a_given_rate_that_contradicts_the_time_stamps_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "r100.csv", &record_100hz(2000));
+    let e = error_of(&["allan".as_ref(), "--sample-rate-hz".as_ref(), "1000".as_ref(), p.as_os_str()]);
+    assert!(
+        e.contains("--sample-rate-hz = 1000 Hz disagrees with the time column of") && e.contains("r100.csv"),
+        "{e}"
+    );
+    assert!(e.contains("100.000000 Hz"), "{e}");
+    // Within 1 %: accepted.
+    gyrolab().args(["allan", "--sample-rate-hz", "100.5"]).arg(&p).assert().success();
+}
+
+#[test]
+fn a_plan_rate_that_contradicts_the_time_stamps_names_the_key_and_file() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "a.csv", &record_100hz(3000));
+    let plan = write(
+        dir.path(),
+        "plan.toml",
+        "[device]\nmodel = \"m\"\nserial = \"1\"\naxes = [\"x\"]\n\n[static.x]\nfiles = [\"a.csv\"]\nsample_rate_hz = 1000\n",
+    );
+    let out = dir.path().join("o");
+    let e = error_of(&["eval".as_ref(), plan.as_os_str(), "--out".as_ref(), out.as_os_str()]);
+    assert!(
+        e.contains("static.x.sample_rate_hz = 1000 Hz disagrees with the time column of") && e.contains("a.csv"),
+        "{e}"
+    );
+}
