@@ -331,3 +331,88 @@ fn a_plan_rate_that_contradicts_the_time_stamps_names_the_key_and_file() {
         "{e}"
     );
 }
+
+// ---- Issue 15: messages ----
+
+#[test]
+fn cr_only_line_ends_are_named() {
+    let e = rate_error("rate_dps,run,stroke,output_v\r-10,1,fwd,1\r10,1,fwd,2\r");
+    assert!(e.contains("bad.csv:1: lines end with CR only"), "{e}");
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "mac.csv", "time_s,output_dps\r0,1\r0.01,2\r");
+    for cmd in ["bias", "allan"] {
+        let e = error_of(&[cmd.as_ref(), p.as_os_str()]);
+        assert!(e.contains("mac.csv:1: lines end with CR only"), "{cmd}: {e}");
+    }
+}
+
+#[test]
+fn long_bad_fields_are_quoted_short() {
+    let field = "z".repeat(500_000);
+    let e = rate_error(&format!("rate_dps,run,stroke,output_v\n-10,1,fwd,{field}\n"));
+    assert!(e.contains(&format!("found '{}...'", "z".repeat(60))), "{}", &e[..200.min(e.len())]);
+    assert!(e.len() < 300, "{} chars", e.len());
+    let e = rate_error(&format!("rate_dps,run,stroke,output_v\n-10,1,{field},1\n"));
+    assert!(e.len() < 400, "{} chars", e.len());
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "s.csv", &format!("time_s,output_dps\n0,1\n0.01,{field}\n"));
+    let e = error_of(&["bias".as_ref(), p.as_os_str()]);
+    assert!(e.contains("s.csv:3:2") && e.len() < 300, "{} chars", e.len());
+    let p = write(dir.path(), "h.csv", &format!("time_s,output_{field}\n0,1\n"));
+    let e = error_of(&["bias".as_ref(), p.as_os_str()]);
+    // The name is quoted three times, each cut at 60 characters.
+    assert!(e.len() < 600 && !e.contains(&"z".repeat(61)), "{} chars", e.len());
+}
+
+/// A raw log of 3000 samples at 100 Hz at rest (table rate 0).
+fn resting_raw_log(dir: &std::path::Path) -> std::path::PathBuf {
+    let mut text = String::from("time_s,table_rate_dps,output_v\n");
+    for i in 0..3000 {
+        text.push_str(&format!("{:.2},0,2.5\n", i as f64 * 0.01));
+    }
+    write(dir, "raw.csv", &text)
+}
+
+#[test]
+fn manual_segment_errors_point_at_the_segment_row_without_debug_text() {
+    let dir = tempfile::tempdir().unwrap();
+    let raw = resting_raw_log(dir.path());
+    // Row 3 (line 4) asks for a window after the log's end.
+    let segs = write(
+        dir.path(),
+        "segs.csv",
+        "start_time_s,end_time_s,kind,run,stroke\n0,5,rest_start,,\n6,10,plateau,1,fwd\n100,200,plateau,1,rev\n",
+    );
+    let e = error_of(&["rate".as_ref(), raw.as_os_str(), "--segments".as_ref(), segs.as_os_str()]);
+    assert!(e.contains("segs.csv:4:"), "{e}");
+    let segs = write(
+        dir.path(),
+        "segs.csv",
+        "start_time_s,end_time_s,kind,run,stroke\n0,5,rest_start,,\n6,10,sideways,1,fwd\n",
+    );
+    let e = error_of(&["rate".as_ref(), raw.as_os_str(), "--segments".as_ref(), segs.as_os_str()]);
+    assert!(e.contains("segs.csv:3:3") && e.contains("with run 1 and stroke fwd"), "{e}");
+    assert!(!e.contains("Some("), "{e}");
+}
+
+#[test]
+fn simulate_config_value_errors_name_their_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write(dir.path(), "sim.toml", "seed = 3\n\n[static_record]\nsample_rate_hz = 100\nduration_s = -5\n");
+    let e = error_of(&["simulate".as_ref(), "static".as_ref(), "--config".as_ref(), cfg.as_os_str()]);
+    assert!(e.contains("sim.toml:5: [static_record] parameter `duration_s` = -5 is invalid"), "{e}");
+}
+
+#[test]
+fn a_plan_error_names_the_plan_not_its_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    write(dir.path(), "a.csv", &record_100hz(300));
+    let plan = write(
+        dir.path(),
+        "plan.toml",
+        "[device]\nmodel = \"m\"\nserial = \"1\"\naxes = [\"x\"]\n\n[static.x]\nfiles = [\"a.csv\"]\nsample_rate_hz = 100\noutput_unit = \"v\"\n",
+    );
+    let out = dir.path().join("o");
+    let e = error_of(&["eval".as_ref(), plan.as_os_str(), "--out".as_ref(), out.as_os_str()]);
+    assert!(e.contains("plan.toml:9:") && e.contains("static.x.output_unit: needs static.x.channel"), "{e}");
+}

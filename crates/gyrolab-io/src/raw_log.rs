@@ -147,7 +147,7 @@ pub fn read_manual_segments(path: &Path) -> Result<Vec<ManualSegmentRow>, DataEr
                 format!(
                     "no '{name}' column: a segment file needs start_time_s,end_time_s,kind and, for plateaus, run,stroke \
                      (found {})",
-                    t.header.join(", ")
+                    crate::text::excerpt(&t.header.join(", "))
                 ),
             )
             .at_line(t.header_line)
@@ -178,26 +178,30 @@ pub fn read_manual_segments(path: &Path) -> Result<Vec<ManualSegmentRow>, DataEr
             }
         }
         let run = match cr.map(field).map(str::trim).filter(|s| !s.is_empty()) {
-            Some(s) => Some(
-                s.parse::<u32>()
-                    .map_err(|_| at(cr.unwrap_or(0), format!("found '{s}', expected a run number (1, 2, ...)")))?,
-            ),
+            Some(s) => Some(s.parse::<u32>().map_err(|_| {
+                at(cr.unwrap_or(0), format!("found '{}', expected a run number (1, 2, ...)", crate::text::excerpt(s)))
+            })?),
             None => None,
         };
         let stroke = match cst.map(field).map(str::trim).filter(|s| !s.is_empty()) {
             Some(s) => Some(Stroke::from_label(s).ok_or_else(|| {
-                at(cst.unwrap_or(0), format!("found '{s}', expected a stroke: {}", Stroke::ACCEPTED))
+                at(
+                    cst.unwrap_or(0),
+                    format!("found '{}', expected a stroke: {}", crate::text::excerpt(s), Stroke::ACCEPTED),
+                )
             })?),
             None => None,
         };
         let label = field(ck);
         let kind = SegmentKind::from_parts(label, run, stroke).ok_or_else(|| {
+            let run = run.map_or_else(|| "no run".to_string(), |r| format!("run {r}"));
+            let stroke = stroke.map_or_else(|| "no stroke".to_string(), |s| format!("stroke {}", s.label()));
             at(
                 ck,
                 format!(
-                    "kind '{label}' with run {run:?} and stroke {:?}: expected rest_start, rest_end, or plateau with a \
-                     run (1, 2, ...) and a stroke (fwd/rev)",
-                    stroke.map(Stroke::label)
+                    "kind '{}' with {run} and {stroke}: expected rest_start, rest_end, or plateau with a run \
+                     (1, 2, ...) and a stroke (fwd/rev)",
+                    crate::text::excerpt(label)
                 ),
             )
         })?;
