@@ -139,7 +139,12 @@ pub struct ManualSegmentRow {
 /// (as in a `--segments-out` file) are ignored. Rows must be in time order.
 pub fn read_manual_segments(path: &Path) -> Result<Vec<ManualSegmentRow>, DataError> {
     let text = crate::text::read_text_file(path, crate::text::MAX_CONFIG_BYTES, "a segment file (CSV)")?;
-    let t = parse_text_table(path, &text)?;
+    parse_manual_segments(path, &text)
+}
+
+/// Parses a manual segment file's text (see [`read_manual_segments`]); `path` names it in errors.
+pub fn parse_manual_segments(path: &Path, text: &str) -> Result<Vec<ManualSegmentRow>, DataError> {
+    let t = parse_text_table(path, text)?;
     let col = |name: &str| {
         t.column(name).ok_or_else(|| {
             DataError::new(
