@@ -102,11 +102,48 @@ pub fn parse_confidence(text: &str) -> Result<Option<f64>, InvalidOption> {
     }
 }
 
+/// Largest relative difference between a given sample rate and the rate of the time stamps: 1 %.
+pub const RATE_TOLERANCE: f64 = 0.01;
+
+/// When a given sample rate disagrees with the time stamps `t` of `path` by more than
+/// [`RATE_TOLERANCE`], the message saying so (`option` names the given rate: a flag placeholder
+/// or a plan key); `None` when they agree or the stamps give no rate.
+pub fn rate_disagreement(t: &[f64], given_hz: f64, option: &str, path: &Path) -> Option<String> {
+    let est = estimate_interval(t).ok()?;
+    let stamps_hz = est.rate_hz();
+    if !stamps_hz.is_finite() || (given_hz * est.interval_s - 1.0).abs() <= RATE_TOLERANCE {
+        return None;
+    }
+    Some(format!(
+        "{option} = {given_hz} Hz disagrees with the time column of {}, whose stamps say {:.6} Hz (interval {} s): \
+         give the rate the stamps say, or leave the rate out to use them",
+        path.display(),
+        stamps_hz,
+        est.interval_s
+    ))
+}
+
+/// The time stamps of the first `rows` samples of a file (none without a time column), for
+/// checking a given rate against them without reading the whole file.
+pub fn first_times(path: &Path, options: &SeriesOptions, rows: usize) -> EvalResult<Option<Vec<f64>>> {
+    let options = SeriesOptions { block_rows: rows.max(2), ..options.clone() };
+    let mut r = gyrolab_io::series::SeriesReader::open(path, &options)?;
+    if r.header().time_column.is_none() {
+        return Ok(None);
+    }
+    Ok(r.next_block()?.and_then(|b| b.time.map(<[f64]>::to_vec)))
+}
+
 /// The sampling interval of a record: the given rate, else the time column's by the one
 /// estimator ([`gyrolab::sampling`]); the Allan variance needs uniform samples, so an irregular
 /// interval is an error naming its line.
 pub fn sample_interval(data: &SeriesData, path: &Path, given_hz: Option<f64>) -> EvalResult<f64> {
     if let Some(f) = given_hz {
+        if let Some(t) = &data.time {
+            if let Some(msg) = rate_disagreement(t, f, "{sample_rate_hz}", path) {
+                return Err(EvalError::conflict_on(&["sample_rate_hz"], msg));
+            }
+        }
         return Ok(1.0 / f);
     }
     let Some(t) = &data.time else {

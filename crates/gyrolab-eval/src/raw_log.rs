@@ -6,7 +6,7 @@ use crate::error::{EvalError, EvalResult};
 use crate::rate::{evaluate_record, EvaluatedAxis};
 use gyrolab::rate_test::{RateTable, RateTestOptions};
 use gyrolab::segment::{
-    rate_observations, segment_log, segments_from_manual, PlateauReduction, Segment, SegmentOptions,
+    rate_observations, segment_log, segments_from_manual, PlateauReduction, Segment, SegmentError, SegmentOptions,
 };
 use gyrolab::units::{split_unit_suffix, RateUnit};
 use gyrolab::validate;
@@ -158,7 +158,13 @@ pub fn segment_file(
             // and the log line.
             let located = log.segment_error(&e);
             let at = e.sample_index().and_then(|i| log.time_s.get(i)).copied();
-            let row = at.and_then(|t| rows.iter().rev().find(|r| r.segment.start_time_s <= t));
+            let row = match e {
+                // The window asked for names its row exactly.
+                SegmentError::EmptySegment { start_s, end_s, .. } => {
+                    rows.iter().find(|r| r.segment.start_time_s == start_s && r.segment.end_time_s == end_s)
+                }
+                _ => at.and_then(|t| rows.iter().rev().find(|r| r.segment.start_time_s <= t)),
+            };
             let mut d = DataError::new(seg_file, format!("{} (log {})", e, location(&located)));
             if let Some(r) = row.or(rows.first()) {
                 d = d.at_line(r.line);

@@ -186,6 +186,62 @@ pub enum SimRecord {
     RateTable,
 }
 
+/// Default bound on the samples (rows) of a simulated record: 1e9, tens of GB of CSV. A larger
+/// record needs an explicit, larger bound (`--max-samples`).
+pub const DEFAULT_MAX_SAMPLES: u64 = 1_000_000_000;
+
+/// Bytes per row of a simulated CSV record, roughly (for the size announced in errors).
+const APPROX_ROW_BYTES: f64 = 30.0;
+
+/// The samples (rows) a record of this set-up would have (a real number: it may be too large
+/// for any integer type).
+pub fn record_samples(record: SimRecord, cfg: &SimConfig) -> f64 {
+    match record {
+        SimRecord::Static => cfg.static_record.duration_s * cfg.static_record.sample_rate_hz,
+        SimRecord::RateTable => {
+            let rt = &cfg.rate_table;
+            let settling = match rt.settling {
+                gyrolab::sim::SettlingRows::Flag => rt.settling_s * rt.sample_rate_hz,
+                gyrolab::sim::SettlingRows::Drop => 0.0,
+            };
+            let per_plateau = f64::from(rt.samples_per_plateau) + settling.max(0.0).ceil();
+            rt.rates_dps.len() as f64 * f64::from(rt.runs) * 2.0 * per_plateau + 2.0 * f64::from(rt.rest_samples)
+        }
+    }
+}
+
+/// Refuses, before anything is written, a record of more than `max_samples` samples; the error
+/// states the record's size and names the bound (`max_samples`). Returns the samples.
+///
+/// ```
+/// use gyrolab_eval::simulate::{check_record_size, sim_config, SimOverrides, SimRecord};
+/// let cfg = sim_config(&SimOverrides { duration_s: Some(1e10), ..Default::default() }).unwrap();
+/// let e = check_record_size(SimRecord::Static, &cfg, 1_000_000_000).unwrap_err();
+/// assert!(e.to_string().contains("1e12 samples"), "{e}");
+/// ```
+pub fn check_record_size(record: SimRecord, cfg: &SimConfig, max_samples: u64) -> EvalResult<f64> {
+    let n = record_samples(record, cfg);
+    if n.is_finite() && n <= max_samples as f64 {
+        return Ok(n);
+    }
+    if n.is_nan() {
+        // An invalid duration or rate: left to the set-up's own validation, which names it.
+        return Ok(n);
+    }
+    let what = match record {
+        SimRecord::Static => "static record",
+        SimRecord::RateTable => "rate-table test",
+    };
+    let bytes = gyrolab_io::text::size_text((n * APPROX_ROW_BYTES).min(u64::MAX as f64) as u64);
+    Err(EvalError::conflict_on(
+        &["max_samples"],
+        format!(
+            "the {what} would have {n:e} samples (about {bytes} of CSV), more than the bound of {max_samples:e} \
+             samples: shorten it, or raise the bound with {{max_samples}} if you mean it"
+        ),
+    ))
+}
+
 /// Writes the record to `w`.
 pub fn simulate_to(
     record: SimRecord,

@@ -138,7 +138,7 @@ impl CalibrationFile {
 
 /// Reads a calibration file; errors name the line and column of a TOML problem.
 pub fn read_calibration(path: &Path) -> Result<CalibrationFile, DataError> {
-    let text = std::fs::read_to_string(path).map_err(|e| DataError::io(path, &e))?;
+    let text = crate::text::read_text_file(path, crate::text::MAX_CONFIG_BYTES, "a calibration file (TOML)")?;
     parse_calibration(path, &text)
 }
 
@@ -158,35 +158,141 @@ pub fn parse_calibration(path: &Path, text: &str) -> Result<CalibrationFile, Dat
             format!("format '{}' is not supported: expected '{CALIBRATION_FORMAT}'", cal.format),
         ));
     }
-    for a in &cal.axes {
-        if !(a.scale_factor.is_finite() && a.scale_factor != 0.0) {
-            return Err(DataError::new(path, format!("axis '{}': scale_factor must be a non-zero number", a.name)));
+    for (i, a) in cal.axes.iter().enumerate() {
+        let axis = crate::text::excerpt(&a.name);
+        let at = |table: &str, key: &str, msg: String| {
+            let d = DataError::new(path, format!("axis '{axis}', {key}: {msg}"));
+            match key_line(text, table, i, key) {
+                Some(l) => d.at_line(l),
+                None => d,
+            }
+        };
+        let values = [
+            ("scale_factor", a.scale_factor),
+            ("zero_offset", a.zero_offset),
+            ("rest_reference", a.rest_reference),
+            ("rate_min_dps", a.rate_min_dps),
+            ("rate_max_dps", a.rate_max_dps),
+        ];
+        for (key, v) in values {
+            if !(v.is_finite() && v.abs() <= crate::text::MAX_MAGNITUDE) {
+                return Err(at(
+                    "[[axis]]",
+                    key,
+                    format!(
+                        "found {v}, expected a finite number of magnitude at most {:e}",
+                        crate::text::MAX_MAGNITUDE
+                    ),
+                ));
+            }
         }
-        if a.polynomial.coefficients.len() != a.polynomial.order + 1 {
-            return Err(DataError::new(
-                path,
+        if a.scale_factor.abs() < MIN_SCALE_FACTOR {
+            return Err(at(
+                "[[axis]]",
+                "scale_factor",
                 format!(
-                    "axis '{}': polynomial of order {} needs {} coefficients",
-                    a.name,
-                    a.polynomial.order,
-                    a.polynomial.order + 1
+                    "found {:e}, expected a non-zero number of magnitude at least {MIN_SCALE_FACTOR:e}",
+                    a.scale_factor
                 ),
             ));
         }
+        if a.polynomial.order > MAX_POLYNOMIAL_ORDER || a.polynomial.coefficients.len() != a.polynomial.order + 1 {
+            return Err(at(
+                "[axis.polynomial]",
+                "coefficients",
+                format!(
+                    "a polynomial of order {} (at most {MAX_POLYNOMIAL_ORDER}) needs {} coefficients, found {}",
+                    a.polynomial.order,
+                    a.polynomial.order.saturating_add(1),
+                    a.polynomial.coefficients.len()
+                ),
+            ));
+        }
+        if let Some(c) =
+            a.polynomial.coefficients.iter().find(|c| !(c.is_finite() && c.abs() <= crate::text::MAX_MAGNITUDE))
+        {
+            return Err(at(
+                "[axis.polynomial]",
+                "coefficients",
+                format!("found {c}, expected finite numbers of magnitude at most {:e}", crate::text::MAX_MAGNITUDE),
+            ));
+        }
+        if a.polynomial.order == 1 {
+            let slope = a.polynomial.coefficients[1];
+            if (slope - a.scale_factor).abs() > SLOPE_TOLERANCE * a.scale_factor.abs() {
+                return Err(at(
+                    "[[axis]]",
+                    "scale_factor",
+                    format!(
+                        "{} disagrees with the slope {slope} of the straight-line polynomial (coefficients[1]): \
+                         expected the same value (relative {SLOPE_TOLERANCE:e}); the file was edited by hand?",
+                        a.scale_factor
+                    ),
+                ));
+            }
+        }
     }
     if let Some(t) = &cal.triad {
-        let finite = t.matrix.iter().flatten().chain(&t.bias).all(|v| v.is_finite());
-        if !finite || t.calibration().inverse_matrix().is_none() {
-            return Err(DataError::new(path, "[triad]: matrix and bias must be finite numbers and matrix invertible"));
+        let line = |key: &str| key_line(text, "[triad]", 0, key);
+        let with_line = |d: DataError, l: Option<u64>| match l {
+            Some(l) => d.at_line(l),
+            None => d,
+        };
+        let sane = |v: &f64| v.is_finite() && v.abs() <= crate::text::MAX_MAGNITUDE;
+        if !t.matrix.iter().flatten().all(sane) || t.calibration().inverse_matrix().is_none() {
+            return Err(with_line(
+                DataError::new(path, "[triad] matrix: expected finite numbers and an invertible matrix"),
+                line("matrix"),
+            ));
         }
-        if !(t.rate_limit_dps.is_finite() && t.rate_limit_dps > 0.0) {
-            return Err(DataError::new(path, "[triad]: rate_limit_dps must be a positive number"));
+        if !t.bias.iter().all(sane) {
+            return Err(with_line(DataError::new(path, "[triad] bias: expected finite numbers"), line("bias")));
+        }
+        if !(sane(&t.rate_limit_dps) && t.rate_limit_dps > 0.0) {
+            return Err(with_line(
+                DataError::new(path, "[triad] rate_limit_dps: expected a positive number"),
+                line("rate_limit_dps"),
+            ));
         }
     }
     if cal.axes.is_empty() && cal.triad.is_none() {
         return Err(DataError::new(path, "the calibration has no [[axis]] entry and no [triad] table"));
     }
     Ok(cal)
+}
+
+/// Relative tolerance between `scale_factor` and the slope of a straight-line polynomial.
+pub const SLOPE_TOLERANCE: f64 = 1e-6;
+
+/// Smallest magnitude of a scale factor (subnormal or absurd values make rates overflow).
+pub const MIN_SCALE_FACTOR: f64 = 1e-100;
+
+/// Highest polynomial order in a calibration file.
+pub const MAX_POLYNOMIAL_ORDER: usize = 9;
+
+/// The 1-based line of `key` in the `index`-th table headed `table` (`[[axis]]`, `[triad]`,
+/// `[axis.polynomial]`) of TOML text, when written as `key = ...` on a line of its own.
+pub fn key_line(text: &str, table: &str, index: usize, key: &str) -> Option<u64> {
+    let mut seen: Option<usize> = None;
+    let mut inside = false;
+    for (n, raw) in text.lines().enumerate() {
+        let t = raw.trim();
+        if t.starts_with('[') {
+            inside = t.split('#').next().map(str::trim) == Some(table);
+            if inside {
+                seen = Some(seen.map_or(0, |s| s + 1));
+            }
+            continue;
+        }
+        if inside && seen == Some(index) {
+            if let Some(rest) = t.strip_prefix(key) {
+                if rest.trim_start().starts_with('=') {
+                    return Some(n as u64 + 1);
+                }
+            }
+        }
+    }
+    None
 }
 
 /// 1-based line and column of a byte offset.
@@ -282,5 +388,28 @@ mod tests {
         let e = parse_calibration(Path::new("c.toml"), &text).unwrap_err();
         assert!(e.line.is_some(), "{e}");
         assert!(e.to_string().contains("scale_factr"), "{e}");
+    }
+
+    #[test]
+    fn value_errors_name_the_line_and_key() {
+        let p = Path::new("cal.toml");
+        let good = sample().to_toml().unwrap();
+        let line_of = |text: &str, key: &str| text.lines().position(|l| l.starts_with(key)).unwrap() as u64 + 1;
+        for (from, to, key) in [
+            ("zero_offset = 2.5", "zero_offset = nan", "zero_offset"),
+            ("zero_offset = 2.5", "zero_offset = 1e308", "zero_offset"),
+            ("scale_factor = 0.0075", "scale_factor = 0.0076", "scale_factor"),
+            ("scale_factor = 0.0075", "scale_factor = 1e-320", "scale_factor"),
+            ("rest_reference = 2.51", "rest_reference = inf", "rest_reference"),
+        ] {
+            let text = good.replace(from, to);
+            let e = parse_calibration(p, &text).unwrap_err();
+            assert_eq!(e.line, Some(line_of(&text, key)), "{e}");
+            assert!(e.to_string().starts_with("cal.toml:"), "{e}");
+            assert!(e.message.contains(key), "{e}");
+        }
+        let text = good.replace("coefficients = [", "coefficients = [1e300, ");
+        let e = parse_calibration(p, &text).unwrap_err();
+        assert_eq!(e.line, Some(line_of(&text, "coefficients")), "{e}");
     }
 }

@@ -4,6 +4,9 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+/// Longest message kept in a [`DataError`], in characters.
+pub const MAX_MESSAGE_CHARS: usize = 1000;
+
 /// A column of a delimited file: its 1-based position and, when known, its header name.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ColumnRef {
@@ -28,8 +31,16 @@ pub struct DataError {
 
 impl DataError {
     /// A problem with a file as a whole.
+    ///
+    /// A message longer than [`MAX_MESSAGE_CHARS`] is cut (a safety net: readers quote fields
+    /// through [`crate::text::excerpt`]).
     pub fn new(file: impl AsRef<Path>, message: impl Into<String>) -> Self {
-        DataError { file: file.as_ref().to_path_buf(), line: None, column: None, message: message.into() }
+        let mut message: String = message.into();
+        if let Some((cut, _)) = message.char_indices().nth(MAX_MESSAGE_CHARS) {
+            message.truncate(cut);
+            message.push_str("...");
+        }
+        DataError { file: file.as_ref().to_path_buf(), line: None, column: None, message }
     }
 
     /// Locates the problem on a line.
@@ -40,7 +51,7 @@ impl DataError {
 
     /// Locates the problem in a column (1-based index and optional header name).
     pub fn at_column(mut self, index: usize, name: Option<&str>) -> Self {
-        self.column = Some(ColumnRef { index, name: name.map(str::to_string) });
+        self.column = Some(ColumnRef { index, name: name.map(crate::text::excerpt) });
         self
     }
 

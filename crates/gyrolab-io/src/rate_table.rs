@@ -14,6 +14,18 @@ use gyrolab::rate_test::{RateObservation, RateTable, RateTestError, RestRecord, 
 use gyrolab::units::{split_unit_suffix, OutputUnit, RateUnit};
 use std::path::Path;
 
+/// Most distinct table rates in one record (a real test has 10 to 100).
+pub const MAX_RATES: usize = 10_000;
+/// Most runs in one record (a real test has 1 to 20).
+pub const MAX_RUNS: usize = 1_000;
+/// Most cells (distinct rates times runs) of a record's grid: the grid is allocated whole.
+pub const MAX_GRID_CELLS: usize = 1_000_000;
+
+/// The error of a record with more rates, runs or grid cells than a real one has.
+fn too_large(path: &Path, what: String) -> DataError {
+    DataError::new(path, format!("{what}: expected a rate-table test (is this the right file or column?)"))
+}
+
 /// Which columns and units to use; `None` means "find it from the header".
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct RateColumns {
@@ -59,13 +71,11 @@ pub struct RateTableFile {
 
 /// Reads a rate-table record from a file.
 pub fn read_rate_table(path: &Path, columns: &RateColumns) -> Result<RateTableFile, DataError> {
-    let bytes = std::fs::read(path).map_err(|e| DataError::io(path, &e))?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        let upto = &e.as_bytes()[..e.utf8_error().valid_up_to()];
-        let line = upto.iter().filter(|&&b| b == b'\n').count() as u64 + 1;
-        DataError::new(path, "the file is not UTF-8 text: expected a CSV, TSV or whitespace-separated text file")
-            .at_line(line)
-    })?;
+    let text = crate::text::read_text_file(
+        path,
+        crate::text::MAX_TABLE_BYTES,
+        "a rate-table record (CSV, TSV or whitespace-separated text)",
+    )?;
     parse_rate_table(path, &text, columns)
 }
 
@@ -99,7 +109,10 @@ fn rate_unit_of(path: &Path, table: &TextTable, col: usize, given: Option<RateUn
     }
     match split_unit_suffix(name).1 {
         Some(s) => RateUnit::parse(&s).ok_or_else(|| {
-            err(format!("unknown rate unit suffix '_{s}': expected one of _dps, _rad_s, _dph (or give --rate-unit)"))
+            err(format!(
+                "unknown rate unit suffix '_{}': expected one of _dps, _rad_s, _dph (or give --rate-unit)",
+                crate::text::excerpt(&s)
+            ))
         }),
         None => Err(err("the rate column has no unit: name it rate_dps or rate_rad_s, or give --rate-unit".into())),
     }
@@ -119,9 +132,12 @@ fn output_unit_of_name(name: &str) -> Result<Option<OutputUnit>, String> {
         }
     }
     match split_unit_suffix(name).1 {
-        Some(s) => OutputUnit::parse(&s)
-            .map(Some)
-            .ok_or_else(|| format!("unknown output unit suffix '_{s}': expected one of _v, _mv, _lsb, _dps, _rad_s")),
+        Some(s) => OutputUnit::parse(&s).map(Some).ok_or_else(|| {
+            format!(
+                "unknown output unit suffix '_{}': expected one of _v, _mv, _lsb, _dps, _rad_s",
+                crate::text::excerpt(&s)
+            )
+        }),
         None => Ok(None),
     }
 }
@@ -202,6 +218,7 @@ fn read_long(
     let width = table.header.len();
     let mut obs = Vec::with_capacity(table.rows.len());
     let mut first_lines: Vec<(f64, u64)> = Vec::new();
+    let mut runs: Vec<u32> = Vec::new();
     let (mut rest_start, mut rest_end) = (Vec::new(), Vec::new());
     for row in &table.rows {
         let line = row.line;
@@ -220,9 +237,12 @@ fn read_long(
         let rate = rate_unit.to_dps(parse_number(path, line, rate_col + 1, name(rate_col), field(rate_col))?);
         let output = parse_number(path, line, output_col + 1, name(output_col), field(output_col))?;
         let run = parse_run(field(run_col)).ok_or_else(|| {
-            DataError::new(path, format!("found '{}', expected a whole run number such as 1", field(run_col)))
-                .at_line(line)
-                .at_column(run_col + 1, Some(name(run_col)))
+            DataError::new(
+                path,
+                format!("found '{}', expected a whole run number such as 1", crate::text::excerpt(field(run_col))),
+            )
+            .at_line(line)
+            .at_column(run_col + 1, Some(name(run_col)))
         })?;
         let label = field(stroke_col);
         let stroke = match label.to_ascii_lowercase().as_str() {
@@ -238,7 +258,8 @@ fn read_long(
                 DataError::new(
                     path,
                     format!(
-                        "unknown stroke label '{label}': expected one of {}, or rest_start/rest_end",
+                        "unknown stroke label '{}': expected one of {}, or rest_start/rest_end",
+                        crate::text::excerpt(label),
                         Stroke::ACCEPTED
                     ),
                 )
@@ -247,7 +268,27 @@ fn read_long(
             })?,
         };
         if !first_lines.iter().any(|(r, _)| *r == rate) {
+            if first_lines.len() == MAX_RATES {
+                return Err(too_large(path, format!("more than {MAX_RATES} distinct table rates")).at_line(line));
+            }
             first_lines.push((rate, line));
+        }
+        if let Err(at) = runs.binary_search(&run) {
+            if runs.len() == MAX_RUNS {
+                return Err(too_large(path, format!("more than {MAX_RUNS} runs")).at_line(line));
+            }
+            runs.insert(at, run);
+        }
+        if first_lines.len() * runs.len() > MAX_GRID_CELLS {
+            return Err(too_large(
+                path,
+                format!(
+                    "{} distinct rates in {} runs, more than {MAX_GRID_CELLS} rate-run cells",
+                    first_lines.len(),
+                    runs.len()
+                ),
+            )
+            .at_line(line));
         }
         obs.push(RateObservation { rate_dps: rate, run, stroke, output });
     }
@@ -315,7 +356,8 @@ fn read_wide(path: &Path, table: &TextTable, columns: &RateColumns) -> Result<Ra
     let hl = table.header_line;
     let rate_col = match columns.rate.as_deref() {
         Some(n) => table.column(n).ok_or_else(|| {
-            DataError::new(path, format!("no column named '{n}': expected it in the header")).at_line(hl)
+            DataError::new(path, format!("no column named '{}': expected it in the header", crate::text::excerpt(n)))
+                .at_line(hl)
         })?,
         None => 0,
     };
@@ -366,7 +408,8 @@ fn read_wide(path: &Path, table: &TextTable, columns: &RateColumns) -> Result<Ra
                     return Err(DataError::new(
                         path,
                         format!(
-                            "found '{top}', expected a run label such as 'run 1' or '第一次' over the stroke columns"
+                            "found '{}', expected a run label such as 'run 1' or '第一次' over the stroke columns",
+                            crate::text::excerpt(top)
                         ),
                     )
                     .at_line(hl)
@@ -377,9 +420,12 @@ fn read_wide(path: &Path, table: &TextTable, columns: &RateColumns) -> Result<Ra
             }
             let label = strokes.fields.get(c).map(String::as_str).unwrap_or("");
             let stroke = Stroke::from_label(label).ok_or_else(|| {
-                DataError::new(path, format!("found '{label}', expected a stroke label ({})", Stroke::ACCEPTED))
-                    .at_line(strokes.line)
-                    .at_column(c + 1, None)
+                DataError::new(
+                    path,
+                    format!("found '{}', expected a stroke label ({})", crate::text::excerpt(label), Stroke::ACCEPTED),
+                )
+                .at_line(strokes.line)
+                .at_column(c + 1, None)
             })?;
             let run = current_run.ok_or_else(|| {
                 DataError::new(
@@ -401,7 +447,8 @@ fn read_wide(path: &Path, table: &TextTable, columns: &RateColumns) -> Result<Ra
                 DataError::new(
                     path,
                     format!(
-                        "cannot read run and stroke from column name '{name}': expected names like run1_fwd_v, run1_rev_v (long layout needs a 'stroke' column)"
+                        "cannot read run and stroke from column name '{}': expected names like run1_fwd_v, run1_rev_v (long layout needs a 'stroke' column)",
+                        crate::text::excerpt(name)
                     ),
                 )
                 .at_line(hl)
@@ -411,7 +458,10 @@ fn read_wide(path: &Path, table: &TextTable, columns: &RateColumns) -> Result<Ra
                 Some(s) => Some(OutputUnit::parse(&s).ok_or_else(|| {
                     DataError::new(
                         path,
-                        format!("unknown output unit suffix '_{s}': expected one of _v, _mv, _lsb, _dps, _rad_s"),
+                        format!(
+                            "unknown output unit suffix '_{}': expected one of _v, _mv, _lsb, _dps, _rad_s",
+                            crate::text::excerpt(&s)
+                        ),
                     )
                     .at_line(hl)
                     .at_column(c + 1, Some(name))
@@ -461,6 +511,9 @@ fn read_wide(path: &Path, table: &TextTable, columns: &RateColumns) -> Result<Ra
                 format!("rate {rate} deg/s has no data: expected an output for every run and stroke"),
             )
             .at_line(row.line));
+        }
+        if first_lines.len() == MAX_RATES {
+            return Err(too_large(path, format!("more than {MAX_RATES} rate rows")).at_line(row.line));
         }
         first_lines.push((rate, row.line));
         for &(c, run, stroke) in &cols {

@@ -10,7 +10,7 @@ use gyrolab::rate_test::Stroke;
 use gyrolab::segment::{ManualSegment, Segment, SegmentError, SegmentKind};
 use gyrolab::units::{split_unit_suffix, RateUnit};
 use std::fmt::Write as _;
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
 /// Base names (before the unit suffix) of a table-rate column, in order of preference.
@@ -21,9 +21,15 @@ pub fn header_names(path: &Path) -> Result<Vec<String>, DataError> {
     let f = std::fs::File::open(path).map_err(|e| DataError::io(path, &e))?;
     let mut r = BufReader::new(f);
     let mut buf = Vec::new();
+    let mut guard = crate::text::TextGuard::default();
     loop {
         buf.clear();
-        let n = r.read_until(b'\n', &mut buf).map_err(|e| DataError::io(path, &e))?;
+        // At most one line over the limit is read: the guard ends an endless line (`/dev/zero`).
+        let n = (&mut r)
+            .take(crate::text::MAX_LINE_BYTES as u64 + 2)
+            .read_until(b'\n', &mut buf)
+            .map_err(|e| DataError::io(path, &e))?;
+        guard.check(path, &buf)?;
         if n == 0 {
             return Err(DataError::new(path, "the file is empty: expected a header row such as 'time_s,output_v'"));
         }
@@ -132,8 +138,13 @@ pub struct ManualSegmentRow {
 /// `rest_end`, `plateau`) and, for plateaus, `run` and `stroke` (`fwd`/`rev`); other columns
 /// (as in a `--segments-out` file) are ignored. Rows must be in time order.
 pub fn read_manual_segments(path: &Path) -> Result<Vec<ManualSegmentRow>, DataError> {
-    let text = std::fs::read_to_string(path).map_err(|e| DataError::io(path, &e))?;
-    let t = parse_text_table(path, &text)?;
+    let text = crate::text::read_text_file(path, crate::text::MAX_CONFIG_BYTES, "a segment file (CSV)")?;
+    parse_manual_segments(path, &text)
+}
+
+/// Parses a manual segment file's text (see [`read_manual_segments`]); `path` names it in errors.
+pub fn parse_manual_segments(path: &Path, text: &str) -> Result<Vec<ManualSegmentRow>, DataError> {
+    let t = parse_text_table(path, text)?;
     let col = |name: &str| {
         t.column(name).ok_or_else(|| {
             DataError::new(
@@ -141,7 +152,7 @@ pub fn read_manual_segments(path: &Path) -> Result<Vec<ManualSegmentRow>, DataEr
                 format!(
                     "no '{name}' column: a segment file needs start_time_s,end_time_s,kind and, for plateaus, run,stroke \
                      (found {})",
-                    t.header.join(", ")
+                    crate::text::excerpt(&t.header.join(", "))
                 ),
             )
             .at_line(t.header_line)
@@ -172,26 +183,30 @@ pub fn read_manual_segments(path: &Path) -> Result<Vec<ManualSegmentRow>, DataEr
             }
         }
         let run = match cr.map(field).map(str::trim).filter(|s| !s.is_empty()) {
-            Some(s) => Some(
-                s.parse::<u32>()
-                    .map_err(|_| at(cr.unwrap_or(0), format!("found '{s}', expected a run number (1, 2, ...)")))?,
-            ),
+            Some(s) => Some(s.parse::<u32>().map_err(|_| {
+                at(cr.unwrap_or(0), format!("found '{}', expected a run number (1, 2, ...)", crate::text::excerpt(s)))
+            })?),
             None => None,
         };
         let stroke = match cst.map(field).map(str::trim).filter(|s| !s.is_empty()) {
             Some(s) => Some(Stroke::from_label(s).ok_or_else(|| {
-                at(cst.unwrap_or(0), format!("found '{s}', expected a stroke: {}", Stroke::ACCEPTED))
+                at(
+                    cst.unwrap_or(0),
+                    format!("found '{}', expected a stroke: {}", crate::text::excerpt(s), Stroke::ACCEPTED),
+                )
             })?),
             None => None,
         };
         let label = field(ck);
         let kind = SegmentKind::from_parts(label, run, stroke).ok_or_else(|| {
+            let run = run.map_or_else(|| "no run".to_string(), |r| format!("run {r}"));
+            let stroke = stroke.map_or_else(|| "no stroke".to_string(), |s| format!("stroke {}", s.label()));
             at(
                 ck,
                 format!(
-                    "kind '{label}' with run {run:?} and stroke {:?}: expected rest_start, rest_end, or plateau with a \
-                     run (1, 2, ...) and a stroke (fwd/rev)",
-                    stroke.map(Stroke::label)
+                    "kind '{}' with {run} and {stroke}: expected rest_start, rest_end, or plateau with a run \
+                     (1, 2, ...) and a stroke (fwd/rev)",
+                    crate::text::excerpt(label)
                 ),
             )
         })?;

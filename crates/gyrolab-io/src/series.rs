@@ -25,8 +25,8 @@ use std::path::{Path, PathBuf};
 pub const DEFAULT_CHUNK_BYTES: usize = 2 << 20;
 /// Default number of rows per block handed to the caller.
 pub const DEFAULT_BLOCK_ROWS: usize = 1 << 16;
-/// Longest line accepted (a guard against binary files read as text).
-pub const MAX_LINE_BYTES: usize = 64 << 20;
+/// Longest line accepted (a guard against binary files read as text): see [`crate::text::MAX_LINE_BYTES`].
+pub use crate::text::MAX_LINE_BYTES;
 /// How many missing cells the reader lists individually (all are counted).
 pub const FIRST_MISSING: usize = 100;
 
@@ -215,6 +215,8 @@ pub struct SeriesReader<R: Read> {
     complete: usize,
     eof: bool,
     line_no: u64,
+    /// Bytes of the unfinished line at the end of the buffer (checked against [`MAX_LINE_BYTES`]).
+    tail_len: usize,
     rows: u64,
     targets: Vec<u32>,
     shapes: Vec<Option<FieldShape>>,
@@ -270,6 +272,7 @@ impl<R: Read> SeriesReader<R> {
             complete: 0,
             eof: false,
             line_no: 0,
+            tail_len: 0,
             rows: 0,
             targets: Vec::new(),
             shapes: Vec::new(),
@@ -306,6 +309,13 @@ impl<R: Read> SeriesReader<R> {
             }
             if !is_blank_or_comment(line) {
                 r.crlf = line.ends_with(b"\r");
+                if memchr::memchr(b'\r', line.strip_suffix(b"\r").unwrap_or(line)).is_some() {
+                    return Err(DataError::new(
+                        &file,
+                        "lines end with CR only (a classic Mac OS text file): expected LF or CR LF line ends",
+                    )
+                    .at_line(r.line_no));
+                }
                 break String::from_utf8_lossy(line).trim().to_string();
             }
         };
@@ -334,7 +344,13 @@ impl<R: Read> SeriesReader<R> {
                 return err(
                     i + 1,
                     Some(n),
-                    format!("duplicate column name: column {} '{}' and column {} '{}'", j + 1, names[j], i + 1, n),
+                    format!(
+                        "duplicate column name: column {} '{}' and column {} '{}'",
+                        j + 1,
+                        crate::text::excerpt(&names[j]),
+                        i + 1,
+                        crate::text::excerpt(n)
+                    ),
                 );
             }
         }
@@ -343,6 +359,7 @@ impl<R: Read> SeriesReader<R> {
         let mut columns = Vec::with_capacity(names.len());
         let mut channels: Vec<ChannelInfo> = Vec::new();
         for (i, name) in names.iter().enumerate() {
+            let shown = crate::text::excerpt(name);
             let (base, suffix) = split_unit_suffix(name);
             let sfx = suffix.as_deref();
             let unit_override = options.column_units.iter().find(|(c, _)| c.eq_ignore_ascii_case(name)).map(|p| p.1);
@@ -352,7 +369,7 @@ impl<R: Read> SeriesReader<R> {
                     return err(
                         i + 1,
                         Some(name),
-                        format!("table-rate column '{name}': expected a rate unit suffix (as in 'table_rate_dps')"),
+                        format!("table-rate column '{shown}': expected a rate unit suffix (as in 'table_rate_dps')"),
                     );
                 };
                 self.header.table_rate_column = Some(i + 1);
@@ -360,7 +377,7 @@ impl<R: Read> SeriesReader<R> {
                 ColumnRole::TableRate
             } else if matches!(base.as_str(), "time" | "t" | "timestamp") {
                 if sfx != Some("s") {
-                    return err(i + 1, Some(name), format!("time column '{name}': expected seconds, named 'time_s'"));
+                    return err(i + 1, Some(name), format!("time column '{shown}': expected seconds, named 'time_s'"));
                 }
                 if let Some(c) = self.header.time_column {
                     return err(i + 1, Some(name), format!("a second time column: column {c} is already the time"));
@@ -372,7 +389,7 @@ impl<R: Read> SeriesReader<R> {
                     return err(
                         i + 1,
                         Some(name),
-                        format!("temperature column '{name}': expected degC, named 'temp_c'"),
+                        format!("temperature column '{shown}': expected degC, named 'temp_c'"),
                     );
                 }
                 if let Some(c) = self.header.temperature_column {
@@ -387,14 +404,14 @@ impl<R: Read> SeriesReader<R> {
                     Some(u) => u,
                     None => {
                         let what = match sfx {
-                            Some(s) => format!("unknown unit suffix '{s}'"),
+                            Some(s) => format!("unknown unit suffix '{}'", crate::text::excerpt(s)),
                             None => "no unit suffix".to_string(),
                         };
                         return err(
                             i + 1,
                             Some(name),
                             format!(
-                                "{what} in column '{name}': expected one of the suffixes {accepted} \
+                                "{what} in column '{shown}': expected one of the suffixes {accepted} \
                                  (as in 'output_v'), a unit named for the column, or a channel selection without it"
                             ),
                         );
@@ -409,7 +426,11 @@ impl<R: Read> SeriesReader<R> {
             if self.header.table_rate_column.is_none() {
                 return Err(DataError::new(
                     &file,
-                    format!("table-rate column '{rate}' is not in the header: found {}", names.join(", ")),
+                    format!(
+                        "table-rate column '{}' is not in the header: found {}",
+                        crate::text::excerpt(rate),
+                        crate::text::excerpt(&names.join(", "))
+                    ),
                 )
                 .at_line(line));
             }
@@ -418,7 +439,11 @@ impl<R: Read> SeriesReader<R> {
             if let Some(missing) = list.iter().find(|c| !names.iter().any(|n| n.eq_ignore_ascii_case(c))) {
                 return Err(DataError::new(
                     &file,
-                    format!("selected channel '{missing}' is not in the header: found {}", names.join(", ")),
+                    format!(
+                        "selected channel '{}' is not in the header: found {}",
+                        crate::text::excerpt(missing),
+                        crate::text::excerpt(&names.join(", "))
+                    ),
                 )
                 .at_line(line));
             }
@@ -505,23 +530,47 @@ impl<R: Read> SeriesReader<R> {
                 return Ok(false);
             }
             if self.filled == self.buf.len() {
-                if self.buf.len() >= MAX_LINE_BYTES {
-                    return Err(DataError::new(
-                        &self.header.file,
-                        format!("a line longer than {MAX_LINE_BYTES} bytes: expected a text file of numbers"),
-                    )
-                    .at_line(self.line_no + 1));
-                }
+                // Only reached with a line longer than the chunk; the checks below end it at
+                // MAX_LINE_BYTES.
                 let n = (self.buf.len() * 2).max(self.chunk_bytes);
                 self.buf.resize(n, 0);
             }
             match self.src.read(&mut self.buf[self.filled..]) {
                 Ok(0) => self.eof = true,
-                Ok(n) => self.filled += n,
+                Ok(n) => {
+                    self.check_new_bytes(self.filled, self.filled + n)?;
+                    self.filled += n;
+                }
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
                 Err(e) => return Err(DataError::io(&self.header.file, &e)),
             }
         }
+    }
+
+    /// Checks bytes just read (`buf[from..to]`): no NUL byte, no line longer than
+    /// [`MAX_LINE_BYTES`], so that a binary file or an endless one (`/dev/zero`) ends early.
+    fn check_new_bytes(&mut self, from: usize, to: usize) -> Result<(), DataError> {
+        let line_at =
+            |r: &Self, i: usize| r.line_no + memchr::memchr_iter(b'\n', &r.buf[r.pos.min(i)..i]).count() as u64 + 1;
+        if let Some(i) = memchr::memchr(0, &self.buf[from..to]) {
+            let line = line_at(self, from + i);
+            return Err(DataError::new(&self.header.file, "binary data (a NUL byte): expected a text file of numbers")
+                .at_line(line));
+        }
+        let mut start = from;
+        for i in memchr::memchr_iter(b'\n', &self.buf[from..to]) {
+            let len = self.tail_len + (from + i - start);
+            if len > MAX_LINE_BYTES {
+                return Err(crate::text::long_line(&self.header.file, line_at(self, from + i)));
+            }
+            self.tail_len = 0;
+            start = from + i + 1;
+        }
+        self.tail_len += to - start;
+        if self.tail_len > MAX_LINE_BYTES {
+            return Err(crate::text::long_line(&self.header.file, line_at(self, to)));
+        }
+        Ok(())
     }
 
     /// The next block of rows, or `None` at the end of the file.
@@ -545,6 +594,14 @@ impl<R: Read> SeriesReader<R> {
                 .at_line(self.header.header_line));
             }
             return Ok(None);
+        }
+        // Values that would overflow the figures: a corrupt cell, reported where it is.
+        for (slot, col) in self.cols.iter().enumerate() {
+            if let Some(k) = col.iter().position(|v| v.abs() > crate::text::MAX_MAGNITUDE) {
+                let ci = self.targets.iter().position(|&t| t as usize == slot).unwrap_or(0);
+                let msg = crate::text::check_magnitude(col[k]).err().unwrap_or_default();
+                return Err(self.err_at(self.lines[k], ci, msg));
+            }
         }
         if let (Some(s), Some(unit)) = (self.rate_slot, self.header.table_rate_unit) {
             if unit != RateUnit::DegPerSec {
@@ -644,7 +701,11 @@ impl<R: Read> SeriesReader<R> {
                     } else {
                         let text = field_text(bytes, field_start, delim, ws);
                         if !self.tolerant || value == f64::INFINITY || value == f64::NEG_INFINITY {
-                            let what = if text.is_empty() { "an empty cell".to_string() } else { format!("'{text}'") };
+                            let what = if text.is_empty() {
+                                "an empty cell".to_string()
+                            } else {
+                                format!("'{}'", crate::text::excerpt(&text))
+                            };
                             let hint = if value.is_nan() { " (tolerant mode reports NaN and empty cells)" } else { "" };
                             break 'rows Err(self.err_at(
                                 line_no,
@@ -706,7 +767,7 @@ impl<R: Read> SeriesReader<R> {
     }
 
     fn bad_number(&self, bytes: &[u8], field_start: usize, line: u64, ci: usize, delim: u8, ws: bool) -> DataError {
-        let text = field_text(bytes, field_start, delim, ws);
+        let text = crate::text::excerpt(&field_text(bytes, field_start, delim, ws));
         self.err_at(line, ci, format!("found '{text}', expected a number"))
     }
 

@@ -258,7 +258,7 @@ pub struct TestPlan {
 
 /// Reads and checks a plan file; `known_figure` tells which `[limits]` names exist.
 pub fn read_plan(path: &Path, known_figure: &dyn Fn(&str) -> bool) -> Result<TestPlan, DataError> {
-    let text = std::fs::read_to_string(path).map_err(|e| DataError::io(path, &e))?;
+    let text = crate::text::read_text_file(path, crate::text::MAX_CONFIG_BYTES, "a test plan (TOML)")?;
     parse_plan(path, &text, known_figure)
 }
 
@@ -328,7 +328,10 @@ impl Ctx<'_> {
                     self.err(
                         s.span(),
                         key,
-                        format!("unknown output unit '{}': expected v, mv, lsb, dps or rad_s", s.get_ref()),
+                        format!(
+                            "unknown output unit '{}': expected v, mv, lsb, dps or rad_s",
+                            crate::text::excerpt(s.get_ref())
+                        ),
                     )
                 })
             })
@@ -472,6 +475,13 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
             )?;
             if let Some(l) = &s.latitude_deg {
                 cx.check(l.span(), &key("latitude_deg"), validate::latitude_deg("latitude_deg", *l.get_ref()))?;
+            }
+            if let (Some(u), None) = (&s.output_unit, &s.channel) {
+                return Err(cx.err(
+                    u.span(),
+                    &key("output_unit"),
+                    format!("needs {} (the column it applies to)", key("channel")),
+                ));
             }
             static_tests.push(StaticAxisPlan {
                 axis: axis.clone(),

@@ -3,7 +3,152 @@
 //! row. Every row keeps its 1-based line number for error messages.
 
 use crate::DataError;
+use std::io::Read;
 use std::path::Path;
+
+/// Longest line any reader accepts: 1 MiB. A real record's lines are well under 1 KiB; a longer
+/// "line" is binary data or a file without line ends, and reading on would only fill memory.
+pub const MAX_LINE_BYTES: usize = 1 << 20;
+
+/// Largest configuration, calibration, test-plan or segment file: 4 MiB (real ones are a few KiB).
+pub const MAX_CONFIG_BYTES: u64 = 4 << 20;
+
+/// Largest rate-table record read whole into memory: 256 MiB (a long-layout record of a
+/// thousand samples per plateau, 40 rates and 10 runs is about 20 MiB).
+pub const MAX_TABLE_BYTES: u64 = 256 << 20;
+
+/// Largest magnitude of a value read from a record: 1e150. Squares and sums of squares of such
+/// values stay finite; a value beyond it is a corrupt cell, never a gyro output or a time.
+pub const MAX_MAGNITUDE: f64 = 1e150;
+
+/// Most characters of a field quoted in an error message (longer fields end in "...").
+pub const MAX_EXCERPT_CHARS: usize = 60;
+
+/// A field as quoted in messages: at most [`MAX_EXCERPT_CHARS`] characters, control characters
+/// shown as `\u{..}`, "..." when cut.
+pub fn excerpt(field: &str) -> String {
+    let mut out = String::new();
+    for (n, c) in field.chars().enumerate() {
+        if n == MAX_EXCERPT_CHARS {
+            out.push_str("...");
+            break;
+        }
+        if c.is_control() {
+            out.extend(c.escape_unicode());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// Checks the bytes of a text file as they arrive: NUL bytes (binary data), lines longer than
+/// [`MAX_LINE_BYTES`], lines that end with CR only. Keeps the line count across calls.
+#[derive(Debug, Clone, Default)]
+pub struct TextGuard {
+    /// Lines ended so far.
+    lines: u64,
+    /// Bytes of the current line so far.
+    line_bytes: usize,
+    /// Whether the previous byte was a CR.
+    after_cr: bool,
+}
+
+impl TextGuard {
+    /// Checks the next bytes of `file`; the error names the line.
+    pub fn check(&mut self, file: &Path, bytes: &[u8]) -> Result<(), DataError> {
+        for &b in bytes {
+            if self.after_cr && b != b'\n' {
+                return Err(DataError::new(
+                    file,
+                    "lines end with CR only (a classic Mac OS text file): expected LF or CR LF line ends",
+                )
+                .at_line(self.lines + 1));
+            }
+            self.after_cr = b == b'\r';
+            match b {
+                b'\n' => {
+                    self.lines += 1;
+                    self.line_bytes = 0;
+                }
+                0 => {
+                    return Err(
+                        DataError::new(file, "binary data (a NUL byte): expected a text file").at_line(self.lines + 1)
+                    )
+                }
+                _ => {
+                    self.line_bytes += 1;
+                    if self.line_bytes > MAX_LINE_BYTES {
+                        return Err(long_line(file, self.lines + 1));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The error of a line longer than [`MAX_LINE_BYTES`].
+pub fn long_line(file: &Path, line: u64) -> DataError {
+    DataError::new(
+        file,
+        format!(
+            "line {line} is longer than {} MiB: expected text lines (is this a binary file?)",
+            MAX_LINE_BYTES >> 20
+        ),
+    )
+    .at_line(line)
+}
+
+/// Reads a whole text file of at most `max_bytes`, checking it as it arrives (see
+/// [`TextGuard`]) so that binary data or an endless file (`/dev/zero`) ends the read early;
+/// `what` names the expected kind of file in the size error.
+pub fn read_text_file(path: &Path, max_bytes: u64, what: &str) -> Result<String, DataError> {
+    let f = std::fs::File::open(path).map_err(|e| DataError::io(path, &e))?;
+    let mut src = f.take(max_bytes + 1);
+    let mut bytes = Vec::new();
+    let mut guard = TextGuard::default();
+    let mut chunk = vec![0u8; 64 << 10];
+    loop {
+        let n = match src.read(&mut chunk) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(DataError::io(path, &e)),
+        };
+        guard.check(path, &chunk[..n])?;
+        bytes.extend_from_slice(&chunk[..n]);
+        if bytes.len() as u64 > max_bytes {
+            return Err(DataError::new(
+                path,
+                format!("the file is larger than {}: expected {what}", size_text(max_bytes)),
+            ));
+        }
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        let upto = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+        let line = upto.iter().filter(|&&b| b == b'\n').count() as u64 + 1;
+        DataError::new(path, "the file is not UTF-8 text: expected a text file").at_line(line)
+    })
+}
+
+/// A byte count as text (`4 MiB`, `1.5 GiB`, `512 bytes`).
+pub fn size_text(bytes: u64) -> String {
+    const UNITS: [&str; 5] = ["bytes", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = bytes as f64;
+    let mut u = 0;
+    while v >= 1024.0 && u + 1 < UNITS.len() {
+        v /= 1024.0;
+        u += 1;
+    }
+    if u == 0 {
+        format!("{bytes} bytes")
+    } else if v.fract() == 0.0 {
+        format!("{v} {}", UNITS[u])
+    } else {
+        format!("{v:.1} {}", UNITS[u])
+    }
+}
 
 /// Field separator of a text file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -85,8 +230,10 @@ impl TextTable {
     }
 }
 
-/// Parses a whole file's text. Errors: empty file, duplicate header names.
+/// Parses a whole file's text. Errors: binary data, overlong lines, CR-only line ends, empty
+/// file, duplicate header names.
 pub fn parse_text_table(file: &Path, text: &str) -> Result<TextTable, DataError> {
+    TextGuard::default().check(file, text.as_bytes())?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut header: Option<(u64, Vec<String>, Delimiter)> = None;
     let mut rows = Vec::new();
@@ -123,7 +270,8 @@ pub fn parse_text_table(file: &Path, text: &str) -> Result<TextTable, DataError>
             return Err(DataError::new(
                 file,
                 format!(
-                    "duplicate column name '{h}' (columns {} and {}): expected every header name once",
+                    "duplicate column name '{}' (columns {} and {}): expected every header name once",
+                    excerpt(h),
                     k + 1,
                     j + 1
                 ),
@@ -135,17 +283,35 @@ pub fn parse_text_table(file: &Path, text: &str) -> Result<TextTable, DataError>
     Ok(TextTable { delimiter, header_line, header, rows, comments })
 }
 
-/// Parses a finite number from a field, or explains what is wrong with it.
+/// Parses a finite number from a field, or explains what is wrong with it: not a number (one
+/// sign at most: `+-2.5` is not read as -2.5), NaN or infinity, or a magnitude above
+/// [`MAX_MAGNITUDE`].
 pub fn parse_number(file: &Path, line: u64, column: usize, name: &str, field: &str) -> Result<f64, DataError> {
     let at = |msg: String| DataError::new(file, msg).at_line(line).at_column(column, Some(name));
     if field.is_empty() {
         return Err(at("empty cell: expected a number".into()));
     }
     let s = field.strip_prefix('+').unwrap_or(field);
+    let shown = excerpt(field);
+    if s.len() < field.len() && s.starts_with(['+', '-']) {
+        return Err(at(format!("found '{shown}', expected a number with one sign at most")));
+    }
     match fast_float2::parse::<f64, _>(s) {
-        Ok(v) if v.is_finite() => Ok(v),
-        Ok(_) => Err(at(format!("found '{field}', expected a finite number (NaN and infinity are not data)"))),
-        Err(_) => Err(at(format!("found '{field}', expected a number"))),
+        Ok(v) if v.is_finite() => check_magnitude(v).map_err(at),
+        Ok(_) => Err(at(format!("found '{shown}', expected a finite number (NaN and infinity are not data)"))),
+        Err(_) => Err(at(format!("found '{shown}', expected a number"))),
+    }
+}
+
+/// `Ok(v)` when |v| is at most [`MAX_MAGNITUDE`], else the reason as a message.
+pub fn check_magnitude(v: f64) -> Result<f64, String> {
+    if v.abs() <= MAX_MAGNITUDE {
+        Ok(v)
+    } else {
+        Err(format!(
+            "found {v:e}, a magnitude above {MAX_MAGNITUDE:e}: such a value would overflow the figures \
+             (sums of squares); expected a measured value"
+        ))
     }
 }
 
@@ -184,5 +350,32 @@ mod tests {
         assert_eq!(e.to_string(), "n.csv:7:2: column 'output_v': found 'abc', expected a number");
         assert!(parse_number(p, 1, 1, "x", "NaN").unwrap_err().message.contains("finite"));
         assert!(parse_number(p, 1, 1, "x", "").unwrap_err().message.contains("empty"));
+    }
+
+    #[test]
+    fn guard_finds_nul_long_lines_and_cr_only() {
+        let p = Path::new("g.csv");
+        let e = TextGuard::default().check(p, b"a,b\n1,2\n\0\0").unwrap_err();
+        assert_eq!((e.line, e.message.contains("binary data")), (Some(3), true), "{e}");
+        let mut long = b"a\n".to_vec();
+        long.extend(std::iter::repeat_n(b'x', MAX_LINE_BYTES + 1));
+        let e = TextGuard::default().check(p, &long).unwrap_err();
+        assert!(e.to_string().starts_with("g.csv:2: line 2 is longer than 1 MiB"), "{e}");
+        let e = parse_text_table(p, "a,b\r1,2\r3,4\r").unwrap_err();
+        assert!(e.message.contains("lines end with CR only"), "{e}");
+        assert!(parse_text_table(p, "a,b\r\n1,2\r\n").is_ok());
+    }
+
+    #[test]
+    fn files_over_their_limit_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("big.toml");
+        std::fs::write(&f, "x = 1\n".repeat(1000)).unwrap();
+        let e = read_text_file(&f, 1024, "a test plan").unwrap_err();
+        assert_eq!(e.message, "the file is larger than 1 KiB: expected a test plan");
+        assert_eq!(read_text_file(&f, 1 << 20, "a plan").unwrap().len(), 6000);
+        assert_eq!(size_text(4 << 20), "4 MiB");
+        assert_eq!(excerpt(&"y".repeat(100)), format!("{}...", "y".repeat(60)));
+        assert_eq!(excerpt("a\0b"), "a\\u{0}b");
     }
 }

@@ -226,7 +226,9 @@ proptest! {
         sep in prop::sample::select(vec![",", "\t", " ", ";"]),
         comments in any::<bool>(),
     ) {
-        let rows: Vec<(f64, f64)> = rows.into_iter().filter(|(a, b)| a.is_finite() && b.is_finite()).collect();
+        // Magnitudes above MAX_MAGNITUDE are refused by design (they would overflow the figures).
+        let small = |v: &f64| v.abs() <= gyrolab_io::text::MAX_MAGNITUDE;
+        let rows: Vec<(f64, f64)> = rows.into_iter().filter(|(a, b)| small(a) && small(b)).collect();
         prop_assume!(!rows.is_empty());
         let mut text = format!("time_s{sep}output_v\n");
         let mut lines = Vec::new();

@@ -101,6 +101,9 @@ pub enum RateTestError {
         /// Run label.
         run: u32,
     },
+    /// The mean outputs do not change with the rate (constant output): K = 0.
+    #[error("the output does not change with the rate: no scale factor (is this the right output column?)")]
+    NoScaleFactor,
     /// An option is out of range.
     #[error("invalid option: {0}")]
     InvalidOption(String),
@@ -392,6 +395,9 @@ pub fn evaluate(table: &RateTable, options: &RateTestOptions) -> Result<RateEval
     let means: Vec<f64> = fwd_mean.iter().zip(&rev_mean).map(|(f, r)| 0.5 * (f + r)).collect();
     let rates = &table.rates_dps;
     let line = fit::fit_line(rates, &means)?;
+    if !(line.slope != 0.0 && line.slope.is_finite()) {
+        return Err(RateTestError::NoScaleFactor);
+    }
 
     let zero_point = rates.iter().position(|&w| w == 0.0);
     let (rest_reference, rest_reference_source) = match (table.rest, zero_point) {

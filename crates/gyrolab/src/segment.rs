@@ -265,6 +265,27 @@ pub enum SegmentError {
         /// Time of the sample before, s.
         previous_s: f64,
     },
+    /// A gap in the time stamps while the table rate stays the same: samples are missing from a
+    /// plateau (or the time column is corrupt).
+    #[error(
+        "sample {index} (t = {time_s} s): time jumps by {gap_s} s from the previous sample (t = {previous_s} s), \
+         more than {GAP_INTERVALS} sampling intervals ({interval_s} s), while the table rate stays at \
+         {rate_dps} deg/s: samples are missing inside a plateau (or the time column is corrupt)"
+    )]
+    TimeGap {
+        /// Sample index after the gap.
+        index: usize,
+        /// Its time, s.
+        time_s: f64,
+        /// Time of the sample before, s.
+        previous_s: f64,
+        /// The gap, s.
+        gap_s: f64,
+        /// The nominal sampling interval, s.
+        interval_s: f64,
+        /// The table rate on both sides, deg/s.
+        rate_dps: f64,
+    },
     /// No stretch of the log is steady long enough.
     #[error(
         "no steady plateau: the table rate never stays within the tolerance for {min_duration_s} s after \
@@ -426,6 +447,7 @@ impl SegmentError {
         match self {
             NonFinite { index, .. }
             | TimeNotIncreasing { index, .. }
+            | TimeGap { index, .. }
             | NoPlateau { index, .. }
             | TooFewPlateaus { index, .. }
             | NoFinalRest { index, .. }
@@ -438,6 +460,31 @@ impl SegmentError {
             InvalidOption(_) | LengthMismatch { .. } | Empty | EmptySegment { .. } => None,
         }
     }
+}
+
+/// Longest step between two time stamps inside a plateau, in nominal sampling intervals; a longer
+/// one with the same table rate on both sides is a [`SegmentError::TimeGap`].
+pub const GAP_INTERVALS: f64 = 100.0;
+
+/// Finds a gap of more than [`GAP_INTERVALS`] nominal intervals with the same rate (within the
+/// steadiness tolerance) on both sides.
+fn check_gaps(time_s: &[f64], rate_dps: &[f64], options: &SegmentOptions) -> Result<(), SegmentError> {
+    let Ok(est) = crate::sampling::estimate_interval(time_s) else { return Ok(()) };
+    let limit = GAP_INTERVALS * est.nominal_s;
+    for i in 1..time_s.len() {
+        let gap = time_s[i] - time_s[i - 1];
+        if gap > limit && (rate_dps[i] - rate_dps[i - 1]).abs() <= options.tolerance_at(rate_dps[i - 1]) {
+            return Err(SegmentError::TimeGap {
+                index: i,
+                time_s: time_s[i],
+                previous_s: time_s[i - 1],
+                gap_s: gap,
+                interval_s: est.nominal_s,
+                rate_dps: rate_dps[i - 1],
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Checks the time and rate columns: same length, finite, time strictly increasing.
@@ -491,6 +538,7 @@ pub fn find_steady_segments(
 ) -> Result<Vec<SteadySegment>, SegmentError> {
     options.validate()?;
     check_log(time_s, rate_dps)?;
+    check_gaps(time_s, rate_dps, options)?;
     let n = time_s.len();
     let mut found = Vec::new();
     // Longest raw stretch seen (start index, span in s), for the message when nothing qualifies.
@@ -1138,5 +1186,18 @@ mod tests {
             assert_eq!(SegmentKind::from_parts(k.label(), run, stroke), Some(k));
         }
         assert_eq!(SegmentKind::from_parts("plateau", None, Some(Stroke::Forward)), None);
+    }
+
+    #[test]
+    fn a_time_jump_inside_a_plateau_is_an_error_with_its_sample() {
+        let mut t: Vec<f64> = (0..3000).map(|i| i as f64 * 0.01).collect();
+        let r: Vec<f64> = (0..3000).map(|i| if (1000..2000).contains(&i) { 10.0 } else { 0.0 }).collect();
+        for x in &mut t[1500..] {
+            *x += 1e6;
+        }
+        let e = find_steady_segments(&t, &r, &SegmentOptions::default()).unwrap_err();
+        assert!(matches!(e, SegmentError::TimeGap { index: 1500, .. }), "{e}");
+        assert_eq!(e.sample_index(), Some(1500));
+        assert!(e.to_string().contains("time jumps by"), "{e}");
     }
 }

@@ -32,6 +32,31 @@ impl InvalidOption {
 /// Result of a validator.
 pub type Valid<T> = Result<T, InvalidOption>;
 
+/// Largest magnitude of a numeric option: 1e100. Figures multiply options by data (up to 1e150)
+/// and square them; beyond this bound they overflow to infinity. No real option comes near.
+pub const MAX_OPTION_MAGNITUDE: f64 = 1e100;
+
+/// Smallest magnitude of a non-zero numeric option: 1e-100 (subnormal or absurdly small values
+/// make quotients overflow).
+pub const MIN_OPTION_MAGNITUDE: f64 = 1e-100;
+
+/// `Ok(v)` when `v` is zero or its magnitude lies within [`MIN_OPTION_MAGNITUDE`] to
+/// [`MAX_OPTION_MAGNITUDE`] (NaN and infinity are left to the caller's own rule).
+fn sane_magnitude(field: &'static str, v: f64) -> Valid<f64> {
+    let a = v.abs();
+    if !v.is_finite() || a == 0.0 || (MIN_OPTION_MAGNITUDE..=MAX_OPTION_MAGNITUDE).contains(&a) {
+        Ok(v)
+    } else {
+        Err(InvalidOption::new(
+            field,
+            format!(
+                "must have a magnitude from {MIN_OPTION_MAGNITUDE:e} to {MAX_OPTION_MAGNITUDE:e} (the figures would \
+                 overflow or lose all precision), got {v:e}"
+            ),
+        ))
+    }
+}
+
 /// A finite number above zero.
 ///
 /// ```
@@ -40,6 +65,7 @@ pub type Valid<T> = Result<T, InvalidOption>;
 /// assert_eq!(positive("coverage", 0.0).unwrap_err().to_string(), "coverage must be a positive number, got 0");
 /// ```
 pub fn positive(field: &'static str, v: f64) -> Valid<f64> {
+    sane_magnitude(field, v)?;
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
@@ -49,6 +75,7 @@ pub fn positive(field: &'static str, v: f64) -> Valid<f64> {
 
 /// A finite number at or above zero.
 pub fn non_negative(field: &'static str, v: f64) -> Valid<f64> {
+    sane_magnitude(field, v)?;
     if v.is_finite() && v >= 0.0 {
         Ok(v)
     } else {
@@ -58,6 +85,7 @@ pub fn non_negative(field: &'static str, v: f64) -> Valid<f64> {
 
 /// A finite, positive percentage.
 pub fn positive_percentage(field: &'static str, v: f64) -> Valid<f64> {
+    sane_magnitude(field, v)?;
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
@@ -94,6 +122,9 @@ pub fn polynomial_order(field: &'static str, n: i64) -> Valid<usize> {
 
 /// Smoothing (averaging) times: each a positive number of seconds.
 pub fn smoothing_times(field: &'static str, times: &[f64]) -> Valid<()> {
+    for &t in times {
+        sane_magnitude(field, t)?;
+    }
     match times.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
         Some(t) => Err(InvalidOption::new(field, format!("must be positive seconds, got {t}"))),
         None => Ok(()),
@@ -102,6 +133,7 @@ pub fn smoothing_times(field: &'static str, times: &[f64]) -> Valid<()> {
 
 /// A scale factor: finite and not zero (its sign is the gyro's sense).
 pub fn scale_factor(field: &'static str, v: f64) -> Valid<f64> {
+    sane_magnitude(field, v)?;
     if v.is_finite() && v != 0.0 {
         Ok(v)
     } else {
@@ -111,6 +143,7 @@ pub fn scale_factor(field: &'static str, v: f64) -> Valid<f64> {
 
 /// Any finite number (a null, an offset).
 pub fn finite(field: &'static str, v: f64) -> Valid<f64> {
+    sane_magnitude(field, v)?;
     if v.is_finite() {
         Ok(v)
     } else {
@@ -120,6 +153,9 @@ pub fn finite(field: &'static str, v: f64) -> Valid<f64> {
 
 /// A range of two increasing positive values (`LOW,HIGH`).
 pub fn increasing_pair(field: &'static str, values: &[f64]) -> Valid<Option<(f64, f64)>> {
+    for &t in values {
+        sane_magnitude(field, t)?;
+    }
     match values {
         [] => Ok(None),
         [a, b] if a.is_finite() && b.is_finite() && *a > 0.0 && b > a => Ok(Some((*a, *b))),
@@ -154,5 +190,19 @@ mod tests {
             positive("sample_rate_hz", -1.0).unwrap_err().render("--sample-rate-hz"),
             "--sample-rate-hz must be a positive number, got -1"
         );
+    }
+
+    #[test]
+    fn absurd_magnitudes_are_refused_with_the_field() {
+        let e = positive("coverage", 1e308).unwrap_err();
+        assert_eq!(e.field, "coverage");
+        assert!(e.message.contains("magnitude") && e.message.contains("1e308"), "{e}");
+        assert!(scale_factor("scale_factor", 1e-320).unwrap_err().message.contains("1e-320"));
+        assert!(finite("null", -1e200).is_err());
+        assert_eq!(finite("null", 0.0), Ok(0.0));
+        assert_eq!(non_negative("x", 0.0), Ok(0.0));
+        assert!(smoothing_times("tau", &[1.0, 1e300]).is_err());
+        assert!(increasing_pair("fit", &[1e-200, 1.0]).is_err());
+        assert_eq!(positive("coverage", 2.0), Ok(2.0));
     }
 }

@@ -5,7 +5,9 @@ use crate::error::{CliError, CliResult};
 use clap::{Args, Subcommand};
 use gyrolab::sim::Preset;
 use gyrolab::units::OutputUnit;
-use gyrolab_eval::simulate::{csv_options, sim_config, simulate_to, SimOverrides, SimRecord};
+use gyrolab_eval::simulate::{
+    check_record_size, csv_options, sim_config, simulate_to, SimOverrides, SimRecord, DEFAULT_MAX_SAMPLES,
+};
 use gyrolab_io::sim_csv::SimCsvError;
 use std::io::Write;
 use std::path::PathBuf;
@@ -28,6 +30,10 @@ pub struct CommonArgs {
     /// A TOML set-up (seed, preset, [sensor], [static_record], [rate_table]); flags override it.
     #[arg(long, value_name = "FILE.toml")]
     pub config: Option<PathBuf>,
+    /// Most samples (rows) the record may have (default 1e9): a larger record is refused before
+    /// anything is written, with its size.
+    #[arg(long, value_name = "N", value_parser = parse_max_samples)]
+    pub max_samples: Option<u64>,
     /// Seed: the same seed gives the same bytes on every run (default 1).
     #[arg(long)]
     pub seed: Option<u64>,
@@ -135,6 +141,16 @@ fn parse_preset(s: &str) -> Result<Preset, String> {
     })
 }
 
+/// Parses `--max-samples`: a whole number, in plain or exponent form (`1e10`).
+fn parse_max_samples(s: &str) -> Result<u64, String> {
+    let v: f64 = s.trim().parse().map_err(|_| format!("'{s}' is not a number of samples"))?;
+    if v.is_finite() && v >= 1.0 && v.fract() == 0.0 && v <= u64::MAX as f64 {
+        Ok(v as u64)
+    } else {
+        Err(format!("{s}: expected a whole number of samples, at least 1"))
+    }
+}
+
 fn sim_error(e: SimCsvError) -> CliError {
     match e {
         SimCsvError::Io(io) => CliError::Output(format!("cannot write the simulated record: {io}")),
@@ -191,6 +207,7 @@ pub fn run(cmd: &SimulateCommand) -> CliResult {
         ),
     };
     let cfg = sim_config(&o)?;
+    check_record_size(record, &cfg, common.max_samples.unwrap_or(DEFAULT_MAX_SAMPLES))?;
     let command = format!("command: {}", std::env::args().collect::<Vec<_>>().join(" "));
     let opts = csv_options(common.decimals, vec![command])?;
     emit(&common.out, |w| simulate_to(record, &cfg, &opts, w))

@@ -176,6 +176,10 @@ fn reference_of(axis: &str, ctx: &StaticContext<'_>) -> EvalResult<(Reference, R
     ))
 }
 
+/// Samples at the start of each static record whose time stamps are checked against the plan's
+/// sample rate.
+const RATE_CHECK_ROWS: usize = 10_000;
+
 /// Evaluates one axis's static records: every test, their repeatability, window means and the
 /// Allan analysis of the Allan record (the plan's `allan_file`, else the longest test).
 fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, progress: &dyn Progress) -> EvalResult<StaticAxisReport> {
@@ -208,6 +212,12 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, progress: &dyn Pro
             smoothing_times_s: smoothing.clone(),
             ..StaticTestConfig::default()
         };
+        if let Some(t) = crate::allan::first_times(path, &options, RATE_CHECK_ROWS)? {
+            let key = format!("static.{axis}.sample_rate_hz");
+            if let Some(msg) = crate::allan::rate_disagreement(&t, s.sample_rate_hz, &key, path) {
+                return Err(EvalError::conflict(msg));
+            }
+        }
         let (results, summary) = evaluate_file(path, &options, &reference, &config)?;
         if let Some(want) = &s.temperature_channel {
             let found = summary
@@ -262,7 +272,7 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, progress: &dyn Pro
         }
     };
     progress.message(&format!("axis {axis}: Allan deviation of {}", shown(&allan_path, ctx.base)));
-    let allan = allan_of(&allan_path, &options, &reference, s.sample_rate_hz, ctx.base)?;
+    let allan = allan_of(axis, &allan_path, &options, &reference, s.sample_rate_hz, ctx.base)?;
     progress.advance(1);
     let simulated = ctx.simulated.map(|f| f(axis));
     Ok(StaticAxisReport {
@@ -281,6 +291,7 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, progress: &dyn Pro
 /// OADEV (octave taus, 68.3 % bounds) of one record's first selected channel, converted to deg/s
 /// with the reference (or the unit's native factor), with slope-line and five-term noise terms.
 fn allan_of(
+    axis: &str,
     path: &Path,
     options: &SeriesOptions,
     reference: &Reference,
@@ -288,6 +299,12 @@ fn allan_of(
     base: &Path,
 ) -> EvalResult<ChannelAnalysis> {
     let mut data = read_series_all(path, options)?;
+    if let Some(t) = &data.time {
+        let key = format!("static.{axis}.sample_rate_hz");
+        if let Some(msg) = crate::allan::rate_disagreement(t, sample_rate_hz, &key, path) {
+            return Err(EvalError::conflict(msg));
+        }
+    }
     data.time = None;
     data.temperature = None;
     let Some(info) = data.header.channels.first().cloned() else {

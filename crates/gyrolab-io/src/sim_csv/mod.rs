@@ -368,15 +368,41 @@ fn write_rate_table_csv_as<N: NumberText, W: Write>(
 /// Reads a simulation set-up (TOML: `seed`, `preset`, `[sensor]`, `[static_record]`,
 /// `[rate_table]`); errors name the line and column.
 pub fn read_sim_config(path: &std::path::Path) -> Result<gyrolab::sim::SimConfig, crate::DataError> {
-    let text = std::fs::read_to_string(path).map_err(|e| crate::DataError::io(path, &e))?;
-    toml::from_str(&text).map_err(|e| {
+    let text = crate::text::read_text_file(path, crate::text::MAX_CONFIG_BYTES, "a simulation set-up (TOML)")?;
+    parse_sim_config(path, &text)
+}
+
+/// Parses a simulation set-up from TOML text and checks its values as written; `path` names it in
+/// errors, which give the line of a bad value (`[sensor]`, `[static_record]`, `[rate_table]`).
+pub fn parse_sim_config(path: &std::path::Path, text: &str) -> Result<gyrolab::sim::SimConfig, crate::DataError> {
+    let cfg: gyrolab::sim::SimConfig = toml::from_str(text).map_err(|e| {
         let mut d = crate::DataError::new(path, format!("not a valid simulation set-up: {}", e.message()));
         if let Some(span) = e.span() {
-            let (line, col) = crate::calibration::line_col(&text, span.start);
+            let (line, col) = crate::calibration::line_col(text, span.start);
             d = d.at_line(line).at_column(col, None);
         }
         d
-    })
+    })?;
+    let checks: [(&str, Result<(), gyrolab::sim::SimError>); 3] = [
+        ("sensor", cfg.sensor_model().validate()),
+        ("static_record", cfg.static_record.validate()),
+        ("rate_table", cfg.rate_table.validate()),
+    ];
+    for (section, r) in checks {
+        let Err(e) = r else { continue };
+        let mut d = crate::DataError::new(path, format!("[{section}] {e}"));
+        if let gyrolab::sim::SimError::OutOfRange { parameter, .. } = &e {
+            let (table, key) = match parameter.rsplit_once('.') {
+                Some((sub, key)) => (format!("[{section}.{sub}]"), key),
+                None => (format!("[{section}]"), *parameter),
+            };
+            if let Some(l) = crate::calibration::key_line(text, &table, 0, key) {
+                d = d.at_line(l);
+            }
+        }
+        return Err(d);
+    }
+    Ok(cfg)
 }
 
 #[cfg(test)]
