@@ -145,7 +145,8 @@ pub fn read_calibration(path: &Path) -> Result<CalibrationFile, DataError> {
 /// Parses calibration TOML text; `path` names it in errors.
 pub fn parse_calibration(path: &Path, text: &str) -> Result<CalibrationFile, DataError> {
     let cal: CalibrationFile = toml::from_str(text).map_err(|e| {
-        let mut d = DataError::new(path, format!("not a valid calibration file: {}", e.message()));
+        let mut d =
+            DataError::new(path, format!("not a valid calibration file: {}", crate::text::short_message(e.message())));
         if let Some(span) = e.span() {
             let (line, col) = line_col(text, span.start);
             d = d.at_line(line).at_column(col, None);

@@ -4,7 +4,7 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-/// Longest message kept in a [`DataError`], in characters.
+/// Longest message kept in a [`DataError`], in bytes (cut at a character boundary, then "...").
 pub const MAX_MESSAGE_CHARS: usize = 1000;
 
 /// A column of a delimited file: its 1-based position and, when known, its header name.
@@ -36,7 +36,9 @@ impl DataError {
     /// through [`crate::text::excerpt`]).
     pub fn new(file: impl AsRef<Path>, message: impl Into<String>) -> Self {
         let mut message: String = message.into();
-        if let Some((cut, _)) = message.char_indices().nth(MAX_MESSAGE_CHARS) {
+        if message.len() > MAX_MESSAGE_CHARS {
+            // Bytes, cut at a character boundary: invalid UTF-8 shown as U+FFFD is 3 bytes each.
+            let cut = (0..=MAX_MESSAGE_CHARS).rev().find(|&i| message.is_char_boundary(i)).unwrap_or(0);
             message.truncate(cut);
             message.push_str("...");
         }

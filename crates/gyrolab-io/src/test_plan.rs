@@ -342,7 +342,7 @@ impl Ctx<'_> {
 /// Parses and checks plan text; `path` names it in errors and its folder anchors relative paths.
 pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) -> Result<TestPlan, DataError> {
     let raw: RawPlan = toml::from_str(text).map_err(|e| {
-        let mut d = DataError::new(path, format!("not a valid test plan: {}", e.message().trim_end()));
+        let mut d = DataError::new(path, format!("not a valid test plan: {}", crate::text::short_message(e.message())));
         if let Some(span) = e.span() {
             let (line, col) = line_col(text, span.start);
             d = d.at_line(line).at_column(col, None);

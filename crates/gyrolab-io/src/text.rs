@@ -42,6 +42,27 @@ pub fn excerpt(field: &str) -> String {
     out
 }
 
+/// Most characters of a parser's message (a TOML error) quoted in an error.
+pub const MAX_QUOTED_MESSAGE_CHARS: usize = 300;
+
+/// A parser's message (which may quote the input) cut to [`MAX_QUOTED_MESSAGE_CHARS`]
+/// characters, control characters escaped.
+pub fn short_message(msg: &str) -> String {
+    let mut out = String::new();
+    for (n, c) in msg.trim_end().chars().enumerate() {
+        if n == MAX_QUOTED_MESSAGE_CHARS {
+            out.push_str("...");
+            break;
+        }
+        if c.is_control() && c != '\n' {
+            out.extend(c.escape_unicode());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
 /// Checks the bytes of a text file as they arrive: NUL bytes (binary data), lines longer than
 /// [`MAX_LINE_BYTES`], lines that end with CR only. Keeps the line count across calls.
 #[derive(Debug, Clone, Default)]

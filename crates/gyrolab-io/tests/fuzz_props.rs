@@ -49,7 +49,8 @@ fn calibration_text() -> String {
 fn bounded<T>(r: Result<T, DataError>) -> Result<(), TestCaseError> {
     if let Err(e) = r {
         let text = e.to_string();
-        prop_assert!(text.chars().count() <= MAX_ERROR_CHARS, "{} chars: {}", text.len(), &text[..200]);
+        // Bytes, not characters: a message of replacement characters is 3 bytes a character.
+        prop_assert!(text.len() <= MAX_ERROR_CHARS, "{} bytes: {}", text.len(), text);
         prop_assert!(!e.message.is_empty());
     }
     Ok(())
@@ -205,6 +206,26 @@ mod regressions {
 
     fn check(bytes: &[u8]) {
         all_readers(bytes).unwrap();
+    }
+
+    /// Crash inputs of the cargo-fuzz runs: TOML errors that quoted a whole line of invalid UTF-8
+    /// (replacement characters, 3 bytes each) gave messages of several KiB.
+    #[test]
+    fn fuzz_crashes() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_regressions");
+        for name in ["calibration-long-message.bin", "test_plan-long-message.bin"] {
+            let bytes = std::fs::read(dir.join(name)).unwrap();
+            let text = String::from_utf8_lossy(&bytes);
+            let errors = [
+                parse_calibration(Path::new("c.toml"), &text).map(|_| ()),
+                parse_plan(&plan_path(), &text, &|_| true).map(|_| ()),
+            ];
+            for e in errors.into_iter().filter_map(Result::err) {
+                let shown = e.to_string();
+                assert!(shown.len() < 2000, "{name}: {} bytes: {shown}", shown.len());
+            }
+            check(&bytes);
+        }
     }
 
     #[test]

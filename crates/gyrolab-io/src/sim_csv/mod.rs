@@ -376,7 +376,10 @@ pub fn read_sim_config(path: &std::path::Path) -> Result<gyrolab::sim::SimConfig
 /// errors, which give the line of a bad value (`[sensor]`, `[static_record]`, `[rate_table]`).
 pub fn parse_sim_config(path: &std::path::Path, text: &str) -> Result<gyrolab::sim::SimConfig, crate::DataError> {
     let cfg: gyrolab::sim::SimConfig = toml::from_str(text).map_err(|e| {
-        let mut d = crate::DataError::new(path, format!("not a valid simulation set-up: {}", e.message()));
+        let mut d = crate::DataError::new(
+            path,
+            format!("not a valid simulation set-up: {}", crate::text::short_message(e.message())),
+        );
         if let Some(span) = e.span() {
             let (line, col) = crate::calibration::line_col(text, span.start);
             d = d.at_line(line).at_column(col, None);
