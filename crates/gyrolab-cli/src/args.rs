@@ -15,6 +15,34 @@ pub fn parse_output_unit(s: &str) -> Result<OutputUnit, String> {
     OutputUnit::parse(s).ok_or_else(|| format!("unknown output unit '{s}': expected v, mv, lsb, dps or rad_s"))
 }
 
+/// Options describing a log file's layout: units, time column, names of a headerless file.
+#[derive(Debug, Clone, Default, Args)]
+pub struct LayoutArgs {
+    /// Unit of a column, `COLUMN=UNIT` (`gx=rad/s`, `ax=m/s^2`, `stamp=ns` for the time
+    /// column), or `UNIT` for every output column without one (one rate or output unit, and one
+    /// acceleration unit for columns named as accelerometers such as `ax`); repeatable. Units:
+    /// v, mv, lsb, dps (deg/s), dph, rad_s (rad/s), mrad_s, m_s2 (m/s^2), g, mg.
+    #[arg(long = "unit", value_name = "[COLUMN=]UNIT")]
+    pub units: Vec<String>,
+    /// The time column (default: the first column named time, t, timestamp, stamp, ...).
+    #[arg(long, value_name = "NAME")]
+    pub time_column: Option<String>,
+    /// Column names of a file without a header row (default c1,c2,...).
+    #[arg(long, value_name = "A,B,...", value_delimiter = ',')]
+    pub names: Vec<String>,
+}
+
+impl LayoutArgs {
+    /// The layout request.
+    pub fn layout(&self) -> gyrolab_eval::layout::LogLayout {
+        gyrolab_eval::layout::LogLayout {
+            units: self.units.clone(),
+            time_column: self.time_column.clone(),
+            names: self.names.clone(),
+        }
+    }
+}
+
 /// Options naming the output-to-rate reference.
 #[derive(Debug, Clone, Args)]
 pub struct ReferenceArgs {

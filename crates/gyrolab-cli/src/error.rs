@@ -48,6 +48,7 @@ pub fn flag(field: &str) -> String {
     match field {
         "axis_names" => "--axis".into(),
         "columns" => "--column".into(),
+        "units" => "--unit".into(),
         "manual_segments" => "--segments".into(),
         "calibration" => "--cal".into(),
         "calibration_axis" => "--cal-axis".into(),

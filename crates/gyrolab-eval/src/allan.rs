@@ -3,12 +3,15 @@
 //! with IEEE 952 noise terms by slope lines and by the five-term fit (docs/METHODS.md section 3).
 
 use crate::error::{EvalError, EvalResult};
+use crate::layout::LogLayout;
 use crate::reference::{Reference, ReferenceRequest};
 use gyrolab::allan::{deviation_from_rate, AllanCurve, AllanError, AllanOptions, DeviationKind, TauList};
 use gyrolab::noise::{fit_noise_model, slope_line_terms};
 use gyrolab::sampling::{estimate_interval, SamplingError};
+use gyrolab::units::{OutputUnit, Quantity, TimeUnit};
 use gyrolab::validate::{self, InvalidOption};
 use gyrolab_io::series::{read_series_all, ChannelInfo, SeriesData, SeriesOptions};
+use gyrolab_io::series::{SkippedColumn, UnitSource};
 use gyrolab_io::DataError;
 use gyrolab_report::allan::ChannelAnalysis;
 use rayon::prelude::*;
@@ -49,6 +52,8 @@ pub struct AllanRequest {
     pub confidence: Option<f64>,
     /// Tau range of the five-term fit, s (default: the whole curve).
     pub fit_range_s: Option<(f64, f64)>,
+    /// Units, time column and names of the file, as the user gives them.
+    pub layout: LogLayout,
 }
 
 impl AllanRequest {
@@ -63,6 +68,7 @@ impl AllanRequest {
             taus: TauList::Octave,
             confidence: Some(0.683),
             fit_range_s: None,
+            layout: LogLayout::default(),
         }
     }
 }
@@ -74,6 +80,76 @@ pub struct AllanOutcome {
     pub analyses: Vec<ChannelAnalysis>,
     /// The sampling interval used, s.
     pub sample_interval_s: f64,
+    /// What the reader decided or left out, for the user (shown as `note:` lines).
+    pub notes: Vec<ReadNote>,
+}
+
+/// Something the reader decided or left out, shown to the user.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ReadNote {
+    /// A column not read, and why.
+    Skipped(SkippedColumn),
+    /// The unit of the time column when it was not written in the header.
+    TimeUnit {
+        /// The column's name.
+        column: String,
+        /// The unit taken.
+        unit: TimeUnit,
+        /// Where it came from.
+        source: UnitSource,
+    },
+    /// Channels without a unit: analysed in their own units, no noise terms.
+    Unitless {
+        /// Their names.
+        channels: Vec<String>,
+    },
+}
+
+impl std::fmt::Display for ReadNote {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ReadNote::Skipped(s) => write!(f, "{s}"),
+            ReadNote::TimeUnit { column, unit, source } => {
+                let why = match source {
+                    UnitSource::Magnitude => "from the magnitude of the stamps (epoch time)",
+                    UnitSource::RosConvention => "by the ROS convention (rostopic echo -p writes nanoseconds)",
+                    _ => "assumed: the header names no unit",
+                };
+                write!(f, "time column '{column}' read in {} ({why}); give {{units}} {column}=UNIT if that is wrong", unit.symbol())
+            }
+            ReadNote::Unitless { channels } => write!(
+                f,
+                "no unit for {}: deviations in the columns' own units, no noise terms; give {{units}} such as {}=rad/s, or a unit for every such column",
+                channels.join(", "),
+                channels.first().map_or("gx", String::as_str)
+            ),
+        }
+    }
+}
+
+impl ReadNote {
+    /// The note with its option placeholders (`{units}`) spelled by the front end.
+    pub fn render(&self, spell: &dyn Fn(&str) -> String) -> String {
+        self.to_string().replace("{units}", &spell("units"))
+    }
+}
+
+/// The notes of a file's header: skipped columns, a time unit not written in the header,
+/// channels without a unit.
+pub fn read_notes(header: &gyrolab_io::series::SeriesHeader) -> Vec<ReadNote> {
+    let mut notes: Vec<ReadNote> = header.skipped.iter().cloned().map(ReadNote::Skipped).collect();
+    if let (Some(c), Some(unit), Some(source)) = (header.time_column, header.time_unit, header.time_unit_source) {
+        if !matches!(source, UnitSource::Header | UnitSource::Column) {
+            let column = header.columns.get(c - 1).map_or(String::new(), |x| x.name.clone());
+            notes.push(ReadNote::TimeUnit { column, unit, source });
+        }
+    }
+    let unitless: Vec<String> =
+        header.channels.iter().filter(|c| c.unit == OutputUnit::Unitless).map(|c| c.name.clone()).collect();
+    if !unitless.is_empty() {
+        notes.push(ReadNote::Unitless { channels: unitless });
+    }
+    notes
 }
 
 /// Parses a tau list: `octave`, `decade`, `all`, `N/decade`, or seconds (`0.1,1,10`).
@@ -220,15 +296,29 @@ pub fn analyse_channel(
     info: &ChannelInfo,
     mut values: Vec<f64>,
 ) -> EvalResult<ChannelAnalysis> {
-    let calibrated = setup
+    let quantity = setup
         .reference
-        .to_rate(info.unit, &mut values)
+        .to_physical(info.unit, &mut values)
         .map_err(|m| EvalError::conflict(format!("{}: channel '{}': {m}", setup.path.display(), info.name)))?;
-    let rate_unit = if calibrated { "deg/s".to_string() } else { info.unit.symbol().to_string() };
+    let calibrated = matches!(quantity, Quantity::AngularRate | Quantity::Acceleration);
+    let rate_unit = match quantity {
+        Quantity::AngularRate => "deg/s".to_string(),
+        Quantity::Acceleration => "m/s^2".to_string(),
+        _ => info.unit.symbol().to_string(),
+    };
     values.reserve_exact(1);
     let curve = channel_curve(setup.path, info, values, setup.lines, setup.tau0_s, setup.options)?;
     let allan_kind = matches!(setup.options.kind, DeviationKind::Oadev | DeviationKind::Adev);
-    let (slope_lines, model_fit, noise_note) = if !calibrated {
+    let (slope_lines, model_fit, noise_note) = if quantity == Quantity::Unitless {
+        (
+            None,
+            None,
+            Some(
+                "the column has no unit: give one (such as rad/s, deg/s, m/s^2, V with a scale factor) for noise terms"
+                    .to_string(),
+            ),
+        )
+    } else if !calibrated {
         (None, None, Some(format!("the data are in {rate_unit}: {}", setup.uncalibrated_hint)))
     } else if !allan_kind {
         (None, None, Some("noise terms are read from the Allan deviation (--kind oadev or adev)".to_string()))
@@ -239,6 +329,7 @@ pub fn analyse_channel(
         file: setup.shown.clone(),
         channel: info.name.clone(),
         rate_unit,
+        quantity,
         curve,
         slope_lines,
         model_fit,
@@ -259,12 +350,13 @@ pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
     }
     let reference = request.reference.resolve()?;
     let path = &request.file;
-    let options = SeriesOptions {
+    let options = request.layout.apply(SeriesOptions {
         sample_rate_hz: request.sample_rate_hz,
         channels: if request.columns.is_empty() { None } else { Some(request.columns.clone()) },
         ..SeriesOptions::default()
-    };
+    })?;
     let mut data = read_series_all(path, &options)?;
+    let notes = read_notes(&data.header);
     let tau0 = sample_interval(&data, path, request.sample_rate_hz)?;
     data.time = None;
     let opts = AllanOptions {
@@ -292,5 +384,5 @@ pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
         .map(|(values, info)| analyse_channel(&setup, &info, values))
         .collect();
     let analyses = results.into_iter().collect::<Result<Vec<_>, _>>()?;
-    Ok(AllanOutcome { analyses, sample_interval_s: tau0 })
+    Ok(AllanOutcome { analyses, sample_interval_s: tau0, notes })
 }

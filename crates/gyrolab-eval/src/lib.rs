@@ -26,6 +26,7 @@ pub mod allan;
 pub mod apply;
 pub mod demo;
 pub mod error;
+pub mod layout;
 pub mod paper;
 pub mod progress;
 pub mod rate;

@@ -7,7 +7,7 @@
 
 use crate::error::{EvalError, EvalResult};
 use gyrolab::static_test::StaticTestConfig;
-use gyrolab::units::OutputUnit;
+use gyrolab::units::{OutputUnit, Quantity};
 use gyrolab::validate;
 use gyrolab_io::calibration::read_calibration;
 use std::path::PathBuf;
@@ -30,7 +30,7 @@ impl ReferenceRequest {
     ///
     /// ```
     /// use gyrolab_eval::reference::{Reference, ReferenceRequest};
-    /// use gyrolab::units::OutputUnit;
+    /// use gyrolab::units::{OutputUnit, Quantity};
     /// let r = ReferenceRequest { scale_factor: Some(0.0075), null: Some(2.5), ..Default::default() };
     /// let reference = r.resolve().unwrap();
     /// let mut v = vec![2.5075, 2.5];
@@ -132,6 +132,24 @@ impl Reference {
             Ok(None) => Ok(()),
             Err(m) => Err(format!("channel '{channel}': {m}")),
         }
+    }
+
+    /// Turns samples in `unit` into physical units in place and says what they now are:
+    /// accelerations become m/s^2 ([`Quantity::Acceleration`], whatever the reference);
+    /// outputs and unitless samples with a reference, and angular rates, become deg/s
+    /// ([`Quantity::AngularRate`], by [`Reference::to_rate`]); anything else is left as it is
+    /// ([`Quantity::SensorOutput`] or [`Quantity::Unitless`]).
+    pub fn to_physical(&self, unit: OutputUnit, values: &mut [f64]) -> Result<Quantity, String> {
+        if let Some(f) = unit.per_m_s2() {
+            if f != 1.0 {
+                values.iter_mut().for_each(|v| *v /= f);
+            }
+            return Ok(Quantity::Acceleration);
+        }
+        if unit == OutputUnit::Unitless && self.is_none() {
+            return Ok(Quantity::Unitless);
+        }
+        Ok(if self.to_rate(unit, values)? { Quantity::AngularRate } else { unit.quantity() })
     }
 
     /// Turns output samples in `unit` into rates in deg/s, in place: `(x - null) / K` with the

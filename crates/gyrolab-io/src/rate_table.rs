@@ -127,12 +127,12 @@ fn bracketed_unit(name: &str) -> Option<String> {
 
 fn output_unit_of_name(name: &str) -> Result<Option<OutputUnit>, String> {
     if let Some(b) = bracketed_unit(name) {
-        if let Some(u) = OutputUnit::parse(&b) {
+        if let Some(u) = OutputUnit::parse_gyro_output(&b) {
             return Ok(Some(u));
         }
     }
     match split_unit_suffix(name).1 {
-        Some(s) => OutputUnit::parse(&s).map(Some).ok_or_else(|| {
+        Some(s) => OutputUnit::parse_gyro_output(&s).map(Some).ok_or_else(|| {
             format!(
                 "unknown output unit suffix '_{}': expected one of _v, _mv, _lsb, _dps, _rad_s",
                 crate::text::excerpt(&s)
@@ -455,7 +455,7 @@ fn read_wide(path: &Path, table: &TextTable, columns: &RateColumns) -> Result<Ra
                 .at_column(c + 1, Some(name))
             })?;
             let u = match unit {
-                Some(s) => Some(OutputUnit::parse(&s).ok_or_else(|| {
+                Some(s) => Some(OutputUnit::parse_gyro_output(&s).ok_or_else(|| {
                     DataError::new(
                         path,
                         format!(

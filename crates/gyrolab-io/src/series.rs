@@ -15,7 +15,7 @@
 
 use crate::error::DataError;
 use gyrolab::static_test::{OutlierScan, SampleBlock, StaticTestAccumulator, StaticTestConfig, StaticTestResult};
-use gyrolab::units::{split_unit_suffix, OutputUnit, RateUnit};
+use gyrolab::units::{is_celsius, parse_column_name, OutputUnit, Quantity, RateUnit, TimeUnit};
 use serde::{Deserialize, Serialize};
 use std::fs::File;
 use std::io::Read;
@@ -41,8 +41,19 @@ pub struct SeriesOptions {
     pub delimiter: Option<Delimiter>,
     /// Sample rate in Hz; required when the file has no time column.
     pub sample_rate_hz: Option<f64>,
-    /// Units for named columns, overriding (or supplying) the header suffix.
+    /// Units for named columns, overriding (or supplying) the header's unit.
     pub column_units: Vec<(String, OutputUnit)>,
+    /// Units for every output column without one, at most one per quantity (an angular-rate or
+    /// sensor-output unit for gyro and unnamed columns, an acceleration unit for columns named
+    /// as accelerometers, such as `ax` or `acc_x`).
+    pub default_units: Vec<OutputUnit>,
+    /// Header name of the time column; `None` takes the first column named as a time
+    /// (`time`, `t`, `timestamp`, `stamp`, ...).
+    pub time_column: Option<String>,
+    /// Unit of the time column, overriding (or supplying) the header's unit.
+    pub time_unit: Option<TimeUnit>,
+    /// Column names of a file without a header row (default `c1`, `c2`, ...).
+    pub names: Option<Vec<String>>,
     /// Output channels to read by header name; `None` reads every non-time, non-temperature column.
     pub channels: Option<Vec<String>>,
     /// Header name of a table-rate column (raw rate-table logs, such as `table_rate_dps`): read
@@ -65,6 +76,10 @@ impl Default for SeriesOptions {
             delimiter: None,
             sample_rate_hz: None,
             column_units: Vec::new(),
+            default_units: Vec::new(),
+            time_column: None,
+            time_unit: None,
+            names: None,
             channels: None,
             table_rate_column: None,
             tolerant: false,
@@ -108,8 +123,81 @@ pub struct ChannelInfo {
     pub name: String,
     /// 1-based column position.
     pub column: usize,
-    /// Output unit.
+    /// Output unit ([`OutputUnit::Unitless`] when none is known).
     pub unit: OutputUnit,
+    /// Where the unit came from.
+    pub unit_source: UnitSource,
+}
+
+/// Where a column's unit came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum UnitSource {
+    /// The header (a suffix such as `_dps`, or brackets such as `[rad/s]`).
+    Header,
+    /// An option naming the column (`--unit COLUMN=UNIT`, a plan key).
+    Column,
+    /// The default unit for columns without one (`--unit UNIT`).
+    Default,
+    /// The ROS message convention (REP 103: `angular_velocity` in rad/s,
+    /// `linear_acceleration` in m/s^2).
+    RosConvention,
+    /// The magnitude of the time stamps (epoch seconds, milliseconds, microseconds or
+    /// nanoseconds), for a time column without a unit.
+    Magnitude,
+    /// Assumed: seconds for a time column, degC for a temperature column without a unit.
+    Assumed,
+    /// No unit: a dimensionless channel.
+    None,
+}
+
+/// Why a column is not read.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SkipReason {
+    /// Not among the selected channels.
+    NotSelected,
+    /// A second time column (the first one is the time).
+    SecondTime,
+    /// A second temperature column.
+    SecondTemperature,
+    /// A counter or index (`seq`, `index`, `frame`, ...).
+    Counter,
+    /// Text in the first data row.
+    Text,
+    /// A unit that no channel can be in (the unit as written).
+    UnknownUnit(String),
+    /// An orientation or covariance field of a ROS message.
+    RosField,
+}
+
+/// A column the reader did not read, and why.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SkippedColumn {
+    /// 1-based column.
+    pub column: usize,
+    /// Header name as written.
+    pub name: String,
+    /// Why.
+    pub reason: SkipReason,
+}
+
+impl std::fmt::Display for SkippedColumn {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let name = crate::text::excerpt(&self.name);
+        let why = match &self.reason {
+            SkipReason::NotSelected => "not selected".to_string(),
+            SkipReason::SecondTime => "a second time column".to_string(),
+            SkipReason::SecondTemperature => "a second temperature column".to_string(),
+            SkipReason::Counter => "a counter or index".to_string(),
+            SkipReason::Text => "text in the first data row".to_string(),
+            SkipReason::UnknownUnit(u) => {
+                format!("unit '{}' is none of {}", crate::text::excerpt(u), OutputUnit::accepted_channel_suffixes())
+            }
+            SkipReason::RosField => "an orientation or covariance field".to_string(),
+        };
+        write!(f, "column {} '{name}' skipped: {why}", self.column)
+    }
 }
 
 /// The parsed header of a time-series file.
@@ -135,6 +223,15 @@ pub struct SeriesHeader {
     pub table_rate_column: Option<usize>,
     /// Unit of the table-rate column as written (values are handed out in deg/s).
     pub table_rate_unit: Option<RateUnit>,
+    /// Unit of the time column as written (values are handed out in seconds).
+    pub time_unit: Option<TimeUnit>,
+    /// Where the time unit came from.
+    pub time_unit_source: Option<UnitSource>,
+    /// Whether the file has no header row (columns named `c1..cN` or by the caller).
+    pub headerless: bool,
+    /// Columns not read (other than the selected channels' neighbours the caller ignored on
+    /// purpose), with the reason: shown to the user as notes.
+    pub skipped: Vec<SkippedColumn>,
 }
 
 /// A NaN or empty cell accepted in tolerant mode.
@@ -200,6 +297,88 @@ impl<'a> SeriesBlock<'a> {
 
 const SKIP: u32 = SKIP_COLUMN;
 
+/// Whether a header field is a number (then the line is data, not a header).
+fn is_number_text(f: &str) -> bool {
+    let t = f.trim();
+    !t.is_empty() && t.parse::<f64>().is_ok()
+}
+
+/// Whether a column's base name says it holds time stamps.
+fn is_time_name(base: &str) -> bool {
+    matches!(base, "time" | "t" | "timestamp" | "timestamps" | "stamp" | "time_stamp" | "ts" | "times")
+        || base.ends_with(".stamp")
+        || base.ends_with("_time")
+        || base.ends_with("_timestamp")
+        || base.ends_with(".timestamp")
+}
+
+/// Whether a column's base name says it holds a temperature.
+fn is_temperature_name(base: &str) -> bool {
+    matches!(base, "temp" | "temperature" | "tmp" | "die_temp" | "imu_temp" | "temp_imu" | "gyro_temp")
+        || base.ends_with(".temperature")
+}
+
+/// The unit of a temperature column named in kelvin or fahrenheit (`temp_k`, `temperature_f`).
+fn other_temperature_unit(base: &str) -> Option<&str> {
+    let (b, u) = base.rsplit_once('_')?;
+    (is_temperature_name(b) && matches!(u, "k" | "f" | "kelvin" | "fahrenheit")).then_some(u)
+}
+
+/// Whether a column's base name says it is a counter or index.
+fn is_counter_name(base: &str) -> bool {
+    matches!(
+        base,
+        "seq"
+            | "sequence"
+            | "counter"
+            | "count"
+            | "index"
+            | "idx"
+            | "frame"
+            | "sample"
+            | "packet"
+            | "id"
+            | "n"
+            | "no"
+            | "nr"
+            | "row"
+            | "line"
+            | "cnt"
+    ) || [".seq", "_seq", "_index", "_counter", "_count", "_id", "_cnt"].iter().any(|s| base.ends_with(s))
+}
+
+/// Orientation and covariance fields of a ROS `sensor_msgs/Imu` export.
+fn is_ros_field_to_skip(base: &str) -> bool {
+    base.contains("covariance") || base.contains("orientation")
+}
+
+/// The unit a ROS `sensor_msgs/Imu` field has by convention (REP 103).
+fn ros_convention_unit(base: &str) -> Option<OutputUnit> {
+    if base.contains("angular_velocity") {
+        Some(OutputUnit::RadPerSec)
+    } else if base.contains("linear_acceleration") {
+        Some(OutputUnit::MeterPerSec2)
+    } else {
+        None
+    }
+}
+
+/// Whether a column's base name says it is an accelerometer channel (`ax`, `acc_x`,
+/// `accel_y`, `a_rs_s_z`, `linear_acceleration.x`, ...).
+pub fn is_accelerometer_name(base: &str) -> bool {
+    let b = base
+        .trim_end_matches(|c: char| matches!(c, 'x' | 'y' | 'z' | '1' | '2' | '3'))
+        .trim_end_matches(['_', '.', '-', ' ']);
+    b == "a"
+        || b.starts_with("acc")
+        || b.contains("_acc")
+        || b.contains(".acc")
+        || b.contains("linear_acceleration")
+        || b == "a_rs_s"
+        || b.ends_with("_a")
+        || b.ends_with("accelerometer")
+}
+
 /// Streaming reader: parse the header with [`SeriesReader::open`], then call
 /// [`SeriesReader::next_block`] until it returns `None`. After an error the reader is spent.
 pub struct SeriesReader<R: Read> {
@@ -229,12 +408,18 @@ pub struct SeriesReader<R: Read> {
     quality: ReaderQuality,
 }
 
-impl SeriesReader<File> {
-    /// Opens a file and reads its header.
+/// The byte source of [`SeriesReader::open`]: a file, or standard input for the path `-`.
+pub type Source = Box<dyn Read + Send>;
+
+impl SeriesReader<Source> {
+    /// Opens a file (`-`: standard input) and reads its header.
     pub fn open(path: impl AsRef<Path>, options: &SeriesOptions) -> Result<Self, DataError> {
         let path = path.as_ref();
+        if path == Path::new("-") {
+            return SeriesReader::from_reader("<stdin>", Box::new(std::io::stdin()) as Source, options);
+        }
         let f = File::open(path).map_err(|e| DataError::io(path, &e))?;
-        SeriesReader::from_reader(path, f, options)
+        SeriesReader::from_reader(path, Box::new(f) as Source, options)
     }
 }
 
@@ -261,6 +446,10 @@ impl<R: Read> SeriesReader<R> {
                 sample_rate_hz: options.sample_rate_hz,
                 table_rate_column: None,
                 table_rate_unit: None,
+                time_unit: None,
+                time_unit_source: None,
+                headerless: false,
+                skipped: Vec::new(),
             },
             tolerant: options.tolerant,
             fast_rows: options.fast_rows,
@@ -289,42 +478,122 @@ impl<R: Read> SeriesReader<R> {
                 return Err(DataError::new(&file, format!("sample rate {f} Hz: expected a positive number")));
             }
         }
-        // Header: the first line that is neither blank nor a comment.
+        // Header: the first line that is neither blank nor a comment, unless it holds only
+        // numbers: then the file has no header row, or (Kalibr's imu0.csv) its header is the
+        // comment line just above the data.
         let mut first = true;
-        let header_text = loop {
+        let mut last_comment: Option<(u64, String)> = None;
+        let (header_text, data_start) = loop {
             if r.pos >= r.complete && !r.fill()? {
                 return Err(DataError::new(
                     &file,
-                    "the file is empty: expected a header row such as 'time_s,output_v'",
+                    "the file is empty: expected a header row such as 'time_s,output_v', or rows of numbers",
                 ));
             }
-            let start = r.pos;
+            let mut start = r.pos;
             let end = memchr::memchr(b'\n', &r.buf[start..r.complete]).map_or(r.complete, |i| start + i);
             r.pos = (end + 1).min(r.complete);
             r.line_no += 1;
-            let mut line = &r.buf[start..end];
             if first {
-                line = line.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(line);
+                if r.buf[start..end].starts_with(b"\xEF\xBB\xBF") {
+                    start += 3;
+                }
                 first = false;
             }
-            if !is_blank_or_comment(line) {
-                r.crlf = line.ends_with(b"\r");
-                if memchr::memchr(b'\r', line.strip_suffix(b"\r").unwrap_or(line)).is_some() {
+            let line = &r.buf[start..end];
+            if is_blank_or_comment(line) {
+                let t = line.trim_ascii();
+                last_comment =
+                    (!t.is_empty()).then(|| (r.line_no, String::from_utf8_lossy(&t[1..]).trim().to_string()));
+                continue;
+            }
+            r.crlf = line.ends_with(b"\r");
+            if memchr::memchr(b'\r', line.strip_suffix(b"\r").unwrap_or(line)).is_some() {
+                return Err(DataError::new(
+                    &file,
+                    "lines end with CR only (a classic Mac OS text file): expected LF or CR LF line ends",
+                )
+                .at_line(r.line_no));
+            }
+            break (String::from_utf8_lossy(line).trim().to_string(), start);
+        };
+        let delim = options.delimiter.unwrap_or_else(|| Delimiter::sniff(&header_text));
+        let fields = delim.split(&header_text);
+        if fields.iter().all(|f| is_number_text(f)) {
+            // No header row: hand the line back to the data parser.
+            let data_line = r.line_no;
+            r.pos = data_start;
+            r.line_no -= 1;
+            let commented = last_comment.filter(|(l, t)| {
+                *l + 1 == data_line && {
+                    let names = delim.split(t);
+                    names.len() == fields.len() && names.iter().any(|n| !is_number_text(n))
+                }
+            });
+            if let (Some((line, text)), None) = (commented, &options.names) {
+                r.header.header_line = line;
+                r.parse_header(&text, options, Some(&fields))?;
+                return Ok(r);
+            }
+            let names: Vec<String> = match &options.names {
+                Some(n) if n.len() != fields.len() => {
                     return Err(DataError::new(
                         &file,
-                        "lines end with CR only (a classic Mac OS text file): expected LF or CR LF line ends",
+                        format!(
+                            "{} names given for a file without a header row whose first row has {} fields",
+                            n.len(),
+                            fields.len()
+                        ),
                     )
-                    .at_line(r.line_no));
+                    .at_line(data_line));
                 }
-                break String::from_utf8_lossy(line).trim().to_string();
-            }
-        };
+                Some(n) => n.clone(),
+                None => (1..=fields.len()).map(|i| format!("c{i}")).collect(),
+            };
+            r.header.headerless = true;
+            r.header.header_line = 0;
+            let joined = names.join(&(delim.byte() as char).to_string());
+            let joined = if delim == Delimiter::Whitespace { names.join(" ") } else { joined };
+            r.parse_header(&joined, &SeriesOptions { delimiter: Some(delim), ..options.clone() }, Some(&fields))?;
+            return Ok(r);
+        }
+        if options.names.is_some() {
+            return Err(DataError::new(
+                &file,
+                "column names given for a file that has a header row: leave the names out",
+            )
+            .at_line(r.line_no));
+        }
         r.header.header_line = r.line_no;
-        r.parse_header(&header_text, options)?;
+        let first_row = r.peek_first_row(delim)?;
+        r.parse_header(&header_text, options, first_row.as_deref())?;
         Ok(r)
     }
 
-    fn parse_header(&mut self, text: &str, options: &SeriesOptions) -> Result<(), DataError> {
+    /// The fields of the first data row after the header, without consuming it (`None` when
+    /// it is not in the buffer).
+    fn peek_first_row(&mut self, delim: Delimiter) -> Result<Option<Vec<String>>, DataError> {
+        if self.pos >= self.complete && !self.fill()? {
+            return Ok(None);
+        }
+        let mut p = self.pos;
+        while p < self.complete {
+            let end = memchr::memchr(b'\n', &self.buf[p..self.complete]).map_or(self.complete, |i| p + i);
+            let line = &self.buf[p..end];
+            if !is_blank_or_comment(line) {
+                return Ok(Some(delim.split(String::from_utf8_lossy(line).trim())));
+            }
+            p = end + 1;
+        }
+        Ok(None)
+    }
+
+    fn parse_header(
+        &mut self,
+        text: &str,
+        options: &SeriesOptions,
+        first_row: Option<&[String]>,
+    ) -> Result<(), DataError> {
         let file = self.header.file.clone();
         let line = self.header.header_line;
         let delim = options.delimiter.unwrap_or_else(|| Delimiter::sniff(text));
@@ -354,74 +623,163 @@ impl<R: Read> SeriesReader<R> {
                 );
             }
         }
-        let selected = |n: &str| options.channels.as_ref().is_none_or(|l| l.iter().any(|c| c.eq_ignore_ascii_case(n)));
-        let accepted = OutputUnit::accepted_suffixes();
+        let parsed: Vec<_> = names.iter().map(|n| parse_column_name(n)).collect();
+        let matches = |given: &str, i: usize| {
+            given.eq_ignore_ascii_case(&names[i]) || given.eq_ignore_ascii_case(&parsed[i].base)
+        };
+        let find = |given: &str| {
+            (0..names.len())
+                .find(|&i| given.eq_ignore_ascii_case(&names[i]))
+                .or_else(|| (0..names.len()).find(|&i| matches(given, i)))
+        };
+        let text_at = |i: usize| first_row.and_then(|r| r.get(i)).is_some_and(|f| !f.is_empty() && !is_number_text(f));
+        // The time column: the one named by the option, else the first whose name is a time.
+        let time_index = match &options.time_column {
+            Some(t) => match find(t) {
+                Some(i) => Some(i),
+                None => {
+                    return Err(DataError::new(
+                        &file,
+                        format!(
+                            "time column '{}' is not in the header: found {}",
+                            crate::text::excerpt(t),
+                            crate::text::excerpt(&names.join(", "))
+                        ),
+                    )
+                    .at_line(line))
+                }
+            },
+            None => (0..names.len()).find(|&i| is_time_name(&parsed[i].base) && !text_at(i)),
+        };
+        let selected = |i: usize| options.channels.as_ref().is_none_or(|l| l.iter().any(|c| matches(c, i)));
         let mut columns = Vec::with_capacity(names.len());
         let mut channels: Vec<ChannelInfo> = Vec::new();
+        let mut skipped = Vec::new();
         for (i, name) in names.iter().enumerate() {
             let shown = crate::text::excerpt(name);
-            let (base, suffix) = split_unit_suffix(name);
-            let sfx = suffix.as_deref();
-            let unit_override = options.column_units.iter().find(|(c, _)| c.eq_ignore_ascii_case(name)).map(|p| p.1);
-            let is_rate = options.table_rate_column.as_ref().is_some_and(|c| c.eq_ignore_ascii_case(name));
+            let cn = &parsed[i];
+            let unit_text = cn.unit.as_deref();
+            let unit_override = options.column_units.iter().find(|(c, _)| matches(c, i)).map(|p| p.1);
+            let is_rate = options.table_rate_column.as_ref().is_some_and(|c| matches(c, i));
+            let explicitly_selected = options.channels.as_ref().is_some_and(|l| l.iter().any(|c| matches(c, i)));
+            let mut skip = |reason: SkipReason| {
+                skipped.push(SkippedColumn { column: i + 1, name: name.clone(), reason });
+                ColumnRole::Ignored
+            };
             let role = if is_rate {
-                let Some(unit) = sfx.and_then(RateUnit::parse) else {
+                let Some(unit) = unit_text.and_then(RateUnit::parse) else {
                     return err(
                         i + 1,
                         Some(name),
-                        format!("table-rate column '{shown}': expected a rate unit suffix (as in 'table_rate_dps')"),
+                        format!("table-rate column '{shown}': expected a rate unit (as in 'table_rate_dps' or 'rate [deg/s]')"),
                     );
                 };
                 self.header.table_rate_column = Some(i + 1);
                 self.header.table_rate_unit = Some(unit);
                 ColumnRole::TableRate
-            } else if matches!(base.as_str(), "time" | "t" | "timestamp") {
-                if sfx != Some("s") {
-                    return err(i + 1, Some(name), format!("time column '{shown}': expected seconds, named 'time_s'"));
-                }
-                if let Some(c) = self.header.time_column {
-                    return err(i + 1, Some(name), format!("a second time column: column {c} is already the time"));
-                }
+            } else if Some(i) == time_index {
+                let (unit, source) = match (options.time_unit, unit_text) {
+                    (Some(u), _) => (u, UnitSource::Column),
+                    (None, Some(t)) => match TimeUnit::parse(t) {
+                        Some(u) => (u, UnitSource::Header),
+                        None => {
+                            return err(
+                                i + 1,
+                                Some(name),
+                                format!(
+                                    "time column '{shown}': unit '{}' is not a time unit: expected s, ms, us or ns (as in 'time_s' or 'timestamp [ns]')",
+                                    crate::text::excerpt(t)
+                                ),
+                            )
+                        }
+                    },
+                    (None, None) if cn.base.ends_with(".stamp") || cn.base == "time" && name.starts_with('%') => {
+                        (TimeUnit::Nanosecond, UnitSource::RosConvention)
+                    }
+                    (None, None) => match first_row.and_then(|r| r.get(i)).and_then(|f| f.parse::<f64>().ok()) {
+                        Some(v) if v.abs() > 1e17 => (TimeUnit::Nanosecond, UnitSource::Magnitude),
+                        Some(v) if v.abs() > 1e14 => (TimeUnit::Microsecond, UnitSource::Magnitude),
+                        Some(v) if v.abs() > 1e11 => (TimeUnit::Millisecond, UnitSource::Magnitude),
+                        _ => (TimeUnit::Second, UnitSource::Assumed),
+                    },
+                };
                 self.header.time_column = Some(i + 1);
+                self.header.time_unit = Some(unit);
+                self.header.time_unit_source = Some(source);
                 ColumnRole::Time
-            } else if matches!(base.as_str(), "temp" | "temperature") && unit_override.is_none() {
-                if !matches!(sfx, Some("c") | Some("degc")) {
+            } else if is_time_name(&cn.base) && unit_override.is_none() && !explicitly_selected {
+                skip(SkipReason::SecondTime)
+            } else if (is_temperature_name(&cn.base) || other_temperature_unit(&cn.base).is_some())
+                && unit_override.is_none()
+                && !explicitly_selected
+            {
+                if let Some(t) = unit_text.or(other_temperature_unit(&cn.base)).filter(|t| !is_celsius(t)) {
                     return err(
                         i + 1,
                         Some(name),
-                        format!("temperature column '{shown}': expected degC, named 'temp_c'"),
+                        format!(
+                            "temperature column '{shown}': unit '{}' is not degC: expected degC (as in 'temp_c' or 'temperature [degC]')",
+                            crate::text::excerpt(t)
+                        ),
                     );
                 }
-                if let Some(c) = self.header.temperature_column {
-                    return err(i + 1, Some(name), format!("a second temperature column: column {c} is already one"));
+                if self.header.temperature_column.is_some() {
+                    skip(SkipReason::SecondTemperature)
+                } else {
+                    self.header.temperature_column = Some(i + 1);
+                    ColumnRole::Temperature
                 }
-                self.header.temperature_column = Some(i + 1);
-                ColumnRole::Temperature
-            } else if !selected(name) {
+            } else if !selected(i) {
                 ColumnRole::Ignored
+            } else if !explicitly_selected && is_counter_name(&cn.base) {
+                skip(SkipReason::Counter)
+            } else if !explicitly_selected && is_ros_field_to_skip(&cn.base) {
+                skip(SkipReason::RosField)
+            } else if !explicitly_selected && text_at(i) {
+                skip(SkipReason::Text)
             } else {
-                let unit = match unit_override.or_else(|| sfx.and_then(OutputUnit::parse)) {
-                    Some(u) => u,
-                    None => {
-                        let what = match sfx {
-                            Some(s) => format!("unknown unit suffix '{}'", crate::text::excerpt(s)),
-                            None => "no unit suffix".to_string(),
-                        };
-                        return err(
-                            i + 1,
-                            Some(name),
-                            format!(
-                                "{what} in column '{shown}': expected one of the suffixes {accepted} \
-                                 (as in 'output_v'), a unit named for the column, or a channel selection without it"
-                            ),
-                        );
+                let from_header = unit_text.map(|t| (t, OutputUnit::parse(t)));
+                let resolved = match (unit_override, from_header) {
+                    (Some(u), _) => Some((u, UnitSource::Column)),
+                    (None, Some((_, Some(u)))) => Some((u, UnitSource::Header)),
+                    (None, Some((t, None))) => {
+                        if explicitly_selected {
+                            return err(
+                                i + 1,
+                                Some(name),
+                                format!(
+                                    "unknown unit '{}' in column '{shown}': expected one of {} (as in 'gyro_x_dps' or 'gyro_x [rad/s]'), or a unit given for the column",
+                                    crate::text::excerpt(t),
+                                    OutputUnit::accepted_channel_suffixes()
+                                ),
+                            );
+                        }
+                        let _ = skip(SkipReason::UnknownUnit(t.to_string()));
+                        None
                     }
+                    (None, None) => Some(ros_convention_unit(&cn.base).map_or_else(
+                        || {
+                            let accel = is_accelerometer_name(&cn.base);
+                            options
+                                .default_units
+                                .iter()
+                                .find(|u| (u.quantity() == Quantity::Acceleration) == accel)
+                                .map_or((OutputUnit::Unitless, UnitSource::None), |&u| (u, UnitSource::Default))
+                        },
+                        |u| (u, UnitSource::RosConvention),
+                    )),
                 };
-                channels.push(ChannelInfo { name: name.clone(), column: i + 1, unit });
-                ColumnRole::Channel(channels.len() - 1)
+                match resolved {
+                    Some((unit, unit_source)) => {
+                        channels.push(ChannelInfo { name: name.clone(), column: i + 1, unit, unit_source });
+                        ColumnRole::Channel(channels.len() - 1)
+                    }
+                    None => ColumnRole::Ignored,
+                }
             };
             columns.push(ColumnInfo { index: i + 1, name: name.clone(), role });
         }
+        self.header.skipped = skipped;
         if let Some(rate) = &options.table_rate_column {
             if self.header.table_rate_column.is_none() {
                 return Err(DataError::new(
@@ -436,7 +794,7 @@ impl<R: Read> SeriesReader<R> {
             }
         }
         if let Some(list) = &options.channels {
-            if let Some(missing) = list.iter().find(|c| !names.iter().any(|n| n.eq_ignore_ascii_case(c))) {
+            if let Some(missing) = list.iter().find(|c| !(0..names.len()).any(|i| matches(c, i))) {
                 return Err(DataError::new(
                     &file,
                     format!(
@@ -449,13 +807,24 @@ impl<R: Read> SeriesReader<R> {
             }
         }
         if channels.is_empty() {
-            return Err(DataError::new(&file, "no output channel in the header: expected a column such as 'output_v'")
-                .at_line(line));
+            let notes: Vec<String> = self.header.skipped.iter().map(|s| s.to_string()).collect();
+            let why = if notes.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", crate::text::excerpt(&notes.join("; ")))
+            };
+            return Err(DataError::new(
+                &file,
+                format!(
+                    "no output channel in the header: expected a column such as 'output_v' or 'gyro_x [rad/s]'{why}"
+                ),
+            )
+            .at_line(line));
         }
         if self.header.time_column.is_none() && self.header.sample_rate_hz.is_none() {
             return Err(DataError::new(
                 &file,
-                "no time column ('time_s') and no sample rate given: expected one of them",
+                "no time column (such as 'time_s' or 'timestamp [ns]') and no sample rate given: expected one of them",
             )
             .at_line(line));
         }
@@ -601,6 +970,12 @@ impl<R: Read> SeriesReader<R> {
                 let ci = self.targets.iter().position(|&t| t as usize == slot).unwrap_or(0);
                 let msg = crate::text::check_magnitude(col[k]).err().unwrap_or_default();
                 return Err(self.err_at(self.lines[k], ci, msg));
+            }
+        }
+        if let (Some(s), Some(unit)) = (self.time_slot, self.header.time_unit) {
+            if unit != TimeUnit::Second {
+                let f = unit.seconds();
+                self.cols[s].iter_mut().for_each(|v| *v *= f);
             }
         }
         if let (Some(s), Some(unit)) = (self.rate_slot, self.header.table_rate_unit) {

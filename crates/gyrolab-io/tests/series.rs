@@ -127,15 +127,16 @@ fn header_errors() {
     let e = err("time_s,output_v,Output_V\n0,1,2\n", &SeriesOptions::default());
     assert_eq!(at(&e), (Some(1), Some(3)));
     assert!(e.message.contains("column 2 'output_v' and column 3 'Output_V'"), "{e}");
-    let e = err("# x\ntime_s,output_furlong\n0,1\n", &SeriesOptions::default());
+    // A selected column whose bracketed unit is unknown is an error naming it and the units.
+    let sel = SeriesOptions { channels: Some(vec!["output".into()]), ..SeriesOptions::default() };
+    let e = err("# x\ntime_s,output [furlong]\n0,1\n", &sel);
     assert_eq!(at(&e), (Some(2), Some(2)));
-    assert!(e.message.contains("unknown unit suffix 'furlong'"), "{e}");
+    assert!(e.message.contains("unknown unit 'furlong'"), "{e}");
     assert!(e.message.contains("v, mv, lsb, dps, rad_s"), "{e}");
-    let e = err("time_s,sensor\n0,1\n", &SeriesOptions::default());
-    assert_eq!(at(&e), (Some(1), Some(2)));
-    assert!(e.message.contains("no unit suffix"), "{e}");
-    let e = err("time_ms,output_v\n0,1\n", &SeriesOptions::default());
+    // A time column whose unit is not a time.
+    let e = err("time [v],output_v\n0,1\n", &SeriesOptions::default());
     assert_eq!(at(&e), (Some(1), Some(1)));
+    assert!(e.message.contains("not a time unit"), "{e}");
     let e = err("temp_k,output_v\n0,1\n", &SeriesOptions { sample_rate_hz: Some(1.0), ..SeriesOptions::default() });
     assert_eq!(at(&e), (Some(1), Some(1)));
     let e = err("output_v\n1\n", &SeriesOptions::default());

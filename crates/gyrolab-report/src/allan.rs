@@ -5,10 +5,11 @@ use crate::format::{short, sig, sig_opt};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Cell, CellAlignment, Table};
 use gyrolab::allan::AllanCurve;
 use gyrolab::noise::{
-    combine_kalibr, kalibr_from_readings, FitQuality, KalibrBasis, KalibrGyroscope, ModelFitResult, NoiseCoefficients,
-    Reading, SlopeLineResult, Unresolved, FIT_RMS_LIMIT,
+    combine_kalibr, combine_kalibr_accelerometer, kalibr_accelerometer_from_readings, kalibr_from_readings, FitQuality,
+    KalibrAccelerometer, KalibrBasis, KalibrGyroscope, ModelFitResult, NoiseCoefficients, Reading, SlopeLineResult,
+    Unresolved, FIT_RMS_LIMIT,
 };
-use gyrolab::units;
+use gyrolab::units::{self, Quantity};
 
 /// sqrt(2 ln 2 / pi): Allan minimum per unit IEEE bias instability.
 const BIAS_FACTOR: f64 = gyrolab::noise::BIAS_INSTABILITY_FACTOR;
@@ -21,8 +22,12 @@ pub struct ChannelAnalysis {
     pub file: String,
     /// Channel name.
     pub channel: String,
-    /// Unit of the rate data analysed: `deg/s` when calibrated, else the output unit.
+    /// Unit of the rate data analysed: `deg/s` when calibrated, `m/s^2` for an accelerometer,
+    /// else the output unit.
     pub rate_unit: String,
+    /// What the analysed data measure: [`Quantity::AngularRate`] (deg/s) or
+    /// [`Quantity::Acceleration`] (m/s^2) when noise terms are given; else the raw output.
+    pub quantity: Quantity,
     /// The curve.
     pub curve: AllanCurve,
     /// Noise terms by slope lines (only for data in deg/s).
@@ -64,6 +69,36 @@ pub struct NoiseJson {
     /// Kalibr imu.yaml gyroscope entries (rad units) with their basis (`value`, `upper_bound`,
     /// `fit_value`).
     pub kalibr: KalibrGyroscope,
+}
+
+/// Accelerometer noise coefficients in JSON (a channel in m/s^2), each key naming its unit
+/// (IEEE Std 1293 terms: velocity random walk, bias instability, acceleration random walk).
+#[derive(Debug, Clone, Serialize)]
+pub struct AccelNoiseJson {
+    /// Velocity random walk, m/s/sqrt(h).
+    pub vrw_m_s_rt_h: Option<f64>,
+    /// Velocity random walk as a noise density, m/s^2/sqrt(Hz) (= m/s/sqrt(s)).
+    pub vrw_m_s2_rt_hz: Option<f64>,
+    /// Bias instability in the IEEE convention (Allan minimum / 0.6643), m/s^2.
+    pub bias_instability_m_s2: Option<f64>,
+    /// The same in micro-g.
+    pub bias_instability_ug: Option<f64>,
+    /// The Allan deviation minimum of the flat region (datasheet convention), micro-g.
+    pub allan_minimum_ug: Option<f64>,
+    /// Tau of the Allan minimum, s.
+    pub allan_minimum_tau_s: Option<f64>,
+    /// Acceleration random walk, m/s^2/sqrt(h).
+    pub accel_random_walk_m_s2_rt_h: Option<f64>,
+    /// Acceleration random walk as a density, m/s^3/sqrt(Hz) (= m/s^2/sqrt(s)).
+    pub accel_random_walk_m_s3_rt_hz: Option<f64>,
+    /// Velocity quantization, m/s.
+    pub quantization_m_s: Option<f64>,
+    /// Acceleration ramp, m/s^2 per hour.
+    pub ramp_m_s2_per_h: Option<f64>,
+    /// Every slope-line term with its basis and support (units as the keys above).
+    pub readings: Vec<ReadingJson>,
+    /// Kalibr imu.yaml accelerometer entries with their basis.
+    pub kalibr: KalibrAccelerometer,
 }
 
 /// One slope-line term: its basis and support.
@@ -149,8 +184,13 @@ pub struct AllanJson {
     pub alpha: Vec<Option<i32>>,
     /// Equivalent degrees of freedom per tau.
     pub edf: Vec<Option<f64>>,
-    /// Noise coefficients (null when the data are not in deg/s).
+    /// What the channel measures: `angular_rate`, `acceleration`, `sensor_output`, `unitless`.
+    pub quantity: Quantity,
+    /// Gyro noise coefficients (null when the data are not an angular rate in deg/s).
     pub noise: Option<NoiseJson>,
+    /// Accelerometer noise coefficients (null unless the channel is an accelerometer in m/s^2).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub accel_noise: Option<AccelNoiseJson>,
     /// Why `noise` is null, if it is.
     pub noise_note: Option<String>,
 }
@@ -167,27 +207,58 @@ pub struct AllanDocument {
     pub channels: Vec<AllanJson>,
 }
 
-/// The terms in report order: key, label, unit, reading in that unit.
+/// The terms in report order: key, label, unit, reading in that unit (gyro units).
 pub fn terms_in_units(s: &SlopeLineResult) -> [(&'static str, &'static str, &'static str, Reading); 6] {
+    terms_for(s, Quantity::AngularRate).map(|(k, l, u, f, r)| (k, l, u, r.scaled(f)))
+}
+
+/// The terms of a curve of `quantity` in report order: key, label, unit, the factor from the
+/// per-second base units of the slope lines to that unit, and the base reading. Gyro curves in
+/// deg/s (IEEE Std 952 units), accelerometer curves in m/s^2 (IEEE Std 1293 terms).
+fn terms_for(s: &SlopeLineResult, quantity: Quantity) -> [(&'static str, &'static str, &'static str, f64, Reading); 6] {
+    if quantity == Quantity::Acceleration {
+        return [
+            ("vrw", "velocity random walk", "m/s/sqrt(h)", units::vrw_m_s_rt_s_to_m_s_rt_h(1.0), s.arw),
+            ("bias_instability", "bias instability B (IEEE)", "ug", units::m_s2_to_ug(1.0), s.bias_instability),
+            ("allan_minimum", "Allan minimum (datasheet)", "ug", units::m_s2_to_ug(1.0), s.allan_minimum),
+            (
+                "accel_random_walk",
+                "acceleration random walk",
+                "m/s^2/sqrt(h)",
+                units::accel_rw_m_s2_rt_s_to_m_s2_rt_h(1.0),
+                s.rrw,
+            ),
+            ("quantization", "velocity quantization", "m/s", 1.0, s.quantization),
+            ("rate_ramp", "acceleration ramp", "m/s^2/h", units::accel_ramp_per_s_to_per_h(1.0), s.rate_ramp),
+        ];
+    }
     [
-        ("arw", "angle random walk N", "deg/sqrt(h)", s.arw.scaled(units::arw_deg_rt_s_to_deg_rt_h(1.0))),
-        (
-            "bias_instability",
-            "bias instability B (IEEE 952)",
-            "deg/h",
-            s.bias_instability.scaled(units::bias_dps_to_dph(1.0)),
-        ),
-        ("allan_minimum", "Allan minimum (datasheet)", "deg/h", s.allan_minimum.scaled(units::bias_dps_to_dph(1.0))),
-        ("rrw", "rate random walk K", "deg/h/sqrt(h)", s.rrw.scaled(units::rrw_dps_rt_s_to_dph_rt_h(1.0))),
-        ("quantization", "quantization Q", "deg", s.quantization),
-        ("rate_ramp", "rate ramp R", "deg/h/h", s.rate_ramp.scaled(units::rate_ramp_dps_per_s_to_dph_per_h(1.0))),
+        ("arw", "angle random walk N", "deg/sqrt(h)", units::arw_deg_rt_s_to_deg_rt_h(1.0), s.arw),
+        ("bias_instability", "bias instability B (IEEE 952)", "deg/h", units::bias_dps_to_dph(1.0), s.bias_instability),
+        ("allan_minimum", "Allan minimum (datasheet)", "deg/h", units::bias_dps_to_dph(1.0), s.allan_minimum),
+        ("rrw", "rate random walk K", "deg/h/sqrt(h)", units::rrw_dps_rt_s_to_dph_rt_h(1.0), s.rrw),
+        ("quantization", "quantization Q", "deg", 1.0, s.quantization),
+        ("rate_ramp", "rate ramp R", "deg/h/h", units::rate_ramp_dps_per_s_to_dph_per_h(1.0), s.rate_ramp),
     ]
 }
 
-fn readings(s: &SlopeLineResult) -> Vec<ReadingJson> {
-    terms_in_units(s)
+/// The five-term fit's value of a term, in the base units of [`terms_for`].
+fn fit_base_value(c: &NoiseCoefficients, term: &str) -> Option<f64> {
+    match term {
+        "arw" | "vrw" => c.arw_deg_rt_s,
+        "bias_instability" => c.bias_instability_dps,
+        "allan_minimum" => c.bias_instability_dps.map(|b| b * BIAS_FACTOR),
+        "rrw" | "accel_random_walk" => c.rrw_deg_s_rt_s,
+        "quantization" => c.quantization_deg,
+        _ => c.rate_ramp_dps_per_s,
+    }
+}
+
+fn readings(s: &SlopeLineResult, quantity: Quantity) -> Vec<ReadingJson> {
+    terms_for(s, quantity)
         .into_iter()
-        .map(|(term, _, unit, r)| ReadingJson {
+        .map(|(term, _, unit, f, r)| (term, unit, r.scaled(f)))
+        .map(|(term, unit, r)| ReadingJson {
             term,
             basis: r.basis().name(),
             value: r.value().or(r.bound()),
@@ -207,7 +278,25 @@ fn readings(s: &SlopeLineResult) -> Vec<ReadingJson> {
 /// Builds the JSON of one channel.
 pub fn allan_json(a: &ChannelAnalysis) -> AllanJson {
     let c = &a.curve;
-    let noise = a.slope_lines.as_ref().map(|s| {
+    let accel = a.quantity == Quantity::Acceleration;
+    let accel_noise = a.slope_lines.as_ref().filter(|_| accel).map(|s| {
+        let k = &s.coefficients;
+        AccelNoiseJson {
+            vrw_m_s_rt_h: k.arw_deg_rt_s.map(units::vrw_m_s_rt_s_to_m_s_rt_h),
+            vrw_m_s2_rt_hz: k.arw_deg_rt_s,
+            bias_instability_m_s2: k.bias_instability_dps,
+            bias_instability_ug: k.bias_instability_dps.map(units::m_s2_to_ug),
+            allan_minimum_ug: s.allan_minimum.value().map(units::m_s2_to_ug),
+            allan_minimum_tau_s: s.allan_minimum.site().map(|x| x.tau_s),
+            accel_random_walk_m_s2_rt_h: k.rrw_deg_s_rt_s.map(units::accel_rw_m_s2_rt_s_to_m_s2_rt_h),
+            accel_random_walk_m_s3_rt_hz: k.rrw_deg_s_rt_s,
+            quantization_m_s: k.quantization_deg,
+            ramp_m_s2_per_h: k.rate_ramp_dps_per_s.map(units::accel_ramp_per_s_to_per_h),
+            readings: readings(s, Quantity::Acceleration),
+            kalibr: kalibr_accelerometer_from_readings(s, a.model_fit.as_ref()),
+        }
+    });
+    let noise = a.slope_lines.as_ref().filter(|_| !accel).map(|s| {
         let k = &s.coefficients;
         NoiseJson {
             arw_deg_rt_h: k.arw_deg_rt_h,
@@ -219,7 +308,7 @@ pub fn allan_json(a: &ChannelAnalysis) -> AllanJson {
             rate_ramp_dph_per_h: k.rate_ramp_dph_per_h,
             arw_deg_rt_s: k.arw_deg_rt_s,
             rrw_deg_s_rt_s: k.rrw_deg_s_rt_s,
-            readings: readings(s),
+            readings: readings(s, Quantity::AngularRate),
             fit: a.model_fit.as_ref().map(|f| FitJson {
                 arw_deg_rt_h: f.coefficients.arw_deg_rt_h,
                 bias_instability_dph: f.coefficients.bias_instability_dph,
@@ -251,7 +340,9 @@ pub fn allan_json(a: &ChannelAnalysis) -> AllanJson {
         n_terms: c.points.iter().map(|p| p.terms).collect(),
         alpha: c.points.iter().map(|p| p.alpha).collect(),
         edf: c.points.iter().map(|p| p.edf).collect(),
+        quantity: a.quantity,
         noise,
+        accel_noise,
         noise_note: a.noise_note.clone(),
     }
 }
@@ -363,15 +454,9 @@ pub fn allan_text(a: &ChannelAnalysis) -> String {
             n.load_preset(UTF8_FULL_CONDENSED);
             n.set_header(vec!["noise term", "unit", "slope lines", "support", "five-term fit"]);
             let f = a.model_fit.as_ref().map(|f| f.coefficients);
-            for (term, label, unit, r) in terms_in_units(sl) {
-                let fv = f.and_then(|f| match term {
-                    "arw" => f.arw_deg_rt_h,
-                    "bias_instability" => f.bias_instability_dph,
-                    "allan_minimum" => f.bias_instability_dph.map(|b| b * BIAS_FACTOR),
-                    "rrw" => f.rrw_deg_h_rt_h,
-                    "quantization" => f.quantization_deg,
-                    _ => f.rate_ramp_dph_per_h,
-                });
+            for (term, label, unit, factor, r) in terms_for(sl, a.quantity) {
+                let r = r.scaled(factor);
+                let fv = f.and_then(|f| fit_base_value(&f, term)).map(|v| v * factor);
                 n.add_row(vec![
                     label.to_string(),
                     unit.to_string(),
@@ -396,6 +481,9 @@ pub fn allan_text(a: &ChannelAnalysis) -> String {
                     ));
                 }
             }
+            if a.quantity == Quantity::Acceleration {
+                s.push_str("\nAccelerometer terms (IEEE Std 1293): velocity random walk, bias instability (1 ug = 9.80665e-6 m/s^2), acceleration random walk.");
+            }
             s.push_str(
                 "\nEach term is a value only where the curve supports its slope at the bounds' confidence; '< x' is an upper bound (docs/METHODS.md section 3). \
                  B (IEEE 952) = Allan minimum / 0.6643; datasheets (ADI, Sensonor) quote the Allan minimum itself. N is read at the tau nearest 1 s on its -1/2 region.\n",
@@ -407,14 +495,17 @@ pub fn allan_text(a: &ChannelAnalysis) -> String {
     s
 }
 
-/// Kalibr's entries for several gyro channels, as written to imu.yaml.
+/// Kalibr's entries for the gyro and accelerometer channels, as written to imu.yaml.
 #[derive(Debug, Clone, PartialEq)]
 pub struct KalibrFile {
     /// The YAML text.
     pub text: String,
-    /// The combined entries.
-    pub entries: KalibrGyroscope,
-    /// One line per entry that is not a resolved value (to print as `warning:` on stderr).
+    /// The combined gyro entries (none when no gyro channel has noise terms).
+    pub entries: Option<KalibrGyroscope>,
+    /// The combined accelerometer entries (none when no accelerometer channel has noise terms).
+    pub accelerometer: Option<KalibrAccelerometer>,
+    /// One line per entry that is not a resolved value or is missing (to print as `warning:`
+    /// on stderr).
     pub warnings: Vec<String>,
 }
 
@@ -429,60 +520,236 @@ fn basis_comment(b: Option<KalibrBasis>) -> &'static str {
     }
 }
 
-/// Kalibr imu.yaml gyroscope entries for the analysed channels: each entry is the largest over
-/// the channels (as ethz-asl allan_variance_ros combines its axes), with its basis in a comment
-/// and a warning for every entry that is an upper bound or a fit value. `None` when no channel
-/// has noise terms or the noise density cannot be given at all.
-pub fn kalibr_yaml(channels: &[ChannelAnalysis], update_rate_hz: f64) -> Option<KalibrFile> {
-    let per: Vec<(usize, KalibrGyroscope)> = channels
-        .iter()
-        .enumerate()
-        .filter_map(|(i, a)| a.slope_lines.as_ref().map(|s| (i, kalibr_from_readings(s, a.model_fit.as_ref()))))
-        .collect();
-    let list: Vec<KalibrGyroscope> = per.iter().map(|x| x.1).collect();
-    let mut e = combine_kalibr(&list);
-    let n = e.gyroscope_noise_density?;
-    let k = e.gyroscope_random_walk?;
-    e.channel_index = (per[e.channel_index.0].0, per[e.channel_index.1].0);
+/// One combined entry of a filter file: key, value, basis, channel index.
+type Entry = (&'static str, Option<f64>, Option<KalibrBasis>, usize);
+
+/// The combined continuous-time entries of the analysed channels: gyro (rad/s/sqrt(Hz),
+/// rad/s^2/sqrt(Hz)) and accelerometer (m/s^2/sqrt(Hz), m/s^3/sqrt(Hz)), each the largest
+/// over its channels, with the per-channel values for comments.
+struct FilterEntries {
+    gyro: Option<KalibrGyroscope>,
+    accel: Option<KalibrAccelerometer>,
+    /// (channel index, noise density, basis, random walk, basis, unit of the two).
+    per: Vec<(usize, Option<f64>, Option<KalibrBasis>, Option<f64>, Option<KalibrBasis>, bool)>,
+}
+
+fn filter_entries(channels: &[ChannelAnalysis]) -> FilterEntries {
+    let mut gyro = Vec::new();
+    let mut accel = Vec::new();
+    let mut per = Vec::new();
+    for (i, a) in channels.iter().enumerate() {
+        let Some(s) = a.slope_lines.as_ref() else { continue };
+        match a.quantity {
+            Quantity::AngularRate => {
+                let mut g = kalibr_from_readings(s, a.model_fit.as_ref());
+                g.channel_index = (i, i);
+                per.push((
+                    i,
+                    g.gyroscope_noise_density,
+                    g.gyroscope_noise_density_basis,
+                    g.gyroscope_random_walk,
+                    g.gyroscope_random_walk_basis,
+                    false,
+                ));
+                gyro.push(g);
+            }
+            Quantity::Acceleration => {
+                let mut g = kalibr_accelerometer_from_readings(s, a.model_fit.as_ref());
+                g.channel_index = (i, i);
+                per.push((
+                    i,
+                    g.accelerometer_noise_density,
+                    g.accelerometer_noise_density_basis,
+                    g.accelerometer_random_walk,
+                    g.accelerometer_random_walk_basis,
+                    true,
+                ));
+                accel.push(g);
+            }
+            _ => {}
+        }
+    }
+    let remap = |list_len: usize, idx: (usize, usize), src: &dyn Fn(usize) -> (usize, usize)| {
+        let _ = list_len;
+        (src(idx.0).0, src(idx.1).1)
+    };
+    let g = (!gyro.is_empty()).then(|| {
+        let mut c = combine_kalibr(&gyro);
+        c.channel_index = remap(gyro.len(), c.channel_index, &|k| gyro[k].channel_index);
+        c
+    });
+    let acc = (!accel.is_empty()).then(|| {
+        let mut c = combine_kalibr_accelerometer(&accel);
+        c.channel_index = remap(accel.len(), c.channel_index, &|k| accel[k].channel_index);
+        c
+    });
+    FilterEntries { gyro: g, accel: acc, per }
+}
+
+impl FilterEntries {
+    fn list(&self) -> [Entry; 4] {
+        let g = self.gyro;
+        let a = self.accel;
+        [
+            (
+                "gyroscope_noise_density",
+                g.and_then(|g| g.gyroscope_noise_density),
+                g.and_then(|g| g.gyroscope_noise_density_basis),
+                g.map_or(0, |g| g.channel_index.0),
+            ),
+            (
+                "gyroscope_random_walk",
+                g.and_then(|g| g.gyroscope_random_walk),
+                g.and_then(|g| g.gyroscope_random_walk_basis),
+                g.map_or(0, |g| g.channel_index.1),
+            ),
+            (
+                "accelerometer_noise_density",
+                a.and_then(|a| a.accelerometer_noise_density),
+                a.and_then(|a| a.accelerometer_noise_density_basis),
+                a.map_or(0, |a| a.channel_index.0),
+            ),
+            (
+                "accelerometer_random_walk",
+                a.and_then(|a| a.accelerometer_random_walk),
+                a.and_then(|a| a.accelerometer_random_walk_basis),
+                a.map_or(0, |a| a.channel_index.1),
+            ),
+        ]
+    }
+}
+
+/// The unit of a continuous-time filter entry.
+fn entry_unit(key: &str) -> &'static str {
+    match key {
+        "gyroscope_noise_density" | "gyr_n" => "rad/s/sqrt(Hz)",
+        "gyroscope_random_walk" | "gyr_w" => "rad/s^2/sqrt(Hz)",
+        "accelerometer_noise_density" | "acc_n" => "m/s^2/sqrt(Hz)",
+        _ => "m/s^3/sqrt(Hz)",
+    }
+}
+
+/// The discrete-time value of a continuous-time entry at `rate_hz` (Kalibr wiki, "IMU Noise
+/// Model"): white noise sigma_d = sigma_c * sqrt(rate); random walk sigma_bd = sigma_b / sqrt(rate).
+fn discrete(key: &str, v: f64, rate_hz: f64) -> f64 {
+    if key.ends_with("noise_density") || key.ends_with("_n") {
+        v * rate_hz.sqrt()
+    } else {
+        v / rate_hz.sqrt()
+    }
+}
+
+/// Filter files (Kalibr, imu_utils) for the analysed channels; `None` when no channel has noise
+/// terms. Each entry is the largest over its channels (as ethz-asl allan_variance_ros combines
+/// its axes), with its basis in a comment, the discrete-time value beside it, and a warning for
+/// every entry that is an upper bound, a fit value, or missing.
+fn filter_file(channels: &[ChannelAnalysis], update_rate_hz: f64, imu_utils: bool) -> Option<KalibrFile> {
+    let fe = filter_entries(channels);
+    if fe.gyro.is_none() && fe.accel.is_none() {
+        return None;
+    }
     let name = |i: usize| format!("{} ({})", channels[i].file, channels[i].channel);
-    let mut text = format!(
-        "# Kalibr imu.yaml gyroscope entries written by gyrolab {}\n\
-         # gyroscope_noise_density = angle random walk N in rad/s/sqrt(Hz);\n\
-         # gyroscope_random_walk = rate random walk K in rad/s^2/sqrt(Hz).\n\
-         # Channels combined by the largest value per entry (as allan_variance_ros): {}\n",
-        env!("CARGO_PKG_VERSION"),
-        per.iter().map(|x| name(x.0)).collect::<Vec<_>>().join(", ")
-    );
-    for (i, g) in &per {
+    let mut text = if imu_utils {
+        format!(
+            "%YAML:1.0\n# imu_utils / VINS-Mono style IMU noise parameters written by gyrolab {}\n\
+             # Continuous-time values (the convention of imu_utils, VINS and Kalibr):\n\
+             # gyr_n: gyro white noise density, rad/s/sqrt(Hz); gyr_w: gyro random walk, rad/s^2/sqrt(Hz);\n\
+             # acc_n: accelerometer white noise density, m/s^2/sqrt(Hz); acc_w: accelerometer random walk, m/s^3/sqrt(Hz).\n",
+            env!("CARGO_PKG_VERSION")
+        )
+    } else {
+        format!(
+            "# Kalibr imu.yaml written by gyrolab {}\n\
+             # Continuous-time noise densities and random walks (Kalibr's convention; the discrete-time\n\
+             # values at update_rate are in the comments: white noise x sqrt(rate), random walk / sqrt(rate)).\n\
+             # gyroscope_noise_density = angle random walk N in rad/s/sqrt(Hz);\n\
+             # gyroscope_random_walk = rate random walk K in rad/s^2/sqrt(Hz);\n\
+             # accelerometer_noise_density = velocity random walk in m/s^2/sqrt(Hz);\n\
+             # accelerometer_random_walk = acceleration random walk in m/s^3/sqrt(Hz).\n",
+            env!("CARGO_PKG_VERSION")
+        )
+    };
+    text.push_str(&format!(
+        "# Channels combined by the largest value per entry (as allan_variance_ros): {}\n",
+        fe.per.iter().map(|x| name(x.0)).collect::<Vec<_>>().join(", ")
+    ));
+    for (i, n, nb, k, kb, accel) in &fe.per {
         text.push_str(&format!(
-            "#   {}: noise density {} ({}), random walk {} ({})\n",
+            "#   {} [{}]: noise density {} ({}), random walk {} ({})\n",
             name(*i),
-            g.gyroscope_noise_density.map_or("none".into(), |x| format!("{x:e}")),
-            g.gyroscope_noise_density_basis.map_or("none", |b| b.name()),
-            g.gyroscope_random_walk.map_or("none".into(), |x| format!("{x:e}")),
-            g.gyroscope_random_walk_basis.map_or("none", |b| b.name()),
+            if *accel { "accelerometer" } else { "gyro" },
+            n.map_or("none".into(), |x| format!("{x:e}")),
+            nb.map_or("none", |b| b.name()),
+            k.map_or("none".into(), |x| format!("{x:e}")),
+            kb.map_or("none", |b| b.name()),
         ));
     }
     let mut warnings = Vec::new();
-    for (key, basis, ch) in [
-        ("gyroscope_noise_density", e.gyroscope_noise_density_basis, e.channel_index.0),
-        ("gyroscope_random_walk", e.gyroscope_random_walk_basis, e.channel_index.1),
-    ] {
-        text.push_str(&format!("# {key}: from {}; {}\n", name(ch), basis_comment(basis)));
-        if basis != Some(KalibrBasis::Value) {
-            warnings.push(format!(
-                "Kalibr {key} is {} ({}), not a resolved value: {}",
-                basis.map_or("none", |b| b.name()),
-                name(ch),
-                basis_comment(basis)
-            ));
+    let mut body = String::new();
+    for (key, value, basis, ch) in fe.list() {
+        let out_key = if imu_utils {
+            match key {
+                "gyroscope_noise_density" => "gyr_n",
+                "gyroscope_random_walk" => "gyr_w",
+                "accelerometer_noise_density" => "acc_n",
+                _ => "acc_w",
+            }
+        } else {
+            key
+        };
+        match value {
+            Some(v) => {
+                text.push_str(&format!("# {out_key}: from {}; {}\n", name(ch), basis_comment(basis)));
+                body.push_str(&format!(
+                    "{out_key}: {v:e}   # {}; discrete-time at {} Hz: {:e}\n",
+                    entry_unit(key),
+                    short(update_rate_hz, 9),
+                    discrete(key, v, update_rate_hz)
+                ));
+                if basis != Some(KalibrBasis::Value) {
+                    warnings.push(format!(
+                        "{} {out_key} is {} ({}), not a resolved value: {}",
+                        if imu_utils { "imu_utils" } else { "Kalibr" },
+                        basis.map_or("none", |b| b.name()),
+                        name(ch),
+                        basis_comment(basis)
+                    ));
+                }
+            }
+            None => {
+                let what = if key.starts_with("gyro") { "gyro" } else { "accelerometer" };
+                body.push_str(&format!(
+                    "# {out_key}: not written: no {what} channel with noise terms (give the {what} columns a unit)\n"
+                ));
+                warnings.push(format!(
+                    "{} {out_key} not written: no {what} channel with noise terms",
+                    if imu_utils { "imu_utils" } else { "Kalibr" }
+                ));
+            }
         }
     }
-    text.push_str(&format!(
-        "gyroscope_noise_density: {n:e}\ngyroscope_random_walk: {k:e}\nupdate_rate: {}\n",
-        short(update_rate_hz, 9)
-    ));
-    Some(KalibrFile { text, entries: e, warnings })
+    text.push_str(&body);
+    if imu_utils {
+        text.push_str(&format!("imu_rate: {}\n", short(update_rate_hz, 9)));
+    } else {
+        text.push_str(&format!(
+            "update_rate: {}\n# rostopic: not known from this file; /imu0 is Kalibr's example topic: set yours\nrostopic: /imu0\n",
+            short(update_rate_hz, 9)
+        ));
+    }
+    Some(KalibrFile { text, entries: fe.gyro, accelerometer: fe.accel, warnings })
+}
+
+/// Kalibr imu.yaml for the analysed channels (gyro and accelerometer entries, `update_rate`,
+/// `rostopic`); see [`filter_file`]. `None` when no channel has noise terms.
+pub fn kalibr_yaml(channels: &[ChannelAnalysis], update_rate_hz: f64) -> Option<KalibrFile> {
+    filter_file(channels, update_rate_hz, false)
+}
+
+/// imu_utils / VINS-style YAML (`gyr_n`, `gyr_w`, `acc_n`, `acc_w`, continuous time) for the
+/// analysed channels. `None` when no channel has noise terms.
+pub fn imu_utils_yaml(channels: &[ChannelAnalysis], update_rate_hz: f64) -> Option<KalibrFile> {
+    filter_file(channels, update_rate_hz, true)
 }
 
 /// A noise-coefficient set has at least one term.
@@ -521,6 +788,7 @@ mod tests {
             file: "hand.csv".into(),
             channel: "rate_dps".into(),
             rate_unit: "deg/s".into(),
+            quantity: Quantity::AngularRate,
             slope_lines: slope_line_terms(&curve).ok(),
             model_fit: fit_noise_model(&curve, None).ok(),
             curve,

@@ -384,6 +384,60 @@ pub fn kalibr_from_readings(s: &SlopeLineResult, fit: Option<&ModelFitResult>) -
     }
 }
 
+/// Kalibr `imu.yaml` accelerometer entries.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct KalibrAccelerometer {
+    /// Velocity random walk as a noise density, m/s^2/sqrt(Hz) (= m/s/sqrt(s)).
+    pub accelerometer_noise_density: Option<f64>,
+    /// Acceleration random walk, m/s^3/sqrt(Hz) (= m/s^2/sqrt(s)).
+    pub accelerometer_random_walk: Option<f64>,
+    /// What `accelerometer_noise_density` is.
+    pub accelerometer_noise_density_basis: Option<KalibrBasis>,
+    /// What `accelerometer_random_walk` is.
+    pub accelerometer_random_walk_basis: Option<KalibrBasis>,
+    /// Index of the channel each entry comes from, when channels were combined.
+    pub channel_index: (usize, usize),
+}
+
+/// Kalibr's accelerometer entries from the slope-line readings of an accelerometer curve in
+/// m/s^2 (the same rule as [`kalibr_from_readings`]: value, else upper bound, else fit value).
+/// The white-noise and random-walk terms of a curve in m/s^2 are already in Kalibr's units.
+pub fn kalibr_accelerometer_from_readings(s: &SlopeLineResult, fit: Option<&ModelFitResult>) -> KalibrAccelerometer {
+    // The gyro entries are the same terms converted deg -> rad; undo nothing: pick in base units.
+    let g = kalibr_from_readings(s, fit);
+    let back = |v: Option<f64>| v.map(units::rad_to_deg);
+    KalibrAccelerometer {
+        accelerometer_noise_density: back(g.gyroscope_noise_density),
+        accelerometer_random_walk: back(g.gyroscope_random_walk),
+        accelerometer_noise_density_basis: g.gyroscope_noise_density_basis,
+        accelerometer_random_walk_basis: g.gyroscope_random_walk_basis,
+        channel_index: (0, 0),
+    }
+}
+
+/// Combines several accelerometer channels into Kalibr's single entries (the largest, as
+/// [`combine_kalibr`]).
+pub fn combine_kalibr_accelerometer(channels: &[KalibrAccelerometer]) -> KalibrAccelerometer {
+    let as_gyro: Vec<KalibrGyroscope> = channels
+        .iter()
+        .map(|a| KalibrGyroscope {
+            gyroscope_noise_density: a.accelerometer_noise_density,
+            gyroscope_random_walk: a.accelerometer_random_walk,
+            gyroscope_noise_density_basis: a.accelerometer_noise_density_basis,
+            gyroscope_random_walk_basis: a.accelerometer_random_walk_basis,
+            channel_index: a.channel_index,
+        })
+        .collect();
+    let c = combine_kalibr(&as_gyro);
+    KalibrAccelerometer {
+        accelerometer_noise_density: c.gyroscope_noise_density,
+        accelerometer_random_walk: c.gyroscope_random_walk,
+        accelerometer_noise_density_basis: c.gyroscope_noise_density_basis,
+        accelerometer_random_walk_basis: c.gyroscope_random_walk_basis,
+        channel_index: c.channel_index,
+    }
+}
+
 /// Combines several gyro channels into Kalibr's single entry per quantity: the largest value of
 /// each entry over the channels (as ethz-asl allan_variance_ros does), with its basis and the
 /// index of the channel it came from. Ties go to the first channel.

@@ -63,6 +63,26 @@ pub fn rrw_dps_rt_s_to_rad_s2_rt_hz(v: f64) -> f64 {
     deg_to_rad(v)
 }
 
+/// Converts a velocity random walk from m/s/sqrt(s) (= m/s^2/sqrt(Hz)) to m/s/sqrt(h).
+pub fn vrw_m_s_rt_s_to_m_s_rt_h(v: f64) -> f64 {
+    v * SECONDS_PER_HOUR.sqrt()
+}
+
+/// Converts an acceleration random walk from m/s^2/sqrt(s) (= m/s^3/sqrt(Hz)) to m/s^2/sqrt(h).
+pub fn accel_rw_m_s2_rt_s_to_m_s2_rt_h(v: f64) -> f64 {
+    v * SECONDS_PER_HOUR.sqrt()
+}
+
+/// Converts an acceleration in m/s^2 to micro-g (1 ug = 9.80665e-6 m/s^2).
+pub fn m_s2_to_ug(v: f64) -> f64 {
+    v / STANDARD_GRAVITY_M_S2 * 1e6
+}
+
+/// Converts an acceleration ramp from m/s^2 per second to m/s^2 per hour.
+pub fn accel_ramp_per_s_to_per_h(v: f64) -> f64 {
+    v * SECONDS_PER_HOUR
+}
+
 /// Converts degrees (or deg/s, deg/s/sqrt(Hz), ...) to radians (rad/s, ...).
 pub fn deg_to_rad(v: f64) -> f64 {
     v / DEG_PER_RAD
@@ -212,7 +232,24 @@ impl fmt::Display for RateUnit {
     }
 }
 
-/// Unit of a gyro's output signal.
+/// What a channel's values measure, by their unit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Quantity {
+    /// A sensor output (V, mV, LSB) that needs a scale factor to become a rate.
+    SensorOutput,
+    /// An angular rate (deg/s, rad/s, deg/h, mrad/s): a gyro channel.
+    AngularRate,
+    /// A specific force (m/s^2, g, mg): an accelerometer channel.
+    Acceleration,
+    /// No unit known: deviations in the channel's own units, no noise terms in physical units.
+    Unitless,
+}
+
+/// Standard gravity g_n in m/s^2 (CGPM 1901; ISO 80000-3).
+pub const STANDARD_GRAVITY_M_S2: f64 = 9.806_65;
+
+/// Unit of a sensor channel: a gyro's output signal, an angular rate, or an acceleration.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum OutputUnit {
     /// Volts (analog output).
@@ -230,12 +267,51 @@ pub enum OutputUnit {
     /// Radians per second (an already scaled digital output).
     #[serde(rename = "rad/s")]
     RadPerSec,
+    /// Degrees per hour.
+    #[serde(rename = "deg/h")]
+    DegPerHour,
+    /// Milliradians per second.
+    #[serde(rename = "mrad/s")]
+    MilliradPerSec,
+    /// Metres per second squared (accelerometer).
+    #[serde(rename = "m/s^2")]
+    MeterPerSec2,
+    /// Standard gravity, 9.80665 m/s^2 (accelerometer).
+    #[serde(rename = "g")]
+    StandardGravity,
+    /// Thousandths of standard gravity (accelerometer).
+    #[serde(rename = "mg")]
+    MilliG,
+    /// No unit: a dimensionless output.
+    #[serde(rename = "1")]
+    Unitless,
 }
 
 impl OutputUnit {
-    /// All output units, for listing in messages.
-    pub const ALL: [OutputUnit; 5] =
-        [OutputUnit::Volt, OutputUnit::Millivolt, OutputUnit::Lsb, OutputUnit::DegPerSec, OutputUnit::RadPerSec];
+    /// The units a rate-table output can be in (sensor outputs and angular rates), for messages.
+    pub const ALL: [OutputUnit; 7] = [
+        OutputUnit::Volt,
+        OutputUnit::Millivolt,
+        OutputUnit::Lsb,
+        OutputUnit::DegPerSec,
+        OutputUnit::RadPerSec,
+        OutputUnit::DegPerHour,
+        OutputUnit::MilliradPerSec,
+    ];
+
+    /// Every unit a time-series channel can be in.
+    pub const CHANNEL_UNITS: [OutputUnit; 10] = [
+        OutputUnit::Volt,
+        OutputUnit::Millivolt,
+        OutputUnit::Lsb,
+        OutputUnit::DegPerSec,
+        OutputUnit::RadPerSec,
+        OutputUnit::DegPerHour,
+        OutputUnit::MilliradPerSec,
+        OutputUnit::MeterPerSec2,
+        OutputUnit::StandardGravity,
+        OutputUnit::MilliG,
+    ];
 
     /// The unit's symbol, such as `mV`.
     pub fn symbol(self) -> &'static str {
@@ -245,6 +321,12 @@ impl OutputUnit {
             OutputUnit::Lsb => "LSB",
             OutputUnit::DegPerSec => "deg/s",
             OutputUnit::RadPerSec => "rad/s",
+            OutputUnit::DegPerHour => "deg/h",
+            OutputUnit::MilliradPerSec => "mrad/s",
+            OutputUnit::MeterPerSec2 => "m/s^2",
+            OutputUnit::StandardGravity => "g",
+            OutputUnit::MilliG => "mg",
+            OutputUnit::Unitless => "1",
         }
     }
 
@@ -256,34 +338,85 @@ impl OutputUnit {
             OutputUnit::Lsb => "lsb",
             OutputUnit::DegPerSec => "dps",
             OutputUnit::RadPerSec => "rad_s",
+            OutputUnit::DegPerHour => "dph",
+            OutputUnit::MilliradPerSec => "mrad_s",
+            OutputUnit::MeterPerSec2 => "m_s2",
+            OutputUnit::StandardGravity => "g",
+            OutputUnit::MilliG => "mg",
+            OutputUnit::Unitless => "",
         }
     }
 
-    /// Parses a suffix or symbol (`v`, `mv`, `lsb`, `dps`, `rad_s`, `deg/s`, `rad/s`).
+    /// What the unit measures.
+    pub fn quantity(self) -> Quantity {
+        match self {
+            OutputUnit::Volt | OutputUnit::Millivolt | OutputUnit::Lsb => Quantity::SensorOutput,
+            OutputUnit::DegPerSec | OutputUnit::RadPerSec | OutputUnit::DegPerHour | OutputUnit::MilliradPerSec => {
+                Quantity::AngularRate
+            }
+            OutputUnit::MeterPerSec2 | OutputUnit::StandardGravity | OutputUnit::MilliG => Quantity::Acceleration,
+            OutputUnit::Unitless => Quantity::Unitless,
+        }
+    }
+
+    /// Parses a suffix or symbol: `v`, `mv`, `lsb`, `dps`, `deg_s`, `deg/s`, `dph`, `deg/h`,
+    /// `rad_s`, `rad/s`, `mrad_s`, `m_s2`, `m/s^2`, `g`, `mg` (and the spellings of
+    /// [`normalise_unit_text`], such as `rad s^-1` or `°/s`).
     pub fn parse(s: &str) -> Option<OutputUnit> {
-        match s.trim().to_ascii_lowercase().as_str() {
+        let t = normalise_unit_text(s);
+        match t.as_str() {
             "v" | "volt" | "volts" => Some(OutputUnit::Volt),
             "mv" => Some(OutputUnit::Millivolt),
-            "lsb" | "counts" => Some(OutputUnit::Lsb),
-            "dps" | "deg/s" | "deg_s" => Some(OutputUnit::DegPerSec),
-            "rad_s" | "rad/s" => Some(OutputUnit::RadPerSec),
+            "lsb" | "counts" | "count" | "digits" => Some(OutputUnit::Lsb),
+            "dps" | "deg/s" | "deg_s" | "degps" => Some(OutputUnit::DegPerSec),
+            "rad_s" | "rad/s" | "rps" => Some(OutputUnit::RadPerSec),
+            "dph" | "deg/h" | "deg_h" => Some(OutputUnit::DegPerHour),
+            "mrad_s" | "mrad/s" => Some(OutputUnit::MilliradPerSec),
+            "m_s2" | "m/s^2" | "m_s^2" | "mps2" | "m/s/s" | "m_s_2" => Some(OutputUnit::MeterPerSec2),
+            "g" | "g0" | "gn" => Some(OutputUnit::StandardGravity),
+            "mg" => Some(OutputUnit::MilliG),
             _ => None,
         }
     }
 
+    /// Parses a unit a rate-table output can be in ([`OutputUnit::ALL`]: sensor outputs and
+    /// angular rates); accelerations and unitless outputs are `None`.
+    pub fn parse_gyro_output(s: &str) -> Option<OutputUnit> {
+        OutputUnit::parse(s).filter(|u| OutputUnit::ALL.contains(u))
+    }
+
     /// The scale factor, in this unit per deg/s, of an output that is already a rate
-    /// (1 for deg/s, pi/180 for rad/s); `None` for V, mV and LSB, which need a calibration.
+    /// (1 for deg/s, pi/180 for rad/s, 3600 for deg/h); `None` for V, mV and LSB, which need a
+    /// calibration, and for accelerations and unitless outputs.
     pub fn native_scale_factor_per_dps(self) -> Option<f64> {
         match self {
             OutputUnit::DegPerSec => Some(1.0),
             OutputUnit::RadPerSec => Some(deg_to_rad(1.0)),
+            OutputUnit::DegPerHour => Some(dps_to_dph(1.0)),
+            OutputUnit::MilliradPerSec => Some(rad_to_mrad(deg_to_rad(1.0))),
             _ => None,
         }
     }
 
-    /// The accepted column-name suffixes, for messages: `v, mv, lsb, dps, rad_s`.
+    /// The factor, in this unit per m/s^2, of an acceleration unit (1 for m/s^2, 1/9.80665 for
+    /// g); `None` for other quantities.
+    pub fn per_m_s2(self) -> Option<f64> {
+        match self {
+            OutputUnit::MeterPerSec2 => Some(1.0),
+            OutputUnit::StandardGravity => Some(1.0 / STANDARD_GRAVITY_M_S2),
+            OutputUnit::MilliG => Some(1e3 / STANDARD_GRAVITY_M_S2),
+            _ => None,
+        }
+    }
+
+    /// The accepted column-name suffixes of rate-table outputs, for messages.
     pub fn accepted_suffixes() -> String {
         OutputUnit::ALL.iter().map(|u| u.suffix()).collect::<Vec<_>>().join(", ")
+    }
+
+    /// The accepted column-name suffixes of time-series channels, for messages.
+    pub fn accepted_channel_suffixes() -> String {
+        OutputUnit::CHANNEL_UNITS.iter().map(|u| u.suffix()).collect::<Vec<_>>().join(", ")
     }
 
     /// The unit in which people usually quote a scale factor for this output, with the factor
@@ -296,18 +429,175 @@ impl OutputUnit {
     }
 
     /// The factor that converts a value in this unit to `other`, when both are the same
-    /// physical quantity (V and mV; deg/s and rad/s).
+    /// physical quantity (V and mV; any two angular rates; any two accelerations).
     pub fn factor_to(self, other: OutputUnit) -> Option<f64> {
         use OutputUnit::*;
+        if self == other {
+            return Some(1.0);
+        }
+        if let (Some(a), Some(b)) = (self.native_scale_factor_per_dps(), other.native_scale_factor_per_dps()) {
+            return Some(b / a);
+        }
+        if let (Some(a), Some(b)) = (self.per_m_s2(), other.per_m_s2()) {
+            return Some(b / a);
+        }
         match (self, other) {
-            (a, b) if a == b => Some(1.0),
             (Volt, Millivolt) => Some(1e3),
             (Millivolt, Volt) => Some(1e-3),
-            (DegPerSec, RadPerSec) => Some(1.0 / DEG_PER_RAD),
-            (RadPerSec, DegPerSec) => Some(DEG_PER_RAD),
             _ => None,
         }
     }
+}
+
+/// Unit of a time column.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum TimeUnit {
+    /// Seconds.
+    #[serde(rename = "s")]
+    Second,
+    /// Milliseconds.
+    #[serde(rename = "ms")]
+    Millisecond,
+    /// Microseconds.
+    #[serde(rename = "us")]
+    Microsecond,
+    /// Nanoseconds.
+    #[serde(rename = "ns")]
+    Nanosecond,
+}
+
+impl TimeUnit {
+    /// Seconds per unit.
+    pub fn seconds(self) -> f64 {
+        match self {
+            TimeUnit::Second => 1.0,
+            TimeUnit::Millisecond => 1e-3,
+            TimeUnit::Microsecond => 1e-6,
+            TimeUnit::Nanosecond => 1e-9,
+        }
+    }
+
+    /// The unit's symbol.
+    pub fn symbol(self) -> &'static str {
+        match self {
+            TimeUnit::Second => "s",
+            TimeUnit::Millisecond => "ms",
+            TimeUnit::Microsecond => "us",
+            TimeUnit::Nanosecond => "ns",
+        }
+    }
+
+    /// Parses `s`, `sec`, `ms`, `us`, `µs`, `ns` (any case).
+    pub fn parse(s: &str) -> Option<TimeUnit> {
+        match normalise_unit_text(s).as_str() {
+            "s" | "sec" | "secs" | "second" | "seconds" => Some(TimeUnit::Second),
+            "ms" | "msec" => Some(TimeUnit::Millisecond),
+            "us" | "usec" => Some(TimeUnit::Microsecond),
+            "ns" | "nsec" => Some(TimeUnit::Nanosecond),
+            _ => None,
+        }
+    }
+}
+
+/// Whether a unit text names a temperature in degC (`c`, `degc`, `°c`, `celsius`).
+pub fn is_celsius(s: &str) -> bool {
+    matches!(normalise_unit_text(s).as_str(), "c" | "degc" | "deg_c" | "celsius")
+}
+
+/// Normalises how a unit is written: lower case; `°` as `deg`, `µ` as `u`, `²` as `^2`;
+/// `sec` as `s`; products with negative powers as a quotient (`rad s^-1` as `rad/s`,
+/// `m s^-2` as `m/s^2`).
+///
+/// ```
+/// use gyrolab::units::normalise_unit_text;
+/// assert_eq!(normalise_unit_text("rad s^-1"), "rad/s");
+/// assert_eq!(normalise_unit_text("m s^-2"), "m/s^2");
+/// assert_eq!(normalise_unit_text("°/s"), "deg/s");
+/// assert_eq!(normalise_unit_text("m/s²"), "m/s^2");
+/// ```
+pub fn normalise_unit_text(s: &str) -> String {
+    let t = s.trim().to_lowercase().replace('°', "deg").replace(['µ', 'μ'], "u").replace('²', "^2");
+    let t = t.replace("/sec", "/s").replace("deg/hr", "deg/h");
+    let tokens: Vec<&str> =
+        t.split(|c: char| c.is_whitespace() || c == '*' || c == '·').filter(|x| !x.is_empty()).collect();
+    if tokens.len() < 2 {
+        return tokens.first().map_or(String::new(), |x| x.to_string());
+    }
+    let (mut num, mut den) = (Vec::new(), Vec::new());
+    for tok in tokens {
+        match tok.split_once("^-").or_else(|| tok.split_once('-').filter(|(a, _)| !a.is_empty())) {
+            Some((base, "1")) => den.push(base.to_string()),
+            Some((base, p)) => den.push(format!("{base}^{p}")),
+            None => num.push(tok.to_string()),
+        }
+    }
+    let mut out = num.join(" ");
+    for d in den {
+        out.push('/');
+        out.push_str(&d);
+    }
+    out
+}
+
+/// A column name split into its base name and its unit text: `GYRO_X[deg/s]`,
+/// `w_RS_S_x [rad s^-1]`, `Rate (rad/s)`, `gyro_x_deg_s`, `output_mv`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ColumnName {
+    /// The name without its unit, lower case, trimmed (a leading `#` or `%` removed).
+    pub base: String,
+    /// The unit as written (lower case): inside brackets, or the suffix after the base.
+    pub unit: Option<String>,
+    /// Whether the unit was written in brackets or parentheses (any text), rather than as a
+    /// suffix (which is only taken when it is a known unit).
+    pub bracketed: bool,
+}
+
+/// Two-part unit suffixes, tried before the last underscore.
+const MULTI_PART_SUFFIXES: [&str; 7] = ["m_s2", "m_s_2", "mrad_s", "rad_s", "deg_s", "deg_h", "deg_c"];
+
+/// Splits a column name into base and unit (see [`ColumnName`]). A suffix after the last
+/// underscore counts as a unit only when it is one ([`OutputUnit::parse`], [`TimeUnit::parse`],
+/// degC): `gyro_x` has no unit.
+///
+/// ```
+/// use gyrolab::units::parse_column_name;
+/// let c = parse_column_name("w_RS_S_x [rad s^-1]");
+/// assert_eq!((c.base.as_str(), c.unit.as_deref()), ("w_rs_s_x", Some("rad s^-1")));
+/// assert_eq!(parse_column_name("gyro_x_deg_s").unit.as_deref(), Some("deg_s"));
+/// assert_eq!(parse_column_name("gyro_x").unit, None);
+/// assert_eq!(parse_column_name("#timestamp [ns]").base, "timestamp");
+/// ```
+pub fn parse_column_name(name: &str) -> ColumnName {
+    let lower = name.trim().trim_start_matches(['#', '%']).trim().to_lowercase();
+    for (open, close) in [('[', ']'), ('(', ')'), ('{', '}')] {
+        if lower.ends_with(close) {
+            if let Some(i) = lower.rfind(open) {
+                let unit = lower[i + 1..lower.len() - 1].trim().to_string();
+                let base = lower[..i].trim().trim_end_matches(['_', '-', ' ']).to_string();
+                if !base.is_empty() {
+                    return ColumnName { base, unit: (!unit.is_empty()).then_some(unit), bracketed: true };
+                }
+            }
+        }
+    }
+    let is_unit = |s: &str| OutputUnit::parse(s).is_some() || TimeUnit::parse(s).is_some() || is_celsius(s);
+    for sfx in MULTI_PART_SUFFIXES {
+        if let Some(base) = lower.strip_suffix(sfx).and_then(|b| b.strip_suffix('_')) {
+            if !base.is_empty() {
+                return ColumnName { base: base.to_string(), unit: Some(sfx.to_string()), bracketed: false };
+            }
+        }
+    }
+    if let Some(i) = lower.rfind('_') {
+        if i > 0 && is_unit(&lower[i + 1..]) {
+            return ColumnName {
+                base: lower[..i].to_string(),
+                unit: Some(lower[i + 1..].to_string()),
+                bracketed: false,
+            };
+        }
+    }
+    ColumnName { base: lower, unit: None, bracketed: false }
 }
 
 impl fmt::Display for OutputUnit {
@@ -322,9 +612,13 @@ impl fmt::Display for OutputUnit {
 /// recognised suffix, or the whole name and `None` when there is no underscore.
 pub fn split_unit_suffix(name: &str) -> (String, Option<String>) {
     let lower = name.trim().to_ascii_lowercase();
-    // Two-part suffixes first (rad_s).
-    if let Some(base) = lower.strip_suffix("_rad_s") {
-        return (base.to_string(), Some("rad_s".to_string()));
+    // Two-part suffixes first (rad_s, deg_s, m_s2, ...).
+    for sfx in MULTI_PART_SUFFIXES {
+        if let Some(base) = lower.strip_suffix(sfx).and_then(|b| b.strip_suffix('_')) {
+            if !base.is_empty() {
+                return (base.to_string(), Some(sfx.to_string()));
+            }
+        }
     }
     match lower.rfind('_') {
         Some(i) if i > 0 => (lower[..i].to_string(), Some(lower[i + 1..].to_string())),

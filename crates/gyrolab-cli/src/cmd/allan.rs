@@ -1,7 +1,7 @@
 //! `gyrolab allan FILE`: Allan-variance family with confidence intervals and noise terms, one
 //! result per output channel (channels computed in parallel).
 
-use crate::args::ReferenceArgs;
+use crate::args::{LayoutArgs, ReferenceArgs};
 use crate::error::CliResult;
 use crate::output::{print, to_json, write_file};
 use crate::progress::Bar;
@@ -10,16 +10,19 @@ use gyrolab::allan::DeviationKind;
 use gyrolab::validate;
 use gyrolab_eval::allan::{analyse_file, parse_confidence, parse_taus, AllanRequest};
 use gyrolab_eval::EvalError;
-use gyrolab_report::allan::{allan_csv, allan_document, allan_text, kalibr_yaml};
+use gyrolab_report::allan::{allan_csv, allan_document, allan_text, imu_utils_yaml, kalibr_yaml};
 use std::path::PathBuf;
 
 /// Options of `gyrolab allan`.
 #[derive(Debug, Args)]
 pub struct AllanArgs {
-    /// A time series: a time column `time_s` (or --sample-rate-hz) and output columns with unit
-    /// suffixes (`rate_dps`, `gyro_x_v`, ...).
+    /// A time series (`-`: standard input): a time column (`time_s`, `timestamp [ns]`, ...; or
+    /// --sample-rate-hz) and gyro or accelerometer columns, their units in the names
+    /// (`rate_dps`, `gyro_x [rad/s]`, `ax_m_s2`) or given with --unit; no header row: c1..cN.
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
+    #[command(flatten)]
+    pub layout: LayoutArgs,
     /// Output columns to analyse (default: every output column), repeatable.
     #[arg(long = "column", value_name = "NAME")]
     pub columns: Vec<String>,
@@ -46,11 +49,15 @@ pub struct AllanArgs {
     /// Print JSON (keys in docs/JSON.md).
     #[arg(long)]
     pub json: bool,
-    /// Write Kalibr imu.yaml gyroscope entries to this file: every analysed channel combined by
-    /// the largest value per entry; unresolved terms hold their upper bound (or the five-term fit
-    /// value), named in a comment and in a `warning:` on stderr.
+    /// Write a Kalibr imu.yaml (gyro and accelerometer noise densities and random walks,
+    /// update_rate, rostopic): channels combined by the largest value per entry; unresolved
+    /// terms hold their upper bound (or the five-term fit value), named in a comment and in a
+    /// `warning:` on stderr.
     #[arg(long, value_name = "FILE.yaml")]
     pub kalibr_yaml: Option<PathBuf>,
+    /// Write an imu_utils / VINS-style YAML (gyr_n, gyr_w, acc_n, acc_w), by the same rule.
+    #[arg(long, value_name = "FILE.yaml")]
+    pub imu_utils_yaml: Option<PathBuf>,
 }
 
 impl AllanArgs {
@@ -65,6 +72,7 @@ impl AllanArgs {
             taus: parse_taus(&self.taus)?,
             confidence: parse_confidence(&self.confidence)?,
             fit_range_s: validate::increasing_pair("fit_range_s", &self.fit_range)?,
+            layout: self.layout.layout(),
         })
     }
 }
@@ -77,11 +85,17 @@ pub fn run(args: &AllanArgs) -> CliResult {
     spinner.finish();
     let outcome = outcome?;
     let analyses = &outcome.analyses;
-    if let Some(yaml) = &args.kalibr_yaml {
-        let file = kalibr_yaml(analyses, 1.0 / outcome.sample_interval_s).ok_or_else(|| {
-            EvalError::conflict("no gyro noise terms could be read from the curve (calibrate the data with --cal or --scale-factor and use --kind oadev)")
+    for n in &outcome.notes {
+        eprintln!("note: {}", n.render(&crate::error::flag));
+    }
+    let writers: [(&Option<PathBuf>, fn(&[_], f64) -> _); 2] =
+        [(&args.kalibr_yaml, kalibr_yaml), (&args.imu_utils_yaml, imu_utils_yaml)];
+    for (path, writer) in writers {
+        let Some(path) = path else { continue };
+        let file = writer(analyses, 1.0 / outcome.sample_interval_s).ok_or_else(|| {
+            EvalError::conflict("no noise terms could be read from the curves (give the gyro channels a unit such as --unit rad/s, or calibrate outputs with --cal or --scale-factor, and use --kind oadev)")
         })?;
-        write_file(yaml, file.text.as_bytes())?;
+        write_file(path, file.text.as_bytes())?;
         for w in &file.warnings {
             eprintln!("warning: {w}");
         }
