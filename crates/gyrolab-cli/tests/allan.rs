@@ -96,7 +96,7 @@ fn json_keys_csv_and_kalibr() {
     let y = std::fs::read_to_string(&yaml).unwrap();
     // N = 0.006 deg/sqrt(s) = 1.047e-4 rad/s/sqrt(Hz).
     let line = y.lines().find(|l| l.starts_with("gyroscope_noise_density:")).unwrap();
-    let nd: f64 = line.split(':').nth(1).unwrap().trim().parse().unwrap();
+    let nd: f64 = line.split(':').nth(1).unwrap().split('#').next().unwrap().trim().parse().unwrap();
     assert!(rel(nd, 0.006_f64.to_radians()) < 0.05, "{y}");
     assert!(y.contains("update_rate: 100"), "{y}");
 }
@@ -168,7 +168,7 @@ fn kalibr_yaml_combines_three_channels_and_writes_bounds_not_zero() {
     let y = std::fs::read_to_string(&yaml).unwrap();
     let entry = |key: &str| -> f64 {
         let line = y.lines().find(|l| l.starts_with(&format!("{key}:"))).unwrap();
-        line.split(':').nth(1).unwrap().trim().parse().unwrap()
+        line.split(':').nth(1).unwrap().split('#').next().unwrap().trim().parse().unwrap()
     };
     let nd = entry("gyroscope_noise_density");
     assert!(rel(nd, (0.3f64 / 60.0).to_radians()) < 0.05, "{y}");

@@ -119,7 +119,7 @@ impl std::fmt::Display for ReadNote {
             }
             ReadNote::Unitless { channels } => write!(
                 f,
-                "no unit for {}: deviations in the columns' own units, no noise terms; give {{units}} such as {}=rad/s, or a unit for every such column",
+                "no unit for {}: deviations in the columns' own units, no noise terms; give {{units}} {}=rad/s for one column, or {{units}} rad/s (and {{units}} m/s^2 for accelerometers) for every column without one",
                 channels.join(", "),
                 channels.first().map_or("gx", String::as_str)
             ),
