@@ -57,6 +57,8 @@ pub struct StaticTestRequest {
     pub drop_outliers: bool,
     /// Accept NaN and empty cells (reported, excluded) instead of stopping.
     pub tolerant: bool,
+    /// Units, time column and names of the files, as the user gives them.
+    pub layout: crate::layout::LogLayout,
 }
 
 impl StaticTestRequest {
@@ -73,6 +75,7 @@ impl StaticTestRequest {
             temperature_quadratic: false,
             drop_outliers: false,
             tolerant: false,
+            layout: crate::layout::LogLayout::default(),
         }
     }
 }
@@ -112,7 +115,7 @@ pub fn evaluate_static_tests(request: &StaticTestRequest) -> EvalResult<StaticOu
         return Err(EvalError::conflict_on(&["output_unit", "columns"], "{output_unit} needs {columns}"));
     }
     let reference = request.reference.resolve()?;
-    let options = SeriesOptions {
+    let options = request.layout.apply(SeriesOptions {
         sample_rate_hz: request.sample_rate_hz,
         channels: if request.columns.is_empty() { None } else { Some(request.columns.clone()) },
         column_units: request
@@ -121,7 +124,7 @@ pub fn evaluate_static_tests(request: &StaticTestRequest) -> EvalResult<StaticOu
             .unwrap_or_default(),
         tolerant: request.tolerant,
         ..SeriesOptions::default()
-    };
+    })?;
     let mut tests: Vec<TestReport> = Vec::new();
     let mut files = Vec::new();
     for path in &request.files {

@@ -1,7 +1,7 @@
 //! `gyrolab bias FILE...`: static tests, one file per test (for example one per power-up), one
 //! result per output channel, and the bias repeatability across the files.
 
-use crate::args::ReferenceArgs;
+use crate::args::{LayoutArgs, ReferenceArgs};
 use crate::error::CliResult;
 use crate::output::{print, to_json};
 use clap::Args;
@@ -17,6 +17,8 @@ pub struct BiasArgs {
     /// columns with unit suffixes (`output_v`, `rate_dps`, ...), optional `temp_c`.
     #[arg(required = true, value_name = "FILE")]
     pub files: Vec<PathBuf>,
+    #[command(flatten)]
+    pub layout: LayoutArgs,
     /// Output columns to evaluate (default: every output column), repeatable.
     #[arg(long = "column", value_name = "NAME")]
     pub columns: Vec<String>,
@@ -61,6 +63,7 @@ pub fn run(args: &BiasArgs) -> CliResult {
         temperature_quadratic: args.temp_quadratic,
         drop_outliers: args.drop_outliers,
         tolerant: args.tolerant,
+        layout: args.layout.layout(),
     };
     let outcome = evaluate_static_tests(&request)?;
     for f in &outcome.files {
