@@ -148,7 +148,15 @@ fn ros_export_needs_units_and_says_so() {
         })
         .collect();
     let pg = write(dir.path(), "ros_g.csv", &g_text);
-    let out = gyrolab().arg("allan").arg(&pg).args(["--column", "ax", "--json"]).assert().success().get_output().stdout.clone();
+    let out = gyrolab()
+        .arg("allan")
+        .arg(&pg)
+        .args(["--column", "ax", "--json"])
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
     let v: serde_json::Value = serde_json::from_slice(&out).unwrap();
     assert!(rel(v["dev"][0].as_f64().unwrap(), dev_ms2) < 1e-6);
 }

@@ -311,7 +311,21 @@ fn read_long(
 }
 
 /// Parses a run label: digits anywhere ("1", "run1", "r1"), or a Chinese ordinal ("第一次").
+/// A column name without its bracketed unit (`Run 1 (V)` -> `Run 1`), and that unit.
+fn strip_bracketed_unit(name: &str) -> (String, Option<String>) {
+    let t = name.trim();
+    if t.ends_with([')', '）', ']']) {
+        if let Some(open) = t.rfind(['(', '（', '[']) {
+            let inner = t[open..].trim_start_matches(['(', '（', '[']).trim_end_matches([')', '）', ']']).trim();
+            return (t[..open].trim().to_string(), Some(inner.replace('°', "deg").replace("deg/sec", "deg/s")));
+        }
+    }
+    (t.to_string(), None)
+}
+
 fn parse_run(label: &str) -> Option<u32> {
+    let (label, _) = strip_bracketed_unit(label);
+    let label = label.as_str();
     let digits: String = label.chars().filter(|c| c.is_ascii_digit()).collect();
     if !digits.is_empty() {
         let rest_ok = label.chars().all(|c| c.is_ascii_digit() || c.is_alphabetic() || c == ' ' || c == '_');
@@ -326,11 +340,12 @@ fn parse_run(label: &str) -> Option<u32> {
 
 /// Splits a wide-layout column name like `run1_fwd_v` or `1 rev` into (run, stroke, unit text).
 fn parse_wide_column(name: &str) -> Option<(u32, Stroke, Option<String>)> {
-    let lower = name.to_lowercase();
+    let (base, bracketed) = strip_bracketed_unit(name);
+    let lower = base.to_lowercase();
     let tokens: Vec<&str> = lower.split(['_', ' ']).filter(|t| !t.is_empty()).collect();
     let mut run = None;
     let mut stroke = None;
-    let mut unit = None;
+    let mut unit = bracketed.map(|u| u.to_lowercase());
     for t in &tokens {
         if let Some(s) = Stroke::from_label(t) {
             if stroke.is_none() {

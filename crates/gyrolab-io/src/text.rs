@@ -227,6 +227,8 @@ pub struct TextRow {
     pub line: u64,
     /// Trimmed fields.
     pub fields: Vec<String>,
+    /// The line as written (for re-splitting when the header turns out to be a title).
+    pub raw_text: String,
 }
 
 /// A parsed text file: header, rows and comment lines.
@@ -257,6 +259,7 @@ pub fn parse_text_table(file: &Path, text: &str) -> Result<TextTable, DataError>
     TextGuard::default().check(file, text.as_bytes())?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut header: Option<(u64, Vec<String>, Delimiter)> = None;
+    let mut header_raw = String::new();
     let mut rows = Vec::new();
     let mut comments = Vec::new();
     for (i, raw) in text.lines().enumerate() {
@@ -273,8 +276,39 @@ pub fn parse_text_table(file: &Path, text: &str) -> Result<TextTable, DataError>
             None => {
                 let d = Delimiter::sniff(raw);
                 header = Some((line, d.split(raw), d));
+                header_raw = raw.to_string();
             }
-            Some((_, _, d)) => rows.push(TextRow { line, fields: d.split(raw) }),
+            Some((_, _, d)) => rows.push(TextRow { line, fields: d.split(raw), raw_text: raw.to_string() }),
+        }
+    }
+    // A title row above the header (as spreadsheets export a sheet with its caption): a first
+    // line with one field, followed by a line with three or more.
+    if let (Some((line, _, _)), Some(first)) = (&header, rows.first()) {
+        let next_delim = Delimiter::sniff(&first.raw_text);
+        let next_fields = next_delim.split(&first.raw_text);
+        let title_fields = next_delim.split(&header_raw);
+        if next_delim != Delimiter::Whitespace
+            && title_fields.iter().filter(|f| !f.is_empty()).count() == 1
+            && next_fields.len() >= 3
+        {
+            comments.push((*line, header_raw.trim().to_string()));
+            let first = rows.remove(0);
+            header = Some((first.line, next_fields, next_delim));
+            for r in &mut rows {
+                r.fields = next_delim.split(&r.raw_text);
+            }
+        }
+    }
+    if let Some((_, _, d)) = &header {
+        if *d != Delimiter::Comma {
+            // Decimal commas (semicolon- or tab-separated files from a European spreadsheet).
+            for r in &mut rows {
+                for f in &mut r.fields {
+                    if is_decimal_comma_number(f) {
+                        *f = f.replace(',', ".");
+                    }
+                }
+            }
         }
     }
     let Some((header_line, header, delimiter)) = header else {
@@ -302,6 +336,24 @@ pub fn parse_text_table(file: &Path, text: &str) -> Result<TextTable, DataError>
         }
     }
     Ok(TextTable { delimiter, header_line, header, rows, comments })
+}
+
+/// Whether a field is a number written with a decimal comma (`-0,25`, `1,5e-3`).
+fn is_decimal_comma_number(f: &str) -> bool {
+    let t = f.strip_prefix(['+', '-']).unwrap_or(f);
+    let Some((a, b)) = t.split_once(',') else { return false };
+    let (frac, exp) = match b.split_once(['e', 'E']) {
+        Some((x, e)) => (x, Some(e)),
+        None => (b, None),
+    };
+    !a.is_empty()
+        && a.bytes().all(|c| c.is_ascii_digit())
+        && !frac.is_empty()
+        && frac.bytes().all(|c| c.is_ascii_digit())
+        && exp.is_none_or(|e| {
+            let e = e.strip_prefix(['+', '-']).unwrap_or(e);
+            !e.is_empty() && e.bytes().all(|c| c.is_ascii_digit())
+        })
 }
 
 /// Parses a finite number from a field, or explains what is wrong with it: not a number (one
