@@ -283,14 +283,11 @@ pub fn parse_text_table(file: &Path, text: &str) -> Result<TextTable, DataError>
     }
     // A title row above the header (as spreadsheets export a sheet with its caption): a first
     // line with one field, followed by a line with three or more.
-    if let (Some((line, _, _)), Some(first)) = (&header, rows.first()) {
+    if let (Some((line, _, Delimiter::Whitespace)), Some(first)) = (&header, rows.first()) {
         let next_delim = Delimiter::sniff(&first.raw_text);
         let next_fields = next_delim.split(&first.raw_text);
-        let title_fields = next_delim.split(&header_raw);
-        if next_delim != Delimiter::Whitespace
-            && title_fields.iter().filter(|f| !f.is_empty()).count() == 1
-            && next_fields.len() >= 3
-        {
+        let names = next_fields.iter().filter(|f| !f.is_empty()).all(|f| f.chars().any(char::is_alphabetic));
+        if next_delim != Delimiter::Whitespace && next_fields.len() >= 3 && names {
             comments.push((*line, header_raw.trim().to_string()));
             let first = rows.remove(0);
             header = Some((first.line, next_fields, next_delim));
