@@ -366,9 +366,7 @@ fn ros_convention_unit(base: &str) -> Option<OutputUnit> {
 /// Whether a column's base name says it is an accelerometer channel (`ax`, `acc_x`,
 /// `accel_y`, `a_rs_s_z`, `linear_acceleration.x`, ...).
 pub fn is_accelerometer_name(base: &str) -> bool {
-    let b = base
-        .trim_end_matches(|c: char| matches!(c, 'x' | 'y' | 'z' | '1' | '2' | '3'))
-        .trim_end_matches(['_', '.', '-', ' ']);
+    let b = base.trim_end_matches(['x', 'y', 'z', '1', '2', '3']).trim_end_matches(['_', '.', '-', ' ']);
     b == "a"
         || b.starts_with("acc")
         || b.contains("_acc")
@@ -406,6 +404,9 @@ pub struct SeriesReader<R: Read> {
     cols: Vec<Vec<f64>>,
     lines: Vec<u64>,
     quality: ReaderQuality,
+    /// A piece of a file parsed by [`read_series_all`]'s parallel path: no header, and no rows
+    /// is not an error.
+    piece: bool,
 }
 
 /// The byte source of [`SeriesReader::open`]: a file, or standard input for the path `-`.
@@ -472,6 +473,7 @@ impl<R: Read> SeriesReader<R> {
             cols: Vec::new(),
             lines: Vec::new(),
             quality: ReaderQuality::default(),
+            piece: false,
         };
         if let Some(f) = options.sample_rate_hz {
             if !(f.is_finite() && f > 0.0) {
@@ -955,7 +957,7 @@ impl<R: Read> SeriesReader<R> {
             self.parse_rows()?;
         }
         if self.lines.is_empty() {
-            if self.rows == 0 {
+            if self.rows == 0 && !self.piece {
                 return Err(DataError::new(
                     &self.header.file,
                     "the file has a header but no data rows: expected at least one row of numbers",
@@ -1227,10 +1229,198 @@ pub struct SeriesData {
     pub quality: ReaderQuality,
 }
 
-/// Reads a whole file into memory (for analyses that need the whole record, such as Allan variance).
+/// Most rows [`read_series_all`] reserves room for before reading them.
+const MAX_RESERVE_ROWS: usize = 1 << 30;
+
+/// Bytes read at once by the parallel path of [`read_series_all`].
+pub const PARALLEL_BATCH_BYTES: usize = 16 << 20;
+
+/// Reads a whole file (`-`: standard input) into memory, for analyses that need the whole
+/// record (such as the Allan variance). Large inputs are parsed in parallel: batches of
+/// [`PARALLEL_BATCH_BYTES`] are read in turn, split at line ends into one piece per thread,
+/// and the pieces parsed at once by the same row parser as [`SeriesReader::next_block`] (same
+/// values, same errors with their lines; the first error in file order is returned).
 pub fn read_series_all(path: impl AsRef<Path>, options: &SeriesOptions) -> Result<SeriesData, DataError> {
+    let path = path.as_ref();
     let r = SeriesReader::open(path, options)?;
-    collect_series(r)
+    let threads = rayon::current_num_threads();
+    let size = std::fs::metadata(path).map(|m| m.len()).unwrap_or(u64::MAX);
+    if threads < 2 || size < (4 << 20) {
+        return collect_series(r);
+    }
+    collect_series_parallel(r, threads, size, PARALLEL_BATCH_BYTES)
+}
+
+/// Reads every row of an open reader into memory like [`collect_series`], parsing batches of
+/// `batch_bytes` in `threads` pieces at once (the parallel path of [`read_series_all`], exposed
+/// to test it against [`collect_series`] on any input).
+pub fn collect_series_in_parallel<R: Read>(
+    r: SeriesReader<R>,
+    threads: usize,
+    batch_bytes: usize,
+) -> Result<SeriesData, DataError> {
+    collect_series_parallel(r, threads.max(1), 0, batch_bytes.max(16))
+}
+
+impl<R: Read> SeriesReader<R> {
+    /// A parser of one piece of the data rows (`buf` holds the piece and ends with a line end;
+    /// `line_no` is the number of lines before it), sharing this reader's header and column
+    /// layout; `cols` and `lines` are reused buffers, large enough for every row of the piece.
+    fn piece_parser(
+        &self,
+        buf: Vec<u8>,
+        line_no: u64,
+        rows: usize,
+        cols: Vec<Vec<f64>>,
+        lines: Vec<u64>,
+    ) -> SeriesReader<std::io::Empty> {
+        let len = buf.len();
+        SeriesReader {
+            src: std::io::empty(),
+            header: self.header.clone(),
+            tolerant: self.tolerant,
+            fast_rows: self.fast_rows,
+            block_rows: rows.max(1),
+            chunk_bytes: len.max(16),
+            buf,
+            pos: 0,
+            filled: len,
+            complete: len,
+            eof: true,
+            line_no,
+            tail_len: 0,
+            rows: 0,
+            targets: self.targets.clone(),
+            shapes: Vec::new(),
+            crlf: self.crlf,
+            time_slot: self.time_slot,
+            temp_slot: self.temp_slot,
+            rate_slot: self.rate_slot,
+            cols,
+            lines,
+            quality: ReaderQuality::default(),
+            piece: true,
+        }
+    }
+}
+
+/// A piece parsed by a piece parser: its rows (channels, then time, temperature, table rate)
+/// and its buffers for reuse.
+struct Piece {
+    buf: Vec<u8>,
+    lines: Vec<u64>,
+    cols: Vec<Vec<f64>>,
+    quality: ReaderQuality,
+}
+
+/// Parses a whole piece in one block (its block size is at least its line count).
+fn parse_piece(mut p: SeriesReader<std::io::Empty>) -> Result<Piece, DataError> {
+    p.next_block()?;
+    Ok(Piece {
+        buf: std::mem::take(&mut p.buf),
+        lines: std::mem::take(&mut p.lines),
+        cols: std::mem::take(&mut p.cols),
+        quality: std::mem::take(&mut p.quality),
+    })
+}
+
+fn collect_series_parallel<R: Read>(
+    mut r: SeriesReader<R>,
+    threads: usize,
+    size: u64,
+    batch_bytes: usize,
+) -> Result<SeriesData, DataError> {
+    use rayon::prelude::*;
+    let header = r.header.clone();
+    let nch = header.channels.len();
+    let nslots = r.cols.len();
+    // Slots in the parser's order: channels, then time, temperature, table rate.
+    let mut slots: Vec<Vec<f64>> = vec![Vec::new(); nslots];
+    let mut lines: Vec<u64> = Vec::new();
+    let mut quality = ReaderQuality::default();
+    if r.buf.len() < batch_bytes {
+        r.buf.resize(batch_bytes, 0);
+    }
+    let mut pool: Vec<Piece> = (0..threads)
+        .map(|_| Piece {
+            buf: Vec::new(),
+            lines: Vec::new(),
+            cols: vec![Vec::new(); nslots],
+            quality: ReaderQuality::default(),
+        })
+        .collect();
+    let mut reserved = false;
+    loop {
+        if r.pos >= r.complete && !r.fill()? {
+            break;
+        }
+        let batch = &r.buf[r.pos..r.complete];
+        // Split at line ends into one piece per thread; count the lines of each piece.
+        let mut bounds = vec![0usize];
+        for k in 1..threads {
+            let at = (batch.len() * k / threads).max(*bounds.last().unwrap_or(&0));
+            let cut = memchr::memchr(b'\n', &batch[at..]).map_or(batch.len(), |i| at + i + 1);
+            bounds.push(cut.min(batch.len()));
+        }
+        bounds.push(batch.len());
+        let mut line_no = r.line_no;
+        let mut parsers = Vec::with_capacity(threads);
+        for (k, w) in bounds.windows(2).enumerate() {
+            let piece = &batch[w[0]..w[1]];
+            let count = memchr::memchr_iter(b'\n', piece).count();
+            let mut slot = std::mem::replace(
+                &mut pool[k],
+                Piece { buf: Vec::new(), lines: Vec::new(), cols: Vec::new(), quality: ReaderQuality::default() },
+            );
+            slot.buf.clear();
+            slot.buf.extend_from_slice(piece);
+            slot.lines.clear();
+            slot.lines.reserve(count);
+            for c in &mut slot.cols {
+                c.clear();
+                c.reserve(count);
+            }
+            parsers.push(r.piece_parser(slot.buf, line_no, count, slot.cols, slot.lines));
+            line_no += count as u64;
+        }
+        if !reserved {
+            // Reserve for the whole file from the first batch's bytes per line (no regrowth).
+            let per_line = (batch.len() as f64 / (line_no - r.line_no).max(1) as f64).max(1.0);
+            let estimate = (((size as f64 / per_line) * 1.02) as usize + 16).min(MAX_RESERVE_ROWS);
+            slots.iter_mut().for_each(|s| s.reserve_exact(estimate));
+            lines.reserve_exact(estimate);
+            reserved = true;
+        }
+        let pieces: Vec<Result<Piece, DataError>> = parsers.into_par_iter().map(parse_piece).collect();
+        for (k, p) in pieces.into_iter().enumerate() {
+            let mut p = p?;
+            lines.extend_from_slice(&p.lines);
+            for (s, c) in slots.iter_mut().zip(&p.cols) {
+                s.extend_from_slice(c);
+            }
+            quality.missing_cells += p.quality.missing_cells;
+            let room = FIRST_MISSING.saturating_sub(quality.first_missing.len());
+            quality.first_missing.extend(std::mem::take(&mut p.quality.first_missing).into_iter().take(room));
+            pool[k] = p;
+        }
+        r.line_no = line_no;
+        r.pos = r.complete;
+    }
+    if lines.is_empty() {
+        return Err(DataError::new(
+            &header.file,
+            "the file has a header but no data rows: expected at least one row of numbers",
+        )
+        .at_line(header.header_line));
+    }
+    let mut it = slots.into_iter();
+    let channels: Vec<Vec<f64>> = it.by_ref().take(nch).collect();
+    let time = header.time_column.map(|_| it.next().unwrap_or_default());
+    let temperature = header.temperature_column.map(|_| it.next().unwrap_or_default());
+    let table_rate = header.table_rate_column.map(|_| it.next().unwrap_or_default());
+    let mut channels = channels;
+    channels.iter_mut().for_each(|c| c.shrink_to_fit());
+    Ok(SeriesData { header, lines, time, temperature, table_rate, channels, quality })
 }
 
 /// Reads every block of an open reader into memory.

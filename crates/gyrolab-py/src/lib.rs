@@ -90,7 +90,8 @@ fn allan<'py>(
     if per_hour {
         values.iter_mut().for_each(|v| *v = gyrolab::units::dph_to_dps(*v));
     }
-    let info = ChannelInfo { name: name.to_string(), column: 1, unit };
+    let info =
+        ChannelInfo { name: name.to_string(), column: 1, unit, unit_source: gyrolab_io::series::UnitSource::Column };
     let options = AllanOptions { kind, taus, confidence, max_factor: None };
     let analysis = py
         .detach(|| {

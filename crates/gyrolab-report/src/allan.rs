@@ -520,6 +520,10 @@ fn basis_comment(b: Option<KalibrBasis>) -> &'static str {
     }
 }
 
+/// One channel's filter entries: index, noise density, basis, random walk, basis, whether it is
+/// an accelerometer.
+type ChannelEntries = (usize, Option<f64>, Option<KalibrBasis>, Option<f64>, Option<KalibrBasis>, bool);
+
 /// One combined entry of a filter file: key, value, basis, channel index.
 type Entry = (&'static str, Option<f64>, Option<KalibrBasis>, usize);
 
@@ -529,8 +533,8 @@ type Entry = (&'static str, Option<f64>, Option<KalibrBasis>, usize);
 struct FilterEntries {
     gyro: Option<KalibrGyroscope>,
     accel: Option<KalibrAccelerometer>,
-    /// (channel index, noise density, basis, random walk, basis, unit of the two).
-    per: Vec<(usize, Option<f64>, Option<KalibrBasis>, Option<f64>, Option<KalibrBasis>, bool)>,
+    /// Per channel: index, noise density, basis, random walk, basis, accelerometer or not.
+    per: Vec<ChannelEntries>,
 }
 
 fn filter_entries(channels: &[ChannelAnalysis]) -> FilterEntries {
@@ -569,18 +573,15 @@ fn filter_entries(channels: &[ChannelAnalysis]) -> FilterEntries {
             _ => {}
         }
     }
-    let remap = |list_len: usize, idx: (usize, usize), src: &dyn Fn(usize) -> (usize, usize)| {
-        let _ = list_len;
-        (src(idx.0).0, src(idx.1).1)
-    };
+    // Combined entries name the channel of the analysis list, not of the per-quantity list.
     let g = (!gyro.is_empty()).then(|| {
         let mut c = combine_kalibr(&gyro);
-        c.channel_index = remap(gyro.len(), c.channel_index, &|k| gyro[k].channel_index);
+        c.channel_index = (gyro[c.channel_index.0].channel_index.0, gyro[c.channel_index.1].channel_index.1);
         c
     });
     let acc = (!accel.is_empty()).then(|| {
         let mut c = combine_kalibr_accelerometer(&accel);
-        c.channel_index = remap(accel.len(), c.channel_index, &|k| accel[k].channel_index);
+        c.channel_index = (accel[c.channel_index.0].channel_index.0, accel[c.channel_index.1].channel_index.1);
         c
     });
     FilterEntries { gyro: g, accel: acc, per }

@@ -88,10 +88,9 @@ pub fn run(args: &AllanArgs) -> CliResult {
     for n in &outcome.notes {
         eprintln!("note: {}", n.render(&crate::error::flag));
     }
-    let writers: [(&Option<PathBuf>, fn(&[_], f64) -> _); 2] =
-        [(&args.kalibr_yaml, kalibr_yaml), (&args.imu_utils_yaml, imu_utils_yaml)];
-    for (path, writer) in writers {
+    for (path, imu_utils) in [(&args.kalibr_yaml, false), (&args.imu_utils_yaml, true)] {
         let Some(path) = path else { continue };
+        let writer = if imu_utils { imu_utils_yaml } else { kalibr_yaml };
         let file = writer(analyses, 1.0 / outcome.sample_interval_s).ok_or_else(|| {
             EvalError::conflict("no noise terms could be read from the curves (give the gyro channels a unit such as --unit rad/s, or calibrate outputs with --cal or --scale-factor, and use --kind oadev)")
         })?;
