@@ -303,11 +303,21 @@ def simulate_static(
     return out
 
 
-def read(path: PathLike, as_dataframe: Optional[bool] = None) -> Any:
-    """Reads a time-series file gyrolab reads (CSV, TSV, ...): a pandas DataFrame when pandas is
-    installed (column units in ``df.attrs["units"]``), else (or with ``as_dataframe=False``) a
-    dict of column name -> float64 array; :func:`read_with_units` gives arrays and units."""
-    arrays, units = _gyrolab.read(str(path))
+def read(
+    path: PathLike,
+    as_dataframe: Optional[bool] = None,
+    units: Optional[Sequence[str]] = None,
+    time_column: Optional[str] = None,
+    names: Optional[Sequence[str]] = None,
+) -> Any:
+    """Reads a time-series file gyrolab reads (CSV, TSV, Kalibr imu0.csv, headerless, ...): a
+    pandas DataFrame when pandas is installed (column units in ``df.attrs["units"]``), else (or
+    with ``as_dataframe=False``) a dict of column name -> float64 array; :func:`read_with_units`
+    gives arrays and units. ``units`` (``["gx=rad/s", "m/s^2"]``), ``time_column`` and ``names``
+    (for a file without a header row) as the CLI's ``--unit``, ``--time-column``, ``--names``."""
+    arrays, units = _gyrolab.read(
+        str(path), None if units is None else list(units), time_column, None if names is None else list(names)
+    )
     if as_dataframe is not False:
         try:
             import pandas as pd
@@ -321,9 +331,16 @@ def read(path: PathLike, as_dataframe: Optional[bool] = None) -> Any:
     return arrays
 
 
-def read_with_units(path: PathLike) -> Tuple[Dict[str, np.ndarray], Dict[str, str]]:
-    """Reads a time-series file: (column -> array, column -> unit symbol)."""
-    return _gyrolab.read(str(path))
+def read_with_units(
+    path: PathLike,
+    units: Optional[Sequence[str]] = None,
+    time_column: Optional[str] = None,
+    names: Optional[Sequence[str]] = None,
+) -> Tuple[Dict[str, np.ndarray], Dict[str, str]]:
+    """Reads a time-series file: (column -> array, column -> unit symbol); options as :func:`read`."""
+    return _gyrolab.read(
+        str(path), None if units is None else list(units), time_column, None if names is None else list(names)
+    )
 
 
 def evaluate_plan(plan: PathLike, out: PathLike) -> Dict[str, Any]:

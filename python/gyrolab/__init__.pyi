@@ -94,10 +94,21 @@ def simulate_static(
 ) -> Dict[str, np.ndarray]:
     """A simulated static record with known truth: time_s, output (and temp_c)."""
 
-def read(path: PathLike, as_dataframe: Optional[bool] = ...) -> Any:
+def read(
+    path: PathLike,
+    as_dataframe: Optional[bool] = ...,
+    units: Optional[Sequence[str]] = ...,
+    time_column: Optional[str] = ...,
+    names: Optional[Sequence[str]] = ...,
+) -> Any:
     """A time-series file as a DataFrame (pandas) or a dict of float64 arrays."""
 
-def read_with_units(path: PathLike) -> Tuple[Dict[str, np.ndarray], Dict[str, str]]:
+def read_with_units(
+    path: PathLike,
+    units: Optional[Sequence[str]] = ...,
+    time_column: Optional[str] = ...,
+    names: Optional[Sequence[str]] = ...,
+) -> Tuple[Dict[str, np.ndarray], Dict[str, str]]:
     """A time-series file: (column -> array, column -> unit symbol)."""
 
 def evaluate_plan(plan: PathLike, out: PathLike) -> Dict[str, Any]:

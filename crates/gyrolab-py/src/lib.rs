@@ -281,10 +281,25 @@ fn simulate_static<'py>(
 }
 
 /// Reads a time series file: a dict of column name -> float64 array, and a dict of column name
-/// -> unit symbol (outputs; `s` for time, `degC` for temperature).
+/// -> unit symbol (outputs; `s` for time, `degC` for temperature). `units` (`["gx=rad/s",
+/// "m/s^2"]`), `time_column` and `names` (a file without a header row) as `gyrolab allan`'s
+/// `--unit`, `--time-column`, `--names`.
 #[pyfunction]
-fn read<'py>(py: Python<'py>, path: PathBuf) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
-    let data = py.detach(|| read_series_all(&path, &SeriesOptions::default())).map_err(|e| err(e.into()))?;
+#[pyo3(signature = (path, units=None, time_column=None, names=None))]
+fn read<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    units: Option<Vec<String>>,
+    time_column: Option<String>,
+    names: Option<Vec<String>>,
+) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
+    let layout = gyrolab_eval::layout::LogLayout {
+        units: units.unwrap_or_default(),
+        time_column,
+        names: names.unwrap_or_default(),
+    };
+    let options = layout.apply(SeriesOptions::default()).map_err(err)?;
+    let data = py.detach(|| read_series_all(&path, &options)).map_err(|e| err(e.into()))?;
     let arrays = PyDict::new(py);
     let units = PyDict::new(py);
     let h = &data.header;

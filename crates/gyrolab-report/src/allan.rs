@@ -652,7 +652,7 @@ fn filter_file(channels: &[ChannelAnalysis], update_rate_hz: f64, imu_utils: boo
     let name = |i: usize| format!("{} ({})", channels[i].file, channels[i].channel);
     let mut text = if imu_utils {
         format!(
-            "%YAML:1.0\n# imu_utils / VINS-Mono style IMU noise parameters written by gyrolab {}\n\
+            "%YAML:1.0\n---\n# imu_utils / VINS-Mono style IMU noise parameters written by gyrolab {}\n\
              # Continuous-time values (the convention of imu_utils, VINS and Kalibr):\n\
              # gyr_n: gyro white noise density, rad/s/sqrt(Hz); gyr_w: gyro random walk, rad/s^2/sqrt(Hz);\n\
              # acc_n: accelerometer white noise density, m/s^2/sqrt(Hz); acc_w: accelerometer random walk, m/s^3/sqrt(Hz).\n",
