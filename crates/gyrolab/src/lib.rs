@@ -22,6 +22,7 @@
 
 pub mod allan;
 pub mod apply;
+pub mod dropout;
 pub mod fit;
 pub mod noise;
 pub mod published;

@@ -29,7 +29,10 @@
 mod chi2;
 mod confidence;
 mod fast;
+mod gaps;
 mod kernels;
+
+pub use gaps::deviation_from_rate_with_gaps;
 
 pub use chi2::{chi_squared_cdf, chi_squared_quantile};
 use rayon::prelude::*;
@@ -277,6 +280,12 @@ pub enum AllanError {
     /// tau0 is not a positive finite number.
     #[error("sample interval tau0 = {0} s must be positive and finite")]
     BadTau0(f64),
+    /// The kind cannot be computed over missing samples.
+    #[error("{kind} cannot be computed over missing samples (gaps): oadev, adev, hdev and ohdev can")]
+    GapsUnsupported {
+        /// Short name of the deviation.
+        kind: &'static str,
+    },
     /// Unknown deviation name.
     #[error("unknown deviation kind '{0}' (expected adev, oadev, mdev, tdev, hdev, ohdev, totdev)")]
     UnknownKind(String),
@@ -606,7 +615,21 @@ fn compute(s: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve,
             }
         })
         .collect();
-    if let Some(confidence) = options.confidence {
+    attach_bounds(&mut points, s, kind, options.confidence, |_| s.len());
+    Ok(AllanCurve { kind, tau0_s, n_rate, confidence: options.confidence, points })
+}
+
+/// Identifies the noise type of every point (lag-1 ACF, else B1, else the previous point's)
+/// and attaches its EDF and chi-squared bounds; `n_phase` gives the record length (phase
+/// points) the EDF of a point is computed for.
+fn attach_bounds(
+    points: &mut [AllanPoint],
+    s: &[f64],
+    kind: DeviationKind,
+    confidence: Option<f64>,
+    n_phase: impl Fn(&AllanPoint) -> usize,
+) {
+    if let Some(confidence) = confidence {
         let ids: Vec<Option<(i32, NoiseIdMethod)>> =
             points.par_iter().map(|p| identify_noise(s, p.m, kind, p.terms)).collect();
         let mut previous: Option<i32> = None;
@@ -624,7 +647,7 @@ fn compute(s: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve,
                 None => {}
             }
             if let Some(alpha) = p.alpha {
-                let edf = equivalent_dof(kind, alpha, p.m, s.len());
+                let edf = equivalent_dof(kind, alpha, p.m, n_phase(p));
                 p.edf = Some(edf);
                 if let Some((lo, hi)) = confidence::chi2_bounds(p.deviation, edf, confidence) {
                     p.lower = Some(lo);
@@ -636,7 +659,6 @@ fn compute(s: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve,
             }
         }
     }
-    Ok(AllanCurve { kind, tau0_s, n_rate, confidence: options.confidence, points })
 }
 
 /// Tau lists at least this long (and records at least 4 times as long) use the FFT expansion.
