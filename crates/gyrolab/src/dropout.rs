@@ -53,10 +53,10 @@ impl Dropouts {
 ///
 /// ```
 /// use gyrolab::dropout::find_dropouts;
-/// // Three channels of noise with 40 all-zero rows: found; a channel often 0 alone is not.
+/// // Three channels (an accelerometer axis reading about 1 g among them) with 40 all-zero rows.
 /// let n = 10_000;
 /// let ch: Vec<Vec<f64>> = (0..3)
-///     .map(|c| (0..n).map(|i| if (2000..2040).contains(&i) { 0.0 } else { ((i * (c + 3) * 7919) % 11) as f64 - 5.0 }).collect())
+///     .map(|c| (0..n).map(|i| if (2000..2040).contains(&i) { 0.0 } else { (c * 10 + (i * 7 + c) % 5) as f64 }).collect())
 ///     .collect();
 /// let refs: Vec<&[f64]> = ch.iter().map(|c| &c[..]).collect();
 /// let d = find_dropouts(&refs);
