@@ -125,8 +125,9 @@ fn allan_error(text: &str, args: &[&str]) -> String {
 fn bad_input() {
     let e = allan_error("rate_dps\n1\n", &["--sample-rate-hz", "1"]);
     assert!(e.contains("too short"), "{e}");
-    let e = allan_error("rate_dps\n1\n2\nnan\n4\n5\n6\n7\n8\n9\n", &["--sample-rate-hz", "1"]);
-    assert!(e.contains("bad.csv:4:1"), "{e}");
+    // A NaN cell is a missing sample: computed over by default, refused with --gaps error.
+    let e = allan_error("rate_dps\n1\n2\nnan\n4\n5\n6\n7\n8\n9\n", &["--sample-rate-hz", "1", "--gaps", "error"]);
+    assert!(e.contains("bad.csv:4"), "{e}");
     let ok = "rate_dps\n1\n2\n3\n4\n5\n6\n7\n8\n9\n";
     let e = allan_error(ok, &["--sample-rate-hz", "1", "--kind", "xdev"]);
     assert!(e.contains("unknown deviation kind 'xdev'"), "{e}");
@@ -134,8 +135,11 @@ fn bad_input() {
     assert!(e.contains("weekly"), "{e}");
     let e = allan_error(ok, &["--sample-rate-hz", "1", "--confidence", "1.5"]);
     assert!(e.contains("confidence"), "{e}");
-    let e = allan_error("time_s,rate_dps\n0,1\n1,2\n2,3\n5,4\n6,5\n7,6\n", &[]);
-    assert!(e.contains("bad.csv:5") && e.contains("irregular sampling"), "{e}");
+    // Two samples missing before line 5: refused with --gaps error, and a reversed stamp always.
+    let e = allan_error("time_s,rate_dps\n0,1\n1,2\n2,3\n5,4\n6,5\n7,6\n", &["--gaps", "error"]);
+    assert!(e.contains("bad.csv:5") && e.contains("2 sample(s) missing"), "{e}");
+    let e = allan_error("time_s,rate_dps\n0,1\n1,2\n2,3\n1.5,4\n6,5\n7,6\n", &[]);
+    assert!(e.contains("bad.csv:5") && e.contains("does not increase"), "{e}");
     let e = allan_error(ok, &[]);
     assert!(e.contains("sample rate") || e.contains("time"), "{e}");
 }

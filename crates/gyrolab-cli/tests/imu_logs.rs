@@ -195,3 +195,106 @@ fn headerless_file_and_standard_input() {
     let p = write(dir.path(), "two.txt", &text);
     gyrolab().arg("allan").arg(&p).args(["--names", "t,gy", "--unit", "gy=rad/s"]).assert().success();
 }
+
+/// The case: 2 h at 200 Hz, six channels, jittered stamps, a dozen dropped samples,
+/// through `gyrolab allan FILE --kalibr-yaml imu.yaml` with no other option.
+#[test]
+fn two_hours_with_jitter_and_dropped_samples_give_truth_and_a_complete_yaml() {
+    let dir = tempfile::tempdir().unwrap();
+    let drops: Vec<usize> = (0..12).map(|k| 40_000 + k * 117_000).collect();
+    let rows = imu_rows(21, 200.0, 7200.0, 0.3, &drops);
+    let p = write(dir.path(), "imu0.csv", &kalibr_csv(&rows));
+    let yaml = dir.path().join("imu.yaml");
+    let out = gyrolab()
+        .arg("allan")
+        .arg(&p)
+        .arg("--kalibr-yaml")
+        .arg(&yaml)
+        .arg("--json")
+        .assert()
+        .success()
+        .get_output()
+        .clone();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(stderr.contains("note: 12 gap(s) in the time stamps, 12 sample(s) missing"), "{stderr}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let ch = v["channels"].as_array().unwrap();
+    for c in &ch[..3] {
+        let n = c["noise"]["arw_deg_rt_h"].as_f64().unwrap();
+        assert!(rel(n, 0.3) < 0.03, "N {n}");
+        // 1 440 000 slots, 12 missing: m = 1 has every pair of neighbours without a gap.
+        assert_eq!(c["samples"], 1_440_000);
+        assert_eq!(c["n_terms"][0], 1_440_000 - 1 - 2 * 12);
+    }
+    for c in &ch[3..] {
+        let vrw = c["accel_noise"]["vrw_m_s_rt_h"].as_f64().unwrap();
+        assert!(rel(vrw, 0.05) < 0.03, "VRW {vrw}");
+    }
+    let y = std::fs::read_to_string(&yaml).unwrap();
+    for k in [
+        "gyroscope_noise_density",
+        "gyroscope_random_walk",
+        "accelerometer_noise_density",
+        "accelerometer_random_walk",
+        "update_rate",
+    ] {
+        assert!(yaml_entry(&y, k) > 0.0, "{k}\n{y}");
+    }
+    assert!((yaml_entry(&y, "update_rate") - 200.0).abs() < 0.01, "{y}");
+    // The same file with --gaps error is refused at the first gap's line (header on line 1).
+    let e = gyrolab().arg("allan").arg(&p).args(["--gaps", "error"]).assert().code(2).get_output().stderr.clone();
+    let e = String::from_utf8(e).unwrap();
+    assert!(e.contains(&format!(":{}:", drops[0] + 2)) && e.contains("gap"), "{e}");
+}
+
+/// Dropout rows and NaN cells are missing samples: the deviations equal those of the record
+/// with those rows left out of every term (computed here directly for m = 1).
+#[test]
+fn dropouts_and_nan_cells_are_missing_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut rows = imu_rows(8, 100.0, 300.0, 0.0, &[]);
+    let zero_rows: Vec<usize> = (0..30).map(|k| 1_000 + k).chain((0..30).map(|k| 9_000 + k)).collect();
+    for &r in &zero_rows {
+        rows[r].1 = [0.0; 6];
+    }
+    let mut text = kalibr_csv(&rows);
+    // A NaN cell in the gyro x column of row 20 000 (line 20 002).
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let mut f: Vec<String> = lines[20_001].split(',').map(str::to_string).collect();
+    f[1] = "nan".into();
+    lines[20_001] = f.join(",");
+    text = lines.join("\n") + "\n";
+    let p = write(dir.path(), "drop.csv", &text);
+    let out = gyrolab()
+        .arg("allan")
+        .arg(&p)
+        .args(["--json", "--taus", "0.01", "--confidence", "none"])
+        .assert()
+        .success()
+        .get_output()
+        .clone();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(stderr.contains("60 dropout row(s) (60 with every channel zero"), "{stderr}");
+    assert!(stderr.contains("1 NaN or empty cell(s), first at line 20002"), "{stderr}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // Direct OADEV at m = 1 of gyro x in deg/s over neighbours that are both present.
+    let x: Vec<Option<f64>> = rows
+        .iter()
+        .enumerate()
+        .map(|(i, r)| if zero_rows.contains(&i) || i == 20_000 { None } else { Some(r.1[0].to_degrees()) })
+        .collect();
+    let (mut sum, mut terms) = (0.0, 0usize);
+    for w in x.windows(2) {
+        if let (Some(a), Some(b)) = (w[0], w[1]) {
+            sum += (b - a) * (b - a);
+            terms += 1;
+        }
+    }
+    let direct = (sum / (2.0 * terms as f64)).sqrt();
+    assert_eq!(v["channels"][0]["n_terms"][0], terms);
+    assert!(
+        rel(v["channels"][0]["dev"][0].as_f64().unwrap(), direct) < 1e-6,
+        "{} vs {direct}",
+        v["channels"][0]["dev"][0]
+    );
+}

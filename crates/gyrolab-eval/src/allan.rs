@@ -5,7 +5,7 @@
 use crate::error::{EvalError, EvalResult};
 use crate::layout::LogLayout;
 use crate::reference::{Reference, ReferenceRequest};
-use gyrolab::allan::{deviation_from_rate, AllanCurve, AllanError, AllanOptions, DeviationKind, TauList};
+use gyrolab::allan::{deviation_from_rate_with_gaps, AllanCurve, AllanError, AllanOptions, DeviationKind, TauList};
 use gyrolab::noise::{fit_noise_model, slope_line_terms};
 use gyrolab::sampling::{estimate_interval, SamplingError};
 use gyrolab::units::{OutputUnit, Quantity, TimeUnit};
@@ -54,6 +54,31 @@ pub struct AllanRequest {
     pub fit_range_s: Option<(f64, f64)>,
     /// Units, time column and names of the file, as the user gives them.
     pub layout: LogLayout,
+    /// What to do with missing samples (gaps in the time stamps, NaN or empty cells, dropout
+    /// rows).
+    pub gaps: GapPolicy,
+}
+
+/// What the Allan analysis does with missing samples.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum GapPolicy {
+    /// Compute over them: terms that touch a missing sample are left out (OADEV, ADEV, OHDEV,
+    /// HDEV), as Stable32 and allantools' gradev.
+    #[default]
+    Analyse,
+    /// Refuse a record with missing samples, naming the first.
+    Error,
+}
+
+impl GapPolicy {
+    /// Parses `analyse` (or `analyze`) or `error`.
+    pub fn parse(text: &str) -> Result<GapPolicy, InvalidOption> {
+        match text.trim() {
+            "analyse" | "analyze" => Ok(GapPolicy::Analyse),
+            "error" => Ok(GapPolicy::Error),
+            other => Err(InvalidOption::new("gaps", format!("'{other}': expected analyse or error"))),
+        }
+    }
 }
 
 impl AllanRequest {
@@ -69,6 +94,7 @@ impl AllanRequest {
             confidence: Some(0.683),
             fit_range_s: None,
             layout: LogLayout::default(),
+            gaps: GapPolicy::Analyse,
         }
     }
 }
@@ -103,6 +129,43 @@ pub enum ReadNote {
         /// Their names.
         channels: Vec<String>,
     },
+    /// Gaps in the time stamps: samples missing, computed over.
+    Gaps {
+        /// Number of gaps.
+        count: usize,
+        /// Samples missing in all of them.
+        missing: usize,
+        /// (file line of the first sample after the gap, samples missing), the first few.
+        first: Vec<(u64, usize)>,
+    },
+    /// NaN or empty cells, treated as missing samples.
+    MissingCells {
+        /// How many.
+        count: u64,
+        /// The first one's line.
+        first_line: u64,
+    },
+    /// Dropout rows (every channel zero, or repeating the row before), treated as missing.
+    Dropouts {
+        /// All-zero rows.
+        all_zero: usize,
+        /// Repeated rows.
+        repeated: usize,
+        /// Lines of the first few.
+        first_lines: Vec<u64>,
+    },
+    /// A sample rate was given beside a time column: which one was used.
+    SampleRateGiven {
+        /// The given rate, Hz.
+        given_hz: f64,
+        /// The rate of the time stamps, Hz.
+        stamps_hz: f64,
+    },
+    /// The sample rate estimated from the time stamps.
+    SampleRateEstimated {
+        /// The rate, Hz.
+        hz: f64,
+    },
 }
 
 impl std::fmt::Display for ReadNote {
@@ -117,6 +180,31 @@ impl std::fmt::Display for ReadNote {
                 };
                 write!(f, "time column '{column}' read in {} ({why}); give {{units}} {column}=UNIT if that is wrong", unit.symbol())
             }
+            ReadNote::Gaps { count, missing, first } => {
+                let shown: Vec<String> = first.iter().map(|(l, m)| format!("line {l} ({m} missing)")).collect();
+                write!(
+                    f,
+                    "{count} gap(s) in the time stamps, {missing} sample(s) missing, first at {}: computed over them (terms that touch a missing sample are left out); {{gaps}} error refuses such records",
+                    shown.join(", ")
+                )
+            }
+            ReadNote::MissingCells { count, first_line } => write!(
+                f,
+                "{count} NaN or empty cell(s), first at line {first_line}: treated as missing samples"
+            ),
+            ReadNote::Dropouts { all_zero, repeated, first_lines } => write!(
+                f,
+                "{} dropout row(s) ({all_zero} with every channel zero, {repeated} repeating the row before), first at line(s) {}: treated as missing samples",
+                all_zero + repeated,
+                first_lines.iter().map(u64::to_string).collect::<Vec<_>>().join(", ")
+            ),
+            ReadNote::SampleRateGiven { given_hz, stamps_hz } => write!(
+                f,
+                "sample rate {given_hz} Hz as given ({{sample_rate_hz}}); the time stamps say {stamps_hz:.6} Hz"
+            ),
+            ReadNote::SampleRateEstimated { hz } => {
+                write!(f, "sample rate {hz:.6} Hz, estimated from the time stamps (mean interval)")
+            }
             ReadNote::Unitless { channels } => write!(
                 f,
                 "no unit for {}: deviations in the columns' own units, no noise terms; give {{units}} {}=rad/s for one column, or {{units}} rad/s (and {{units}} m/s^2 for accelerometers) for every column without one",
@@ -130,7 +218,11 @@ impl std::fmt::Display for ReadNote {
 impl ReadNote {
     /// The note with its option placeholders (`{units}`) spelled by the front end.
     pub fn render(&self, spell: &dyn Fn(&str) -> String) -> String {
-        self.to_string().replace("{units}", &spell("units"))
+        let mut t = self.to_string();
+        for f in ["units", "gaps", "sample_rate_hz"] {
+            t = t.replace(&format!("{{{f}}}"), &spell(f));
+        }
+        t
     }
 }
 
@@ -210,40 +302,106 @@ pub fn first_times(path: &Path, options: &SeriesOptions, rows: usize) -> EvalRes
     Ok(r.next_block()?.and_then(|b| b.time.map(<[f64]>::to_vec)))
 }
 
-/// The sampling interval of a record: the given rate, else the time column's by the one
-/// estimator ([`gyrolab::sampling`]); the Allan variance needs uniform samples, so an irregular
-/// interval is an error naming its line.
-pub fn sample_interval(data: &SeriesData, path: &Path, given_hz: Option<f64>) -> EvalResult<f64> {
-    if let Some(f) = given_hz {
-        if let Some(t) = &data.time {
-            if let Some(msg) = rate_disagreement(t, f, "{sample_rate_hz}", path) {
-                return Err(EvalError::conflict_on(&["sample_rate_hz"], msg));
+/// The timing of a record: its sampling interval and where it came from, and the samples
+/// missing from its time stamps.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Timing {
+    /// The sampling interval used, s.
+    pub tau0_s: f64,
+    /// The gaps found in the time stamps (none without a time column).
+    pub gaps: Vec<gyrolab::sampling::Gap>,
+    /// Samples missing in all gaps.
+    pub missing: usize,
+    /// The note saying which rate was used.
+    pub note: Option<ReadNote>,
+}
+
+/// The timing of a record: the given rate (checked against the time stamps), else the time
+/// column's by the one estimator ([`gyrolab::sampling`]), with the gaps of the stamps. A stamp
+/// that does not increase is an error naming its line; gaps are an error under
+/// [`GapPolicy::Error`].
+pub fn record_timing(data: &SeriesData, path: &Path, given_hz: Option<f64>, policy: GapPolicy) -> EvalResult<Timing> {
+    let estimate = match &data.time {
+        Some(t) => Some(estimate_interval(t).map_err(|e| match e {
+            SamplingError::TooShort => DataError::new(path, "fewer than two samples: nothing to analyse"),
+            SamplingError::NotIncreasing => {
+                DataError::new(path, "the time stamps do not increase: expected increasing time stamps")
+            }
+        })?),
+        None => None,
+    };
+    if let Some(e) = &estimate {
+        if let Some(g) = e.first_non_increasing {
+            let line = data.lines.get(g.index).copied().unwrap_or(0);
+            return Err(DataError::new(
+                path,
+                format!(
+                    "the time stamp does not increase (interval {} s): the Allan variance needs increasing time stamps (remove repeated or unsorted rows)",
+                    g.interval_s
+                ),
+            )
+            .at_line(line)
+            .into());
+        }
+        if policy == GapPolicy::Error {
+            if let Some(g) = e.gaps.first() {
+                let line = data.lines.get(g.index).copied().unwrap_or(0);
+                return Err(DataError::new(
+                    path,
+                    format!(
+                        "a gap in the time stamps: {} sample(s) missing (interval {} s where the record's is {} s), and gaps were refused",
+                        g.missing, g.interval_s, e.interval_s
+                    ),
+                )
+                .at_line(line)
+                .into());
             }
         }
-        return Ok(1.0 / f);
     }
-    let Some(t) = &data.time else {
-        return Err(DataError::new(path, "no time column (time_s): give --sample-rate-hz").into());
-    };
-    let estimate = estimate_interval(t).map_err(|e| match e {
-        SamplingError::TooShort => DataError::new(path, "fewer than two samples: nothing to analyse"),
-        SamplingError::NotIncreasing => {
-            DataError::new(path, "the time stamps do not increase: expected a uniform time column")
+    let (gaps, missing) = estimate.as_ref().map_or((Vec::new(), 0), |e| (e.gaps.clone(), e.missing));
+    match (given_hz, &estimate) {
+        (Some(f), Some(e)) => {
+            if let Some(t) = &data.time {
+                if let Some(msg) = rate_disagreement(t, f, "{sample_rate_hz}", path) {
+                    return Err(EvalError::conflict_on(&["sample_rate_hz"], msg));
+                }
+            }
+            Ok(Timing {
+                tau0_s: 1.0 / f,
+                gaps,
+                missing,
+                note: Some(ReadNote::SampleRateGiven { given_hz: f, stamps_hz: e.rate_hz() }),
+            })
         }
-    })?;
-    if let Some(g) = estimate.first_irregular {
-        let line = data.lines.get(g.index).copied().unwrap_or(0);
-        return Err(DataError::new(
-            path,
-            format!(
-                "irregular sampling: interval {} s where the record's interval is {} s; the Allan variance needs uniform samples (cut the record at the gap)",
-                g.interval_s, estimate.nominal_s
-            ),
-        )
-        .at_line(line)
-        .into());
+        (Some(f), None) => Ok(Timing { tau0_s: 1.0 / f, gaps, missing, note: None }),
+        (None, Some(e)) => Ok(Timing {
+            tau0_s: e.interval_s,
+            gaps,
+            missing,
+            note: Some(ReadNote::SampleRateEstimated { hz: e.rate_hz() }),
+        }),
+        (None, None) => Err(EvalError::conflict_on(
+            &["sample_rate_hz"],
+            format!("{}: no time column (such as time_s): give {{sample_rate_hz}}", path.display()),
+        )),
     }
-    Ok(estimate.interval_s)
+}
+
+/// Places a channel's samples on the uniform grid of the record: sample i goes to slot
+/// i + (samples missing before it); missing slots hold NaN.
+pub fn on_grid(values: Vec<f64>, gaps: &[gyrolab::sampling::Gap], missing: usize) -> Vec<f64> {
+    if missing == 0 {
+        return values;
+    }
+    let mut out = Vec::with_capacity(values.len() + missing + 1);
+    let mut from = 0usize;
+    for g in gaps {
+        out.extend_from_slice(&values[from..g.index.min(values.len())]);
+        out.extend(std::iter::repeat_n(f64::NAN, g.missing));
+        from = g.index.min(values.len());
+    }
+    out.extend_from_slice(&values[from..]);
+    out
 }
 
 /// The deviation curve of one channel's rate samples; a non-finite sample is an error naming
@@ -256,7 +414,7 @@ pub fn channel_curve(
     tau0_s: f64,
     opts: &AllanOptions,
 ) -> EvalResult<AllanCurve> {
-    deviation_from_rate(values, tau0_s, opts).map_err(|e| match e {
+    deviation_from_rate_with_gaps(values, tau0_s, opts).map_err(|e| match e {
         AllanError::NonFinite { index, value } => EvalError::Data(
             DataError::new(
                 path,
@@ -353,11 +511,55 @@ pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
     let options = request.layout.apply(SeriesOptions {
         sample_rate_hz: request.sample_rate_hz,
         channels: if request.columns.is_empty() { None } else { Some(request.columns.clone()) },
+        tolerant: true,
         ..SeriesOptions::default()
     })?;
     let mut data = read_series_all(path, &options)?;
-    let notes = read_notes(&data.header);
-    let tau0 = sample_interval(&data, path, request.sample_rate_hz)?;
+    let mut notes = read_notes(&data.header);
+    let timing = record_timing(&data, path, request.sample_rate_hz, request.gaps)?;
+    let tau0 = timing.tau0_s;
+    notes.extend(timing.note.clone());
+    if timing.missing > 0 {
+        let first =
+            timing.gaps.iter().take(5).map(|g| (data.lines.get(g.index).copied().unwrap_or(0), g.missing)).collect();
+        notes.push(ReadNote::Gaps { count: timing.gaps.len(), missing: timing.missing, first });
+    }
+    if data.quality.missing_cells > 0 {
+        let first_line = data.quality.first_missing.first().map_or(0, |c| c.line);
+        if request.gaps == GapPolicy::Error {
+            return Err(DataError::new(path, "a NaN or empty cell, and missing samples were refused")
+                .at_line(first_line)
+                .into());
+        }
+        notes.push(ReadNote::MissingCells { count: data.quality.missing_cells, first_line });
+    }
+    // Dropout rows (over every channel of the file that was read): missing samples.
+    let dropouts = {
+        let refs: Vec<&[f64]> = data.channels.iter().map(|c| &c[..]).collect();
+        gyrolab::dropout::find_dropouts(&refs)
+    };
+    if !dropouts.is_empty() {
+        let rows = dropouts.rows();
+        if request.gaps == GapPolicy::Error {
+            let line = data.lines.get(rows[0]).copied().unwrap_or(0);
+            return Err(DataError::new(
+                path,
+                "a dropout row (every channel zero, or repeating the row before), and missing samples were refused",
+            )
+            .at_line(line)
+            .into());
+        }
+        for c in &mut data.channels {
+            for &r in &rows {
+                c[r] = f64::NAN;
+            }
+        }
+        notes.push(ReadNote::Dropouts {
+            all_zero: dropouts.all_zero.len(),
+            repeated: dropouts.repeated.len(),
+            first_lines: rows.iter().take(5).map(|&r| data.lines.get(r).copied().unwrap_or(0)).collect(),
+        });
+    }
     data.time = None;
     let opts = AllanOptions {
         kind: request.kind,
@@ -381,7 +583,7 @@ pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
     let results: Vec<EvalResult<ChannelAnalysis>> = channels
         .into_par_iter()
         .zip(infos.into_par_iter())
-        .map(|(values, info)| analyse_channel(&setup, &info, values))
+        .map(|(values, info)| analyse_channel(&setup, &info, on_grid(values, &timing.gaps, timing.missing)))
         .collect();
     let analyses = results.into_iter().collect::<Result<Vec<_>, _>>()?;
     Ok(AllanOutcome { analyses, sample_interval_s: tau0, notes })

@@ -168,7 +168,15 @@ pub fn estimate_interval(t: &[f64]) -> Result<IntervalEstimate, SamplingError> {
         .map(|k| (t[(k + 1) * block] - t[k * block]) / block as f64)
         .filter(|d| increasing(*d))
         .collect();
-    let nominal = if blocks.is_empty() {
+    let nominal = if n - 1 < 4 * BLOCK {
+        // Too few blocks: the median interval.
+        let mut d: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).filter(|d| increasing(*d)).collect();
+        if d.is_empty() {
+            return Err(SamplingError::NotIncreasing);
+        }
+        d.sort_by(f64::total_cmp);
+        d[d.len() / 2]
+    } else if blocks.is_empty() {
         span_dt
     } else {
         blocks.sort_by(f64::total_cmp);
@@ -182,12 +190,21 @@ pub fn estimate_interval(t: &[f64]) -> Result<IntervalEstimate, SamplingError> {
     let mut gaps = find_gaps(t, nominal);
     let mut missing: usize = gaps.iter().map(|g| g.missing).sum();
     let mut interval_s = span / ((last - first) + missing) as f64;
-    if missing > 0 {
-        // Once more with the interval that counts the missing samples.
-        gaps = find_gaps(t, interval_s);
-        missing = gaps.iter().map(|g| g.missing).sum();
-        interval_s = span / ((last - first) + missing) as f64;
+    // Again with the interval that counts the missing samples, until the count holds.
+    for _ in 0..3 {
+        if missing == 0 {
+            break;
+        }
+        let again = find_gaps(t, interval_s);
+        let m: usize = again.iter().map(|g| g.missing).sum();
+        gaps = again;
+        interval_s = span / ((last - first) + m) as f64;
+        if m == missing {
+            break;
+        }
+        missing = m;
     }
+    missing = gaps.iter().map(|g| g.missing).sum();
     let gap_irregular = gaps.first().map(|g| IrregularInterval { index: g.index, interval_s: g.interval_s });
     let first_irregular = match (gap_irregular, first_non_increasing) {
         (Some(a), Some(b)) => Some(if a.index <= b.index { a } else { b }),

@@ -55,6 +55,10 @@ pub struct AllanArgs {
     /// `warning:` on stderr.
     #[arg(long, value_name = "FILE.yaml")]
     pub kalibr_yaml: Option<PathBuf>,
+    /// Missing samples (gaps in the time stamps, NaN or empty cells, dropout rows): `analyse`
+    /// (default: terms that touch one are left out; OADEV, ADEV, OHDEV, HDEV) or `error`.
+    #[arg(long, default_value = "analyse", value_name = "POLICY")]
+    pub gaps: String,
     /// Write an imu_utils / VINS-style YAML (gyr_n, gyr_w, acc_n, acc_w), by the same rule.
     #[arg(long, value_name = "FILE.yaml")]
     pub imu_utils_yaml: Option<PathBuf>,
@@ -73,6 +77,7 @@ impl AllanArgs {
             confidence: parse_confidence(&self.confidence)?,
             fit_range_s: validate::increasing_pair("fit_range_s", &self.fit_range)?,
             layout: self.layout.layout(),
+            gaps: gyrolab_eval::allan::GapPolicy::parse(&self.gaps)?,
         })
     }
 }
