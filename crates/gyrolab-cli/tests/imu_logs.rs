@@ -298,3 +298,42 @@ fn dropouts_and_nan_cells_are_missing_samples() {
         v["channels"][0]["dev"][0]
     );
 }
+
+/// An MPU6050 log as a PC records it: host stamps in USB bursts (about 100.3 Hz on average,
+/// 0.9 ms apart inside a burst), six LSB channels, 720 all-zero dropout rows. `gyrolab bias`
+/// finds the true rate (its 1 s and 10 s stabilities are there) and leaves the dropouts out of
+/// the mean: the bias equals the mean of the other rows (computed here).
+#[test]
+fn mpu6050_bursty_log_with_dropouts() {
+    use rand::Rng;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let (rate, n) = (100.3, 60_000usize);
+    let mut text = String::from("time_s,gx_lsb,gy_lsb,gz_lsb,ax_lsb,ay_lsb,az_lsb\n");
+    let mut last = f64::NEG_INFINITY;
+    let mut gx_sum = 0.0;
+    let mut kept = 0usize;
+    for i in 0..n {
+        let frame = (i as f64 / rate / 0.02).ceil() * 0.02 + 0.005 * rng.gen::<f64>();
+        let t = frame.max(last + 0.0009);
+        last = t;
+        let dropout = (10_000..10_720).contains(&i);
+        let v: [i64; 6] =
+            if dropout { [0; 6] } else { [-40, 12, 7, 120, -300, 16_384].map(|b| b + rng.gen_range(-20..=20)) };
+        if !dropout {
+            gx_sum += v[0] as f64;
+            kept += 1;
+        }
+        text.push_str(&format!("{t:.4},{},{},{},{},{},{}\n", v[0], v[1], v[2], v[3], v[4], v[5]));
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "mpu.csv", &text);
+    let out = gyrolab().arg("bias").arg(&p).arg("--json").assert().success().get_output().clone();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(stderr.contains("720 dropout row(s)") && stderr.contains("mpu.csv:10002"), "{stderr}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let t = &v["tests"][0];
+    let hz = t["sample_rate_hz"].as_f64().unwrap();
+    assert!((hz / rate - 1.0).abs() < 0.005, "{hz} Hz");
+    let mean = t["mean_output"].as_f64().unwrap();
+    assert!((mean - gx_sum / kept as f64).abs() < 1e-9, "{mean} vs {}", gx_sum / kept as f64);
+}

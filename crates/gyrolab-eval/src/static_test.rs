@@ -156,6 +156,9 @@ pub fn evaluate_file(
     config: &StaticTestConfig,
 ) -> EvalResult<(Vec<StaticTestResult>, SeriesSummary)> {
     let mut mismatch = None;
+    let mut options = options.clone();
+    options.zero_rows_missing = zero_rows_are_dropouts(path, &options)?;
+    let options = &options;
     let evaluated = evaluate_static_file(path, options, |ch| {
         let mut cfg = config.clone();
         if let Err(m) = reference.configure(&mut cfg, &ch.name, ch.unit) {
@@ -167,6 +170,33 @@ pub fn evaluate_file(
         Some(m) => Err(EvalError::conflict(format!("{}: {m}", path.display()))),
         None => Ok(evaluated),
     }
+}
+
+/// Whether the rows of `path` whose output channels are all exactly zero are dropouts, by the
+/// rule of [`gyrolab::dropout`] (far more of them than independent channels would give); read
+/// in a streaming pass that counts zeros, only for files of two channels or more.
+pub fn zero_rows_are_dropouts(path: &Path, options: &SeriesOptions) -> EvalResult<bool> {
+    let opts = SeriesOptions { zero_rows_missing: false, ..options.clone() };
+    let mut r = gyrolab_io::series::SeriesReader::open(path, &opts)?;
+    let nch = r.header().channels.len();
+    if nch < 2 {
+        return Ok(false);
+    }
+    let (mut rows, mut all_zero) = (0u64, 0u64);
+    let mut zeros = vec![0u64; nch];
+    while let Some(b) = r.next_block()? {
+        for i in 0..b.len() {
+            let mut all = true;
+            for (c, z) in b.channels.iter().zip(zeros.iter_mut()) {
+                let zero = c[i] == 0.0;
+                *z += u64::from(zero);
+                all &= zero;
+            }
+            all_zero += u64::from(all);
+        }
+        rows += b.len() as u64;
+    }
+    Ok(gyrolab::dropout::beyond_chance(all_zero, rows, &zeros))
 }
 
 /// Bias repeatability of each channel present in two or more tests (paper eq. 12), in order of

@@ -61,6 +61,9 @@ pub struct SeriesOptions {
     pub table_rate_column: Option<String>,
     /// Tolerant mode: NaN and empty cells become NaN and are listed, instead of being errors.
     pub tolerant: bool,
+    /// Rows whose output channels are all exactly zero (dropouts, as the caller decided with
+    /// [`gyrolab::dropout`]) are passed on as NaN in every channel and counted.
+    pub zero_rows_missing: bool,
     /// Bytes read from the file at once.
     pub chunk_bytes: usize,
     /// Rows per block handed to the caller.
@@ -83,6 +86,7 @@ impl Default for SeriesOptions {
             channels: None,
             table_rate_column: None,
             tolerant: false,
+            zero_rows_missing: false,
             chunk_bytes: DEFAULT_CHUNK_BYTES,
             block_rows: DEFAULT_BLOCK_ROWS,
             fast_rows: true,
@@ -254,6 +258,11 @@ pub struct ReaderQuality {
     pub missing_cells: u64,
     /// The first of them (at most [`FIRST_MISSING`]).
     pub first_missing: Vec<MissingCell>,
+    /// Rows whose channels were all exactly zero, passed on as NaN
+    /// ([`SeriesOptions::zero_rows_missing`]).
+    pub zero_rows: u64,
+    /// Lines of the first of them (at most [`FIRST_MISSING`]).
+    pub first_zero_rows: Vec<u64>,
 }
 
 /// A block of parsed rows, column by column (all slices have the same length).
@@ -383,6 +392,7 @@ pub struct SeriesReader<R: Read> {
     src: R,
     header: SeriesHeader,
     tolerant: bool,
+    zero_rows_missing: bool,
     fast_rows: bool,
     block_rows: usize,
     chunk_bytes: usize,
@@ -453,6 +463,7 @@ impl<R: Read> SeriesReader<R> {
                 skipped: Vec::new(),
             },
             tolerant: options.tolerant,
+            zero_rows_missing: options.zero_rows_missing,
             fast_rows: options.fast_rows,
             block_rows: options.block_rows.max(1),
             chunk_bytes,
@@ -986,6 +997,17 @@ impl<R: Read> SeriesReader<R> {
             }
         }
         let nch = self.header.channels.len();
+        if self.zero_rows_missing && nch > 0 {
+            for i in 0..self.lines.len() {
+                if self.cols[..nch].iter().all(|c| c[i] == 0.0) {
+                    self.cols[..nch].iter_mut().for_each(|c| c[i] = f64::NAN);
+                    self.quality.zero_rows += 1;
+                    if self.quality.first_zero_rows.len() < FIRST_MISSING {
+                        self.quality.first_zero_rows.push(self.lines[i]);
+                    }
+                }
+            }
+        }
         Ok(Some(SeriesBlock {
             first_line: self.lines[0],
             lines: &self.lines,
@@ -1279,6 +1301,7 @@ impl<R: Read> SeriesReader<R> {
             src: std::io::empty(),
             header: self.header.clone(),
             tolerant: self.tolerant,
+            zero_rows_missing: self.zero_rows_missing,
             fast_rows: self.fast_rows,
             block_rows: rows.max(1),
             chunk_bytes: len.max(16),
@@ -1399,6 +1422,9 @@ fn collect_series_parallel<R: Read>(
                 s.extend_from_slice(c);
             }
             quality.missing_cells += p.quality.missing_cells;
+            quality.zero_rows += p.quality.zero_rows;
+            let zroom = FIRST_MISSING.saturating_sub(quality.first_zero_rows.len());
+            quality.first_zero_rows.extend(std::mem::take(&mut p.quality.first_zero_rows).into_iter().take(zroom));
             let room = FIRST_MISSING.saturating_sub(quality.first_missing.len());
             quality.first_missing.extend(std::mem::take(&mut p.quality.first_missing).into_iter().take(room));
             pool[k] = p;

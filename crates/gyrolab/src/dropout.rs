@@ -49,6 +49,17 @@ impl Dropouts {
     }
 }
 
+/// Whether `hits` rows hit on every channel, of `rows`, are far more than chance gives when
+/// channel c is hit independently in `per_channel[c]` rows: more than 10 x the expected count
+/// plus 3 (the module's rule).
+pub fn beyond_chance(hits: u64, rows: u64, per_channel: &[u64]) -> bool {
+    if rows == 0 || per_channel.len() < 2 {
+        return false;
+    }
+    let expected = per_channel.iter().fold(rows as f64, |e, &c| e * c as f64 / rows as f64);
+    hits as f64 > 10.0 * expected + 3.0
+}
+
 /// Finds the dropout rows of `channels` (equal lengths; NaN never counts as zero or equal).
 ///
 /// ```
@@ -77,6 +88,7 @@ pub fn find_dropouts(channels: &[&[f64]]) -> Dropouts {
         }
         let rows: Vec<usize> = (0..n).filter(|&i| !skip(i) && channels.iter().all(|c| hit(c, i))).collect();
         if rows.len() as f64 > 10.0 * expected + 3.0 {
+            // The same rule as beyond_chance.
             rows
         } else {
             Vec::new()

@@ -73,6 +73,12 @@ pub fn run(args: &BiasArgs) -> CliResult {
                 f.file, c.line, c.column, f.quality.missing_cells, c.name
             );
         }
+        if let Some(l) = f.quality.first_zero_rows.first() {
+            eprintln!(
+                "warning: {}:{l}: {} dropout row(s) (every channel exactly zero, far more often than chance) left out of every figure",
+                f.file, f.quality.zero_rows
+            );
+        }
     }
     let tests = outcome.tests;
     for t in &tests {
