@@ -479,7 +479,7 @@ pub fn analyse_channel(
     } else if !calibrated {
         (None, None, Some(format!("the data are in {rate_unit}: {}", setup.uncalibrated_hint)))
     } else if !allan_kind {
-        (None, None, Some("noise terms are read from the Allan deviation (--kind oadev or adev)".to_string()))
+        (None, None, Some("noise terms are read from the Allan deviation (kind oadev or adev)".to_string()))
     } else {
         (slope_line_terms(&curve).ok(), fit_noise_model(&curve, setup.fit_range_s).ok(), None)
     };
@@ -578,7 +578,7 @@ pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
         options: &opts,
         reference: &reference,
         fit_range_s: request.fit_range_s,
-        uncalibrated_hint: "give --cal or --scale-factor for noise terms in deg units",
+        uncalibrated_hint: "give a calibration or a scale factor for noise terms in deg units",
     };
     let results: Vec<EvalResult<ChannelAnalysis>> = channels
         .into_par_iter()

@@ -79,15 +79,16 @@ fn choose_columns(input: &Path, given: &[String], axis_names: &[String], skip: &
         .map(|a| outputs.iter().find(|c| split_unit_suffix(c).0.eq_ignore_ascii_case(a)).map(|c| c.to_string()))
         .collect();
     by_axis.ok_or_else(|| {
-        EvalError::Data(DataError::new(
-            input,
+        EvalError::conflict_on(
+            &["columns"],
             format!(
-                "{} output column(s) ({}) where the calibration needs {n} ({}): choose with --column",
+                "{}: {} output column(s) ({}) where the calibration needs {n} ({}): choose with {{columns}}",
+                input.display(),
                 outputs.len(),
                 outputs.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", "),
                 axis_names.join(", ")
             ),
-        ))
+        )
     })
 }
 

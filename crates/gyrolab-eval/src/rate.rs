@@ -185,6 +185,9 @@ pub fn evaluate_rates(request: &RateRequest) -> EvalResult<RateOutcome> {
             "{{manual_segments}} and {{segments_out}} take exactly one raw log, but {raw_count} of the files are raw logs"
         )));
     }
+    for n in &request.axis_names {
+        gyrolab::validate::axis_name("axis_names", n)?;
+    }
     let mut axes: Vec<EvaluatedAxis> = Vec::new();
     let mut logs: Vec<SegmentedLog> = Vec::new();
     let mut names = request.axis_names.iter().cloned();

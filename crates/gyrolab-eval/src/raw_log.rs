@@ -76,14 +76,15 @@ pub fn rate_column(path: &Path, given: Option<&str>) -> EvalResult<String> {
     }
     let names = header_names(path)?;
     table_rate_column(&names).ok_or_else(|| {
-        EvalError::Data(DataError::new(
-            path,
+        EvalError::conflict_on(
+            &["table_rate_column"],
             format!(
-                "no table-rate column: expected a column named like 'table_rate_dps' or 'rate_dps' (found {}), \
-                 or name it with --table-rate-column",
+                "{}: no table-rate column: expected a column named like 'table_rate_dps' or 'rate_dps' (found {}), \
+                 or name it with {{table_rate_column}}",
+                path.display(),
                 names.join(", ")
             ),
-        ))
+        )
     })
 }
 
@@ -206,7 +207,14 @@ pub fn evaluate_channels(
             layout: RateLayout::Raw,
             samples,
         };
-        let name = next_name().unwrap_or_else(|| split_unit_suffix(&ch.name).0);
+        // A name taken from a column header becomes a plain file name ('/' and the like as '_').
+        let name = next_name().unwrap_or_else(|| {
+            split_unit_suffix(&ch.name)
+                .0
+                .chars()
+                .map(|c| if matches!(c, '/' | '\\' | ':') || c.is_control() { '_' } else { c })
+                .collect()
+        });
         out.push(evaluate_record(name, file.clone(), record, options)?);
     }
     Ok(out)

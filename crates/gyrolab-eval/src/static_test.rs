@@ -137,6 +137,14 @@ pub fn evaluate_static_tests(request: &StaticTestRequest) -> EvalResult<StaticOu
         if !request.smoothing_s.is_empty() {
             config.smoothing_times_s = request.smoothing_s.clone();
         }
+        if let Some(f) = request.sample_rate_hz {
+            // A given rate must agree with the time stamps (as for the Allan analysis).
+            if let Some(t) = crate::allan::first_times(path, &options, 4097)? {
+                if let Some(msg) = crate::allan::rate_disagreement(&t, f, "{sample_rate_hz}", path) {
+                    return Err(EvalError::conflict_on(&["sample_rate_hz"], msg));
+                }
+            }
+        }
         let (results, summary) = evaluate_file(path, &options, &reference, &config)?;
         files.push(FileQuality { file: path.display().to_string(), quality: summary.quality });
         for result in results {

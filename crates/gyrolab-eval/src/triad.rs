@@ -124,17 +124,16 @@ pub fn evaluate_triad(request: &TriadRequest) -> EvalResult<TriadResult> {
         let order: Vec<usize> = if request.gyro_columns.is_empty() {
             if chans.len() != 3 {
                 let names: Vec<&str> = chans.iter().map(|c| c.name.as_str()).collect();
-                return Err(EvalError::Data(
-                    DataError::new(
-                        path,
-                        format!(
-                            "{} output column(s) ({}): a three-axis log needs three; name them with \
-                             --gyro-columns GX,GY,GZ",
-                            chans.len(),
-                            names.join(", ")
-                        ),
-                    )
-                    .at_line(log.header.header_line),
+                return Err(EvalError::conflict_on(
+                    &["gyro_columns"],
+                    format!(
+                        "{}:{}: {} output column(s) ({}): a three-axis log needs three; name them with \
+                         {{gyro_columns}} GX,GY,GZ",
+                        path.display(),
+                        log.header.header_line,
+                        chans.len(),
+                        names.join(", ")
+                    ),
                 ));
             }
             vec![0, 1, 2]

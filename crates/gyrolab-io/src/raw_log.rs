@@ -107,7 +107,26 @@ pub fn locate_segment_error(file: &Path, lines: &[u64], e: &SegmentError) -> Dat
 /// Reads a raw log: `table_rate` names the table-rate column, `channels` selects outputs (all
 /// others by default). A time column is required.
 pub fn read_raw_log(path: &Path, table_rate: &str, channels: Option<Vec<String>>) -> Result<RawLog, DataError> {
-    let options = SeriesOptions { table_rate_column: Some(table_rate.to_string()), channels, ..Default::default() };
+    read_raw_log_limited(path, table_rate, channels, MAX_RAW_LOG_ROWS)
+}
+
+/// Most rows of a raw rate-table log: 50 M (about 14 h at 1 kHz; a log held whole in memory
+/// needs 8 bytes per row and column).
+pub const MAX_RAW_LOG_ROWS: u64 = 50_000_000;
+
+/// [`read_raw_log`] with another row limit (more rows is an error naming the line).
+pub fn read_raw_log_limited(
+    path: &Path,
+    table_rate: &str,
+    channels: Option<Vec<String>>,
+    max_rows: u64,
+) -> Result<RawLog, DataError> {
+    let options = SeriesOptions {
+        table_rate_column: Some(table_rate.to_string()),
+        channels,
+        max_rows: Some(max_rows),
+        ..Default::default()
+    };
     let data = read_series_all(path, &options)?;
     let Some(time_s) = data.time else {
         return Err(
@@ -298,5 +317,21 @@ mod tests {
         assert_eq!(log.channels[0], [2.5, 2.6]);
         let e = read_raw_log(&p, "table_rate_dps", None).unwrap_err();
         assert!(e.to_string().contains("'table_rate_dps' is not in the header"), "{e}");
+    }
+
+    #[test]
+    fn a_log_beyond_the_row_limit_is_refused_at_its_line() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("big.csv");
+        let mut text = String::from("time_s,rate_dps,gx_v\n");
+        for i in 0..10 {
+            text.push_str(&format!("{},0,2.5\n", i as f64 * 0.01));
+        }
+        std::fs::write(&p, &text).unwrap();
+        assert!(read_raw_log_limited(&p, "rate_dps", None, 10).is_ok());
+        let e = read_raw_log_limited(&p, "rate_dps", None, 6).unwrap_err();
+        // Row 7 (the first beyond 6) is on line 8.
+        assert_eq!(e.line, Some(8), "{e}");
+        assert!(e.to_string().contains("more than 6 data rows"), "{e}");
     }
 }

@@ -61,6 +61,8 @@ pub struct SeriesOptions {
     pub table_rate_column: Option<String>,
     /// Tolerant mode: NaN and empty cells become NaN and are listed, instead of being errors.
     pub tolerant: bool,
+    /// Most data rows accepted (`None`: no limit); more is an error naming the line.
+    pub max_rows: Option<u64>,
     /// Rows whose output channels are all exactly zero (dropouts, as the caller decided with
     /// [`gyrolab::dropout`]) are passed on as NaN in every channel and counted.
     pub zero_rows_missing: bool,
@@ -87,6 +89,7 @@ impl Default for SeriesOptions {
             table_rate_column: None,
             tolerant: false,
             zero_rows_missing: false,
+            max_rows: None,
             chunk_bytes: DEFAULT_CHUNK_BYTES,
             block_rows: DEFAULT_BLOCK_ROWS,
             fast_rows: true,
@@ -393,6 +396,7 @@ pub struct SeriesReader<R: Read> {
     header: SeriesHeader,
     tolerant: bool,
     zero_rows_missing: bool,
+    max_rows: Option<u64>,
     fast_rows: bool,
     block_rows: usize,
     chunk_bytes: usize,
@@ -464,6 +468,7 @@ impl<R: Read> SeriesReader<R> {
             },
             tolerant: options.tolerant,
             zero_rows_missing: options.zero_rows_missing,
+            max_rows: options.max_rows,
             fast_rows: options.fast_rows,
             block_rows: options.block_rows.max(1),
             chunk_bytes,
@@ -996,6 +1001,17 @@ impl<R: Read> SeriesReader<R> {
                 self.cols[s].iter_mut().for_each(|v| *v = unit.to_dps(*v));
             }
         }
+        if let Some(limit) = self.max_rows {
+            if self.rows > limit {
+                let over = self.lines.len().saturating_sub((self.rows - limit) as usize);
+                let line = self.lines.get(over).copied().unwrap_or(self.line_no);
+                return Err(DataError::new(
+                    &self.header.file,
+                    format!("more than {limit} data rows: this record is larger than the reader accepts here (cut it into parts)"),
+                )
+                .at_line(line));
+            }
+        }
         let nch = self.header.channels.len();
         if self.zero_rows_missing && nch > 0 {
             for i in 0..self.lines.len() {
@@ -1302,6 +1318,7 @@ impl<R: Read> SeriesReader<R> {
             header: self.header.clone(),
             tolerant: self.tolerant,
             zero_rows_missing: self.zero_rows_missing,
+            max_rows: None,
             fast_rows: self.fast_rows,
             block_rows: rows.max(1),
             chunk_bytes: len.max(16),
@@ -1431,6 +1448,16 @@ fn collect_series_parallel<R: Read>(
         }
         r.line_no = line_no;
         r.pos = r.complete;
+        if let Some(limit) = r.max_rows {
+            if lines.len() as u64 > limit {
+                let line = lines[limit as usize];
+                return Err(DataError::new(
+                    &header.file,
+                    format!("more than {limit} data rows: this record is larger than the reader accepts here (cut it into parts)"),
+                )
+                .at_line(line));
+            }
+        }
     }
     if lines.is_empty() {
         return Err(DataError::new(

@@ -367,6 +367,9 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         if a.trim().is_empty() || axes[..i].contains(a) {
             return Err(cx.err(raw.device.axes.span(), "device.axes", format!("axis name '{a}' is empty or repeated")));
         }
+        if let Err(e) = gyrolab::validate::axis_name("device.axes", a) {
+            return Err(cx.err(raw.device.axes.span(), "device.axes", e.message));
+        }
     }
     for (table, keys) in [
         ("rate", raw.rate.iter().map(|(k, v)| (k, v.span())).collect::<Vec<_>>()),

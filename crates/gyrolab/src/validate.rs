@@ -151,6 +151,35 @@ pub fn finite(field: &'static str, v: f64) -> Valid<f64> {
     }
 }
 
+/// An axis name: it names files in report folders and keys in results, so it must be a plain
+/// file name: not empty, at most 64 characters, no `/`, `\`, `:`, control characters, and not
+/// `.` or `..`.
+///
+/// ```
+/// use gyrolab::validate::axis_name;
+/// assert!(axis_name("axis_names", "x").is_ok());
+/// assert!(axis_name("axis_names", "x/y").unwrap_err().message.contains("'/'"));
+/// ```
+pub fn axis_name<'a>(field: &'static str, name: &'a str) -> Valid<&'a str> {
+    let bad = |why: String| Err(InvalidOption::new(field, format!("axis name '{}': {why}", name.escape_debug())));
+    if name.trim().is_empty() {
+        return bad("empty".into());
+    }
+    if name.chars().count() > 64 {
+        return bad("longer than 64 characters".into());
+    }
+    if name == "." || name == ".." {
+        return bad("not a file name".into());
+    }
+    if let Some(c) = name.chars().find(|c| matches!(c, '/' | '\\' | ':') || c.is_control()) {
+        return bad(format!(
+            "'{}' cannot be part of a file name: expected letters, digits, '-' or '_'",
+            c.escape_debug()
+        ));
+    }
+    Ok(name)
+}
+
 /// A range of two increasing positive values (`LOW,HIGH`).
 pub fn increasing_pair(field: &'static str, values: &[f64]) -> Valid<Option<(f64, f64)>> {
     for &t in values {
