@@ -416,3 +416,27 @@ fn a_plan_error_names_the_plan_not_its_folder() {
     let e = error_of(&["eval".as_ref(), plan.as_os_str(), "--out".as_ref(), out.as_os_str()]);
     assert!(e.contains("plan.toml:9:") && e.contains("static.x.output_unit: needs static.x.channel"), "{e}");
 }
+
+/// A cubic calibration (`--order 3`) reads back as written; its `scale_factor` edited by 10 %
+/// disagrees with the least-squares slope of its polynomial over the calibrated range.
+#[test]
+fn a_hand_edited_scale_factor_of_a_cubic_calibration_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let cal = dir.path().join("cal.toml");
+    gyrolab().arg("rate").arg(paper("paper_rate_table_x.csv")).args(["--order", "3", "--cal-out"]).arg(&cal).assert().success();
+    let data = write(dir.path(), "data.csv", "time_s,output_v\n0,2.5\n0.01,2.6\n0.02,2.5\n0.03,2.4\n");
+    let out = dir.path().join("out.csv");
+    gyrolab().arg("apply").arg(&data).arg("--cal").arg(&cal).arg("--out").arg(&out).assert().success();
+    let text = std::fs::read_to_string(&cal).unwrap();
+    let k: f64 = text.lines().find_map(|l| l.strip_prefix("scale_factor = ")).unwrap().trim().parse().unwrap();
+    std::fs::write(&cal, set_key(&text, "scale_factor", &format!("{}", k * 1.1))).unwrap();
+    let e = error_of(&[
+        "apply".as_ref(),
+        data.as_os_str(),
+        "--cal".as_ref(),
+        cal.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert!(e.contains("order-3 polynomial") && e.contains("scale_factor"), "{e}");
+}

@@ -218,6 +218,33 @@ pub fn parse_calibration(path: &Path, text: &str) -> Result<CalibrationFile, Dat
                 format!("found {c}, expected finite numbers of magnitude at most {:e}", crate::text::MAX_MAGNITUDE),
             ));
         }
+        if a.polynomial.order >= 2 {
+            // K is the least-squares line's slope over the calibration points; the polynomial's
+            // least-squares slope over the calibrated range (1001 even points) must be close to it.
+            let (lo, hi) = (a.rate_min_dps, a.rate_max_dps);
+            if lo.is_finite() && hi.is_finite() && hi > lo {
+                let xs: Vec<f64> = (0..=1000).map(|i| lo + (hi - lo) * i as f64 / 1000.0).collect();
+                let p = |x: f64| a.polynomial.coefficients.iter().rev().fold(0.0, |acc, c| acc * x + c);
+                let mx = xs.iter().sum::<f64>() / xs.len() as f64;
+                let my = xs.iter().map(|&x| p(x)).sum::<f64>() / xs.len() as f64;
+                let sxy: f64 = xs.iter().map(|&x| (x - mx) * (p(x) - my)).sum();
+                let sxx: f64 = xs.iter().map(|&x| (x - mx) * (x - mx)).sum();
+                let slope = sxy / sxx;
+                if slope.is_finite() && (slope - a.scale_factor).abs() > POLYNOMIAL_SLOPE_TOLERANCE * a.scale_factor.abs() {
+                    return Err(at(
+                        "[[axis]]",
+                        "scale_factor",
+                        format!(
+                            "{} disagrees with the slope {slope} of the order-{} polynomial over {lo}..{hi} deg/s (its least-squares line): \
+                             expected within {} %; the file was edited by hand?",
+                            a.scale_factor,
+                            a.polynomial.order,
+                            POLYNOMIAL_SLOPE_TOLERANCE * 100.0
+                        ),
+                    ));
+                }
+            }
+        }
         if a.polynomial.order == 1 {
             let slope = a.polynomial.coefficients[1];
             if (slope - a.scale_factor).abs() > SLOPE_TOLERANCE * a.scale_factor.abs() {
@@ -264,6 +291,12 @@ pub fn parse_calibration(path: &Path, text: &str) -> Result<CalibrationFile, Dat
 
 /// Relative tolerance between `scale_factor` and the slope of a straight-line polynomial.
 pub const SLOPE_TOLERANCE: f64 = 1e-6;
+
+/// Largest relative difference between `scale_factor` and the least-squares slope of a
+/// polynomial of order 2 or more over the calibrated range: 2 % (the straight-line fit through
+/// the calibration points and through the polynomial's curve differ by a fraction of the
+/// nonlinearity; a hand edit of K is caught).
+pub const POLYNOMIAL_SLOPE_TOLERANCE: f64 = 0.02;
 
 /// Smallest magnitude of a scale factor (subnormal or absurd values make rates overflow).
 pub const MIN_SCALE_FACTOR: f64 = 1e-100;
