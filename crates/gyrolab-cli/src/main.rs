@@ -48,6 +48,12 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Ctrl-C: remove the temporary files of outputs being written (the outputs they were to
+    // replace stay as they were), then stop with the usual 130.
+    let _ = ctrlc::set_handler(|| {
+        gyrolab_io::atomic::remove_temporaries();
+        std::process::exit(130);
+    });
     let result = match &cli.command {
         Command::Rate(a) => cmd::rate::run(a),
         Command::Eval(a) => cmd::eval::run(a),

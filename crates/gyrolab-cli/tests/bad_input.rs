@@ -423,7 +423,13 @@ fn a_plan_error_names_the_plan_not_its_folder() {
 fn a_hand_edited_scale_factor_of_a_cubic_calibration_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let cal = dir.path().join("cal.toml");
-    gyrolab().arg("rate").arg(paper("paper_rate_table_x.csv")).args(["--order", "3", "--cal-out"]).arg(&cal).assert().success();
+    gyrolab()
+        .arg("rate")
+        .arg(paper("paper_rate_table_x.csv"))
+        .args(["--order", "3", "--cal-out"])
+        .arg(&cal)
+        .assert()
+        .success();
     let data = write(dir.path(), "data.csv", "time_s,output_v\n0,2.5\n0.01,2.6\n0.02,2.5\n0.03,2.4\n");
     let out = dir.path().join("out.csv");
     gyrolab().arg("apply").arg(&data).arg("--cal").arg(&cal).arg("--out").arg(&out).assert().success();
@@ -439,4 +445,48 @@ fn a_hand_edited_scale_factor_of_a_cubic_calibration_is_refused() {
         out.as_os_str(),
     ]);
     assert!(e.contains("order-3 polynomial") && e.contains("scale_factor"), "{e}");
+}
+
+/// Ctrl-C during a long `simulate --out` leaves no temporary file, and the file it was to replace
+/// as it was.
+#[cfg(unix)]
+#[test]
+fn ctrl_c_during_simulate_leaves_no_temporary() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = write(dir.path(), "s.csv", "old contents\n");
+    let bin = assert_cmd::cargo::cargo_bin("gyrolab");
+    let mut child = std::process::Command::new(bin)
+        .args([
+            "simulate",
+            "static",
+            "--duration-s",
+            "1e6",
+            "--sample-rate-hz",
+            "1000",
+            "--max-samples",
+            "2e9",
+            "--out",
+        ])
+        .arg(&out)
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Wait until the temporary file exists (the simulation is writing), at most 20 s.
+    let tmp_exists = || {
+        std::fs::read_dir(dir.path())
+            .unwrap()
+            .any(|e| e.unwrap().file_name().to_string_lossy().starts_with(".gyrolab-"))
+    };
+    let start = std::time::Instant::now();
+    while !tmp_exists() && start.elapsed().as_secs() < 20 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert!(tmp_exists(), "the simulation never started writing");
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let ok = std::process::Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    assert!(ok.success());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "{status:?}");
+    assert!(!tmp_exists(), "a temporary file was left behind");
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "old contents\n");
 }

@@ -10,6 +10,32 @@ use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+/// Temporary files being written (their paths), removed by [`remove_temporaries`] when the
+/// program is interrupted (the front end's Ctrl-C handler calls it).
+static TEMPORARIES: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn register(path: &Path) {
+    if let Ok(mut t) = TEMPORARIES.lock() {
+        t.push(path.to_path_buf());
+    }
+}
+
+fn unregister(path: &Path) {
+    if let Ok(mut t) = TEMPORARIES.lock() {
+        t.retain(|p| p != path);
+    }
+}
+
+/// Removes every temporary file still being written (for an interrupt handler; the outputs
+/// they were to replace stay untouched). Returns how many were removed.
+pub fn remove_temporaries() -> usize {
+    let list = match TEMPORARIES.lock() {
+        Ok(mut t) => std::mem::take(&mut *t),
+        Err(_) => return 0,
+    };
+    list.iter().filter(|p| std::fs::remove_file(p).is_ok()).count()
+}
+
 /// Bytes written between two requests to start write-back.
 const WRITEBACK_CHUNK: u64 = 32 << 20;
 
@@ -29,6 +55,18 @@ pub fn write_atomic_with(
         _ => Path::new("."),
     };
     let tmp = tempfile::Builder::new().prefix(".gyrolab-").suffix(".tmp").tempfile_in(dir)?;
+    let tmp_path = tmp.path().to_path_buf();
+    register(&tmp_path);
+    let result = write_and_persist(tmp, path, fill);
+    unregister(&tmp_path);
+    result
+}
+
+fn write_and_persist(
+    tmp: tempfile::NamedTempFile,
+    path: &Path,
+    fill: impl FnOnce(&mut (dyn Write + Send)) -> std::io::Result<()>,
+) -> std::io::Result<()> {
     // Temporary files are private (0600); an output file is an ordinary file (0644).
     #[cfg(unix)]
     {
@@ -60,6 +98,7 @@ pub fn write_folder(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>,
         }
         let stage = || -> std::io::Result<tempfile::NamedTempFile> {
             let mut tmp = tempfile::Builder::new().prefix(".gyrolab-").suffix(".tmp").tempfile_in(dir)?;
+            register(tmp.path());
             #[cfg(unix)]
             {
                 use std::os::unix::fs::PermissionsExt;
@@ -69,14 +108,26 @@ pub fn write_folder(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>,
             tmp.as_file().sync_all()?;
             Ok(tmp)
         };
-        staged.push((stage().map_err(|e| (path.clone(), e))?, path));
+        match stage() {
+            Ok(tmp) => staged.push((tmp, path)),
+            Err(e) => {
+                staged.iter().for_each(|(t, _)| unregister(t.path()));
+                return Err((path, e));
+            }
+        }
     }
+    let temporaries: Vec<PathBuf> = staged.iter().map(|(t, _)| t.path().to_path_buf()).collect();
     let mut written = Vec::with_capacity(staged.len());
+    let mut result = Ok(());
     for (tmp, path) in staged {
-        tmp.persist(&path).map_err(|e| (path.clone(), e.error))?;
+        if let Err(e) = tmp.persist(&path) {
+            result = Err((path.clone(), e.error));
+            break;
+        }
         written.push(path);
     }
-    Ok(written)
+    temporaries.iter().for_each(|t| unregister(t));
+    result.map(|()| written)
 }
 
 /// A file written from its start that asks for write-back of every finished `chunk` bytes by

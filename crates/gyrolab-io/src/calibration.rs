@@ -230,7 +230,9 @@ pub fn parse_calibration(path: &Path, text: &str) -> Result<CalibrationFile, Dat
                 let sxy: f64 = xs.iter().map(|&x| (x - mx) * (p(x) - my)).sum();
                 let sxx: f64 = xs.iter().map(|&x| (x - mx) * (x - mx)).sum();
                 let slope = sxy / sxx;
-                if slope.is_finite() && (slope - a.scale_factor).abs() > POLYNOMIAL_SLOPE_TOLERANCE * a.scale_factor.abs() {
+                if slope.is_finite()
+                    && (slope - a.scale_factor).abs() > POLYNOMIAL_SLOPE_TOLERANCE * a.scale_factor.abs()
+                {
                     return Err(at(
                         "[[axis]]",
                         "scale_factor",
