@@ -805,7 +805,8 @@ fn assign_nominal_rates(segments: &mut [Segment], options: &SegmentOptions) -> R
 /// Builds labelled segments from hand-given windows (a manual segment file) over a raw log.
 ///
 /// Windows are used as given (no settling is dropped); they must be in time order, must not
-/// overlap and must each hold at least one sample. Runs and strokes are checked as for
+/// overlap, must each hold at least one sample and no time gap longer than [`GAP_INTERVALS`]
+/// sampling intervals. Runs and strokes are checked as for
 /// automatic segmentation (every run both strokes, every stroke the same rates).
 pub fn segments_from_manual(
     time_s: &[f64],
@@ -816,6 +817,7 @@ pub fn segments_from_manual(
     options.validate()?;
     check_log(time_s, rate_dps)?;
     let (log_start_s, log_end_s) = (time_s[0], time_s[time_s.len() - 1]);
+    let nominal_s = crate::sampling::estimate_interval(time_s).ok().map(|e| e.nominal_s);
     let mut out: Vec<Segment> = Vec::with_capacity(manual.len());
     for m in manual {
         let a = time_s.partition_point(|&t| t < m.start_time_s);
@@ -832,6 +834,19 @@ pub fn segments_from_manual(
         if let Some(prev) = out.last() {
             if a < prev.end_index {
                 return Err(SegmentError::Overlap { index: a, time_s: time_s[a], previous_end_s: prev.end_time_s });
+            }
+        }
+        // A time gap inside a window: samples are missing from a segment the user drew.
+        if let Some(nominal) = nominal_s {
+            if let Some(i) = (a + 1..b).find(|&i| time_s[i] - time_s[i - 1] > GAP_INTERVALS * nominal) {
+                return Err(SegmentError::TimeGap {
+                    index: i,
+                    time_s: time_s[i],
+                    previous_s: time_s[i - 1],
+                    gap_s: time_s[i] - time_s[i - 1],
+                    interval_s: nominal,
+                    rate_dps: rate_dps[i - 1],
+                });
             }
         }
         let rate = rate_dps[a..b].iter().sum::<f64>() / (b - a) as f64;
@@ -1056,6 +1071,25 @@ mod tests {
         let e = segments_from_manual(&sim.time, &sim.logged_rate, &bad, &o).unwrap_err();
         assert!(matches!(e, SegmentError::Overlap { .. }), "{e}");
         assert!(e.sample_index().is_some());
+        // A time gap inside a window (500 intervals, beyond 100): refused at the sample after it.
+        let mut gapped = sim.time.clone();
+        let inside = (seg[3].start_index + seg[3].end_index) / 2;
+        let dt = sim.time[1] - sim.time[0];
+        gapped[inside..].iter_mut().for_each(|t| *t += 500.0 * dt);
+        let shifted: Vec<ManualSegment> = manual
+            .iter()
+            .enumerate()
+            .map(|(k, m)| {
+                let d = if k > 3 { 500.0 * dt } else { 0.0 };
+                ManualSegment {
+                    start_time_s: m.start_time_s + d,
+                    end_time_s: m.end_time_s + if k >= 3 { 500.0 * dt } else { 0.0 },
+                    kind: m.kind,
+                }
+            })
+            .collect();
+        let e = segments_from_manual(&gapped, &sim.logged_rate, &shifted, &o).unwrap_err();
+        assert!(matches!(e, SegmentError::TimeGap { index, .. } if index == inside), "{e}");
         // A window outside the log.
         bad = manual.clone();
         bad.push(ManualSegment { start_time_s: 1e6, end_time_s: 1e6 + 5.0, kind: SegmentKind::RestEnd });
