@@ -159,7 +159,7 @@ pub fn estimate_interval(t: &[f64]) -> Result<IntervalEstimate, SamplingError> {
     let (first, last) = (t.iter().position(|v| v.is_finite()), t.iter().rposition(|v| v.is_finite()));
     let (Some(first), Some(last)) = (first, last) else { return Err(SamplingError::NotIncreasing) };
     let span = t[last] - t[first];
-    if !(span > 0.0) || last == first {
+    if span.is_nan() || span <= 0.0 || last == first {
         return Err(SamplingError::NotIncreasing);
     }
     let span_dt = span / (last - first) as f64;
