@@ -423,7 +423,10 @@ pub fn channel_curve(
             .at_line(lines.get(index).copied().unwrap_or(0))
             .at_column(info.column, Some(&info.name)),
         ),
-        other => EvalError::Data(DataError::new(path, format!("channel '{}': {other}", info.name))),
+        other => EvalError::Data(DataError::new(
+            path,
+            format!("channel '{}': {other}", gyrolab_io::text::excerpt(&info.name)),
+        )),
     })
 }
 
@@ -454,10 +457,13 @@ pub fn analyse_channel(
     info: &ChannelInfo,
     mut values: Vec<f64>,
 ) -> EvalResult<ChannelAnalysis> {
-    let quantity = setup
-        .reference
-        .to_physical(info.unit, &mut values)
-        .map_err(|m| EvalError::conflict(format!("{}: channel '{}': {m}", setup.path.display(), info.name)))?;
+    let quantity = setup.reference.to_physical(info.unit, &mut values).map_err(|m| {
+        EvalError::conflict(format!(
+            "{}: channel '{}': {m}",
+            setup.path.display(),
+            gyrolab_io::text::excerpt(&info.name)
+        ))
+    })?;
     let calibrated = matches!(quantity, Quantity::AngularRate | Quantity::Acceleration);
     let rate_unit = match quantity {
         Quantity::AngularRate => "deg/s".to_string(),

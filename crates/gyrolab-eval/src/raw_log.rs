@@ -198,8 +198,9 @@ pub fn evaluate_channels(
         let (obs, rest) =
             rate_observations(&s.segments, &log.time_s, &log.channels[k], PlateauReduction::Mean, seg_options.rest)
                 .map_err(|e| log.segment_error(&e))?;
-        let table = RateTable::from_observations(&obs, rest)
-            .map_err(|e| DataError::new(&log.file, format!("channel '{}': {e}", ch.name)))?;
+        let table = RateTable::from_observations(&obs, rest).map_err(|e| {
+            DataError::new(&log.file, format!("channel '{}': {e}", gyrolab_io::text::excerpt(&ch.name)))
+        })?;
         let record = RateTableFile {
             table,
             output_unit: ch.unit,

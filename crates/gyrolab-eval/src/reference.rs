@@ -130,7 +130,7 @@ impl Reference {
                 Ok(())
             }
             Ok(None) => Ok(()),
-            Err(m) => Err(format!("channel '{channel}': {m}")),
+            Err(m) => Err(format!("channel '{}': {m}", gyrolab_io::text::excerpt(channel))),
         }
     }
 

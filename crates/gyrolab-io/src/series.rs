@@ -1526,8 +1526,9 @@ pub fn evaluate_static_file(
             cfg
         })
         .collect();
-    let wrap =
-        |ch: &str, e: gyrolab::static_test::StaticTestError| DataError::new(path, format!("channel '{ch}': {e}"));
+    let wrap = |ch: &str, e: gyrolab::static_test::StaticTestError| {
+        DataError::new(path, format!("channel '{}': {e}", crate::text::excerpt(ch)))
+    };
     let mut accs = Vec::with_capacity(configs.len());
     for cfg in &configs {
         accs.push(StaticTestAccumulator::new(cfg.clone()).map_err(|e| wrap(&cfg.channel, e))?);
