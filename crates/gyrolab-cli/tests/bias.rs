@@ -112,8 +112,9 @@ fn bad_inputs() {
     assert!(e.contains("empty"), "{e}");
     let e = bias_error("output_v\n1\n2\n", &[]);
     assert!(e.contains("sample rate") || e.contains("time"), "{e}");
-    let e = bias_error("time_s,output_amps\n0,1\n", &[]);
-    assert!(e.contains("bad.csv:1:2"), "{e}");
+    // A selected column whose bracketed unit is unknown (an unknown suffix is no unit at all).
+    let e = bias_error("time_s,output [amps]\n0,1\n", &["--column", "output"]);
+    assert!(e.contains("bad.csv:1:2") && e.contains("unknown unit 'amps'"), "{e}");
 }
 
 #[test]
