@@ -3,7 +3,7 @@
 //! m = 1 against a direct computation.
 
 use gyrolab::allan::TauList;
-use gyrolab_eval::allan::{analyse_file, AllanRequest};
+use gyrolab_eval::allan::{analyse_file, AllanRequest, GapPolicy};
 use gyrolab_eval::EvalError;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -54,22 +54,32 @@ fn white_noise_oadev_and_arw_match_the_generating_n() {
     assert!((n / N_DEG_RT_H - 1.0).abs() < 0.03, "slope-line N = {n}, truth {N_DEG_RT_H}");
 }
 
-/// A 10 s gap in the time column: a data error naming the line of the first sample after the
-/// gap (the header is line 1, sample i is on line i + 2).
+/// A 10 s gap in the time column (1000 samples missing): computed over by default, with a note
+/// naming the line of the first sample after the gap (the header is line 1, sample i is on line
+/// i + 2); a data error naming that line under `GapPolicy::Error`.
 #[test]
-fn a_gap_is_a_data_error_naming_its_line() {
+fn a_gap_is_computed_over_or_refused_naming_its_line() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("gap.csv");
     write_rates(&path, &white(2000, 0.1, 1), Some(999));
-    let e = analyse_file(&AllanRequest::new(&path)).unwrap_err();
+    let outcome = analyse_file(&AllanRequest::new(&path)).unwrap();
+    let gaps = outcome.notes.iter().find_map(|n| match n {
+        gyrolab_eval::allan::ReadNote::Gaps { count, missing, first } => Some((*count, *missing, first.clone())),
+        _ => None,
+    });
+    assert_eq!(gaps, Some((1, 1000, vec![(1002, 1000)])));
+    // 3000 slots; at m = 1 every pair of neighbours but the one across the gap: 1998 terms.
+    let a = &outcome.analyses[0];
+    assert_eq!((a.curve.n_rate, a.curve.points[0].terms), (3000, 1998));
+    let request = AllanRequest { gaps: GapPolicy::Error, ..AllanRequest::new(&path) };
+    let e = analyse_file(&request).unwrap_err();
     match &e {
         EvalError::Data(d) => {
             assert_eq!(d.line, Some(1000 + 2), "{e}");
-            assert!(d.message.contains("irregular sampling"), "{e}");
+            assert!(d.message.contains("1000 sample(s) missing"), "{e}");
         }
         other => panic!("expected a data error, got {other:?}"),
     }
-    assert!(e.to_string().contains("1002"), "{e}");
 }
 
 /// The deviation at m = 1 is sqrt(0.5 mean((y[i+1] - y[i])^2)), computed here from the
