@@ -14,7 +14,7 @@ def test_kalibr_layout_reads_with_units_and_seconds(tmp_path):
     arrays, units = gyrolab.read_with_units(p)
     assert units["w_RS_S_x [rad s^-1]"] == "rad/s"
     assert units["a_RS_S_x [m s^-2]"] == "m/s^2"
-    t = arrays["#timestamp [ns]"]
+    t = arrays["timestamp [ns]"]  # the comment mark is not part of the name
     # 5 000 192 ns between the stamps, read in seconds (f64 resolution at 1.4e9 s: 2.4e-7 s).
     assert abs((t[1] - t[0]) - 0.005000192) < 5e-7
     np.testing.assert_array_equal(arrays["w_RS_S_x [rad s^-1]"], [0.5, 0.25])
