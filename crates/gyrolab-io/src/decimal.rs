@@ -170,10 +170,51 @@ impl ScannedDecimal {
 #[inline]
 pub fn plain_decimal(b: &[u8]) -> Option<(f64, usize)> {
     let d = ScannedDecimal::scan(b, 0)?;
-    if matches!(b.get(d.end), Some(b'e' | b'E' | b'.')) {
+    match b.get(d.end) {
+        Some(b'.') => None,
+        Some(b'e' | b'E') => exponent_decimal(b, &d),
+        _ => Some((d.value(), d.end)),
+    }
+}
+
+/// A decimal with an exponent (`-1.2345670e-02`, as `printf("%e")` and `np.savetxt` write
+/// them): w x 10^p with w < 10^15 the digits and p = exponent - digits after the point. For
+/// |p| <= 22 both w and 10^p are exact doubles, so one multiplication (p >= 0) or division
+/// (p < 0) is correctly rounded (Clinger 1990, the fast path); other exponents are left to the
+/// full parser (`None`).
+#[inline]
+fn exponent_decimal(b: &[u8], d: &ScannedDecimal) -> Option<(f64, usize)> {
+    let mut i = d.end + 1;
+    let negative_exp = match b.get(i) {
+        Some(b'-') => {
+            i += 1;
+            true
+        }
+        Some(b'+') => {
+            i += 1;
+            false
+        }
+        _ => false,
+    };
+    let start = i;
+    let mut e: i32 = 0;
+    while let Some(c) = b.get(i).filter(|c| c.is_ascii_digit()) {
+        if i - start >= 3 {
+            return None;
+        }
+        e = e * 10 + i32::from(c - b'0');
+        i += 1;
+    }
+    if i == start || matches!(b.get(i), Some(b'.' | b'e' | b'E')) {
         return None;
     }
-    Some((d.value(), d.end))
+    let p = if negative_exp { -e } else { e } - d.frac_digits as i32;
+    if !(-22..=22).contains(&p) {
+        return None;
+    }
+    let w = d.significand as f64;
+    let v = if p >= 0 { w * POW10[p as usize] } else { w / POW10[(-p) as usize] };
+    Some((if d.negative { -v } else { v }, i))
 }
 
 /// The layout of a number after its sign: digits before the point, whether there is a point,

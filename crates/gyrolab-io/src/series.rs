@@ -1045,6 +1045,10 @@ impl<R: Read> SeriesReader<R> {
         // spaces, tabs and leading spaces go to the general path, which reads them the same).
         let fast = self.fast_rows;
         let mut refused_at = usize::MAX;
+        // Rows the fast path refused in a row, and rows to leave to the general path before
+        // trying it again (files whose numbers it never takes, such as `%e` exponents, would
+        // otherwise pay for a refused attempt on every row).
+        let (mut refusals, mut general_only) = (0u32, 0u32);
         let layout = RowLayout { delim, crlf: self.crlf };
         if self.shapes.len() != ncols {
             self.shapes = vec![None; ncols];
@@ -1055,13 +1059,24 @@ impl<R: Read> SeriesReader<R> {
             if p >= end || self.lines.len() >= self.block_rows {
                 break 'rows Ok(());
             }
-            if fast && p != refused_at {
+            if general_only > 0 {
+                general_only -= 1;
+            } else if fast && p != refused_at {
                 let room = self.block_rows - self.lines.len();
                 let (next, rows) = read_rows(bytes, p, layout, &self.targets, &mut self.shapes, &mut self.cols, room);
                 // The row where it stopped short of the room (refused, or the data's end) is the
                 // general path's: no second attempt.
                 if rows < room {
                     refused_at = next;
+                }
+                if rows == 0 {
+                    refusals += 1;
+                    if refusals >= 16 {
+                        general_only = 4096;
+                        refusals = 0;
+                    }
+                } else {
+                    refusals = 0;
                 }
                 if rows > 0 {
                     self.lines.extend((1..=rows as u64).map(|k| line_no + k));

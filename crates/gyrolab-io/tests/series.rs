@@ -287,6 +287,20 @@ proptest! {
         }
     }
 
+    /// Numbers with exponents, as `%e` writes them: read bit-identical to the full parser, or
+    /// declined (exponents beyond Clinger's exact range).
+    #[test]
+    fn exponent_decimals_are_exact(neg in any::<bool>(), int in 0u64..10, frac in "[0-9]{0,14}", e in -40i32..40, big in any::<bool>()) {
+        let text = format!("{}{int}.{frac}{}{e:+03}", if neg { "-" } else { "" }, if big { "E" } else { "e" });
+        if let Some((v, n)) = gyrolab_io::series::plain_decimal(text.as_bytes()) {
+            let (full, m) = fast_float2::parse_partial::<f64, _>(text.as_bytes()).unwrap();
+            prop_assert_eq!(n, m, "{}", text);
+            prop_assert_eq!(v.to_bits(), full.to_bits(), "{}", text);
+        } else {
+            prop_assert!((e - frac.len() as i32).abs() > 22, "{} declined", text);
+        }
+    }
+
     /// Long digit runs (across the eight-byte groups) are read exactly or declined.
     #[test]
     fn plain_decimal_long_runs(int in "[0-9]{1,20}", frac in "[0-9]{0,20}") {
@@ -306,7 +320,13 @@ proptest! {
 #[test]
 fn plain_decimal_declines_what_it_cannot_do_exactly() {
     use gyrolab_io::series::plain_decimal;
-    assert_eq!(plain_decimal(b"1e5"), None);
+    // Exponents within Clinger's exact range are read (correctly rounded), others declined.
+    assert_eq!(plain_decimal(b"1e5"), Some((1e5, 3)));
+    assert_eq!(plain_decimal(b"-1.2345670e-02,"), Some((-1.234567e-2, 14)));
+    assert_eq!(plain_decimal(b"1e23"), None);
+    assert_eq!(plain_decimal(b"1e-30"), None);
+    assert_eq!(plain_decimal(b"1e"), None);
+    assert_eq!(plain_decimal(b"1e1234"), None);
     assert_eq!(plain_decimal(b"1234567890.123456"), None); // 16 digits
     assert_eq!(plain_decimal(b"nan"), None);
     assert_eq!(plain_decimal(b"-"), None);
