@@ -78,26 +78,49 @@ pub fn find_dropouts(channels: &[&[f64]]) -> Dropouts {
     if channels.len() < 2 || n < 2 {
         return Dropouts::default();
     }
-    // Rows hit on every channel, when far more than independent channels would give.
-    let find = |hit: &dyn Fn(&[f64], usize) -> bool, skip: &dyn Fn(usize) -> bool| -> Vec<usize> {
-        let rows_considered = (0..n).filter(|&i| !skip(i)).count().max(1);
-        let mut expected = rows_considered as f64;
-        for c in channels {
-            let count = (0..n).filter(|&i| !skip(i) && hit(c, i)).count();
-            expected *= count as f64 / rows_considered as f64;
+    // One pass per test: each channel's hits and the rows hit on every channel; dropouts when
+    // those are far more than independent channels would give (`beyond_chance`).
+    fn scan(
+        channels: &[&[f64]],
+        n: usize,
+        hit: impl Fn(&[f64], usize) -> bool,
+        skip: impl Fn(usize) -> bool,
+    ) -> Vec<usize> {
+        let mut per = vec![0u64; channels.len()];
+        let mut rows = Vec::new();
+        let mut considered = 0u64;
+        for i in 0..n {
+            if skip(i) {
+                continue;
+            }
+            considered += 1;
+            let mut all = true;
+            for (c, count) in channels.iter().zip(per.iter_mut()) {
+                let h = hit(c, i);
+                *count += u64::from(h);
+                all &= h;
+            }
+            if all {
+                rows.push(i);
+            }
         }
-        let rows: Vec<usize> = (0..n).filter(|&i| !skip(i) && channels.iter().all(|c| hit(c, i))).collect();
-        if rows.len() as f64 > 10.0 * expected + 3.0 {
-            // The same rule as beyond_chance.
+        if beyond_chance(rows.len() as u64, considered, &per) {
             rows
         } else {
             Vec::new()
         }
-    };
-    let all_zero = find(&|c: &[f64], i: usize| c[i] == 0.0, &|_| false);
+    }
+    let all_zero = scan(channels, n, |c, i| c[i] == 0.0, |_| false);
     // Repeats are looked for among the other rows (a run of zeros repeats itself).
-    let zero = |i: usize| all_zero.binary_search(&i).is_ok() || (i > 0 && all_zero.binary_search(&(i - 1)).is_ok());
-    let repeated = find(&|c: &[f64], i: usize| i > 0 && c[i] == c[i - 1], &zero);
+    let mut zero_or_after = vec![false; if all_zero.is_empty() { 0 } else { n }];
+    for &i in &all_zero {
+        zero_or_after[i] = true;
+        if i + 1 < n {
+            zero_or_after[i + 1] = true;
+        }
+    }
+    let repeated =
+        scan(channels, n, |c, i| i > 0 && c[i] == c[i - 1], |i| zero_or_after.get(i).copied().unwrap_or(false));
     Dropouts { all_zero, repeated }
 }
 
