@@ -29,3 +29,13 @@ def test_units_time_column_and_names(tmp_path):
         gyrolab.read_with_units(p, units=["furlong"], names=["t", "gx", "az"])
     arrays, units = gyrolab.read_with_units(p, units=["host=ms"], names=["host", "gx", "az"])
     np.testing.assert_allclose(arrays["host"], [0.0, 0.01])
+
+
+def test_accelerometer_array_gives_velocity_random_walk():
+    # White noise of VRW 0.05 m/s/sqrt(h) = 8.33e-4 m/s^2/sqrt(Hz) at 200 Hz for 1 h.
+    rate = 200.0
+    x = np.random.default_rng(3).standard_normal(720_000) * (0.05 / 60 * np.sqrt(rate))
+    d = gyrolab.allan(x, rate_hz=rate, unit="m/s^2").to_dict()
+    assert d["quantity"] == "acceleration" and d["dev_unit"] == "m/s^2"
+    assert d["noise"] is None
+    assert abs(d["accel_noise"]["vrw_m_s_rt_h"] / 0.05 - 1) < 0.05
