@@ -349,6 +349,21 @@ fn cell() -> impl Strategy<Value = String> {
     ]
 }
 
+/// A file of random rows (`time_s`, `output_v`, `other_v`): every delimiter, CRLF or LF, with
+/// comment and blank lines when `comments`.
+fn random_file(rows: &[Vec<String>], sep: &str, crlf: bool, comments: bool) -> String {
+    let eol = if crlf { "\r\n" } else { "\n" };
+    let mut text = format!("time_s{sep}output_v{sep}other_v{eol}");
+    for (i, row) in rows.iter().enumerate() {
+        if comments && i % 5 == 2 {
+            text.push_str(&format!("# note{eol}{eol}"));
+        }
+        text.push_str(&row.join(sep));
+        text.push_str(eol);
+    }
+    text
+}
+
 proptest! {
     /// The fast row path changes nothing: on random files (every delimiter, CRLF or LF, comments,
     /// blank lines, odd cells, tolerant or strict) the reader gives the same values (to the bit),
@@ -363,15 +378,7 @@ proptest! {
         chunk in 16usize..300,
         block_rows in 1usize..30,
     ) {
-        let eol = if crlf { "\r\n" } else { "\n" };
-        let mut text = format!("time_s{sep}output_v{sep}other_v{eol}");
-        for (i, row) in rows.iter().enumerate() {
-            if comments && i % 5 == 2 {
-                text.push_str(&format!("# note{eol}{eol}"));
-            }
-            text.push_str(&row.join(sep));
-            text.push_str(eol);
-        }
+        let text = random_file(&rows, sep, crlf, comments);
         let with = SeriesOptions { tolerant, chunk_bytes: chunk, block_rows, ..SeriesOptions::default() };
         let without = SeriesOptions { fast_rows: false, ..with.clone() };
         match (read_str(&text, &with), read_str(&text, &without)) {
@@ -405,15 +412,7 @@ proptest! {
         threads in 1usize..5,
         batch in 16usize..400,
     ) {
-        let eol = if crlf { "\r\n" } else { "\n" };
-        let mut text = format!("time_s{sep}output_v{sep}other_v{eol}");
-        for (i, row) in rows.iter().enumerate() {
-            if comments && i % 5 == 2 {
-                text.push_str(&format!("# note{eol}{eol}"));
-            }
-            text.push_str(&row.join(sep));
-            text.push_str(eol);
-        }
+        let text = random_file(&rows, sep, crlf, comments);
         let opts = SeriesOptions { tolerant, chunk_bytes: 64, ..SeriesOptions::default() };
         let parallel = SeriesReader::from_reader("t.csv", text.as_bytes(), &opts)
             .and_then(|r| collect_series_in_parallel(r, threads, batch));
