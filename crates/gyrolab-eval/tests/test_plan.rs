@@ -240,3 +240,38 @@ fn static_null_is_the_rest_reference_and_keeps_its_earth_rate() {
         assert!((b - bias).abs() < 5.0 * se_dph, "bias {b} deg/h, truth {bias}, tolerance {}", 5.0 * se_dph);
     }
 }
+
+/// A static record with 300 samples missing (a gap in its time stamps): the plan's Allan analysis
+/// computes over the gap on the uniform grid (30 000 slots, as the record would have without the
+/// gap; before, the samples were joined as if none were missing).
+#[test]
+fn a_gap_in_a_static_record_is_computed_over() {
+    let dir = tempfile::tempdir().unwrap();
+    let x = common::paper_file("paper_rate_table_x.csv");
+    let path = dir.path().join("s0.csv");
+    write_static(&path, 20.0, 9);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let kept: Vec<&str> = text
+        .lines()
+        .enumerate()
+        .filter(|(i, l)| l.starts_with('#') || l.starts_with("time") || !(10_000..10_300).contains(i))
+        .map(|(_, l)| l)
+        .collect();
+    std::fs::write(&path, kept.join("\n") + "\n").unwrap();
+    let plan = dir.path().join("plan.toml");
+    std::fs::write(
+        &plan,
+        format!(
+            "[device]\nmodel = \"m\"\nserial = \"s\"\naxes = [\"x\"]\n[rate.x]\nfile = \"{}\"\n[static.x]\n\
+             files = [\"s0.csv\"]\nsample_rate_hz = 100.0\n",
+            x.display()
+        ),
+    )
+    .unwrap();
+    let folder = evaluate_test_plan(&read_test_plan(&plan).unwrap(), "plan.toml", &Silent).unwrap();
+    let v: serde_json::Value = serde_json::from_slice(output(&folder, "results.json")).unwrap();
+    let allan = &v["sections"]["allan"]["x"];
+    assert_eq!(allan["samples"], 30_000, "{allan:.300}");
+    // m = 1: every pair of neighbours but the one across the gap.
+    assert_eq!(allan["n_terms"][0], 30_000 - 300 - 2);
+}

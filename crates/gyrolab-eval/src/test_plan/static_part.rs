@@ -305,6 +305,24 @@ fn allan_of(
             return Err(EvalError::conflict(msg));
         }
     }
+    // Gaps in the stamps are missing samples (computed over, as `gyrolab allan` does); a stamp
+    // that does not increase is an error naming its line.
+    let (gaps, missing) = match data.time.as_deref().map(gyrolab::sampling::estimate_interval) {
+        Some(Ok(e)) => {
+            if let Some(g) = e.first_non_increasing {
+                let line = data.lines.get(g.index).copied().unwrap_or(0);
+                return Err(EvalError::Data(
+                    DataError::new(
+                        path,
+                        "the time stamp does not increase: the Allan variance needs increasing time stamps",
+                    )
+                    .at_line(line),
+                ));
+            }
+            (e.gaps, e.missing)
+        }
+        _ => (Vec::new(), 0),
+    };
     data.time = None;
     data.temperature = None;
     let Some(info) = data.header.channels.first().cloned() else {
@@ -323,7 +341,7 @@ fn allan_of(
         fit_range_s: None,
         uncalibrated_hint: "give the axis a rate-table record or a calibration file",
     };
-    analyse_channel(&setup, &info, values)
+    analyse_channel(&setup, &info, crate::allan::on_grid(values, &gaps, missing))
 }
 
 /// Number of progress steps of the static part.
