@@ -205,12 +205,17 @@ impl std::fmt::Display for ReadNote {
             ReadNote::SampleRateEstimated { hz } => {
                 write!(f, "sample rate {hz:.6} Hz, estimated from the time stamps (mean interval)")
             }
-            ReadNote::Unitless { channels } => write!(
-                f,
-                "no unit for {}: deviations in the columns' own units, no noise terms; give {{units}} {}=rad/s for one column, or {{units}} rad/s (and {{units}} m/s^2 for accelerometers) for every column without one",
-                channels.join(", "),
-                channels.first().map_or("gx", String::as_str)
-            ),
+            ReadNote::Unitless { channels } => {
+                let first = channels.first().map_or("gx", String::as_str);
+                let accel =
+                    gyrolab_io::series::is_accelerometer_name(&gyrolab::units::parse_column_name(first).base);
+                write!(
+                    f,
+                    "no unit for {}: deviations in the columns' own units, no noise terms; give {{units}} {first}={} for one column, or {{units}} rad/s (and {{units}} m/s^2 for accelerometers) for every column without one",
+                    channels.join(", "),
+                    if accel { "m/s^2" } else { "rad/s" }
+                )
+            }
         }
     }
 }
