@@ -11,7 +11,7 @@ use gyrolab::sampling::{estimate_interval, SamplingError};
 use gyrolab::units::{OutputUnit, Quantity, TimeUnit};
 use gyrolab::validate::{self, InvalidOption};
 use gyrolab_io::series::{read_series_all, ChannelInfo, SeriesData, SeriesOptions};
-use gyrolab_io::series::{SkippedColumn, UnitSource};
+use gyrolab_io::series::{LineMap, SkippedColumn, UnitSource};
 use gyrolab_io::DataError;
 use gyrolab_report::allan::ChannelAnalysis;
 use rayon::prelude::*;
@@ -337,7 +337,7 @@ pub fn record_timing(data: &SeriesData, path: &Path, given_hz: Option<f64>, poli
     };
     if let Some(e) = &estimate {
         if let Some(g) = e.first_non_increasing {
-            let line = data.lines.get(g.index).copied().unwrap_or(0);
+            let line = data.lines.get(g.index).unwrap_or(0);
             return Err(DataError::new(
                 path,
                 format!(
@@ -350,7 +350,7 @@ pub fn record_timing(data: &SeriesData, path: &Path, given_hz: Option<f64>, poli
         }
         if policy == GapPolicy::Error {
             if let Some(g) = e.gaps.first() {
-                let line = data.lines.get(g.index).copied().unwrap_or(0);
+                let line = data.lines.get(g.index).unwrap_or(0);
                 return Err(DataError::new(
                     path,
                     format!(
@@ -415,7 +415,7 @@ pub fn channel_curve(
     path: &Path,
     info: &ChannelInfo,
     values: Vec<f64>,
-    lines: &[u64],
+    lines: &LineMap,
     tau0_s: f64,
     opts: &AllanOptions,
 ) -> EvalResult<AllanCurve> {
@@ -425,7 +425,7 @@ pub fn channel_curve(
                 path,
                 format!("sample {value} is not a finite number: the Allan variance needs a complete record"),
             )
-            .at_line(lines.get(index).copied().unwrap_or(0))
+            .at_line(lines.get(index).unwrap_or(0))
             .at_column(info.column, Some(&info.name)),
         ),
         other => EvalError::Data(DataError::new(
@@ -442,7 +442,7 @@ pub struct ChannelSetup<'a> {
     /// The file as shown in results.
     pub shown: String,
     /// Source line of each sample.
-    pub lines: &'a [u64],
+    pub lines: &'a LineMap,
     /// Sampling interval, s.
     pub tau0_s: f64,
     /// Deviation options.
@@ -531,8 +531,7 @@ pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
     let tau0 = timing.tau0_s;
     notes.extend(timing.note.clone());
     if timing.missing > 0 {
-        let first =
-            timing.gaps.iter().take(5).map(|g| (data.lines.get(g.index).copied().unwrap_or(0), g.missing)).collect();
+        let first = timing.gaps.iter().take(5).map(|g| (data.lines.get(g.index).unwrap_or(0), g.missing)).collect();
         notes.push(ReadNote::Gaps { count: timing.gaps.len(), missing: timing.missing, first });
     }
     if data.quality.missing_cells > 0 {
@@ -552,7 +551,7 @@ pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
     if !dropouts.is_empty() {
         let rows = dropouts.rows();
         if request.gaps == GapPolicy::Error {
-            let line = data.lines.get(rows[0]).copied().unwrap_or(0);
+            let line = data.lines.get(rows[0]).unwrap_or(0);
             return Err(DataError::new(
                 path,
                 "a dropout row (every channel zero, or repeating the row before), and missing samples were refused",
@@ -568,7 +567,7 @@ pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
         notes.push(ReadNote::Dropouts {
             all_zero: dropouts.all_zero.len(),
             repeated: dropouts.repeated.len(),
-            first_lines: rows.iter().take(5).map(|&r| data.lines.get(r).copied().unwrap_or(0)).collect(),
+            first_lines: rows.iter().take(5).map(|&r| data.lines.get(r).unwrap_or(0)).collect(),
         });
     }
     data.time = None;

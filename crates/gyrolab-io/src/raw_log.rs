@@ -137,7 +137,7 @@ pub fn read_raw_log_limited(
     Ok(RawLog {
         file: path.to_path_buf(),
         header: data.header,
-        lines: data.lines,
+        lines: data.lines.to_vec(),
         time_s,
         table_rate_dps,
         channels: data.channels,

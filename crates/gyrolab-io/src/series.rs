@@ -268,6 +268,58 @@ pub struct ReaderQuality {
     pub first_zero_rows: Vec<u64>,
 }
 
+/// The source line of every row of a record, stored as runs of consecutive lines (a record
+/// without comment or blank lines between its rows is one run): the same answers as a vector
+/// of line numbers in a few bytes instead of 8 per row.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct LineMap {
+    /// (first row, its line) of each run of consecutive lines.
+    runs: Vec<(usize, u64)>,
+    /// Rows.
+    len: usize,
+}
+
+impl LineMap {
+    /// Appends the line of the next row.
+    pub fn push(&mut self, line: u64) {
+        match self.runs.last() {
+            Some(&(row, first)) if first + (self.len - row) as u64 == line => {}
+            _ => self.runs.push((self.len, line)),
+        }
+        self.len += 1;
+    }
+
+    /// Appends the lines of the next rows.
+    pub fn extend_from_slice(&mut self, lines: &[u64]) {
+        lines.iter().for_each(|&l| self.push(l));
+    }
+
+    /// The line of row `row`.
+    pub fn get(&self, row: usize) -> Option<u64> {
+        if row >= self.len {
+            return None;
+        }
+        let k = self.runs.partition_point(|&(r, _)| r <= row).checked_sub(1)?;
+        let (r, line) = self.runs[k];
+        Some(line + (row - r) as u64)
+    }
+
+    /// Rows.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether there are no rows.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Every row's line.
+    pub fn to_vec(&self) -> Vec<u64> {
+        (0..self.len).filter_map(|i| self.get(i)).collect()
+    }
+}
+
 /// A block of parsed rows, column by column (all slices have the same length).
 #[derive(Debug, Clone, Copy)]
 pub struct SeriesBlock<'a> {
@@ -1269,7 +1321,7 @@ pub struct SeriesData {
     /// The header.
     pub header: SeriesHeader,
     /// Source line of each row.
-    pub lines: Vec<u64>,
+    pub lines: LineMap,
     /// Time stamps, seconds.
     pub time: Option<Vec<f64>>,
     /// Temperature, degC.
@@ -1391,7 +1443,7 @@ fn collect_series_parallel<R: Read>(
     let nslots = r.cols.len();
     // Slots in the parser's order: channels, then time, temperature, table rate.
     let mut slots: Vec<Vec<f64>> = vec![Vec::new(); nslots];
-    let mut lines: Vec<u64> = Vec::new();
+    let mut lines = LineMap::default();
     let mut quality = ReaderQuality::default();
     if r.buf.len() < batch_bytes {
         r.buf.resize(batch_bytes, 0);
@@ -1443,7 +1495,6 @@ fn collect_series_parallel<R: Read>(
             let per_line = (batch.len() as f64 / (line_no - r.line_no).max(1) as f64).max(1.0);
             let estimate = (((size as f64 / per_line) * 1.02) as usize + 16).min(MAX_RESERVE_ROWS);
             slots.iter_mut().for_each(|s| s.reserve_exact(estimate));
-            lines.reserve_exact(estimate);
             reserved = true;
         }
         let pieces: Vec<Result<Piece, DataError>> = parsers.into_par_iter().map(parse_piece).collect();
@@ -1465,7 +1516,7 @@ fn collect_series_parallel<R: Read>(
         r.pos = r.complete;
         if let Some(limit) = r.max_rows {
             if lines.len() as u64 > limit {
-                let line = lines[limit as usize];
+                let line = lines.get(limit as usize).unwrap_or(0);
                 return Err(DataError::new(
                     &header.file,
                     format!("more than {limit} data rows: this record is larger than the reader accepts here (cut it into parts)"),
@@ -1494,7 +1545,7 @@ fn collect_series_parallel<R: Read>(
 /// Reads every block of an open reader into memory.
 pub fn collect_series<R: Read>(mut r: SeriesReader<R>) -> Result<SeriesData, DataError> {
     let header = r.header.clone();
-    let mut lines = Vec::new();
+    let mut lines = LineMap::default();
     let mut time = header.time_column.map(|_| Vec::new());
     let mut temperature = header.temperature_column.map(|_| Vec::new());
     let mut table_rate = header.table_rate_column.map(|_| Vec::new());
@@ -1622,4 +1673,24 @@ pub fn window_means_file(
         acc.push(out, b.temp);
     }
     Ok(acc.finish())
+}
+
+#[cfg(test)]
+mod line_map_tests {
+    use super::LineMap;
+
+    #[test]
+    fn runs_answer_as_the_vector_would() {
+        // Lines 3..=5, a comment on 6, 7..=8, two blank lines, 11.
+        let lines = [3u64, 4, 5, 7, 8, 11];
+        let mut m = LineMap::default();
+        m.extend_from_slice(&lines);
+        assert_eq!(m.runs.len(), 3);
+        assert_eq!(m.to_vec(), lines);
+        for (i, &l) in lines.iter().enumerate() {
+            assert_eq!(m.get(i), Some(l));
+        }
+        assert_eq!(m.get(6), None);
+        assert_eq!(LineMap::default().get(0), None);
+    }
 }

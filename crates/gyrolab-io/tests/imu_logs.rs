@@ -116,13 +116,13 @@ fn headerless_files_get_numbered_or_given_names() {
     assert!(d.header.headerless);
     assert_eq!(d.header.channels[0].name, "c1");
     assert_eq!(d.channels[0], vec![-0.05, 0.02, 0.01]);
-    assert_eq!(d.lines, vec![1, 2, 3]);
+    assert_eq!(d.lines.to_vec(), vec![1, 2, 3]);
     // Comments above, whitespace separated, names given, one of them the time.
     let o = SeriesOptions { names: Some(vec!["t".into(), "gx".into(), "gy".into()]), ..Default::default() };
     let d = read("# from np.savetxt\n0.00 1.5 2.5\n0.01 1.6 2.6\n", &o).unwrap();
     assert_eq!(d.header.time_column, Some(1));
     assert_eq!(d.channels[1], vec![2.5, 2.6]);
-    assert_eq!(d.lines, vec![2, 3]);
+    assert_eq!(d.lines.to_vec(), vec![2, 3]);
     // A UTF-8 BOM before the first number.
     let d =
         read("\u{feff}1.0,2.0\n3.0,4.0\n", &SeriesOptions { sample_rate_hz: Some(1.0), ..Default::default() }).unwrap();

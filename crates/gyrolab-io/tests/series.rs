@@ -33,7 +33,7 @@ fn csv_with_bom_comments_blank_lines_crlf() {
     assert_eq!(d.header.temperature_column, Some(2));
     let units: Vec<OutputUnit> = d.header.channels.iter().map(|c| c.unit).collect();
     assert_eq!(units, vec![OutputUnit::Millivolt, OutputUnit::RadPerSec]);
-    assert_eq!(d.lines, vec![4, 7]);
+    assert_eq!(d.lines.to_vec(), vec![4, 7]);
     assert_eq!(d.time.unwrap(), vec![0.0, 0.01]);
     assert_eq!(d.temperature.unwrap(), vec![20.5, 20.6]);
     assert_eq!(d.channels, vec![vec![1500.0, 1500.25], vec![-2.0, 0.03]]);
@@ -252,7 +252,7 @@ proptest! {
         let x: Vec<f64> = rows.iter().map(|r| r.1).collect();
         prop_assert_eq!(d.time.unwrap(), t);
         prop_assert_eq!(&d.channels[0], &x);
-        prop_assert_eq!(d.lines, lines);
+        prop_assert_eq!(d.lines.to_vec(), lines);
     }
 }
 
@@ -393,7 +393,7 @@ proptest! {
                 prop_assert_eq!(a.quality, b.quality);
             }
             (Err(a), Err(b)) => prop_assert_eq!(a.to_string(), b.to_string()),
-            (a, b) => prop_assert!(false, "fast {:?} vs general {:?}\n{:?}", a.map(|d| d.lines), b.map(|d| d.lines), text),
+            (a, b) => prop_assert!(false, "fast {:?} vs general {:?}\n{:?}", a.map(|d| d.lines.to_vec()), b.map(|d| d.lines.to_vec()), text),
         }
     }
 }
@@ -427,7 +427,7 @@ proptest! {
                 prop_assert_eq!(a.quality, b.quality);
             }
             (Err(a), Err(b)) => prop_assert_eq!(a.to_string(), b.to_string()),
-            (a, b) => prop_assert!(false, "parallel {:?} vs sequential {:?}\n{:?}", a.map(|d| d.lines), b.map(|d| d.lines), text),
+            (a, b) => prop_assert!(false, "parallel {:?} vs sequential {:?}\n{:?}", a.map(|d| d.lines.to_vec()), b.map(|d| d.lines.to_vec()), text),
         }
     }
 }

@@ -310,7 +310,7 @@ fn allan_of(
     let (gaps, missing) = match data.time.as_deref().map(gyrolab::sampling::estimate_interval) {
         Some(Ok(e)) => {
             if let Some(g) = e.first_non_increasing {
-                let line = data.lines.get(g.index).copied().unwrap_or(0);
+                let line = data.lines.get(g.index).unwrap_or(0);
                 return Err(EvalError::Data(
                     DataError::new(
                         path,
