@@ -48,6 +48,8 @@ pub fn flag(field: &str) -> String {
     match field {
         "axis_names" => "--axis".into(),
         "columns" => "--column".into(),
+        "out" => "--out".into(),
+        "topics" => "--topic".into(),
         "units" => "--unit".into(),
         "manual_segments" => "--segments".into(),
         "calibration" => "--cal".into(),

@@ -34,6 +34,10 @@ enum Command {
     Allan(Box<cmd::allan::AllanArgs>),
     /// Apply a calibration to a time series of outputs, streaming: outputs in, rates out.
     Apply(Box<cmd::apply::ApplyArgs>),
+    /// List the topics of a recording (MCAP, ROS 1 bag, PX4 ULog): types, counts, rates, gaps.
+    Inspect(cmd::inspect::InspectArgs),
+    /// Write the IMU topics of a recording as CSV or Parquet, units in the column names.
+    Convert(cmd::convert::ConvertArgs),
     /// Plan a test: the record length needed to measure a noise term to a stated precision.
     #[command(subcommand)]
     Plan(cmd::record_length::PlanCommand),
@@ -61,6 +65,8 @@ fn main() -> ExitCode {
         Command::Bias(a) => cmd::bias::run(a),
         Command::Allan(a) => cmd::allan::run(a),
         Command::Apply(a) => cmd::apply::run(a),
+        Command::Inspect(a) => cmd::inspect::run(a),
+        Command::Convert(a) => cmd::convert::run(a),
         Command::Simulate(c) => cmd::simulate::run(c),
         Command::Plan(c) => cmd::record_length::run(c),
     };

@@ -10,8 +10,9 @@ use gyrolab::noise::{fit_noise_model, slope_line_terms};
 use gyrolab::sampling::{estimate_interval, SamplingError};
 use gyrolab::units::{OutputUnit, Quantity, TimeUnit};
 use gyrolab::validate::{self, InvalidOption};
-use gyrolab_io::series::{read_series_all, ChannelInfo, SeriesData, SeriesOptions};
-use gyrolab_io::series::{LineMap, SkippedColumn, UnitSource};
+use gyrolab_io::recording::{read_records, TopicMeta};
+use gyrolab_io::series::{ChannelInfo, SeriesData, SeriesOptions};
+use gyrolab_io::series::{LineMap, RowKind, SkippedColumn, UnitSource};
 use gyrolab_io::DataError;
 use gyrolab_report::allan::ChannelAnalysis;
 use rayon::prelude::*;
@@ -57,6 +58,8 @@ pub struct AllanRequest {
     /// What to do with missing samples (gaps in the time stamps, NaN or empty cells, dropout
     /// rows).
     pub gaps: GapPolicy,
+    /// Topics of a recording (MCAP, ROS 1 bag, ULog) to analyse (default: every IMU topic).
+    pub topics: Vec<String>,
 }
 
 /// What the Allan analysis does with missing samples.
@@ -95,13 +98,16 @@ impl AllanRequest {
             fit_range_s: None,
             layout: LogLayout::default(),
             gaps: GapPolicy::Analyse,
+            topics: Vec::new(),
         }
     }
 }
 
-/// The analyses of a file.
+/// The analyses of a file (or of one topic of a recording).
 #[derive(Debug, Clone)]
 pub struct AllanOutcome {
+    /// The topic, for a recording.
+    pub topic: Option<TopicMeta>,
     /// One per channel, in column order.
     pub analyses: Vec<ChannelAnalysis>,
     /// The sampling interval used, s.
@@ -135,15 +141,19 @@ pub enum ReadNote {
         count: usize,
         /// Samples missing in all of them.
         missing: usize,
-        /// (file line of the first sample after the gap, samples missing), the first few.
+        /// (row of the first sample after the gap, samples missing), the first few.
         first: Vec<(u64, usize)>,
+        /// What the rows count.
+        rows: RowKind,
     },
     /// NaN or empty cells, treated as missing samples.
     MissingCells {
         /// How many.
         count: u64,
-        /// The first one's line.
+        /// The first one's row.
         first_line: u64,
+        /// What the rows count.
+        rows: RowKind,
     },
     /// Dropout rows (every channel zero, or repeating the row before), treated as missing.
     Dropouts {
@@ -151,8 +161,10 @@ pub enum ReadNote {
         all_zero: usize,
         /// Repeated rows.
         repeated: usize,
-        /// Lines of the first few.
+        /// Rows of the first few.
         first_lines: Vec<u64>,
+        /// What the rows count.
+        rows: RowKind,
     },
     /// A sample rate was given beside a time column: which one was used.
     SampleRateGiven {
@@ -166,6 +178,10 @@ pub enum ReadNote {
         /// The rate, Hz.
         hz: f64,
     },
+    /// The topic of a recording that was read.
+    Topic(TopicMeta),
+    /// The recording ends early or is damaged: what was read is analysed.
+    Truncated(String),
 }
 
 impl std::fmt::Display for ReadNote {
@@ -180,28 +196,46 @@ impl std::fmt::Display for ReadNote {
                 };
                 write!(f, "time column '{column}' read in {} ({why}); give {{units}} {column}=UNIT if that is wrong", unit.symbol())
             }
-            ReadNote::Gaps { count, missing, first } => {
-                let shown: Vec<String> = first.iter().map(|(l, m)| format!("line {l} ({m} missing)")).collect();
+            ReadNote::Gaps { count, missing, first, rows } => {
+                let shown: Vec<String> =
+                    first.iter().map(|(l, m)| format!("{} {l} ({m} missing)", rows.word())).collect();
                 write!(
                     f,
                     "{count} gap(s) in the time stamps, {missing} sample(s) missing, first at {}: computed over them (terms that touch a missing sample are left out); {{gaps}} error refuses such records",
                     shown.join(", ")
                 )
             }
-            ReadNote::MissingCells { count, first_line } => write!(
+            ReadNote::MissingCells { count, first_line, rows } => write!(
                 f,
-                "{count} NaN or empty cell(s), first at line {first_line}: treated as missing samples"
+                "{count} NaN or empty cell(s), first at {} {first_line}: treated as missing samples",
+                rows.word()
             ),
-            ReadNote::Dropouts { all_zero, repeated, first_lines } => write!(
+            ReadNote::Dropouts { all_zero, repeated, first_lines, rows } => write!(
                 f,
-                "{} dropout row(s) ({all_zero} with every channel zero, {repeated} repeating the row before), first at line(s) {}: treated as missing samples",
+                "{} dropout row(s) ({all_zero} with every channel zero, {repeated} repeating the row before), first at {}(s) {}: treated as missing samples",
                 all_zero + repeated,
+                rows.word(),
                 first_lines.iter().map(u64::to_string).collect::<Vec<_>>().join(", ")
             ),
             ReadNote::SampleRateGiven { given_hz, stamps_hz } => write!(
                 f,
                 "sample rate {given_hz} Hz as given ({{sample_rate_hz}}); the time stamps say {stamps_hz:.6} Hz"
             ),
+            ReadNote::Topic(t) => {
+                write!(
+                    f,
+                    "topic {} ({}): {} messages, time from {}",
+                    gyrolab_io::text::excerpt(&t.topic),
+                    gyrolab_io::text::excerpt(&t.message_type),
+                    t.messages,
+                    t.stamp_source.describe()
+                )?;
+                if t.out_of_order > 0 {
+                    write!(f, "; {} message(s) came out of stamp order in the file and were put in order", t.out_of_order)?;
+                }
+                Ok(())
+            }
+            ReadNote::Truncated(what) => f.write_str(what),
             ReadNote::SampleRateEstimated { hz } => {
                 write!(f, "sample rate {hz:.6} Hz, estimated from the time stamps (mean interval)")
             }
@@ -441,6 +475,8 @@ pub struct ChannelSetup<'a> {
     pub path: &'a Path,
     /// The file as shown in results.
     pub shown: String,
+    /// The topic of a recording the channel belongs to.
+    pub topic: Option<String>,
     /// Source line of each sample.
     pub lines: &'a LineMap,
     /// Sampling interval, s.
@@ -496,6 +532,7 @@ pub fn analyse_channel(
     };
     Ok(ChannelAnalysis {
         file: setup.shown.clone(),
+        topic: setup.topic.clone(),
         channel: info.name.clone(),
         rate_unit,
         quantity,
@@ -506,8 +543,31 @@ pub fn analyse_channel(
     })
 }
 
-/// Analyses every selected channel of a file, in parallel.
+/// Analyses every selected channel of a file, in parallel: a delimited text or Parquet file,
+/// or the single IMU topic of a recording (several topics: an error asking for one; see
+/// [`analyse_records`]).
 pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
+    let mut outcomes = analyse_records(request)?;
+    if outcomes.len() == 1 {
+        return Ok(outcomes.remove(0));
+    }
+    let names: Vec<String> =
+        outcomes.iter().filter_map(|o| o.topic.as_ref().map(|t| gyrolab_io::text::excerpt(&t.topic))).collect();
+    Err(EvalError::conflict_on(
+        &["topics"],
+        format!(
+            "{}: {} IMU topics ({}): choose one with {{topics}}",
+            request.file.display(),
+            names.len(),
+            names.join(", ")
+        ),
+    ))
+}
+
+/// Analyses every record of any file gyrolab reads (by content): the table of a delimited
+/// text or Parquet file, or each IMU topic of an MCAP file, ROS 1 bag or ULog file (read in
+/// one pass; `request.topics` selects), each record's channels in parallel.
+pub fn analyse_records(request: &AllanRequest) -> EvalResult<Vec<AllanOutcome>> {
     if let Some(f) = request.sample_rate_hz {
         validate::positive("sample_rate_hz", f)?;
     }
@@ -525,14 +585,63 @@ pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
         tolerant: true,
         ..SeriesOptions::default()
     })?;
-    let mut data = read_series_all(path, &options)?;
+    let records = read_records(path, &options, &request.topics)?;
+    let mut outcomes = Vec::with_capacity(records.records.len());
+    for record in records.records {
+        let rows = record.data.header.rows;
+        let topic = record.topic;
+        let mut outcome = analyse_data(request, &reference, record.data, topic.as_ref())
+            .map_err(|e| located_in(e, rows, topic.as_ref()))?;
+        let mut notes = Vec::new();
+        if let Some(t) = &topic {
+            notes.push(ReadNote::Topic(t.clone()));
+        }
+        if let Some(what) = &records.truncated {
+            notes.push(ReadNote::Truncated(what.clone()));
+        }
+        notes.append(&mut outcome.notes);
+        outcome.notes = notes;
+        outcome.topic = topic;
+        outcomes.push(outcome);
+    }
+    Ok(outcomes)
+}
+
+/// An error of a record whose rows are not text lines (messages, table rows): the row is named
+/// in the message (`message 12: ...`) rather than as a line, with the topic.
+pub fn located_in(e: EvalError, rows: RowKind, topic: Option<&TopicMeta>) -> EvalError {
+    match e {
+        EvalError::Data(mut d) if rows != RowKind::Line || topic.is_some() => {
+            if rows != RowKind::Line {
+                if let Some(l) = d.line.take() {
+                    d.message = format!("{} {l}: {}", rows.word(), d.message);
+                }
+            }
+            if let Some(t) = topic {
+                d.message = format!("topic '{}': {}", gyrolab_io::text::excerpt(&t.topic), d.message);
+            }
+            EvalError::Data(d)
+        }
+        other => other,
+    }
+}
+
+/// Analyses the channels of one record held in memory, in parallel.
+pub fn analyse_data(
+    request: &AllanRequest,
+    reference: &Reference,
+    mut data: SeriesData,
+    topic: Option<&TopicMeta>,
+) -> EvalResult<AllanOutcome> {
+    let path = &request.file;
+    let rows = data.header.rows;
     let mut notes = read_notes(&data.header);
     let timing = record_timing(&data, path, request.sample_rate_hz, request.gaps)?;
     let tau0 = timing.tau0_s;
     notes.extend(timing.note.clone());
     if timing.missing > 0 {
         let first = timing.gaps.iter().take(5).map(|g| (data.lines.get(g.index).unwrap_or(0), g.missing)).collect();
-        notes.push(ReadNote::Gaps { count: timing.gaps.len(), missing: timing.missing, first });
+        notes.push(ReadNote::Gaps { count: timing.gaps.len(), missing: timing.missing, first, rows });
     }
     if data.quality.missing_cells > 0 {
         let first_line = data.quality.first_missing.first().map_or(0, |c| c.line);
@@ -541,7 +650,7 @@ pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
                 .at_line(first_line)
                 .into());
         }
-        notes.push(ReadNote::MissingCells { count: data.quality.missing_cells, first_line });
+        notes.push(ReadNote::MissingCells { count: data.quality.missing_cells, first_line, rows });
     }
     // Dropout rows (over every channel of the file that was read): missing samples.
     let dropouts = {
@@ -549,9 +658,9 @@ pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
         gyrolab::dropout::find_dropouts(&refs)
     };
     if !dropouts.is_empty() {
-        let rows = dropouts.rows();
+        let dropped = dropouts.rows();
         if request.gaps == GapPolicy::Error {
-            let line = data.lines.get(rows[0]).unwrap_or(0);
+            let line = data.lines.get(dropped[0]).unwrap_or(0);
             return Err(DataError::new(
                 path,
                 "a dropout row (every channel zero, or repeating the row before), and missing samples were refused",
@@ -560,14 +669,15 @@ pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
             .into());
         }
         for c in &mut data.channels {
-            for &r in &rows {
+            for &r in &dropped {
                 c[r] = f64::NAN;
             }
         }
         notes.push(ReadNote::Dropouts {
             all_zero: dropouts.all_zero.len(),
             repeated: dropouts.repeated.len(),
-            first_lines: rows.iter().take(5).map(|&r| data.lines.get(r).unwrap_or(0)).collect(),
+            first_lines: dropped.iter().take(5).map(|&r| data.lines.get(r).unwrap_or(0)).collect(),
+            rows,
         });
     }
     data.time = None;
@@ -583,10 +693,11 @@ pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
     let setup = ChannelSetup {
         path,
         shown: path.display().to_string(),
+        topic: topic.map(|t| t.topic.clone()),
         lines: &lines,
         tau0_s: tau0,
         options: &opts,
-        reference: &reference,
+        reference,
         fit_range_s: request.fit_range_s,
         uncalibrated_hint: "give a calibration or a scale factor for noise terms in deg units",
     };
@@ -596,5 +707,5 @@ pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
         .map(|(values, info)| analyse_channel(&setup, &info, on_grid(values, &timing.gaps, timing.missing)))
         .collect();
     let analyses = results.into_iter().collect::<Result<Vec<_>, _>>()?;
-    Ok(AllanOutcome { analyses, sample_interval_s: tau0, notes })
+    Ok(AllanOutcome { topic: None, analyses, sample_interval_s: tau0, notes })
 }

@@ -11,6 +11,7 @@
 //! - [`apply`]: a calibration applied to a time series, streaming;
 //! - [`simulate`]: simulator configurations from a file and overrides;
 //! - [`record_length`]: the record length a noise term's precision needs;
+//! - [`recording`]: recordings (MCAP, ROS 1 bags, ULog): inventories and conversion to CSV/Parquet;
 //! - [`test_plan`]: TOML test plans evaluated into a report folder;
 //! - [`demo`]: the paper's worked example and its report folder ([`paper`]: its data);
 //! - [`report_folder`]: a report folder as named outputs the caller writes;
@@ -32,6 +33,7 @@ pub mod progress;
 pub mod rate;
 pub mod raw_log;
 pub mod record_length;
+pub mod recording;
 pub mod reference;
 pub mod report_folder;
 pub mod simulate;

@@ -59,6 +59,8 @@ pub struct StaticTestRequest {
     pub tolerant: bool,
     /// Units, time column and names of the files, as the user gives them.
     pub layout: crate::layout::LogLayout,
+    /// Topics of recordings (MCAP, ROS 1 bag, ULog) to evaluate (default: every IMU topic).
+    pub topics: Vec<String>,
 }
 
 impl StaticTestRequest {
@@ -76,6 +78,7 @@ impl StaticTestRequest {
             drop_outliers: false,
             tolerant: false,
             layout: crate::layout::LogLayout::default(),
+            topics: Vec::new(),
         }
     }
 }
@@ -145,10 +148,39 @@ pub fn evaluate_static_tests(request: &StaticTestRequest) -> EvalResult<StaticOu
                 }
             }
         }
-        let (results, summary) = evaluate_file(path, &options, &reference, &config)?;
-        files.push(FileQuality { file: path.display().to_string(), quality: summary.quality });
-        for result in results {
-            tests.push(TestReport { file: path.display().to_string(), result });
+        let format = gyrolab_io::recording::sniff_format(path)?;
+        if format == gyrolab_io::recording::FileFormat::Text {
+            if !request.topics.is_empty() {
+                return Err(EvalError::conflict_on(
+                    &["topics"],
+                    format!("{}: {{topics}} applies to recordings (MCAP, ROS 1 bag, PX4 ULog); this is a delimited text file", path.display()),
+                ));
+            }
+            let (results, summary) = evaluate_file(path, &options, &reference, &config)?;
+            files.push(FileQuality { file: path.display().to_string(), quality: summary.quality });
+            for result in results {
+                tests.push(TestReport { file: path.display().to_string(), result });
+            }
+            continue;
+        }
+        // Parquet tables and the IMU topics of recordings, read whole.
+        let records = gyrolab_io::recording::read_records(path, &options, &request.topics)?;
+        for record in records.records {
+            let rows = record.data.header.rows;
+            let topic = record.topic;
+            let (results, summary) = evaluate_record(record.data, &reference, &config)
+                .map_err(|e| crate::allan::located_in(e, rows, topic.as_ref()))?;
+            let shown = match &topic {
+                Some(t) => format!("{} {}", path.display(), t.topic),
+                None => path.display().to_string(),
+            };
+            files.push(FileQuality { file: shown.clone(), quality: summary.quality });
+            for mut result in results {
+                if let Some(t) = &topic {
+                    result.channel = format!("{}/{}", t.topic.trim_end_matches('/'), result.channel);
+                }
+                tests.push(TestReport { file: shown.clone(), result });
+            }
         }
     }
     let repeatability = repeatability_by_channel(&tests);
@@ -168,6 +200,45 @@ pub fn evaluate_file(
     options.zero_rows_missing = zero_rows_are_dropouts(path, &options)?;
     let options = &options;
     let evaluated = evaluate_static_file(path, options, |ch| {
+        let mut cfg = config.clone();
+        if let Err(m) = reference.configure(&mut cfg, &ch.name, ch.unit) {
+            mismatch = Some(m);
+        }
+        cfg
+    })?;
+    match mismatch {
+        Some(m) => Err(EvalError::conflict(format!("{}: {m}", path.display()))),
+        None => Ok(evaluated),
+    }
+}
+
+/// Evaluates every channel of one record held in memory (a Parquet table, a recording's topic),
+/// as [`evaluate_file`] does for a text file.
+pub fn evaluate_record(
+    mut data: gyrolab_io::series::SeriesData,
+    reference: &Reference,
+    config: &StaticTestConfig,
+) -> EvalResult<(Vec<StaticTestResult>, SeriesSummary)> {
+    let path = data.header.file.clone();
+    let zero_rows = if data.channels.len() >= 2 {
+        let n = data.lines.len() as u64;
+        let mut zeros = vec![0u64; data.channels.len()];
+        let mut all_zero = 0u64;
+        for i in 0..data.lines.len() {
+            let mut all = true;
+            for (c, z) in data.channels.iter().zip(zeros.iter_mut()) {
+                let zero = c[i] == 0.0;
+                *z += u64::from(zero);
+                all &= zero;
+            }
+            all_zero += u64::from(all);
+        }
+        gyrolab::dropout::beyond_chance(all_zero, n, &zeros)
+    } else {
+        false
+    };
+    let mut mismatch = None;
+    let evaluated = gyrolab_io::series::evaluate_static_data(&mut data, zero_rows, |ch| {
         let mut cfg = config.clone();
         if let Err(m) = reference.configure(&mut cfg, &ch.name, ch.unit) {
             mismatch = Some(m);

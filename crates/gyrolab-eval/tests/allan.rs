@@ -64,7 +64,7 @@ fn a_gap_is_computed_over_or_refused_naming_its_line() {
     write_rates(&path, &white(2000, 0.1, 1), Some(999));
     let outcome = analyse_file(&AllanRequest::new(&path)).unwrap();
     let gaps = outcome.notes.iter().find_map(|n| match n {
-        gyrolab_eval::allan::ReadNote::Gaps { count, missing, first } => Some((*count, *missing, first.clone())),
+        gyrolab_eval::allan::ReadNote::Gaps { count, missing, first, .. } => Some((*count, *missing, first.clone())),
         _ => None,
     });
     assert_eq!(gaps, Some((1, 1000, vec![(1002, 1000)])));

@@ -176,6 +176,8 @@ pub enum SkipReason {
     UnknownUnit(String),
     /// An orientation or covariance field of a ROS message.
     RosField,
+    /// Not a numeric column (a Parquet string, boolean or list column).
+    NotNumeric,
 }
 
 /// A column the reader did not read, and why.
@@ -202,6 +204,7 @@ impl std::fmt::Display for SkippedColumn {
                 format!("unit '{}' is none of {}", crate::text::excerpt(u), OutputUnit::accepted_channel_suffixes())
             }
             SkipReason::RosField => "an orientation or covariance field".to_string(),
+            SkipReason::NotNumeric => "not a numeric column".to_string(),
         };
         write!(f, "column {} '{name}' skipped: {why}", self.column)
     }
@@ -239,6 +242,33 @@ pub struct SeriesHeader {
     /// Columns not read (other than the selected channels' neighbours the caller ignored on
     /// purpose), with the reason: shown to the user as notes.
     pub skipped: Vec<SkippedColumn>,
+    /// What a row's number counts: text lines, or messages and rows of a binary file.
+    #[serde(default)]
+    pub rows: RowKind,
+}
+
+/// What the number of a row ([`LineMap`], [`DataError::line`]) counts.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RowKind {
+    /// Lines of a text file (1-based, header and comments included).
+    #[default]
+    Line,
+    /// Messages of a topic in a recording (1-based, in time-stamp order).
+    Message,
+    /// Rows of a table file such as Parquet (1-based).
+    Row,
+}
+
+impl RowKind {
+    /// The word for one row: `line`, `message` or `row`.
+    pub fn word(self) -> &'static str {
+        match self {
+            RowKind::Line => "line",
+            RowKind::Message => "message",
+            RowKind::Row => "row",
+        }
+    }
 }
 
 /// A NaN or empty cell accepted in tolerant mode.
@@ -517,6 +547,7 @@ impl<R: Read> SeriesReader<R> {
                 time_unit_source: None,
                 headerless: false,
                 skipped: Vec::new(),
+                rows: RowKind::Line,
             },
             tolerant: options.tolerant,
             zero_rows_missing: options.zero_rows_missing,
@@ -1630,6 +1661,72 @@ pub fn evaluate_static_file(
     Ok((results, summary))
 }
 
+/// Evaluates the static (bias) test of every channel of a record held in memory (a Parquet
+/// table, a recording's topic) as [`evaluate_static_file`] does for a file; with
+/// `zero_rows_missing`, rows whose channels are all exactly zero are left out as missing
+/// (counted in the summary's quality).
+pub fn evaluate_static_data(
+    data: &mut SeriesData,
+    zero_rows_missing: bool,
+    mut config_for: impl FnMut(&ChannelInfo) -> StaticTestConfig,
+) -> Result<(Vec<StaticTestResult>, SeriesSummary), DataError> {
+    let header = data.header.clone();
+    let path = header.file.clone();
+    let nch = data.channels.len();
+    if zero_rows_missing && nch > 0 {
+        let n = data.lines.len();
+        for i in 0..n {
+            if data.channels.iter().all(|c| c[i] == 0.0) {
+                data.channels.iter_mut().for_each(|c| c[i] = f64::NAN);
+                data.quality.zero_rows += 1;
+                if data.quality.first_zero_rows.len() < FIRST_MISSING {
+                    data.quality.first_zero_rows.push(data.lines.get(i).unwrap_or(0));
+                }
+            }
+        }
+    }
+    let configs: Vec<StaticTestConfig> = header
+        .channels
+        .iter()
+        .map(|c| {
+            let mut cfg = config_for(c);
+            cfg.channel = c.name.clone();
+            cfg.output_unit = c.unit;
+            if cfg.sample_rate_hz.is_none() {
+                cfg.sample_rate_hz = header.sample_rate_hz;
+            }
+            cfg
+        })
+        .collect();
+    let wrap = |ch: &str, e: gyrolab::static_test::StaticTestError| {
+        DataError::new(&path, format!("channel '{}': {e}", crate::text::excerpt(ch)))
+    };
+    let lines = data.lines.to_vec();
+    let block = SeriesBlock {
+        first_line: lines.first().copied().unwrap_or(0),
+        lines: &lines,
+        time: data.time.as_deref(),
+        temp: data.temperature.as_deref(),
+        table_rate: data.table_rate.as_deref(),
+        channels: &data.channels,
+    };
+    let mut results = Vec::with_capacity(configs.len());
+    for (k, cfg) in configs.iter().enumerate() {
+        let mut acc = StaticTestAccumulator::new(cfg.clone()).map_err(|e| wrap(&cfg.channel, e))?;
+        acc.push(&block.samples(k)).map_err(|e| wrap(&cfg.channel, e))?;
+        let first = acc.finish().map_err(|e| wrap(&cfg.channel, e))?;
+        if !first.outlier_scan_needed {
+            results.push(first.with_no_outliers(cfg));
+            continue;
+        }
+        let mut scan = OutlierScan::new(&first, cfg).map_err(|e| wrap(&cfg.channel, e))?;
+        scan.push(&block.samples(k)).map_err(|e| wrap(&cfg.channel, e))?;
+        results.push(scan.finish(first).map_err(|e| wrap(&cfg.channel, e))?);
+    }
+    let summary = SeriesSummary { header, rows: lines.len() as u64, quality: data.quality.clone() };
+    Ok((results, summary))
+}
+
 /// Means of consecutive `window_s`-second windows of one output channel (index into the
 /// header's channels) and the temperature, streaming the file once (memory per window, not
 /// per sample). The sample rate is the options' one, else the mean interval of the time column.
@@ -1673,6 +1770,86 @@ pub fn window_means_file(
         acc.push(out, b.temp);
     }
     Ok(acc.finish())
+}
+
+/// Named numeric columns already in memory (a Parquet table, the messages of a recording's
+/// topic), read by the same header rules as a delimited file: roles, units from the names or
+/// `options`, the time column and its unit, skipped columns. Rows are numbered 1..N as
+/// `rows`; a NaN in an output channel is a missing cell (tolerant mode) or an error naming its
+/// row and column.
+pub fn series_from_columns(
+    file: &Path,
+    names: &[String],
+    mut columns: Vec<Vec<f64>>,
+    rows: RowKind,
+    options: &SeriesOptions,
+) -> Result<SeriesData, DataError> {
+    let n = columns.first().map_or(0, Vec::len);
+    if columns.len() != names.len() || columns.iter().any(|c| c.len() != n) {
+        return Err(DataError::new(file, "columns of different lengths: expected a table"));
+    }
+    if let Some(limit) = options.max_rows {
+        if n as u64 > limit {
+            return Err(DataError::new(
+                file,
+                format!("{n} {}s: more than the {limit} this reader accepts", rows.word()),
+            ));
+        }
+    }
+    // The header rules are those of the text reader: it reads a header row and one data row
+    // (for the magnitude of unitless time stamps) built from the names and the first values.
+    let clean: Vec<String> = names.iter().map(|c| c.replace([',', '\n', '\r', '"', '#'], " ")).collect();
+    let first: Vec<String> = columns
+        .iter()
+        .map(|c| c.first().filter(|v| v.is_finite()).map_or("0".to_string(), |v| format!("{v:?}")))
+        .collect();
+    let text = format!("{}\n{}\n", clean.join(","), first.join(","));
+    let opts = SeriesOptions { delimiter: Some(Delimiter::Comma), ..options.clone() };
+    let reader = SeriesReader::from_reader(file, std::io::Cursor::new(text.into_bytes()), &opts)?;
+    let mut header = reader.header.clone();
+    header.rows = rows;
+    header.header_line = 0;
+    let mut take = |c: usize| std::mem::take(&mut columns[c - 1]);
+    let mut time = header.time_column.map(&mut take);
+    if let (Some(t), Some(unit)) = (time.as_mut(), header.time_unit) {
+        if unit != TimeUnit::Second {
+            let f = unit.seconds();
+            t.iter_mut().for_each(|v| *v *= f);
+        }
+    }
+    let temperature = header.temperature_column.map(&mut take);
+    let mut table_rate = header.table_rate_column.map(&mut take);
+    if let (Some(r), Some(unit)) = (table_rate.as_mut(), header.table_rate_unit) {
+        r.iter_mut().for_each(|v| *v = unit.to_dps(*v));
+    }
+    let channels: Vec<Vec<f64>> = header.channels.iter().map(|c| take(c.column)).collect();
+    let mut quality = ReaderQuality::default();
+    for (info, values) in header.channels.iter().zip(&channels) {
+        for (i, v) in values.iter().enumerate().filter(|(_, v)| !v.is_finite()) {
+            if !options.tolerant || !v.is_nan() {
+                return Err(DataError::new(
+                    file,
+                    format!("{} {}: value {v}: expected a finite number", rows.word(), i + 1),
+                )
+                .at_column(info.column, Some(&info.name)));
+            }
+            quality.missing_cells += 1;
+            if quality.first_missing.len() < FIRST_MISSING {
+                quality.first_missing.push(MissingCell {
+                    line: i as u64 + 1,
+                    column: info.column,
+                    name: info.name.clone(),
+                    text: "NaN".into(),
+                });
+            }
+        }
+    }
+    let mut lines = LineMap::default();
+    if n > 0 {
+        lines.runs.push((0, 1));
+        lines.len = n;
+    }
+    Ok(SeriesData { header, lines, time, temperature, table_rate, channels, quality })
 }
 
 #[cfg(test)]

@@ -98,6 +98,7 @@ fn allan<'py>(
             let setup = ChannelSetup {
                 path: Path::new("<array>"),
                 shown: "<array>".into(),
+                topic: None,
                 lines: &gyrolab_io::series::LineMap::default(),
                 tau0_s: 1.0 / rate_hz,
                 options: &options,

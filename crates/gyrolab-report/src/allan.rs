@@ -20,6 +20,8 @@ use serde::Serialize;
 pub struct ChannelAnalysis {
     /// Source file.
     pub file: String,
+    /// The topic of a recording (MCAP, ROS 1 bag, ULog) the channel belongs to.
+    pub topic: Option<String>,
     /// Channel name.
     pub channel: String,
     /// Unit of the rate data analysed: `deg/s` when calibrated, `m/s^2` for an accelerometer,
@@ -156,6 +158,9 @@ pub struct FitJson {
 pub struct AllanJson {
     /// Source file.
     pub file: String,
+    /// Topic of a recording (absent for tables).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub topic: Option<String>,
     /// Channel.
     pub channel: String,
     /// Deviation kind: oadev, adev, mdev, tdev, hdev, ohdev, totdev.
@@ -326,6 +331,7 @@ pub fn allan_json(a: &ChannelAnalysis) -> AllanJson {
     });
     AllanJson {
         file: a.file.clone(),
+        topic: a.topic.clone(),
         channel: a.channel.clone(),
         kind: c.kind.name().to_string(),
         dev_unit: if c.kind.name() == "tdev" { format!("s*{}", a.rate_unit) } else { a.rate_unit.clone() },
@@ -366,7 +372,7 @@ pub fn allan_csv(channels: &[ChannelAnalysis]) -> String {
             s.push_str(&format!(
                 "{},{},{:e},{},{:e},{},{},{},{}\n",
                 a.file,
-                a.channel,
+                a.topic.as_ref().map_or(a.channel.clone(), |t| format!("{t}/{}", a.channel)),
                 p.tau_s,
                 p.m,
                 p.deviation,
@@ -441,7 +447,7 @@ pub fn allan_text(a: &ChannelAnalysis) -> String {
     let mut s = format!(
         "{} ({}): {} of {} samples at tau0 = {} s, rate in {}\n{}\n",
         a.file,
-        a.channel,
+        a.topic.as_ref().map_or(a.channel.clone(), |t| format!("{t} {}", a.channel)),
         c.kind.name().to_uppercase(),
         c.n_rate,
         short(c.tau0_s, 6),
@@ -733,10 +739,17 @@ fn filter_file(channels: &[ChannelAnalysis], update_rate_hz: f64, imu_utils: boo
     if imu_utils {
         text.push_str(&format!("imu_rate: {}\n", short(update_rate_hz, 9)));
     } else {
-        text.push_str(&format!(
-            "update_rate: {}\n# rostopic: not known from this file; /imu0 is Kalibr's example topic: set yours\nrostopic: /imu0\n",
-            short(update_rate_hz, 9)
-        ));
+        let topic = channels
+            .first()
+            .and_then(|c| c.topic.clone())
+            .filter(|t| channels.iter().all(|c| c.topic.as_deref() == Some(t.as_str())));
+        match topic {
+            Some(t) => text.push_str(&format!("update_rate: {}\nrostopic: {t}\n", short(update_rate_hz, 9))),
+            None => text.push_str(&format!(
+                "update_rate: {}\n# rostopic: not known from this file; /imu0 is Kalibr's example topic: set yours\nrostopic: /imu0\n",
+                short(update_rate_hz, 9)
+            )),
+        }
     }
     Some(KalibrFile { text, entries: fe.gyro, accelerometer: fe.accel, warnings })
 }
@@ -787,6 +800,7 @@ mod tests {
         let curve = AllanCurve { kind: DeviationKind::Oadev, tau0_s: 0.01, n_rate: 1 << 20, confidence: None, points };
         ChannelAnalysis {
             file: "hand.csv".into(),
+            topic: None,
             channel: "rate_dps".into(),
             rate_unit: "deg/s".into(),
             quantity: Quantity::AngularRate,

@@ -7,6 +7,7 @@
 //! - [`limits`]: spec limits checked against the figures (PASS, FAIL, NOT EVALUATED);
 //! - [`plot`]: SVG plot building blocks; [`rate_plots`]: the rate-table plots;
 //! - [`html`]: the self-contained HTML report (header, summary, sections, methods appendix);
+//! - [`inventory`]: the topics of a recording (`gyrolab inspect`);
 //! - [`results`]: the results.json document of `gyrolab eval`;
 //! - [`segments`]: segmentation summaries of raw rate-table logs;
 //! - [`triad`]: three-axis calibration tables and JSON;
@@ -19,6 +20,7 @@ pub mod bias;
 pub mod figures;
 pub mod format;
 pub mod html;
+pub mod inventory;
 pub mod limits;
 pub mod paper;
 pub mod plot;

@@ -8,7 +8,7 @@ use crate::progress::Bar;
 use clap::Args;
 use gyrolab::allan::DeviationKind;
 use gyrolab::validate;
-use gyrolab_eval::allan::{analyse_file, parse_confidence, parse_taus, AllanRequest};
+use gyrolab_eval::allan::{analyse_records, parse_confidence, parse_taus, AllanRequest};
 use gyrolab_eval::EvalError;
 use gyrolab_report::allan::{allan_csv, allan_document, allan_text, imu_utils_yaml, kalibr_yaml};
 use std::path::PathBuf;
@@ -19,8 +19,14 @@ pub struct AllanArgs {
     /// A time series (`-`: standard input): a time column (`time_s`, `timestamp [ns]`, ...; or
     /// --sample-rate-hz) and gyro or accelerometer columns, their units in the names
     /// (`rate_dps`, `gyro_x [rad/s]`, `ax_m_s2`) or given with --unit; no header row: c1..cN.
+    /// Also, by content: Parquet tables, and recordings (ROS 2 MCAP, ROS 1 bags, PX4 ULog):
+    /// every IMU topic, six channels each.
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
+    /// Topic of a recording to analyse (default: every IMU topic), repeatable; `gyrolab inspect
+    /// FILE` lists them.
+    #[arg(long = "topic", value_name = "NAME")]
+    pub topics: Vec<String>,
     #[command(flatten)]
     pub layout: LayoutArgs,
     /// Output columns to analyse (default: every output column), repeatable.
@@ -78,6 +84,7 @@ impl AllanArgs {
             fit_range_s: validate::increasing_pair("fit_range_s", &self.fit_range)?,
             layout: self.layout.layout(),
             gaps: gyrolab_eval::allan::GapPolicy::parse(&self.gaps)?,
+            topics: self.topics.clone(),
         })
     }
 }
@@ -86,24 +93,38 @@ impl AllanArgs {
 pub fn run(args: &AllanArgs) -> CliResult {
     let request = args.request()?;
     let spinner = Bar::spinner(format!("analysing {}", args.file.display()));
-    let outcome = analyse_file(&request);
+    let outcomes = analyse_records(&request);
     spinner.finish();
-    let outcome = outcome?;
-    let analyses = &outcome.analyses;
-    for n in &outcome.notes {
-        eprintln!("note: {}", n.render(&crate::error::flag));
+    let outcomes = outcomes?;
+    let several = outcomes.len() > 1;
+    for outcome in &outcomes {
+        for n in &outcome.notes {
+            eprintln!("note: {}", n.render(&crate::error::flag));
+        }
     }
     for (path, imu_utils) in [(&args.kalibr_yaml, false), (&args.imu_utils_yaml, true)] {
         let Some(path) = path else { continue };
         let writer = if imu_utils { imu_utils_yaml } else { kalibr_yaml };
-        let file = writer(analyses, 1.0 / outcome.sample_interval_s).ok_or_else(|| {
-            EvalError::conflict("no noise terms could be read from the curves (give the gyro channels a unit such as --unit rad/s, or calibrate outputs with --cal or --scale-factor, and use --kind oadev)")
-        })?;
-        write_file(path, file.text.as_bytes())?;
-        for w in &file.warnings {
-            eprintln!("warning: {w}");
+        for outcome in &outcomes {
+            // One file per topic when there are several: imu.yaml -> imu_<topic>.yaml.
+            let target = match (&outcome.topic, several) {
+                (Some(t), true) => gyrolab_eval::recording::per_topic_path(path, &t.topic),
+                _ => path.clone(),
+            };
+            let file = writer(&outcome.analyses, 1.0 / outcome.sample_interval_s).ok_or_else(|| {
+                EvalError::conflict("no noise terms could be read from the curves (give the gyro channels a unit such as --unit rad/s, or calibrate outputs with --cal or --scale-factor, and use --kind oadev)")
+            })?;
+            write_file(&target, file.text.as_bytes())?;
+            if several {
+                eprintln!("note: wrote {}", target.display());
+            }
+            for w in &file.warnings {
+                eprintln!("warning: {w}");
+            }
         }
     }
+    let analyses: Vec<_> = outcomes.into_iter().flat_map(|o| o.analyses).collect();
+    let analyses = &analyses;
     if args.json {
         let doc = allan_document(analyses).ok_or_else(|| EvalError::conflict("no channel to analyse"))?;
         return print(&to_json(&doc)?);

@@ -14,9 +14,14 @@ use std::path::PathBuf;
 #[derive(Debug, Args)]
 pub struct BiasArgs {
     /// Static records, one file per test: a time column `time_s` (or --sample-rate-hz), output
-    /// columns with unit suffixes (`output_v`, `rate_dps`, ...), optional `temp_c`.
+    /// columns with unit suffixes (`output_v`, `rate_dps`, ...), optional `temp_c`. Also, by
+    /// content: Parquet tables, and recordings (ROS 2 MCAP, ROS 1 bags, PX4 ULog): every IMU
+    /// topic, one test per topic.
     #[arg(required = true, value_name = "FILE")]
     pub files: Vec<PathBuf>,
+    /// Topic of a recording to evaluate (default: every IMU topic), repeatable.
+    #[arg(long = "topic", value_name = "NAME")]
+    pub topics: Vec<String>,
     #[command(flatten)]
     pub layout: LayoutArgs,
     /// Output columns to evaluate (default: every output column), repeatable.
@@ -64,6 +69,7 @@ pub fn run(args: &BiasArgs) -> CliResult {
         drop_outliers: args.drop_outliers,
         tolerant: args.tolerant,
         layout: args.layout.layout(),
+        topics: args.topics.clone(),
     };
     let outcome = evaluate_static_tests(&request)?;
     for f in &outcome.files {

@@ -3,8 +3,10 @@
 pub mod allan;
 pub mod apply;
 pub mod bias;
+pub mod convert;
 pub mod demo;
 pub mod eval;
+pub mod inspect;
 pub mod rate;
 pub mod record_length;
 pub mod simulate;

@@ -334,6 +334,7 @@ fn allan_of(
     let setup = ChannelSetup {
         path,
         shown: shown(path, base),
+        topic: None,
         lines: &lines,
         tau0_s: 1.0 / sample_rate_hz,
         options: &opts,

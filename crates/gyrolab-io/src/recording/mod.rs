@@ -1,0 +1,638 @@
+//! Robotics recordings: ROS 2 MCAP files, ROS 1 bags and PX4 ULog files, read in one pass into
+//! the IMU topics they hold (each a table of time stamps and gyro/accelerometer channels with
+//! their units) and an inventory of every topic.
+//!
+//! - [`sniff_format`]: what a file is, by its first bytes (not its extension);
+//! - [`read_recording`]: one pass over a recording: every topic counted, the selected IMU topics
+//!   decoded ([`ros_msg`] for ROS messages, [`ulog`] for PX4 topics);
+//! - [`read_records`]: any file gyrolab reads, by content, as records (a table, or one per
+//!   IMU topic);
+//! - [`ImuTopic::into_series`]: a topic as a [`SeriesData`], read by the header rules of a
+//!   delimited file, so that every analysis of a CSV log takes it unchanged.
+//!
+//! Message time is the header stamp (ROS) or the sample time stamp (PX4); messages are put in
+//! stamp order after reading (no separate sorting step).
+
+mod bag;
+mod mcap_file;
+pub mod ros_msg;
+pub mod ulog;
+
+use crate::error::DataError;
+use crate::series::{series_from_columns, RowKind, SeriesData, SeriesOptions};
+use std::io::Read;
+use std::path::Path;
+
+/// The formats gyrolab reads, told apart by their first bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FileFormat {
+    /// Delimited text (CSV, TSV, whitespace).
+    Text,
+    /// MCAP (ROS 2's default bag storage, Foxglove).
+    Mcap,
+    /// ROS 1 bag (format 2.0).
+    RosBag,
+    /// PX4 ULog.
+    ULog,
+    /// Apache Parquet.
+    Parquet,
+}
+
+impl FileFormat {
+    /// The format's usual name.
+    pub fn name(self) -> &'static str {
+        match self {
+            FileFormat::Text => "delimited text",
+            FileFormat::Mcap => "MCAP",
+            FileFormat::RosBag => "ROS 1 bag",
+            FileFormat::ULog => "PX4 ULog",
+            FileFormat::Parquet => "Parquet",
+        }
+    }
+
+    /// Whether the format is a recording of topics (MCAP, ROS 1 bag, ULog).
+    pub fn is_recording(self) -> bool {
+        matches!(self, FileFormat::Mcap | FileFormat::RosBag | FileFormat::ULog)
+    }
+}
+
+/// The format of a file by its first bytes (`-`, standard input, is text).
+pub fn sniff_format(path: &Path) -> Result<FileFormat, DataError> {
+    if path.as_os_str() == "-" {
+        return Ok(FileFormat::Text);
+    }
+    let mut head = [0u8; 16];
+    let mut f = std::fs::File::open(path).map_err(|e| DataError::io(path, &e))?;
+    let mut n = 0;
+    while n < head.len() {
+        match f.read(&mut head[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(DataError::io(path, &e)),
+        }
+    }
+    Ok(format_of(&head[..n]))
+}
+
+/// The format of a file that starts with `head`.
+pub fn format_of(head: &[u8]) -> FileFormat {
+    if head.starts_with(b"\x89MCAP") {
+        FileFormat::Mcap
+    } else if head.starts_with(b"#ROSBAG V2.0") {
+        FileFormat::RosBag
+    } else if head.starts_with(b"ULog\x01\x12\x35") {
+        FileFormat::ULog
+    } else if head.starts_with(b"PAR1") {
+        FileFormat::Parquet
+    } else {
+        FileFormat::Text
+    }
+}
+
+/// Where a topic's time stamps come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StampSource {
+    /// The message's header stamp (ROS).
+    Header,
+    /// The time the recorder logged the message (used when the header stamp is zero).
+    LogTime,
+    /// PX4's `timestamp_sample` (the time the sensor was sampled).
+    Sample,
+    /// PX4's `timestamp` (the time the message was published).
+    Published,
+}
+
+impl StampSource {
+    /// How the stamps were taken, for notes.
+    pub fn describe(self) -> &'static str {
+        match self {
+            StampSource::Header => "header stamps",
+            StampSource::LogTime => "log times (the header stamps are zero)",
+            StampSource::Sample => "timestamp_sample (sensor sampling time)",
+            StampSource::Published => "timestamp (publication time; the topic has no timestamp_sample)",
+        }
+    }
+}
+
+/// One topic of a recording.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TopicInfo {
+    /// Topic name (`/imu0`; PX4: `sensor_gyro.0` with its instance).
+    pub topic: String,
+    /// Message type (`sensor_msgs/msg/Imu`, `sensor_combined`).
+    pub message_type: String,
+    /// Messages in the file.
+    pub messages: u64,
+    /// Whether gyrolab reads it as an IMU topic.
+    pub imu: bool,
+    /// First and last time stamps, ns (log time, or the sample stamps of an IMU topic).
+    pub span_ns: Option<(i64, i64)>,
+    /// Every time stamp, ns, in file order (kept when asked for: [`RecordingOptions::stamps`]).
+    pub stamps_ns: Vec<i64>,
+}
+
+/// A decoded IMU topic.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImuTopic {
+    /// Topic name.
+    pub topic: String,
+    /// Message type.
+    pub message_type: String,
+    /// Where the stamps come from.
+    pub stamp_source: StampSource,
+    /// Time stamps, ns, increasing (ties kept).
+    pub stamps_ns: Vec<i64>,
+    /// Channel names with their units in the gyrolab convention (`gyro_x_rad_s`,
+    /// `accel_x_m_s2`; `x`, `y`, `z` for a Vector3Stamped, whose unit is not stated).
+    pub names: Vec<String>,
+    /// One column per channel, in stamp order.
+    pub channels: Vec<Vec<f64>>,
+    /// Messages that came before an earlier-stamped one in the file (put in order).
+    pub out_of_order: u64,
+}
+
+impl ImuTopic {
+    /// The topic as a time series: `time_s` (seconds from the first stamp) and the channels,
+    /// read by the header rules of a delimited file (units from the names, `options` for the
+    /// rest); rows are messages.
+    pub fn into_series(self, file: &Path, options: &SeriesOptions) -> Result<(TopicMeta, SeriesData), DataError> {
+        let first = self.stamps_ns.first().copied().unwrap_or(0);
+        let time: Vec<f64> = self.stamps_ns.iter().map(|&t| (t - first) as f64 * 1e-9).collect();
+        let meta = TopicMeta {
+            topic: self.topic,
+            message_type: self.message_type,
+            stamp_source: self.stamp_source,
+            messages: self.stamps_ns.len() as u64,
+            out_of_order: self.out_of_order,
+            first_stamp_ns: first,
+        };
+        drop(self.stamps_ns);
+        let mut names = vec!["time_s".to_string()];
+        names.extend(self.names);
+        let mut columns = vec![time];
+        columns.extend(self.channels);
+        let options = SeriesOptions { time_column: None, time_unit: None, names: None, ..options.clone() };
+        let data = series_from_columns(file, &names, columns, RowKind::Message, &options)?;
+        Ok((meta, data))
+    }
+}
+
+/// What a record read from a recording's topic was.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TopicMeta {
+    /// Topic name.
+    pub topic: String,
+    /// Message type.
+    pub message_type: String,
+    /// Where the stamps come from.
+    pub stamp_source: StampSource,
+    /// Messages read.
+    pub messages: u64,
+    /// Messages that came before an earlier-stamped one in the file (put in order).
+    pub out_of_order: u64,
+    /// The first stamp, ns (`time_s` counts from it).
+    pub first_stamp_ns: i64,
+}
+
+/// One record of a file: the table of a text or Parquet file, or one topic of a recording.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FileRecord {
+    /// The topic, for a recording.
+    pub topic: Option<TopicMeta>,
+    /// The time series.
+    pub data: SeriesData,
+}
+
+/// Every record of a file, read whole.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FileRecords {
+    /// The file's format.
+    pub format: FileFormat,
+    /// Its records (one for a table; one per IMU topic of a recording).
+    pub records: Vec<FileRecord>,
+    /// Where a recording ends early or is damaged (the messages before it are read).
+    pub truncated: Option<String>,
+}
+
+/// Reads any file gyrolab reads, by its content: delimited text and Parquet as one table,
+/// MCAP, ROS 1 bags and ULog as one record per IMU topic (`topics` selects; empty: all).
+pub fn read_records(path: &Path, options: &SeriesOptions, topics: &[String]) -> Result<FileRecords, DataError> {
+    let format = sniff_format(path)?;
+    if !format.is_recording() && !topics.is_empty() {
+        return Err(DataError::new(
+            path,
+            format!(
+                "topics were given, but this is a {} file, not a recording (MCAP, ROS 1 bag, PX4 ULog)",
+                format.name()
+            ),
+        ));
+    }
+    let table = |data| FileRecords { format, records: vec![FileRecord { topic: None, data }], truncated: None };
+    match format {
+        FileFormat::Text => Ok(table(crate::series::read_series_all(path, options)?)),
+        FileFormat::Parquet => Ok(table(crate::parquet_table::read_parquet(path, options)?)),
+        _ => {
+            let rec = read_recording(path, &RecordingOptions { topics: topics.to_vec(), ..Default::default() })?;
+            let mut records = Vec::with_capacity(rec.imu.len());
+            for t in rec.imu {
+                let topic = t.topic.clone();
+                let (meta, data) = t.into_series(path, options).map_err(|mut e| {
+                    e.message = format!("topic '{}': {}", crate::text::excerpt(&topic), e.message);
+                    e
+                })?;
+                records.push(FileRecord { topic: Some(meta), data });
+            }
+            Ok(FileRecords { format, records, truncated: rec.truncated })
+        }
+    }
+}
+
+/// What [`read_recording`] reads.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct RecordingOptions {
+    /// Topics to decode (default: every IMU topic). A name that is not in the file, or not an
+    /// IMU topic, is an error listing the topics that are.
+    pub topics: Vec<String>,
+    /// Keep every topic's time stamps ([`TopicInfo::stamps_ns`], for inventories).
+    pub stamps: bool,
+    /// Count topics only: decode nothing.
+    pub inventory_only: bool,
+}
+
+/// A recording as read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recording {
+    /// Its format.
+    pub format: FileFormat,
+    /// Every topic, in the order they appear.
+    pub topics: Vec<TopicInfo>,
+    /// The decoded IMU topics, in the order they appear.
+    pub imu: Vec<ImuTopic>,
+    /// When the file ends early or is damaged after some messages: where and what, the
+    /// messages before it being kept.
+    pub truncated: Option<String>,
+}
+
+/// Reads a recording (MCAP, ROS 1 bag, ULog) in one pass.
+pub fn read_recording(path: &Path, options: &RecordingOptions) -> Result<Recording, DataError> {
+    let format = sniff_format(path)?;
+    let mut c = Collector::new(options);
+    let end = match format {
+        FileFormat::Mcap => mcap_file::read(path, &mut c),
+        FileFormat::RosBag => bag::read(path, &mut c),
+        FileFormat::ULog => ulog::read(path, &mut c),
+        _ => {
+            return Err(DataError::new(
+                path,
+                format!("a {} file, not a recording: expected MCAP, a ROS 1 bag or a PX4 ULog file", format.name()),
+            ))
+        }
+    };
+    let truncated = match end {
+        Ok(()) => None,
+        Err(Stop::Damaged { at, what }) if c.decoded_messages() > 0 => {
+            Some(format!("the file ends early or is damaged at {at} ({what}); the messages before it are analysed"))
+        }
+        Err(Stop::Damaged { at, what }) => {
+            return Err(DataError::new(path, format!("at {at}: {what}: expected a complete {} file", format.name())))
+        }
+        Err(Stop::Error(e)) => return Err(e),
+    };
+    c.finish(path, format, truncated)
+}
+
+/// Why a pass over a file stopped early.
+pub(crate) enum Stop {
+    /// The file is damaged or ends early here.
+    Damaged {
+        /// Where: `byte 1234`, `chunk 5`.
+        at: String,
+        /// What was wrong.
+        what: String,
+    },
+    /// Another error (a message that cannot be decoded, a wrong selection).
+    Error(DataError),
+}
+
+impl From<DataError> for Stop {
+    fn from(e: DataError) -> Self {
+        Stop::Error(e)
+    }
+}
+
+/// How the values of one topic's messages are laid out.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) struct ImuLayout {
+    /// Channel names with units.
+    pub names: Vec<String>,
+}
+
+impl ImuLayout {
+    /// Gyro x/y/z (rad/s) and accel x/y/z (m/s^2).
+    pub fn six() -> ImuLayout {
+        ImuLayout {
+            names: ["gyro_x_rad_s", "gyro_y_rad_s", "gyro_z_rad_s", "accel_x_m_s2", "accel_y_m_s2", "accel_z_m_s2"]
+                .map(String::from)
+                .to_vec(),
+        }
+    }
+    /// Three channels by name.
+    pub fn three(names: [&str; 3]) -> ImuLayout {
+        ImuLayout { names: names.map(String::from).to_vec() }
+    }
+}
+
+struct TopicState {
+    info: TopicInfo,
+    layout: Option<ImuLayout>,
+    decode: bool,
+    stamps: Vec<i64>,
+    channels: Vec<Vec<f64>>,
+    out_of_order: u64,
+    zero_stamps: u64,
+    source: StampSource,
+}
+
+/// Gathers topics and messages during a pass over a recording.
+pub(crate) struct Collector {
+    want: Vec<String>,
+    stamps: bool,
+    inventory_only: bool,
+    topics: Vec<TopicState>,
+}
+
+impl Collector {
+    fn new(options: &RecordingOptions) -> Self {
+        Collector {
+            want: options.topics.clone(),
+            stamps: options.stamps,
+            inventory_only: options.inventory_only,
+            topics: Vec::new(),
+        }
+    }
+
+    /// Registers a topic (or finds it again: ROS 1 bags repeat connections); returns its id.
+    pub fn topic(&mut self, name: &str, message_type: &str, layout: Option<ImuLayout>, source: StampSource) -> usize {
+        if let Some(i) = self.topics.iter().position(|t| t.info.topic == name && t.info.message_type == message_type) {
+            return i;
+        }
+        let selected = self.want.is_empty() || self.want.iter().any(|w| w == name);
+        let decode = layout.is_some() && selected && !self.inventory_only;
+        let width = layout.as_ref().map_or(0, |l| l.names.len());
+        self.topics.push(TopicState {
+            info: TopicInfo {
+                topic: name.to_string(),
+                message_type: message_type.to_string(),
+                messages: 0,
+                imu: layout.is_some(),
+                span_ns: None,
+                stamps_ns: Vec::new(),
+            },
+            layout,
+            decode,
+            stamps: Vec::new(),
+            channels: vec![Vec::new(); if decode { width } else { 0 }],
+            out_of_order: 0,
+            zero_stamps: 0,
+            source,
+        });
+        self.topics.len() - 1
+    }
+
+    /// Whether the messages of topic `id` are to be decoded.
+    pub fn decodes(&self, id: usize) -> bool {
+        self.topics[id].decode
+    }
+
+    /// Counts a message that is not decoded (`log_ns`: its log time).
+    pub fn count(&mut self, id: usize, log_ns: i64) {
+        let keep = self.stamps;
+        let t = &mut self.topics[id];
+        t.info.messages += 1;
+        t.info.span_ns = Some(match t.info.span_ns {
+            None => (log_ns, log_ns),
+            Some((a, b)) => (a.min(log_ns), b.max(log_ns)),
+        });
+        if keep {
+            t.info.stamps_ns.push(log_ns);
+        }
+    }
+
+    /// Adds a decoded message: its stamp (ns; zero: use `log_ns`) and values.
+    pub fn push(&mut self, id: usize, stamp_ns: i64, log_ns: i64, values: &[f64]) {
+        let t = &mut self.topics[id];
+        let stamp = if stamp_ns == 0 {
+            t.zero_stamps += 1;
+            log_ns
+        } else {
+            stamp_ns
+        };
+        if t.stamps.last().is_some_and(|&last| stamp < last) {
+            t.out_of_order += 1;
+        }
+        t.stamps.push(stamp);
+        for (c, v) in t.channels.iter_mut().zip(values) {
+            c.push(*v);
+        }
+        t.info.messages += 1;
+        t.info.span_ns = Some(match t.info.span_ns {
+            None => (stamp, stamp),
+            Some((a, b)) => (a.min(stamp), b.max(stamp)),
+        });
+    }
+
+    fn decoded_messages(&self) -> u64 {
+        self.topics.iter().filter(|t| t.decode).map(|t| t.stamps.len() as u64).sum()
+    }
+
+    fn listing(&self) -> String {
+        if self.topics.is_empty() {
+            return "no topics".into();
+        }
+        let shown: Vec<String> = self
+            .topics
+            .iter()
+            .take(20)
+            .map(|t| {
+                format!(
+                    "{} ({}, {} messages)",
+                    crate::text::excerpt(&t.info.topic),
+                    crate::text::excerpt(&t.info.message_type),
+                    t.info.messages
+                )
+            })
+            .collect();
+        let more = self.topics.len().saturating_sub(20);
+        format!("{}{}", shown.join(", "), if more > 0 { format!(" and {more} more") } else { String::new() })
+    }
+
+    fn finish(self, path: &Path, format: FileFormat, truncated: Option<String>) -> Result<Recording, DataError> {
+        for w in &self.want {
+            match self.topics.iter().find(|t| &t.info.topic == w) {
+                None => {
+                    return Err(DataError::new(
+                        path,
+                        format!("topic '{}' is not in the file; it has: {}", crate::text::excerpt(w), self.listing()),
+                    ))
+                }
+                Some(t) if t.layout.is_none() => {
+                    return Err(DataError::new(
+                        path,
+                        format!(
+                            "topic '{}' holds {} messages, not IMU data (sensor_msgs/Imu, geometry_msgs/Vector3Stamped, or PX4 sensor_combined, sensor_gyro, sensor_accel, vehicle_imu); the file has: {}",
+                            crate::text::excerpt(w),
+                            crate::text::excerpt(&t.info.message_type),
+                            self.listing()
+                        ),
+                    ))
+                }
+                Some(_) => {}
+            }
+        }
+        if !self.inventory_only && !self.topics.iter().any(|t| t.decode && !t.stamps.is_empty()) {
+            return Err(DataError::new(
+                path,
+                format!(
+                    "no IMU messages (sensor_msgs/Imu, geometry_msgs/Vector3Stamped, or PX4 sensor_combined, sensor_gyro, sensor_accel, vehicle_imu) in this {} file; it has: {}",
+                    format.name(),
+                    self.listing()
+                ),
+            ));
+        }
+        let mut topics = Vec::with_capacity(self.topics.len());
+        let mut imu = Vec::new();
+        for t in self.topics {
+            let mut info = t.info;
+            if t.decode && !t.stamps.is_empty() {
+                if self.stamps {
+                    info.stamps_ns = t.stamps.clone();
+                }
+                let (stamps_ns, channels) = in_stamp_order(t.stamps, t.channels, t.out_of_order);
+                imu.push(ImuTopic {
+                    topic: info.topic.clone(),
+                    message_type: info.message_type.clone(),
+                    stamp_source: if t.zero_stamps > 0 { StampSource::LogTime } else { t.source },
+                    stamps_ns,
+                    names: t.layout.map(|l| l.names).unwrap_or_default(),
+                    channels,
+                    out_of_order: t.out_of_order,
+                });
+            }
+            topics.push(info);
+        }
+        Ok(Recording { format, topics, imu, truncated })
+    }
+}
+
+/// Sorts the messages by stamp (stable: ties keep file order) when some came out of order.
+fn in_stamp_order(stamps: Vec<i64>, channels: Vec<Vec<f64>>, out_of_order: u64) -> (Vec<i64>, Vec<Vec<f64>>) {
+    if out_of_order == 0 {
+        return (stamps, channels);
+    }
+    let mut order: Vec<u32> = (0..stamps.len() as u32).collect();
+    order.sort_by_key(|&i| stamps[i as usize]);
+    let permute = |v: &[f64]| order.iter().map(|&i| v[i as usize]).collect::<Vec<f64>>();
+    let channels = channels.iter().map(|c| permute(c)).collect();
+    let stamps = order.iter().map(|&i| stamps[i as usize]).collect();
+    (stamps, channels)
+}
+
+/// Writes a topic as CSV: `timestamp_ns` (integer, as recorded) and the channels with their
+/// units in the names, each value in the shortest form that reads back to the same f64.
+pub fn write_topic_csv(out: &mut dyn std::io::Write, topic: &ImuTopic) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut w = std::io::BufWriter::with_capacity(1 << 20, out);
+    writeln!(w, "timestamp_ns,{}", topic.names.join(","))?;
+    let mut fmt = ryu::Buffer::new();
+    let mut line = String::with_capacity(256);
+    for (i, t) in topic.stamps_ns.iter().enumerate() {
+        line.clear();
+        line.push_str(&t.to_string());
+        for c in &topic.channels {
+            line.push(',');
+            let v = c[i];
+            line.push_str(if v.is_finite() { fmt.format(v) } else { "NaN" });
+        }
+        line.push('\n');
+        w.write_all(line.as_bytes())?;
+    }
+    w.flush()
+}
+
+/// Writes a topic as a Parquet table: `timestamp_ns` (INT64) and the channels (DOUBLE).
+pub fn write_topic_parquet(out: &mut (dyn std::io::Write + Send), topic: &ImuTopic) -> std::io::Result<()> {
+    let cols: Vec<&[f64]> = topic.channels.iter().map(|c| &c[..]).collect();
+    crate::parquet_table::write_parquet(out, "timestamp_ns", &topic.stamps_ns, &topic.names, &cols)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn formats_by_first_bytes() {
+        assert_eq!(format_of(b"\x89MCAP0\r\n"), FileFormat::Mcap);
+        assert_eq!(format_of(b"#ROSBAG V2.0\n"), FileFormat::RosBag);
+        assert_eq!(format_of(b"ULog\x01\x12\x35\x01"), FileFormat::ULog);
+        assert_eq!(format_of(b"PAR1\x15"), FileFormat::Parquet);
+        assert_eq!(format_of(b"time_s,rate_dps\n"), FileFormat::Text);
+        assert_eq!(format_of(b""), FileFormat::Text);
+    }
+
+    #[test]
+    fn unsorted_messages_are_put_in_stamp_order() {
+        let mut c = Collector::new(&RecordingOptions::default());
+        let id = c.topic("/imu", "sensor_msgs/msg/Imu", Some(ImuLayout::six()), StampSource::Header);
+        for (s, v) in [(10, 1.0), (30, 3.0), (20, 2.0), (40, 4.0)] {
+            c.push(id, s, 0, &[v; 6]);
+        }
+        let r = c.finish(Path::new("x.mcap"), FileFormat::Mcap, None).unwrap();
+        assert_eq!(r.imu[0].stamps_ns, [10, 20, 30, 40]);
+        assert_eq!(r.imu[0].channels[5], [1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(r.imu[0].out_of_order, 1);
+    }
+
+    #[test]
+    fn selection_errors_list_the_topics() {
+        let opts = RecordingOptions { topics: vec!["/imu9".into()], ..Default::default() };
+        let mut c = Collector::new(&opts);
+        let id = c.topic("/imu0", "sensor_msgs/msg/Imu", Some(ImuLayout::six()), StampSource::Header);
+        c.count(id, 5);
+        let e = c.finish(Path::new("x.mcap"), FileFormat::Mcap, None).unwrap_err().to_string();
+        assert!(
+            e.contains("'/imu9' is not in the file") && e.contains("/imu0 (sensor_msgs/msg/Imu, 1 messages)"),
+            "{e}"
+        );
+        let opts = RecordingOptions { topics: vec!["/tf".into()], ..Default::default() };
+        let mut c = Collector::new(&opts);
+        c.topic("/tf", "tf2_msgs/msg/TFMessage", None, StampSource::Header);
+        let e = c.finish(Path::new("x.mcap"), FileFormat::Mcap, None).unwrap_err().to_string();
+        assert!(e.contains("not IMU data"), "{e}");
+        let mut c = Collector::new(&RecordingOptions::default());
+        c.topic("/tf", "tf2_msgs/msg/TFMessage", None, StampSource::Header);
+        let e = c.finish(Path::new("x.mcap"), FileFormat::Mcap, None).unwrap_err().to_string();
+        assert!(e.contains("no IMU messages") && e.contains("/tf (tf2_msgs/msg/TFMessage"), "{e}");
+    }
+
+    #[test]
+    fn a_topic_reads_as_a_series_with_units_from_its_names() {
+        let t = ImuTopic {
+            topic: "/imu".into(),
+            message_type: "sensor_msgs/msg/Imu".into(),
+            stamp_source: StampSource::Header,
+            stamps_ns: vec![1_700_000_000_000_000_000, 1_700_000_000_005_000_000],
+            names: ImuLayout::six().names,
+            channels: vec![vec![0.5, 0.25]; 6],
+            out_of_order: 0,
+        };
+        let (meta, s) = t.into_series(Path::new("x.mcap"), &SeriesOptions::default()).unwrap();
+        assert_eq!((meta.messages, meta.first_stamp_ns), (2, 1_700_000_000_000_000_000));
+        assert_eq!(s.time.as_deref(), Some(&[0.0, 0.005][..]));
+        assert_eq!(s.header.channels.len(), 6);
+        assert_eq!(s.header.channels[0].unit, gyrolab::units::OutputUnit::RadPerSec);
+        assert_eq!(s.header.channels[3].unit, gyrolab::units::OutputUnit::MeterPerSec2);
+        assert_eq!(s.header.rows, RowKind::Message);
+        assert_eq!(s.lines.get(1), Some(2));
+    }
+}
