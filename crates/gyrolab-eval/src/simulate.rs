@@ -112,6 +112,9 @@ pub fn sim_config(o: &SimOverrides) -> EvalResult<SimConfig> {
         s.scale_factor_per_dps = Some(k);
     }
     if s.output_unit.is_some() && s.scale_factor_per_dps.is_none() && cfg.preset.is_none() {
+        // An output that is already a rate (rad/s, deg/h, mrad/s) has its exact scale factor:
+        // the sensor's rate in that unit (before, rad/s outputs held deg/s numbers).
+        s.scale_factor_per_dps = s.output_unit.and_then(OutputUnit::native_scale_factor_per_dps);
         if let Some(OutputUnit::Volt | OutputUnit::Millivolt | OutputUnit::Lsb) = s.output_unit {
             return Err(EvalError::conflict_on(
                 &["scale_factor", "null", "preset"],

@@ -99,7 +99,8 @@ pub fn run(args: &AllanArgs) -> CliResult {
     let several = outcomes.len() > 1;
     for outcome in &outcomes {
         for n in &outcome.notes {
-            eprintln!("note: {}", n.render(&crate::error::flag));
+            let level = if matches!(n, gyrolab_eval::allan::ReadNote::Truncated(_)) { "warning" } else { "note" };
+            eprintln!("{level}: {}", n.render(&crate::error::flag));
         }
     }
     for (path, imu_utils) in [(&args.kalibr_yaml, false), (&args.imu_utils_yaml, true)] {

@@ -8,8 +8,55 @@ use rosbag::{ChunkRecord, MessageRecord, RosBag};
 use std::collections::HashMap;
 use std::path::Path;
 
+/// The `index_pos` field of a bag's header record (ROS wiki "Bags/Format/2.0": after the
+/// version line, a record of u32 header length and `name=value` fields, each with a u32 length).
+fn index_pos(head: &[u8]) -> Option<u64> {
+    let rest = head.strip_prefix(b"#ROSBAG V2.0\n")?;
+    let len = u32::from_le_bytes(rest.get(..4)?.try_into().ok()?) as usize;
+    let mut fields = rest.get(4..4 + len)?;
+    while fields.len() >= 4 {
+        let n = u32::from_le_bytes(fields[..4].try_into().ok()?) as usize;
+        let field = fields.get(4..4 + n)?;
+        if let Some(v) = field.strip_prefix(b"index_pos=") {
+            return Some(u64::from_le_bytes(v.get(..8)?.try_into().ok()?));
+        }
+        fields = &fields[4 + n..];
+    }
+    None
+}
+
+/// Refuses a bag whose index lies beyond its end (cut off) or that has none (not closed): the
+/// `rosbag` crate reads the chunks through the index position.
+fn check_index(path: &Path) -> Result<(), Stop> {
+    use std::io::Read;
+    let mut head = vec![0u8; 4096];
+    let mut f = std::fs::File::open(path).map_err(|e| DataError::io(path, &e))?;
+    let size = f.metadata().map_err(|e| DataError::io(path, &e))?.len();
+    let mut n = 0;
+    while n < head.len() {
+        match f.read(&mut head[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(e) => return Err(DataError::io(path, &e).into()),
+        }
+    }
+    match index_pos(&head[..n]) {
+        None => Err(Stop::Damaged { at: "the start".into(), what: "no readable bag header record".into() }),
+        Some(0) => Err(Stop::Damaged {
+            at: "the start".into(),
+            what: "the bag has no index (it was not closed; `rosbag reindex` rebuilds it)".into(),
+        }),
+        Some(p) if p > size => Err(Stop::Damaged {
+            at: format!("byte {size}"),
+            what: format!("the file ends before its index at byte {p} (cut off; `rosbag reindex` may recover it)"),
+        }),
+        Some(_) => Ok(()),
+    }
+}
+
 /// Reads every message of a ROS 1 bag into `c`.
 pub(super) fn read(path: &Path, c: &mut Collector) -> Result<(), Stop> {
+    check_index(path)?;
     let bag = RosBag::new(path).map_err(|e| Stop::Damaged { at: "the start".into(), what: e.to_string() })?;
     let mut conns: HashMap<u32, (usize, Option<RosImuType>)> = HashMap::new();
     let mut chunks = 0u64;

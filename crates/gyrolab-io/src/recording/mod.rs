@@ -291,11 +291,15 @@ pub fn read_recording(path: &Path, options: &RecordingOptions) -> Result<Recordi
     };
     let truncated = match end {
         Ok(()) => None,
-        Err(Stop::Damaged { at, what }) if c.decoded_messages() > 0 => {
-            Some(format!("the file ends early or is damaged at {at} ({what}); the messages before it are analysed"))
-        }
+        Err(Stop::Damaged { at, what }) if c.decoded_messages() > 0 => Some(format!(
+            "the file ends early or is damaged at {at} ({}); the messages before it are analysed",
+            crate::text::short_message(&what)
+        )),
         Err(Stop::Damaged { at, what }) => {
-            return Err(DataError::new(path, format!("at {at}: {what}: expected a complete {} file", format.name())))
+            return Err(DataError::new(
+                path,
+                format!("at {at}: {}: expected a complete {} file", crate::text::short_message(&what), format.name()),
+            ))
         }
         Err(Stop::Error(e)) => return Err(e),
     };

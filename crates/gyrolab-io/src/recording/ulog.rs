@@ -105,6 +105,14 @@ fn plan_of(f: &FlattenedFormat) -> Option<(ImuLayout, StampSource, Option<Flatte
     }
 }
 
+/// The description inside the parser's debug text of an error, without the message format it
+/// quotes (`UlogParseError { .., description: "data message had wrong size 50, format: ..." }`).
+fn parse_error_text(why: &str) -> String {
+    let d = why.split_once("description: \"").map_or(why, |(_, d)| d);
+    let d = d.split(", format:").next().unwrap_or(d);
+    d.trim_end_matches(['"', ' ', '}']).to_string()
+}
+
 /// Reads every data message of a ULog file into `c`.
 pub(super) fn read(path: &Path, c: &mut Collector) -> Result<(), Stop> {
     let shown = path.to_string_lossy().to_string();
@@ -177,7 +185,9 @@ pub(super) fn read(path: &Path, c: &mut Collector) -> Result<(), Stop> {
         Ok(Completeness::Truncated) => {
             Err(Stop::Damaged { at: "the end".into(), what: "the last message is cut off".into() })
         }
-        Ok(Completeness::MalformedRecord(why)) => Err(Stop::Damaged { at: "a data message".into(), what: why }),
+        Ok(Completeness::MalformedRecord(why)) => {
+            Err(Stop::Damaged { at: "a data message".into(), what: parse_error_text(&why) })
+        }
         Err(e) => Err(Stop::Damaged { at: "the header or definitions".into(), what: e.to_string() }),
     }
 }
