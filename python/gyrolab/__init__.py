@@ -309,14 +309,16 @@ def read(
     units: Optional[Sequence[str]] = None,
     time_column: Optional[str] = None,
     names: Optional[Sequence[str]] = None,
+    topic: Optional[str] = None,
 ) -> Any:
-    """Reads a time-series file gyrolab reads (CSV, TSV, Kalibr imu0.csv, headerless, ...): a
+    """Reads a time-series file gyrolab reads (CSV, TSV, Kalibr imu0.csv, headerless, Parquet;
+    ROS 2 MCAP, ROS 1 bags and PX4 ULog by content, ``topic`` picking one IMU topic): a
     pandas DataFrame when pandas is installed (column units in ``df.attrs["units"]``), else (or
     with ``as_dataframe=False``) a dict of column name -> float64 array; :func:`read_with_units`
     gives arrays and units. ``units`` (``["gx=rad/s", "m/s^2"]``), ``time_column`` and ``names``
     (for a file without a header row) as the CLI's ``--unit``, ``--time-column``, ``--names``."""
     arrays, units = _gyrolab.read(
-        str(path), None if units is None else list(units), time_column, None if names is None else list(names)
+        str(path), None if units is None else list(units), time_column, None if names is None else list(names), topic
     )
     if as_dataframe is not False:
         try:

@@ -100,8 +100,10 @@ def read(
     units: Optional[Sequence[str]] = ...,
     time_column: Optional[str] = ...,
     names: Optional[Sequence[str]] = ...,
+    topic: Optional[str] = ...,
 ) -> Any:
-    """A time-series file as a DataFrame (pandas) or a dict of float64 arrays."""
+    """A time-series file (CSV, Parquet; MCAP, ROS 1 bag, ULog by content, one IMU ``topic``)
+    as a DataFrame (pandas) or a dict of float64 arrays."""
 
 def read_with_units(
     path: PathLike,

@@ -39,3 +39,44 @@ def test_accelerometer_array_gives_velocity_random_walk():
     assert d["quantity"] == "acceleration" and d["dev_unit"] == "m/s^2"
     assert d["noise"] is None
     assert abs(d["accel_noise"]["vrw_m_s_rt_h"] / 0.05 - 1) < 0.05
+
+
+def test_parquet_and_mcap_recordings_are_read_by_content(tmp_path):
+    # Independent writers: pyarrow (Parquet) and rosbags (rosbag2 with MCAP storage).
+    pa = pytest.importorskip("pyarrow")
+    pq = pytest.importorskip("pyarrow.parquet")
+    rng = np.random.default_rng(5)
+    gx = rng.standard_normal(500) * 1e-3
+    stamps = 1_700_000_000_000_000_000 + np.arange(500, dtype=np.int64) * 5_000_000
+    p = tmp_path / "imu.bin"  # no extension: read by its content
+    pq.write_table(pa.table({"timestamp_ns": stamps, "gx_rad_s": gx}), p)
+    arrays, units = gyrolab.read_with_units(p)
+    np.testing.assert_array_equal(arrays["gx_rad_s"], gx)
+    assert units["gx_rad_s"] == "rad/s"
+
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    t = ts.types
+    z = np.zeros(9)
+    with Writer(tmp_path / "bag", version=9, storage_plugin=StoragePlugin.MCAP) as w:
+        conns = [w.add_connection(name, "sensor_msgs/msg/Imu", typestore=ts) for name in ("/imu0", "/imu1")]
+        for i, s in enumerate(stamps.tolist()):
+            m = t["sensor_msgs/msg/Imu"](
+                header=t["std_msgs/msg/Header"](stamp=t["builtin_interfaces/msg/Time"](sec=s // 10**9, nanosec=s % 10**9), frame_id="imu"),
+                orientation=t["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0),
+                orientation_covariance=z,
+                angular_velocity=t["geometry_msgs/msg/Vector3"](x=float(gx[i]), y=0.0, z=0.0),
+                angular_velocity_covariance=z,
+                linear_acceleration=t["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=9.81),
+                linear_acceleration_covariance=z,
+            )
+            for c in conns:
+                w.write(c, s, ts.serialize_cdr(m, "sensor_msgs/msg/Imu"))
+    mcap = next((tmp_path / "bag").glob("*.mcap"))
+    with pytest.raises(gyrolab.Error, match="2 IMU topics"):
+        gyrolab.read_with_units(mcap)
+    arrays = gyrolab.read(mcap, as_dataframe=False, topic="/imu1")
+    np.testing.assert_array_equal(arrays["gyro_x_rad_s"], gx)
+    np.testing.assert_allclose(np.diff(arrays["time_s"]), 0.005, rtol=0, atol=1e-12)

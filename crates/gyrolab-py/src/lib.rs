@@ -14,7 +14,7 @@ use gyrolab::units::OutputUnit;
 use gyrolab_eval::allan::{analyse_channel, parse_taus, ChannelSetup};
 use gyrolab_eval::reference::ReferenceRequest;
 use gyrolab_eval::EvalError;
-use gyrolab_io::series::{read_series_all, ChannelInfo, SeriesOptions};
+use gyrolab_io::series::{ChannelInfo, SeriesOptions};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
@@ -284,15 +284,18 @@ fn simulate_static<'py>(
 /// Reads a time series file: a dict of column name -> float64 array, and a dict of column name
 /// -> unit symbol (outputs; `s` for time, `degC` for temperature). `units` (`["gx=rad/s",
 /// "m/s^2"]`), `time_column` and `names` (a file without a header row) as `gyrolab allan`'s
-/// `--unit`, `--time-column`, `--names`.
+/// `--unit`, `--time-column`, `--names`. Parquet tables and recordings (MCAP, ROS 1 bags, PX4
+/// ULog) are read by content; `topic` picks one IMU topic of a recording (needed when it has
+/// several).
 #[pyfunction]
-#[pyo3(signature = (path, units=None, time_column=None, names=None))]
+#[pyo3(signature = (path, units=None, time_column=None, names=None, topic=None))]
 fn read<'py>(
     py: Python<'py>,
     path: PathBuf,
     units: Option<Vec<String>>,
     time_column: Option<String>,
     names: Option<Vec<String>>,
+    topic: Option<String>,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
     let layout = gyrolab_eval::layout::LogLayout {
         units: units.unwrap_or_default(),
@@ -300,7 +303,19 @@ fn read<'py>(
         names: names.unwrap_or_default(),
     };
     let options = layout.apply(SeriesOptions::default()).map_err(err)?;
-    let data = py.detach(|| read_series_all(&path, &options)).map_err(|e| err(e.into()))?;
+    let topics: Vec<String> = topic.into_iter().collect();
+    let mut records =
+        py.detach(|| gyrolab_io::recording::read_records(&path, &options, &topics)).map_err(|e| err(e.into()))?.records;
+    if records.len() > 1 {
+        let names: Vec<String> = records.iter().filter_map(|r| r.topic.as_ref().map(|t| t.topic.clone())).collect();
+        return Err(err(gyrolab_eval::EvalError::conflict(format!(
+            "{}: {} IMU topics ({}): choose one with topic=",
+            path.display(),
+            names.len(),
+            names.join(", ")
+        ))));
+    }
+    let data = records.remove(0).data;
     let arrays = PyDict::new(py);
     let units = PyDict::new(py);
     let h = &data.header;
