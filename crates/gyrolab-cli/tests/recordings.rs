@@ -374,3 +374,42 @@ fn bias_and_inspect_read_recordings_per_topic() {
     let temp = inv["topics"].as_array().unwrap().iter().find(|t| t["topic"] == "/temperature").unwrap();
     assert_eq!(temp["imu"], false);
 }
+
+#[test]
+fn apply_calibrates_a_recording_topic_as_it_does_the_csv() {
+    let Some(f) = fixture() else { return };
+    let work = tempfile::tempdir().unwrap();
+    // A calibration of an axis whose output is in rad/s, from a simulated rate-table test.
+    let rt = work.path().join("rt.csv");
+    let out = gyrolab()
+        .args(["simulate", "rate-table", "--output-unit", "rad_s", "--runs", "2", "--out", rt.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let cal = work.path().join("cal.toml");
+    let out = gyrolab().args(["rate", rt.to_str().unwrap(), "--cal-out", cal.to_str().unwrap()]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let run = |input: &Path, topic: Option<&str>| {
+        let mut c = gyrolab();
+        c.args(["apply", "--cal", cal.to_str().unwrap(), input.to_str().unwrap(), "--column", "gyro_x_rad_s"]);
+        if let Some(t) = topic {
+            c.args(["--topic", t]);
+        }
+        let out = c.output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        (String::from_utf8(out.stdout).unwrap(), String::from_utf8_lossy(&out.stderr).to_string())
+    };
+    let (want, _) = run(&f.reference, None);
+    let (got, err) = run(&f.dir.join("rec/imu_lz4.bag"), Some("/imu0"));
+    assert!(err.contains("topic /imu0 (sensor_msgs/Imu)"), "{err}");
+    let rates = |t: &str| -> Vec<String> { t.lines().map(|l| l.split(',').skip(1).collect::<Vec<_>>().join(",")).collect() };
+    assert_eq!(rates(&got), rates(&want), "the same rates as from the CSV of the same numbers");
+    // Several topics and none chosen: the error names them.
+    let out = gyrolab()
+        .args(["apply", "--cal", cal.to_str().unwrap(), f.dir.join("rec/imu_lz4.bag").to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("2 IMU topics (/imu0, /imu1): choose one with --topic"), "{err}");
+}

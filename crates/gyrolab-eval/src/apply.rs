@@ -169,6 +169,86 @@ pub fn apply_arrays(
     }
 }
 
+/// An input as the streaming apply reads it: a delimited text file as it is, or one IMU topic of
+/// a recording (MCAP, ROS 1 bag, ULog) or a Parquet table written to a temporary CSV file
+/// (`timestamp_ns` or `time_s` and the channels with their units in the names).
+#[derive(Debug)]
+pub struct StagedInput {
+    /// The file to stream.
+    pub path: PathBuf,
+    /// What was staged, for a note (`None` for a text file).
+    pub note: Option<String>,
+    /// The temporary folder holding the staged file (removed when dropped).
+    _dir: Option<tempfile::TempDir>,
+}
+
+/// Stages `input` for [`prepare_apply`] and [`apply_to`]: a text file is used as it is; a
+/// recording's IMU topic (`topic`, needed when it has several) or a Parquet table is written as
+/// CSV to a temporary folder, so every input takes the one streaming path.
+pub fn stage_input(input: &Path, topic: Option<&str>) -> EvalResult<StagedInput> {
+    use gyrolab_io::recording::{read_recording, sniff_format, FileFormat, RecordingOptions};
+    let format = sniff_format(input)?;
+    if format == FileFormat::Text {
+        if let Some(t) = topic {
+            return Err(EvalError::conflict_on(
+                &["topics"],
+                format!("{}: {{topics}} '{t}' given, but this is a delimited text file, not a recording", input.display()),
+            ));
+        }
+        return Ok(StagedInput { path: input.to_path_buf(), note: None, _dir: None });
+    }
+    let dir = tempfile::Builder::new()
+        .prefix(".gyrolab-apply-")
+        .tempdir()
+        .map_err(|e| EvalError::Output(format!("cannot create a temporary folder: {e}")))?;
+    let stem = input.file_stem().map_or("input".into(), |s| s.to_string_lossy().to_string());
+    let path = dir.path().join(format!("{stem}.csv"));
+    let write_err = |e: std::io::Error| EvalError::Output(format!("{}: cannot write the file: {e}", path.display()));
+    let note = if format == FileFormat::Parquet {
+        let data = gyrolab_io::parquet_table::read_parquet(input, &gyrolab_io::series::SeriesOptions::default())?;
+        let mut names: Vec<String> = Vec::new();
+        let mut cols: Vec<&[f64]> = Vec::new();
+        if let Some(t) = &data.time {
+            names.push("time_s".into());
+            cols.push(t);
+        }
+        for (info, c) in data.header.channels.iter().zip(&data.channels) {
+            names.push(info.name.clone());
+            cols.push(c);
+        }
+        gyrolab_io::atomic::write_atomic_with(&path, |w| {
+            let mut w = std::io::BufWriter::new(w);
+            writeln!(w, "{}", names.join(","))?;
+            let mut fmt = ryu::Buffer::new();
+            for i in 0..data.lines.len() {
+                let row: Vec<String> = cols.iter().map(|c| fmt.format(c[i]).to_string()).collect();
+                writeln!(w, "{}", row.join(","))?;
+            }
+            w.flush()
+        })
+        .map_err(write_err)?;
+        format!("{}: Parquet table, {} rows", input.display(), data.lines.len())
+    } else {
+        let topics: Vec<String> = topic.map(str::to_string).into_iter().collect();
+        let rec = read_recording(input, &RecordingOptions { topics, ..Default::default() })?;
+        if rec.imu.len() > 1 {
+            let names: Vec<String> = rec.imu.iter().map(|t| gyrolab_io::text::excerpt(&t.topic)).collect();
+            return Err(EvalError::conflict_on(
+                &["topics"],
+                format!("{}: {} IMU topics ({}): choose one with {{topics}}", input.display(), names.len(), names.join(", ")),
+            ));
+        }
+        let t = &rec.imu[0];
+        gyrolab_io::atomic::write_atomic_with(&path, |w| gyrolab_io::recording::write_topic_csv(w, t)).map_err(write_err)?;
+        let mut note = format!("{}: topic {} ({}), {} messages", input.display(), t.topic, t.message_type, t.stamps_ns.len());
+        if let Some(w) = &rec.truncated {
+            note.push_str(&format!("; {w}"));
+        }
+        note
+    };
+    Ok(StagedInput { path, note: Some(note), _dir: Some(dir) })
+}
+
 /// Streams the input through the plan into `out`; `progress` gets the rows done so far.
 pub fn apply_to(
     input: &Path,

@@ -2,7 +2,7 @@
 
 use crate::error::{CliError, CliResult};
 use clap::Args;
-use gyrolab_eval::apply::{apply_to, prepare_apply, ApplyRequest};
+use gyrolab_eval::apply::{apply_to, prepare_apply, stage_input, ApplyRequest};
 use gyrolab_io::apply_csv::{ApplySummary, StreamError};
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -13,7 +13,8 @@ pub struct ApplyArgs {
     /// Calibration file (written by `gyrolab rate --cal-out`).
     #[arg(long, value_name = "FILE.toml")]
     pub cal: PathBuf,
-    /// Time series of outputs (time_s and output columns such as gyro_v; CSV, TSV, ...).
+    /// Time series of outputs (time_s and output columns such as gyro_v; CSV, TSV, ...), or by
+    /// content a Parquet table or a recording (ROS 2 MCAP, ROS 1 bag, PX4 ULog: one IMU topic).
     #[arg(value_name = "IN.csv")]
     pub input: PathBuf,
     /// Write the calibrated rates to this file (atomically) instead of standard output.
@@ -26,13 +27,23 @@ pub struct ApplyArgs {
     /// (default: the file's only output, or the columns named after the axes).
     #[arg(long = "column", value_name = "NAME", value_delimiter = ',')]
     pub columns: Vec<String>,
+    /// The IMU topic of a recording (MCAP, ROS 1 bag, PX4 ULog) to calibrate, when it has
+    /// several; its channels are `gyro_x_rad_s` ... (`--column` picks them).
+    #[arg(long, value_name = "NAME")]
+    pub topic: Option<String>,
 }
 
 /// Runs `gyrolab apply`.
 pub fn run(args: &ApplyArgs) -> CliResult {
+    // Recordings and Parquet tables are staged as CSV (one IMU topic) for the streaming path.
+    let staged = stage_input(&args.input, args.topic.as_deref())?;
+    if let Some(n) = &staged.note {
+        eprintln!("note: read {n}");
+    }
+    let input = staged.path.clone();
     let plan = prepare_apply(&ApplyRequest {
         calibration: args.cal.clone(),
-        input: args.input.clone(),
+        input: input.clone(),
         calibration_axis: args.cal_axis.clone(),
         columns: args.columns.clone(),
     })?;
@@ -48,7 +59,7 @@ pub fn run(args: &ApplyArgs) -> CliResult {
         Some(path) => {
             let (mut data_error, mut done) = (None, None);
             let r =
-                gyrolab_io::atomic::write_atomic_with(path, |w| match apply_to(&args.input, &plan, w, &mut progress) {
+                gyrolab_io::atomic::write_atomic_with(path, |w| match apply_to(&input, &plan, w, &mut progress) {
                     Ok(s) => {
                         done = Some(s);
                         Ok(())
@@ -69,7 +80,7 @@ pub fn run(args: &ApplyArgs) -> CliResult {
         None => {
             let stdout = std::io::stdout();
             let mut w = std::io::BufWriter::with_capacity(1 << 20, stdout.lock());
-            let r = apply_to(&args.input, &plan, &mut w, &mut progress).and_then(|s| {
+            let r = apply_to(&input, &plan, &mut w, &mut progress).and_then(|s| {
                 w.flush().map_err(StreamError::Write)?;
                 Ok(s)
             });
