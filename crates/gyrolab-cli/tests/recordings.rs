@@ -402,7 +402,8 @@ fn apply_calibrates_a_recording_topic_as_it_does_the_csv() {
     let (want, _) = run(&f.reference, None);
     let (got, err) = run(&f.dir.join("rec/imu_lz4.bag"), Some("/imu0"));
     assert!(err.contains("topic /imu0 (sensor_msgs/Imu)"), "{err}");
-    let rates = |t: &str| -> Vec<String> { t.lines().map(|l| l.split(',').skip(1).collect::<Vec<_>>().join(",")).collect() };
+    let rates =
+        |t: &str| -> Vec<String> { t.lines().map(|l| l.split(',').skip(1).collect::<Vec<_>>().join(",")).collect() };
     assert_eq!(rates(&got), rates(&want), "the same rates as from the CSV of the same numbers");
     // Several topics and none chosen: the error names them.
     let out = gyrolab()

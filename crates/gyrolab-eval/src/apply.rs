@@ -192,7 +192,10 @@ pub fn stage_input(input: &Path, topic: Option<&str>) -> EvalResult<StagedInput>
         if let Some(t) = topic {
             return Err(EvalError::conflict_on(
                 &["topics"],
-                format!("{}: {{topics}} '{t}' given, but this is a delimited text file, not a recording", input.display()),
+                format!(
+                    "{}: {{topics}} '{t}' given, but this is a delimited text file, not a recording",
+                    input.display()
+                ),
             ));
         }
         return Ok(StagedInput { path: input.to_path_buf(), note: None, _dir: None });
@@ -235,12 +238,19 @@ pub fn stage_input(input: &Path, topic: Option<&str>) -> EvalResult<StagedInput>
             let names: Vec<String> = rec.imu.iter().map(|t| gyrolab_io::text::excerpt(&t.topic)).collect();
             return Err(EvalError::conflict_on(
                 &["topics"],
-                format!("{}: {} IMU topics ({}): choose one with {{topics}}", input.display(), names.len(), names.join(", ")),
+                format!(
+                    "{}: {} IMU topics ({}): choose one with {{topics}}",
+                    input.display(),
+                    names.len(),
+                    names.join(", ")
+                ),
             ));
         }
         let t = &rec.imu[0];
-        gyrolab_io::atomic::write_atomic_with(&path, |w| gyrolab_io::recording::write_topic_csv(w, t)).map_err(write_err)?;
-        let mut note = format!("{}: topic {} ({}), {} messages", input.display(), t.topic, t.message_type, t.stamps_ns.len());
+        gyrolab_io::atomic::write_atomic_with(&path, |w| gyrolab_io::recording::write_topic_csv(w, t))
+            .map_err(write_err)?;
+        let mut note =
+            format!("{}: topic {} ({}), {} messages", input.display(), t.topic, t.message_type, t.stamps_ns.len());
         if let Some(w) = &rec.truncated {
             note.push_str(&format!("; {w}"));
         }

@@ -58,18 +58,17 @@ pub fn run(args: &ApplyArgs) -> CliResult {
     let summary = match &args.out {
         Some(path) => {
             let (mut data_error, mut done) = (None, None);
-            let r =
-                gyrolab_io::atomic::write_atomic_with(path, |w| match apply_to(&input, &plan, w, &mut progress) {
-                    Ok(s) => {
-                        done = Some(s);
-                        Ok(())
-                    }
-                    Err(StreamError::Write(e)) => Err(e),
-                    Err(StreamError::Data(d)) => {
-                        data_error = Some(d);
-                        Err(std::io::Error::other("bad input"))
-                    }
-                });
+            let r = gyrolab_io::atomic::write_atomic_with(path, |w| match apply_to(&input, &plan, w, &mut progress) {
+                Ok(s) => {
+                    done = Some(s);
+                    Ok(())
+                }
+                Err(StreamError::Write(e)) => Err(e),
+                Err(StreamError::Data(d)) => {
+                    data_error = Some(d);
+                    Err(std::io::Error::other("bad input"))
+                }
+            });
             bar.finish_and_clear();
             if let Some(d) = data_error {
                 return Err(d.into());
