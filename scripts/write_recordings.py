@@ -95,25 +95,30 @@ def temperature_messages(typestore, stamps, ros1):
     return out
 
 
+def write_topics(w, conns, stamps, imu0, imu1, temps):
+    """/imu0 in write order (log time = the k-th stamp), /imu1 in order, /temperature between."""
+    c0, c1, ct = conns
+    ti = 0
+    for k, i in enumerate(write_order(len(stamps))):
+        log = stamps[k]
+        w.write(c0, log, imu0[i])
+        w.write(c1, stamps[i], imu1[i])
+        while ti < len(temps) and temps[ti][0] <= log:
+            w.write(ct, temps[ti][0], temps[ti][1])
+            ti += 1
+
+
 def write_ros2(out, stamps, imu0, imu1, temps):
     from rosbags.rosbag2 import StoragePlugin, Writer
     from rosbags.typesys import Stores, get_typestore
 
     ts = get_typestore(Stores.ROS2_HUMBLE)
     path = out / "ros2"
-    order = write_order(len(stamps))
     with Writer(path, version=9, storage_plugin=StoragePlugin.MCAP) as w:
         c0 = w.add_connection("/imu0", "sensor_msgs/msg/Imu", typestore=ts)
         c1 = w.add_connection("/imu1", "sensor_msgs/msg/Imu", typestore=ts)
         ct = w.add_connection("/temperature", "sensor_msgs/msg/Temperature", typestore=ts)
-        ti = 0
-        for k, i in enumerate(order):
-            log = stamps[k]
-            w.write(c0, log, imu0[i])
-            w.write(c1, stamps[i], imu1[i])
-            while ti < len(temps) and temps[ti][0] <= log:
-                w.write(ct, temps[ti][0], temps[ti][1])
-                ti += 1
+        write_topics(w, (c0, c1, ct), stamps, imu0, imu1, temps)
     mcap = sorted(path.glob("*.mcap"))[0]
     print(f"ros2_mcap={mcap}")
 
@@ -156,7 +161,6 @@ def write_bags(out, stamps, imu0, imu1, temps):
     from rosbags.typesys import Stores, get_typestore
 
     ts = get_typestore(Stores.ROS1_NOETIC)
-    order = write_order(len(stamps))
     for name, comp in [("imu.bag", None), ("imu_bz2.bag", Writer.CompressionFormat.BZ2), ("imu_lz4.bag", Writer.CompressionFormat.LZ4)]:
         path = out / name
         if path.exists():
@@ -168,14 +172,7 @@ def write_bags(out, stamps, imu0, imu1, temps):
         c0 = w.add_connection("/imu0", "sensor_msgs/msg/Imu", typestore=ts)
         c1 = w.add_connection("/imu1", "sensor_msgs/msg/Imu", typestore=ts)
         ct = w.add_connection("/temperature", "sensor_msgs/msg/Temperature", typestore=ts)
-        ti = 0
-        for k, i in enumerate(order):
-            log = stamps[k]
-            w.write(c0, log, imu0[i])
-            w.write(c1, stamps[i], imu1[i])
-            while ti < len(temps) and temps[ti][0] <= log:
-                w.write(ct, temps[ti][0], temps[ti][1])
-                ti += 1
+        write_topics(w, (c0, c1, ct), stamps, imu0, imu1, temps)
         w.close()
         print(f"wrote {path}")
 

@@ -195,11 +195,23 @@ pub fn evaluate_file(
     reference: &Reference,
     config: &StaticTestConfig,
 ) -> EvalResult<(Vec<StaticTestResult>, SeriesSummary)> {
-    let mut mismatch = None;
     let mut options = options.clone();
     options.zero_rows_missing = zero_rows_are_dropouts(path, &options)?;
-    let options = &options;
-    let evaluated = evaluate_static_file(path, options, |ch| {
+    with_reference(path, reference, config, |config_for| evaluate_static_file(path, &options, config_for))
+}
+
+/// Runs a static evaluation whose channel options come from `config` and the reference for each
+/// channel's unit; a unit the reference cannot convert is a conflict naming `path`.
+fn with_reference<T>(
+    path: &Path,
+    reference: &Reference,
+    config: &StaticTestConfig,
+    run: impl FnOnce(
+        &mut dyn FnMut(&gyrolab_io::series::ChannelInfo) -> StaticTestConfig,
+    ) -> Result<T, gyrolab_io::DataError>,
+) -> EvalResult<T> {
+    let mut mismatch = None;
+    let evaluated = run(&mut |ch| {
         let mut cfg = config.clone();
         if let Err(m) = reference.configure(&mut cfg, &ch.name, ch.unit) {
             mismatch = Some(m);
@@ -212,6 +224,22 @@ pub fn evaluate_file(
     }
 }
 
+/// Adds the exact zeros of `rows` rows of `channels` to `zeros` (per channel); returns the
+/// rows whose channels are all zero.
+fn tally_zeros(channels: &[Vec<f64>], rows: usize, zeros: &mut [u64]) -> u64 {
+    let mut all_zero = 0u64;
+    for i in 0..rows {
+        let mut all = true;
+        for (c, z) in channels.iter().zip(zeros.iter_mut()) {
+            let zero = c[i] == 0.0;
+            *z += u64::from(zero);
+            all &= zero;
+        }
+        all_zero += u64::from(all);
+    }
+    all_zero
+}
+
 /// Evaluates every channel of one record held in memory (a Parquet table, a recording's topic),
 /// as [`evaluate_file`] does for a text file.
 pub fn evaluate_record(
@@ -221,34 +249,16 @@ pub fn evaluate_record(
 ) -> EvalResult<(Vec<StaticTestResult>, SeriesSummary)> {
     let path = data.header.file.clone();
     let zero_rows = if data.channels.len() >= 2 {
-        let n = data.lines.len() as u64;
+        let n = data.lines.len();
         let mut zeros = vec![0u64; data.channels.len()];
-        let mut all_zero = 0u64;
-        for i in 0..data.lines.len() {
-            let mut all = true;
-            for (c, z) in data.channels.iter().zip(zeros.iter_mut()) {
-                let zero = c[i] == 0.0;
-                *z += u64::from(zero);
-                all &= zero;
-            }
-            all_zero += u64::from(all);
-        }
-        gyrolab::dropout::beyond_chance(all_zero, n, &zeros)
+        let all_zero = tally_zeros(&data.channels, n, &mut zeros);
+        gyrolab::dropout::beyond_chance(all_zero, n as u64, &zeros)
     } else {
         false
     };
-    let mut mismatch = None;
-    let evaluated = gyrolab_io::series::evaluate_static_data(&mut data, zero_rows, |ch| {
-        let mut cfg = config.clone();
-        if let Err(m) = reference.configure(&mut cfg, &ch.name, ch.unit) {
-            mismatch = Some(m);
-        }
-        cfg
-    })?;
-    match mismatch {
-        Some(m) => Err(EvalError::conflict(format!("{}: {m}", path.display()))),
-        None => Ok(evaluated),
-    }
+    with_reference(&path, reference, config, |config_for| {
+        gyrolab_io::series::evaluate_static_data(&mut data, zero_rows, config_for)
+    })
 }
 
 /// Whether the rows of `path` whose output channels are all exactly zero are dropouts, by the
@@ -264,15 +274,7 @@ pub fn zero_rows_are_dropouts(path: &Path, options: &SeriesOptions) -> EvalResul
     let (mut rows, mut all_zero) = (0u64, 0u64);
     let mut zeros = vec![0u64; nch];
     while let Some(b) = r.next_block()? {
-        for i in 0..b.len() {
-            let mut all = true;
-            for (c, z) in b.channels.iter().zip(zeros.iter_mut()) {
-                let zero = c[i] == 0.0;
-                *z += u64::from(zero);
-                all &= zero;
-            }
-            all_zero += u64::from(all);
-        }
+        all_zero += tally_zeros(b.channels, b.len(), &mut zeros);
         rows += b.len() as u64;
     }
     Ok(gyrolab::dropout::beyond_chance(all_zero, rows, &zeros))

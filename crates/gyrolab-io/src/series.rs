@@ -1600,17 +1600,13 @@ pub fn collect_series<R: Read>(mut r: SeriesReader<R>) -> Result<SeriesData, Dat
     Ok(SeriesData { header, lines, time, temperature, table_rate, channels, quality })
 }
 
-/// Evaluates the static (bias) test of every channel of a file, streaming it twice (figures,
-/// then outliers); `config_for` gives each channel's options (scale factor, null, latitude ...).
-pub fn evaluate_static_file(
-    path: impl AsRef<Path>,
-    options: &SeriesOptions,
-    mut config_for: impl FnMut(&ChannelInfo) -> StaticTestConfig,
-) -> Result<(Vec<StaticTestResult>, SeriesSummary), DataError> {
-    let path = path.as_ref();
-    let mut r = SeriesReader::open(path, options)?;
-    let header = r.header.clone();
-    let configs: Vec<StaticTestConfig> = header
+/// Each channel's static-test options: `config_for`'s, with the channel's name, unit and the
+/// header's sample rate when none is set.
+fn channel_configs(
+    header: &SeriesHeader,
+    config_for: &mut impl FnMut(&ChannelInfo) -> StaticTestConfig,
+) -> Vec<StaticTestConfig> {
+    header
         .channels
         .iter()
         .map(|c| {
@@ -1622,7 +1618,20 @@ pub fn evaluate_static_file(
             }
             cfg
         })
-        .collect();
+        .collect()
+}
+
+/// Evaluates the static (bias) test of every channel of a file, streaming it twice (figures,
+/// then outliers); `config_for` gives each channel's options (scale factor, null, latitude ...).
+pub fn evaluate_static_file(
+    path: impl AsRef<Path>,
+    options: &SeriesOptions,
+    mut config_for: impl FnMut(&ChannelInfo) -> StaticTestConfig,
+) -> Result<(Vec<StaticTestResult>, SeriesSummary), DataError> {
+    let path = path.as_ref();
+    let mut r = SeriesReader::open(path, options)?;
+    let header = r.header.clone();
+    let configs = channel_configs(&header, &mut config_for);
     let wrap = |ch: &str, e: gyrolab::static_test::StaticTestError| {
         DataError::new(path, format!("channel '{}': {e}", crate::text::excerpt(ch)))
     };
@@ -1685,19 +1694,7 @@ pub fn evaluate_static_data(
             }
         }
     }
-    let configs: Vec<StaticTestConfig> = header
-        .channels
-        .iter()
-        .map(|c| {
-            let mut cfg = config_for(c);
-            cfg.channel = c.name.clone();
-            cfg.output_unit = c.unit;
-            if cfg.sample_rate_hz.is_none() {
-                cfg.sample_rate_hz = header.sample_rate_hz;
-            }
-            cfg
-        })
-        .collect();
+    let configs = channel_configs(&header, &mut config_for);
     let wrap = |ch: &str, e: gyrolab::static_test::StaticTestError| {
         DataError::new(&path, format!("channel '{}': {e}", crate::text::excerpt(ch)))
     };

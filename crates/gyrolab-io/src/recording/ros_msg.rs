@@ -261,6 +261,34 @@ mod tests {
     }
 
     #[test]
+    fn vector3_stamped_decodes_in_both_encodings() {
+        // CDR: header (stamp, frame_id "g" + NUL), padding to 8-byte alignment counted from
+        // the end of the encapsulation header (14 -> 16), then x, y, z.
+        let mut b = vec![0u8, 1, 0, 0];
+        b.extend_from_slice(&9i32.to_le_bytes());
+        b.extend_from_slice(&11u32.to_le_bytes());
+        b.extend_from_slice(&2u32.to_le_bytes());
+        b.extend_from_slice(b"g\0");
+        b.extend_from_slice(&[0; 2]);
+        for v in [0.5f64, -0.25, 2.0] {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+        let d = decode(RosImuType::Vector3Stamped, Encoding::Cdr, &b).unwrap();
+        assert_eq!((d.stamp_ns, &d.values[..3]), (9_000_000_011, &[0.5, -0.25, 2.0][..]));
+        // ROS 1: seq, sec, nsec, frame_id (u32 length, no NUL), x, y, z.
+        let mut r = Vec::new();
+        for v in [1u32, 9, 11, 1] {
+            r.extend_from_slice(&v.to_le_bytes());
+        }
+        r.push(b'g');
+        for v in [0.5f64, -0.25, 2.0] {
+            r.extend_from_slice(&v.to_le_bytes());
+        }
+        let d = decode(RosImuType::Vector3Stamped, Encoding::Ros1, &r).unwrap();
+        assert_eq!((d.stamp_ns, &d.values[..3]), (9_000_000_011, &[0.5, -0.25, 2.0][..]));
+    }
+
+    #[test]
     fn type_names_of_both_ros_versions() {
         assert_eq!(RosImuType::from_name("sensor_msgs/msg/Imu"), Some(RosImuType::Imu));
         assert_eq!(RosImuType::from_name("sensor_msgs/Imu"), Some(RosImuType::Imu));
