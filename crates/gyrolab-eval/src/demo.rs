@@ -227,6 +227,7 @@ pub fn paper_report_folder(request: &PaperReportRequest, progress: &dyn Progress
              such section, table and summary row is labelled SIMULATED."
                 .into(),
         ],
+        ..Default::default()
     };
     let inputs = ReportInputs {
         header,

@@ -108,6 +108,8 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
         created: inputs.header.date.clone(),
         plan_file: inputs.header.plan_file.clone(),
         device: inputs.device,
+        test: inputs.header.test.clone(),
+        equipment: inputs.header.equipment.clone(),
         rate_axes: axis_json.clone(),
         sections: inputs.extra_json,
         limits: inputs.limits.iter().map(|l| LimitJson { figure: l.figure.clone(), min: l.min, max: l.max }).collect(),

@@ -275,3 +275,43 @@ fn a_gap_in_a_static_record_is_computed_over() {
     // m = 1: every pair of neighbours but the one across the gap.
     assert_eq!(allan["n_terms"][0], 30_000 - 300 - 2);
 }
+
+/// `[test]` and `[[equipment]]`: the report's header shows the conditions and each piece of
+/// equipment's calibration status on the test date (due before it: expired), and ends with a
+/// sign-off block naming the operator and the approver; results.json carries the same.
+#[test]
+fn test_conditions_equipment_and_sign_off_reach_the_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let paper = repo_root().join("data/paper");
+    let text = std::fs::read_to_string(repo_root().join("examples/paper_plan.toml"))
+        .unwrap()
+        .replace("../data/paper", &paper.display().to_string());
+    // The example's [test] table gets the people, date and conditions; equipment at the end.
+    let text = text.replace(
+        "[test]\n",
+        "[test]\noperator = \"A. Operator\"\napprover = \"B. Approver\"\ndate = \"2014-03-12\"\n\
+         ambient_temperature_c = 22.5\nambient_humidity_pct = 40\n",
+    );
+    let text = format!(
+        "{text}\n[[equipment]]\nname = \"rate table\"\nid = \"RT-7\"\ncalibration_due = \"2014-03-11\"\n\n\
+         [[equipment]]\nname = \"data acquisition\"\nid = \"DAQ-2\"\ncalibration_due = \"2014-03-12\"\n"
+    );
+    let plan_path = dir.path().join("plan.toml");
+    std::fs::write(&plan_path, text).unwrap();
+    let plan = read_test_plan(&plan_path).unwrap();
+    let folder = evaluate_test_plan(&plan, "plan.toml", &Silent).unwrap();
+    let html = String::from_utf8(output(&folder, "report.html").to_vec()).unwrap();
+    for s in ["Test conditions", "2014-03-12", "22.5 degC", "40 %", "RT-7", "CALIBRATION EXPIRED", "within calibration"]
+    {
+        assert!(html.contains(s), "no '{s}' in the report");
+    }
+    let sign = &html[html.find("<h2>Sign-off</h2>").expect("a sign-off block")..];
+    assert!(sign.contains("tested by") && sign.contains("A. Operator") && sign.contains("B. Approver"));
+    assert!(html.find("<h2>Sign-off</h2>") > html.find("Summary"), "the sign-off block follows the results");
+    let v: serde_json::Value = serde_json::from_slice(output(&folder, "results.json")).unwrap();
+    assert_eq!(v["test"]["operator"], "A. Operator");
+    assert_eq!(v["test"]["ambient_humidity_pct"], 40.0);
+    // Due the day before the test: expired; due on the test day: valid.
+    assert_eq!(v["equipment"][0]["status"], "expired");
+    assert_eq!(v["equipment"][1]["status"], "valid");
+}

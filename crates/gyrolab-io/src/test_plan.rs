@@ -30,6 +30,31 @@ struct RawPlan {
     limits: BTreeMap<String, Spanned<RawLimit>>,
     #[serde(default)]
     triad: Option<Spanned<RawTriad>>,
+    #[serde(default)]
+    test: RawTest,
+    #[serde(default)]
+    equipment: Vec<Spanned<RawEquipment>>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTest {
+    operator: Option<String>,
+    approver: Option<String>,
+    date: Option<Spanned<String>>,
+    site: Option<String>,
+    procedure: Option<String>,
+    ambient_temperature_c: Option<Spanned<f64>>,
+    ambient_humidity_pct: Option<Spanned<f64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawEquipment {
+    name: String,
+    id: String,
+    model: Option<String>,
+    calibration_due: Option<Spanned<String>>,
 }
 
 /// Raw-log keys, shared by `[rate.<axis>]` and `[triad]` (written out in both, because toml's
@@ -138,6 +163,60 @@ pub struct DevicePlan {
     pub axes: Vec<String>,
     /// Free description.
     pub description: Option<String>,
+}
+
+/// Who tested, where, under which conditions and to which procedure (`[test]`), for the
+/// report's header and sign-off block.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TestInfo {
+    /// Who ran the test.
+    pub operator: Option<String>,
+    /// Who approves the report.
+    pub approver: Option<String>,
+    /// Date of the test, `YYYY-MM-DD`.
+    pub date: Option<String>,
+    /// Laboratory or site.
+    pub site: Option<String>,
+    /// Procedure or standard followed (`GJB 2426A-2004 5.3`).
+    pub procedure: Option<String>,
+    /// Ambient temperature, degC.
+    pub ambient_temperature_c: Option<f64>,
+    /// Ambient relative humidity, %.
+    pub ambient_humidity_pct: Option<f64>,
+}
+
+/// One piece of test equipment (`[[equipment]]`): rate table, chamber, data acquisition.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Equipment {
+    /// What it is (`rate table`).
+    pub name: String,
+    /// Asset number or serial.
+    pub id: String,
+    /// Make and model.
+    pub model: Option<String>,
+    /// Calibration due date, `YYYY-MM-DD`.
+    pub calibration_due: Option<String>,
+    /// 1-based line in the plan.
+    pub line: u64,
+}
+
+/// A date `YYYY-MM-DD` (Gregorian, years 1900 to 2999) as (year, month, day).
+pub fn parse_date(text: &str) -> Option<(u32, u32, u32)> {
+    let b = text.as_bytes();
+    if b.len() != 10 || b[4] != b'-' || b[7] != b'-' {
+        return None;
+    }
+    let num = |r: std::ops::Range<usize>| text.get(r)?.parse::<u32>().ok();
+    let (y, m, d) = (num(0..4)?, num(5..7)?, num(8..10)?);
+    let leap = (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
+    let days = match m {
+        1 | 3 | 5 | 7 | 8 | 10 | 12 => 31,
+        4 | 6 | 9 | 11 => 30,
+        2 if leap => 29,
+        2 => 28,
+        _ => return None,
+    };
+    ((1900..3000).contains(&y) && (1..=days).contains(&d)).then_some((y, m, d))
 }
 
 /// Evaluation options (`[options]`).
@@ -254,6 +333,10 @@ pub struct TestPlan {
     pub limits: Vec<PlanLimit>,
     /// A three-axis calibration set.
     pub triad: Option<TriadPlan>,
+    /// Who, where, when, under which conditions (`[test]`).
+    pub test: TestInfo,
+    /// The equipment used (`[[equipment]]`), in plan order.
+    pub equipment: Vec<Equipment>,
 }
 
 /// Reads and checks a plan file; `known_figure` tells which `[limits]` names exist.
@@ -523,6 +606,57 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
     }
     limits.sort_by_key(|l| l.line);
 
+    let date = |v: &Spanned<String>, key: &str| -> Result<String, DataError> {
+        parse_date(v.get_ref()).map(|_| v.get_ref().clone()).ok_or_else(|| {
+            cx.err(v.span(), key, format!("'{}': expected a date YYYY-MM-DD", crate::text::excerpt(v.get_ref())))
+        })
+    };
+    let t = &raw.test;
+    if let Some(c) = &t.ambient_temperature_c {
+        let v = *c.get_ref();
+        if !(-60.0..=100.0).contains(&v) {
+            return Err(cx.err(c.span(), "test.ambient_temperature_c", format!("{v} degC: expected -60 to 100")));
+        }
+    }
+    if let Some(h) = &t.ambient_humidity_pct {
+        let v = *h.get_ref();
+        if !(0.0..=100.0).contains(&v) {
+            return Err(cx.err(h.span(), "test.ambient_humidity_pct", format!("{v} %: expected 0 to 100")));
+        }
+    }
+    let test = TestInfo {
+        operator: t.operator.clone(),
+        approver: t.approver.clone(),
+        date: t.date.as_ref().map(|d| date(d, "test.date")).transpose()?,
+        site: t.site.clone(),
+        procedure: t.procedure.clone(),
+        ambient_temperature_c: t.ambient_temperature_c.as_ref().map(|v| *v.get_ref()),
+        ambient_humidity_pct: t.ambient_humidity_pct.as_ref().map(|v| *v.get_ref()),
+    };
+    let mut equipment = Vec::with_capacity(raw.equipment.len());
+    for (i, e) in raw.equipment.iter().enumerate() {
+        let line = line_col(text, e.span().start).0;
+        let e = e.get_ref();
+        if e.name.trim().is_empty() || e.id.trim().is_empty() {
+            return Err(cx.err(
+                raw.equipment[i].span(),
+                &format!("equipment[{i}]"),
+                "name and id must not be empty (what it is, and its asset number or serial)",
+            ));
+        }
+        equipment.push(Equipment {
+            name: e.name.clone(),
+            id: e.id.clone(),
+            model: e.model.clone(),
+            calibration_due: e
+                .calibration_due
+                .as_ref()
+                .map(|d| date(d, &format!("equipment[{i}].calibration_due")))
+                .transpose()?,
+            line,
+        });
+    }
+
     let triad = match &raw.triad {
         None => None,
         Some(t) => {
@@ -567,6 +701,8 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         static_tests,
         limits,
         triad,
+        test,
+        equipment,
     })
 }
 
@@ -632,6 +768,62 @@ bias_stability_dph_10s = { max = 20 }
     fn error(plan: &str) -> DataError {
         let (_d, r) = setup(plan);
         r.unwrap_err()
+    }
+
+    const TEST_AND_EQUIPMENT: &str = r#"
+[test]
+operator = "A. Operator"
+approver = "B. Approver"
+date = "2026-11-20"
+procedure = "GJB 2426A-2004"
+ambient_temperature_c = 23.5
+ambient_humidity_pct = 41
+
+[[equipment]]
+name = "rate table"
+id = "RT-7"
+calibration_due = "2027-01-31"
+
+[[equipment]]
+name = "DAQ"
+id = "DAQ-2"
+"#;
+
+    #[test]
+    fn test_conditions_and_equipment_are_read_and_checked() {
+        let p = setup(&format!("{GOOD}{TEST_AND_EQUIPMENT}")).1.unwrap();
+        assert_eq!(p.test.operator.as_deref(), Some("A. Operator"));
+        assert_eq!(p.test.date.as_deref(), Some("2026-11-20"));
+        assert_eq!((p.test.ambient_temperature_c, p.test.ambient_humidity_pct), (Some(23.5), Some(41.0)));
+        assert_eq!(p.equipment.len(), 2);
+        assert_eq!(
+            (p.equipment[0].id.as_str(), p.equipment[0].calibration_due.as_deref()),
+            ("RT-7", Some("2027-01-31"))
+        );
+        assert_eq!(p.equipment[1].calibration_due, None);
+        // Lines: GOOD ends with line 21, a blank line, [test] on 23, its date on 26.
+        let e = error(&format!("{GOOD}{}", TEST_AND_EQUIPMENT.replace("2026-11-20", "20.11.2026")));
+        assert_eq!(e.line, Some(26), "{e}");
+        assert!(e.to_string().contains("test.date: '20.11.2026': expected a date YYYY-MM-DD"), "{e}");
+        let e = error(&format!("{GOOD}{}", TEST_AND_EQUIPMENT.replace("2027-01-31", "2027-02-30")));
+        assert!(e.to_string().contains("equipment[0].calibration_due"), "{e}");
+        let e = error(&format!("{GOOD}{}", TEST_AND_EQUIPMENT.replace("= 41", "= 141")));
+        assert!(e.to_string().contains("test.ambient_humidity_pct: 141 %: expected 0 to 100"), "{e}");
+        let e = error(&format!("{GOOD}{}", TEST_AND_EQUIPMENT.replace("operator =", "operater =")));
+        assert!(e.to_string().contains("operater"), "{e}");
+        let e = error(&format!("{GOOD}{}", TEST_AND_EQUIPMENT.replace("id = \"DAQ-2\"", "id = \" \"")));
+        assert!(e.to_string().contains("equipment[1]: name and id must not be empty"), "{e}");
+    }
+
+    #[test]
+    fn dates_follow_the_calendar() {
+        assert_eq!(parse_date("2024-02-29"), Some((2024, 2, 29)));
+        assert_eq!(parse_date("2023-02-29"), None);
+        assert_eq!(parse_date("1900-02-29"), None);
+        assert_eq!(parse_date("2000-02-29"), Some((2000, 2, 29)));
+        for bad in ["2024-13-01", "2024-04-31", "2024-1-01", "24-01-01", "2024/01/01", ""] {
+            assert_eq!(parse_date(bad), None, "{bad}");
+        }
     }
 
     #[test]

@@ -51,6 +51,56 @@ pub struct ReportHeader {
     pub plan_file: String,
     /// Further lines shown under the header (plain text).
     pub notes: Vec<String>,
+    /// Who, where, when, under which conditions (the plan's `[test]`).
+    pub test: TestConditions,
+    /// The equipment used, with its calibration status on the test date.
+    pub equipment: Vec<EquipmentRow>,
+}
+
+/// The conditions of a test, for the header and the sign-off block.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct TestConditions {
+    /// Who ran the test.
+    pub operator: Option<String>,
+    /// Who approves the report.
+    pub approver: Option<String>,
+    /// Date of the test, `YYYY-MM-DD`.
+    pub test_date: Option<String>,
+    /// Laboratory or site.
+    pub site: Option<String>,
+    /// Procedure or standard followed.
+    pub procedure: Option<String>,
+    /// Ambient temperature, degC.
+    pub ambient_temperature_c: Option<f64>,
+    /// Ambient relative humidity, %.
+    pub ambient_humidity_pct: Option<f64>,
+}
+
+/// Whether a piece of equipment was within its calibration on the test date.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CalibrationStatus {
+    /// Due on or after the test date.
+    Valid,
+    /// Due before the test date.
+    Expired,
+    /// No due date given.
+    NotStated,
+}
+
+/// One piece of test equipment.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct EquipmentRow {
+    /// What it is.
+    pub name: String,
+    /// Make and model.
+    pub model: Option<String>,
+    /// Asset number or serial.
+    pub id: String,
+    /// Calibration due date, `YYYY-MM-DD`.
+    pub calibration_due: Option<String>,
+    /// Its status on the test date.
+    pub status: CalibrationStatus,
 }
 
 /// One row of a section's figure table.
@@ -234,6 +284,9 @@ figure.plot svg { display: block; width: 100%; max-width: 760px; height: auto; b
 figcaption { font-size: 9.5pt; color: #333; margin-top: 3px; }
 .note { font-size: 9.5pt; color: #333; }
 section.page-break { break-before: page; page-break-before: always; }
+table.conditions, table.equipment { margin-top: 8px; }
+table.sign-off td.sign { min-width: 180px; height: 40px; }
+section.sign-off { break-inside: avoid; page-break-inside: avoid; }
 tr { break-inside: avoid; page-break-inside: avoid; }
 @page { size: A4; margin: 14mm 12mm; }
 @media print {
@@ -402,6 +455,62 @@ fn write_methods(h: &mut String) {
     h.push_str("</section>\n");
 }
 
+/// The test conditions and the equipment table of the header (blank cells where the plan gives
+/// nothing, so that a printed report can be completed by hand).
+fn write_conditions(h: &mut String, t: &TestConditions, equipment: &[EquipmentRow]) {
+    let text = |v: &Option<String>| v.as_deref().map_or(String::new(), escape);
+    let num =
+        |v: Option<f64>, unit: &str| v.map_or(String::new(), |x| format!("{} {unit}", crate::format::short(x, 4)));
+    h.push_str("<table class=\"conditions\"><caption>Test conditions</caption><tbody>\n");
+    let rows = [
+        ("test date", text(&t.test_date)),
+        ("site", text(&t.site)),
+        ("procedure", text(&t.procedure)),
+        ("ambient temperature", num(t.ambient_temperature_c, "degC")),
+        ("ambient relative humidity", num(t.ambient_humidity_pct, "%")),
+        ("operator", text(&t.operator)),
+    ];
+    for (k, v) in rows {
+        let _ = writeln!(h, "<tr><th class=\"name\">{k}</th><td class=\"name\">{v}</td></tr>");
+    }
+    h.push_str("</tbody></table>\n");
+    h.push_str("<table class=\"equipment\"><caption>Equipment</caption><thead><tr><th class=\"name\">equipment</th><th class=\"name\">model</th><th class=\"name\">identifier</th><th class=\"name\">calibration due</th><th class=\"name\">status on the test date</th></tr></thead><tbody>\n");
+    if equipment.is_empty() {
+        h.push_str("<tr><td class=\"name\" colspan=\"5\">none listed in the plan ([[equipment]])</td></tr>\n");
+    }
+    for e in equipment {
+        let (cls, status) = match e.status {
+            CalibrationStatus::Valid => ("PASS", "within calibration"),
+            CalibrationStatus::Expired => ("FAIL", "CALIBRATION EXPIRED"),
+            CalibrationStatus::NotStated => ("NOT_EVALUATED", "due date not stated"),
+        };
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\"><span class=\"verdict {cls}\">{status}</span></td></tr>",
+            escape(&e.name),
+            text(&e.model),
+            escape(&e.id),
+            text(&e.calibration_due)
+        );
+    }
+    h.push_str("</tbody></table>\n");
+}
+
+/// The sign-off block: who tested and who approves, each with a signature and a date to fill
+/// in by hand.
+fn write_sign_off(h: &mut String, t: &TestConditions) {
+    let name = |v: &Option<String>| v.as_deref().map_or(String::new(), escape);
+    h.push_str("<section class=\"sign-off\">\n<h2>Sign-off</h2>\n<table class=\"sign-off\"><thead><tr><th class=\"name\">role</th><th class=\"name\">name</th><th class=\"name\">signature</th><th class=\"name\">date</th></tr></thead><tbody>\n");
+    for (role, who) in [("tested by", &t.operator), ("approved by", &t.approver)] {
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"name\">{role}</td><td class=\"name\">{}</td><td class=\"sign\"></td><td class=\"sign\"></td></tr>",
+            name(who)
+        );
+    }
+    h.push_str("</tbody></table>\n</section>\n");
+}
+
 /// Renders the whole report as one self-contained HTML document.
 pub fn render_html(r: &Report) -> String {
     let hd = &r.header;
@@ -418,7 +527,7 @@ pub fn render_html(r: &Report) -> String {
         ("model", &hd.model),
         ("serial", &hd.serial),
         ("axes", &hd.axes.join(", ")),
-        ("date", &hd.date),
+        ("evaluated", &hd.date),
         ("gyrolab", &hd.gyrolab_version),
         ("plan", &hd.plan_file),
     ];
@@ -426,6 +535,7 @@ pub fn render_html(r: &Report) -> String {
         let _ = writeln!(h, "<tr><td><b>{k}</b></td><td>{}</td></tr>", escape(v));
     }
     h.push_str("</table>\n");
+    write_conditions(&mut h, &hd.test, &hd.equipment);
     for n in &hd.notes {
         let _ = writeln!(h, "<p class=\"note\">{}</p>", escape(n));
     }
@@ -434,6 +544,7 @@ pub fn render_html(r: &Report) -> String {
     for s in &r.sections {
         write_section(&mut h, s);
     }
+    write_sign_off(&mut h, &hd.test);
     write_methods(&mut h);
     h.push_str("</body>\n</html>\n");
     h
@@ -484,9 +595,13 @@ pub fn rate_section(a: &AxisReport<'_>, limits: &[Limit]) -> Result<ReportSectio
             "ppm".into(),
         ),
     ];
-    // A limit on scale_factor is in output units per deg/s (as the JSON key), not in the display unit.
-    if let Some(f) = figures.iter_mut().find(|f| f.key == "scale_factor" && !f.limit.is_empty()) {
-        f.limit = format!("{} {u}/(deg/s)", f.limit);
+    // A limit on scale_factor is given in output units per deg/s (the JSON key's unit): shown
+    // in the row's display unit (mV/(deg/s) for volt outputs), so value and limit share a unit.
+    if let Some(l) = limits.iter().find(|l| l.figure == "scale_factor") {
+        let shown = Limit { figure: l.figure.clone(), min: l.min.map(|x| x * df), max: l.max.map(|x| x * df) };
+        if let Some(f) = figures.iter_mut().find(|f| f.key == "scale_factor") {
+            f.limit = shown.text();
+        }
     }
     let mut plots = vec![
         PlotBlock {

@@ -42,6 +42,10 @@ pub struct ResultsJson {
     pub plan_file: String,
     /// The device.
     pub device: DeviceJson,
+    /// Who, where, when, under which conditions (the plan's `[test]`).
+    pub test: crate::html::TestConditions,
+    /// The equipment used, with its calibration status on the test date.
+    pub equipment: Vec<crate::html::EquipmentRow>,
     /// Rate-table figures per axis (keys in docs/JSON.md).
     pub rate_axes: Vec<AxisJson>,
     /// Further sections by name (`static`, `allan`, `paper`), keys in docs/JSON.md.

@@ -192,8 +192,11 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         parts.json.insert("triad".into(), value);
     }
     let created = humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string();
+    let (test, equipment) = conditions(&plan.test, &plan.equipment, &created);
     let header = ReportHeader {
-        title: format!("Gyro test report: {} {}", plan.device.model, plan.device.serial),
+        title: "Gyro test report".into(),
+        test,
+        equipment,
         model: plan.device.model.clone(),
         serial: plan.device.serial.clone(),
         axes: plan.device.axes.clone(),
@@ -219,4 +222,44 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         triad: triad_report,
     };
     assemble_report(inputs, progress)
+}
+
+/// The report's test conditions and equipment rows: each piece of equipment's calibration status
+/// on the test date (the plan's `test.date`, else the evaluation date `created`, RFC 3339).
+fn conditions(
+    test: &gyrolab_io::test_plan::TestInfo,
+    equipment: &[gyrolab_io::test_plan::Equipment],
+    created: &str,
+) -> (gyrolab_report::html::TestConditions, Vec<gyrolab_report::html::EquipmentRow>) {
+    use gyrolab_io::test_plan::parse_date;
+    use gyrolab_report::html::{CalibrationStatus, EquipmentRow, TestConditions};
+    let on = test.date.as_deref().and_then(parse_date).or_else(|| created.get(..10).and_then(parse_date));
+    let rows = equipment
+        .iter()
+        .map(|e| {
+            let due = e.calibration_due.as_deref().and_then(parse_date);
+            let status = match (due, on) {
+                (Some(d), Some(t)) if d < t => CalibrationStatus::Expired,
+                (Some(_), _) => CalibrationStatus::Valid,
+                (None, _) => CalibrationStatus::NotStated,
+            };
+            EquipmentRow {
+                name: e.name.clone(),
+                model: e.model.clone(),
+                id: e.id.clone(),
+                calibration_due: e.calibration_due.clone(),
+                status,
+            }
+        })
+        .collect();
+    let conditions = TestConditions {
+        operator: test.operator.clone(),
+        approver: test.approver.clone(),
+        test_date: test.date.clone(),
+        site: test.site.clone(),
+        procedure: test.procedure.clone(),
+        ambient_temperature_c: test.ambient_temperature_c,
+        ambient_humidity_pct: test.ambient_humidity_pct,
+    };
+    (conditions, rows)
 }
