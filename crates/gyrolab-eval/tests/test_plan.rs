@@ -239,6 +239,11 @@ fn static_null_is_the_rest_reference_and_keeps_its_earth_rate() {
         let b = t["bias_dph"].as_f64().unwrap();
         assert!((b - bias).abs() < 5.0 * se_dph, "bias {b} deg/h, truth {bias}, tolerance {}", 5.0 * se_dph);
     }
+    // The report says so: the earth-rate component (Omega_e sin 40 deg = 9.67 deg/h) is named and
+    // not subtracted.
+    let html = String::from_utf8(output(&folder, "report.html").to_vec()).unwrap();
+    let e = 15.041_067 * 40f64.to_radians().sin();
+    assert!(html.contains(&format!("Ω_e sin φ = {:.4} deg/h, is not subtracted", e)), "{e}");
 }
 
 /// A static record with 300 samples missing (a gap in its time stamps): the plan's Allan analysis

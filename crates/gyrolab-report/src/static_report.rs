@@ -348,7 +348,7 @@ pub fn bias_temperature_plot(a: &StaticAxisReport) -> Option<Result<String, Plot
     let (x, y): (Vec<f64>, Vec<f64>) = pts.iter().copied().unzip();
     let fit = gyrolab::fit::fit_line(&x, &y)
         .ok()
-        .map(|l| (l.intercept, l.slope, format!("least-squares line: {} ({u})/degC", sig(l.slope, 4))));
+        .map(|l| (l.intercept, l.slope, format!("pooled line (all tests): {} ({u})/degC", sig(l.slope, 4))));
     Some(scatter_fit_plot(
         &format!("Axis {}: bias against temperature ({}-s window means)", a.axis, short(a.window_s, 4)),
         "temperature (degC)",
@@ -470,6 +470,22 @@ pub fn static_section(a: &StaticAxisReport, limits: &[Limit]) -> Result<ReportSe
         a.tests.iter().map(|t| t.file.as_str()).collect::<Vec<_>>().join(", "),
         a.reference.text
     ));
+    // The earth-rate correction, stated where it is applied (or why not).
+    if let Some(t) = a.tests.iter().find(|t| t.result.earth_rate_component_dph.is_some()) {
+        let e = t.result.earth_rate_component_dph.unwrap_or(0.0);
+        paragraphs.push(if t.result.earth_rate_subtracted {
+            format!(
+                "Earth rate: the component along a vertical input axis, Ω_e sin φ = {} deg/h, is subtracted from every bias.",
+                sig(e, 5)
+            )
+        } else {
+            format!(
+                "Earth rate: the component along a vertical input axis, Ω_e sin φ = {} deg/h, is not subtracted (the null \
+                 already contains it).",
+                sig(e, 5)
+            )
+        });
+    }
     if let Some(q) = a.tests.first().and_then(|t| t.result.bias_stability_quoted_s).map(smoothing_key) {
         paragraphs.push(format!(
             "Bias stability is the standard deviation (n − 1) of consecutive T-second window means; the bias time series \
@@ -489,7 +505,9 @@ pub fn static_section(a: &StaticAxisReport, limits: &[Limit]) -> Result<ReportSe
     if let Some(svg) = bias_temperature_plot(a) {
         plots.push(PlotBlock {
             caption: format!(
-                "Axis {}: bias against temperature, {}-s window means of every test, with the least-squares line.",
+                "Axis {}: bias against temperature, {}-s window means of every test, with the least-squares line fitted to \
+                 all tests pooled. The summary and the test table quote each test's own slope (the summary: the largest in \
+                 magnitude), which differs from the pooled slope when the tests' biases or temperature spans differ.",
                 a.axis,
                 short(a.window_s, 4)
             ),
