@@ -151,3 +151,50 @@ fn short_record_and_bad_options() {
     gyrolab().args(["bias", "--null", "2.5"]).arg(&p).assert().code(2);
     gyrolab().args(["bias", "--scale-factor", "0"]).arg(&p).assert().code(2);
 }
+
+/// Warm-up against simulated truth: bias B + A exp(-t/tau) from power-on with A = 300 deg/h,
+/// tau = 60 s, B = 30 deg/h, white noise N = 0.1 deg/sqrt(h) (10-s window means scatter by
+/// N / sqrt(10 s) = 1.9 deg/h). Truth: the model's tau and A; the settling time to +-10 deg/h,
+/// tau ln(A / 10) = 204 s, within two windows; the turn-on bias, B + A (tau / W)(1 - e^(-W/tau))
+/// = 306.3 deg/h for the first 10-s window, within 2 deg/h.
+#[test]
+fn warmup_figures_recover_the_simulated_transient() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = dir.path().join("wu.csv");
+    gyrolab()
+        .args(["simulate", "static", "--seed", "7", "--sample-rate-hz", "100", "--duration-s", "1200"])
+        .args(["--arw-deg-rt-h", "0.1", "--bias-dph", "30", "--warmup-amplitude-dph", "300"])
+        .args(["--warmup-time-constant-s", "60", "--out", f.to_str().unwrap()])
+        .assert()
+        .success();
+    let out = gyrolab().args(["bias", f.to_str().unwrap(), "--warmup-band-dph", "10", "--json"]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let w = &v["warmup"][0];
+    let m = &w["model"];
+    let tau = m["time_constant_s"].as_f64().unwrap();
+    let a = m["amplitude_dph"].as_f64().unwrap();
+    assert!((tau / 60.0 - 1.0).abs() < 0.05, "tau {tau}");
+    assert!((a / 300.0 - 1.0).abs() < 0.05, "A {a}");
+    assert!((m["settled_bias_dph"].as_f64().unwrap() - 30.0).abs() < 2.0, "{m}");
+    let ts = w["settling_time_s"].as_f64().unwrap();
+    let truth = 60.0 * (300.0f64 / 10.0).ln();
+    assert!((ts - truth).abs() <= 20.0, "settling {ts} s, truth {truth} s");
+    let turn_on = 30.0 + 300.0 * 6.0 * (1.0 - (-10.0f64 / 60.0).exp());
+    assert!((w["turn_on_bias_dph"].as_f64().unwrap() - turn_on).abs() < 2.0, "{w}");
+    // A record that does not start at power-on is refused, naming the file.
+    let late = dir.path().join("late.csv");
+    let text = std::fs::read_to_string(&f).unwrap();
+    let shifted: String = text
+        .lines()
+        .map(|l| match l.split_once(',') {
+            Some((t, rest)) if t.parse::<f64>().is_ok() => format!("{},{rest}\n", t.parse::<f64>().unwrap() + 600.0),
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(&late, shifted).unwrap();
+    let out = gyrolab().args(["bias", late.to_str().unwrap(), "--warmup-band-dph", "10"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("late.csv") && err.contains("not at power-on"), "{err}");
+}

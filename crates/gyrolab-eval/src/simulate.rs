@@ -37,6 +37,10 @@ pub struct SimOverrides {
     pub rrw_deg_h_rt_h: Option<f64>,
     /// Rate ramp R, deg/h per hour.
     pub rate_ramp_dph_per_h: Option<f64>,
+    /// Warm-up transient amplitude, deg/h.
+    pub warmup_amplitude_dph: Option<f64>,
+    /// Warm-up time constant, s.
+    pub warmup_time_constant_s: Option<f64>,
     /// Output quantization step, output units.
     pub output_quantization_step: Option<f64>,
     /// Bias temperature coefficient, (deg/h)/degC.
@@ -101,6 +105,8 @@ pub fn sim_config(o: &SimOverrides) -> EvalResult<SimConfig> {
         bias_instability_dph,
         rrw_deg_h_rt_h,
         rate_ramp_dph_per_h,
+        warmup_amplitude_dph,
+        warmup_time_constant_s,
         output_quantization_step,
         bias_temp_coeff_dph_per_c,
         hysteresis_dps,

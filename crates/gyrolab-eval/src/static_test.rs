@@ -61,6 +61,8 @@ pub struct StaticTestRequest {
     pub layout: crate::layout::LogLayout,
     /// Topics of recordings (MCAP, ROS 1 bag, ULog) to evaluate (default: every IMU topic).
     pub topics: Vec<String>,
+    /// Also evaluate the warm-up of each record (records that start at power-on).
+    pub warmup: Option<gyrolab::warmup::WarmupConfig>,
 }
 
 impl StaticTestRequest {
@@ -79,6 +81,7 @@ impl StaticTestRequest {
             tolerant: false,
             layout: crate::layout::LogLayout::default(),
             topics: Vec::new(),
+            warmup: None,
         }
     }
 }
@@ -103,6 +106,8 @@ pub struct StaticOutcome {
     pub files: Vec<FileQuality>,
     /// The reference used.
     pub reference: Reference,
+    /// Warm-up figures per file and channel (when asked for).
+    pub warmup: Vec<gyrolab_report::bias::WarmupReport>,
 }
 
 /// Evaluates every file of the request and the repeatability across them.
@@ -184,7 +189,76 @@ pub fn evaluate_static_tests(request: &StaticTestRequest) -> EvalResult<StaticOu
         }
     }
     let repeatability = repeatability_by_channel(&tests);
-    Ok(StaticOutcome { tests, repeatability, files, reference })
+    let mut warmup = Vec::new();
+    if let Some(w) = &request.warmup {
+        for path in &request.files {
+            warmup.extend(evaluate_warmups(path, &options, &request.topics, &reference, request, w)?);
+        }
+    }
+    Ok(StaticOutcome { tests, repeatability, files, reference, warmup })
+}
+
+/// The warm-up of every channel of every record of `path` (a record must start at power-on):
+/// outputs turned into bias in deg/h by the reference (the earth rate subtracted as for the
+/// static figures), then [`gyrolab::warmup::evaluate_warmup`].
+fn evaluate_warmups(
+    path: &Path,
+    options: &SeriesOptions,
+    topics: &[String],
+    reference: &Reference,
+    request: &StaticTestRequest,
+    config: &gyrolab::warmup::WarmupConfig,
+) -> EvalResult<Vec<gyrolab_report::bias::WarmupReport>> {
+    let records = gyrolab_io::recording::read_records(path, options, topics)?;
+    let mut out = Vec::new();
+    for record in records.records {
+        let data = record.data;
+        let shown = match &record.topic {
+            Some(t) => format!("{} {}", path.display(), t.topic),
+            None => path.display().to_string(),
+        };
+        let n = data.lines.len();
+        let time: Vec<f64> = match (&data.time, request.sample_rate_hz.or(data.header.sample_rate_hz)) {
+            (Some(t), _) => t.clone(),
+            (None, Some(f)) => (0..n).map(|i| i as f64 / f).collect(),
+            (None, None) => {
+                return Err(EvalError::conflict_on(
+                    &["sample_rate_hz"],
+                    format!("{}: no time column: give {{sample_rate_hz}} for the warm-up", path.display()),
+                ))
+            }
+        };
+        for (info, values) in data.header.channels.iter().zip(&data.channels) {
+            let mut cfg = StaticTestConfig { latitude_deg: request.latitude_deg, ..StaticTestConfig::default() };
+            reference.configure(&mut cfg, &info.name, info.unit).map_err(EvalError::conflict)?;
+            // Outputs that are already rates (deg/s, rad/s, ...) need no reference: null 0.
+            let native = info.unit.native_scale_factor_per_dps();
+            let k = cfg.scale_factor.or(native);
+            let null = cfg.null_output.or(native.map(|_| 0.0));
+            let (Some(k), Some(null)) = (k, null) else {
+                return Err(EvalError::conflict_on(
+                    &["scale_factor"],
+                    format!(
+                        "{shown} ({}): the warm-up needs the bias in deg/h: give a calibration or {{scale_factor}}",
+                        gyrolab_io::text::excerpt(&info.name)
+                    ),
+                ));
+            };
+            let earth = match request.latitude_deg {
+                Some(l) if !cfg.null_contains_earth_rate => gyrolab::units::earth_rate_vertical_dph(l),
+                _ => 0.0,
+            };
+            let bias: Vec<f64> = values.iter().map(|&f| gyrolab::units::dps_to_dph((f - null) / k) - earth).collect();
+            let result = gyrolab::warmup::evaluate_warmup(&time, &bias, config).map_err(|e| {
+                EvalError::Data(gyrolab_io::DataError::new(
+                    path,
+                    format!("channel '{}': warm-up: {e}", gyrolab_io::text::excerpt(&info.name)),
+                ))
+            })?;
+            out.push(gyrolab_report::bias::WarmupReport { file: shown.clone(), channel: info.name.clone(), result });
+        }
+    }
+    Ok(out)
 }
 
 /// Evaluates every channel of one file with `config`, its scale factor and null set from the

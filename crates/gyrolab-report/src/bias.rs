@@ -40,16 +40,149 @@ pub struct BiasJson {
     pub bias_repeatability_dph: Option<f64>,
     /// Repeatability per channel (channels present in two or more files).
     pub repeatability: Vec<ChannelRepeatability>,
+    /// Warm-up figures per file and channel (`--warmup-band-dph`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warmup: Vec<WarmupJson>,
+}
+
+/// The warm-up of one channel of one record (from power-on).
+#[derive(Debug, Clone)]
+pub struct WarmupReport {
+    /// Source file.
+    pub file: String,
+    /// Channel.
+    pub channel: String,
+    /// The figures, in deg/h.
+    pub result: gyrolab::warmup::WarmupResult,
+}
+
+/// The exponential settling model in JSON.
+#[derive(Debug, Clone, Serialize)]
+pub struct SettlingModelJson {
+    /// Settled bias B_inf, deg/h.
+    pub settled_bias_dph: f64,
+    /// Amplitude A at power-on, deg/h.
+    pub amplitude_dph: f64,
+    /// Time constant, s.
+    pub time_constant_s: f64,
+    /// RMS residual of the window means about the model, deg/h.
+    pub rms_residual_dph: f64,
+    /// The model's time to enter the band, s.
+    pub settling_time_s: f64,
+}
+
+/// Warm-up figures in JSON, each key naming its unit.
+#[derive(Debug, Clone, Serialize)]
+pub struct WarmupJson {
+    /// Source file.
+    pub file: String,
+    /// Channel.
+    pub channel: String,
+    /// Turn-on bias: the first window's mean, deg/h.
+    pub turn_on_bias_dph: f64,
+    /// Final bias: the mean of the record's last part, deg/h.
+    pub final_bias_dph: f64,
+    /// Settling band, +- deg/h.
+    pub band_dph: f64,
+    /// Window of the window means, s.
+    pub window_s: f64,
+    /// Settling time to the band, s (null: the record never stays inside it).
+    pub settling_time_s: Option<f64>,
+    /// Standard deviation of the final part's window means, deg/h.
+    pub final_scatter_dph: f64,
+    /// The exponential model, when resolved.
+    pub model: Option<SettlingModelJson>,
+    /// Why the model has no value (`time_constant_at_edge`, `amplitude_below_noise`,
+    /// `too_few_windows`), null when resolved.
+    pub model_reason: Option<String>,
+}
+
+impl WarmupJson {
+    /// The JSON of a report.
+    pub fn new(w: &WarmupReport) -> Self {
+        use gyrolab::warmup::ModelSupport;
+        let r = &w.result;
+        WarmupJson {
+            file: w.file.clone(),
+            channel: w.channel.clone(),
+            turn_on_bias_dph: r.turn_on,
+            final_bias_dph: r.final_bias,
+            band_dph: r.config.band,
+            window_s: r.config.window_s,
+            settling_time_s: r.settling_time_s,
+            final_scatter_dph: r.final_scatter,
+            model: r.model.map(|m| SettlingModelJson {
+                settled_bias_dph: m.settled,
+                amplitude_dph: m.amplitude,
+                time_constant_s: m.time_constant_s,
+                rms_residual_dph: m.rms_residual,
+                settling_time_s: m.settling_time_s,
+            }),
+            model_reason: match r.model_support {
+                ModelSupport::Resolved => None,
+                ModelSupport::TimeConstantAtEdge => Some("time_constant_at_edge".into()),
+                ModelSupport::AmplitudeBelowNoise => Some("amplitude_below_noise".into()),
+                ModelSupport::TooFewWindows => Some("too_few_windows".into()),
+            },
+        }
+    }
+}
+
+/// One line per warm-up report.
+pub fn warmup_text(reports: &[WarmupReport]) -> String {
+    use gyrolab::warmup::ModelSupport;
+    let mut s = String::new();
+    for w in reports {
+        let r = &w.result;
+        let settle = r.settling_time_s.map_or_else(
+            || {
+                format!(
+                    "not settled within the record (the final window means scatter by {} deg/h: a band below about three times that, or short windows, cannot be met)",
+                    sig(r.final_scatter, 3)
+                )
+            },
+            |t| format!("{} s", short(t, 6)),
+        );
+        let model = match (&r.model, r.model_support) {
+            (Some(m), _) => format!(
+                "model B_inf + A exp(-t/tau): tau = {} s, A = {} deg/h, B_inf = {} deg/h (time to the band {} s)",
+                sig(m.time_constant_s, 4),
+                sig(m.amplitude, 4),
+                sig(m.settled, 5),
+                sig(m.settling_time_s, 4)
+            ),
+            (None, ModelSupport::TimeConstantAtEdge) => {
+                "no model: the record does not show a transient (time constant at the edge of the range)".into()
+            }
+            (None, ModelSupport::AmplitudeBelowNoise) => "no model: no transient above the noise".into(),
+            (None, _) => "no model: too few windows".into(),
+        };
+        s.push_str(&format!(
+            "warm-up {} ({}): turn-on bias {} deg/h, final {} deg/h, settling time to +-{} deg/h ({}-s windows): {settle}; {model}\n",
+            w.file,
+            w.channel,
+            sig(r.turn_on, 5),
+            sig(r.final_bias, 5),
+            short(r.config.band, 6),
+            short(r.config.window_s, 6)
+        ));
+    }
+    s
 }
 
 /// Builds the JSON document.
-pub fn bias_json(tests: Vec<TestReport>, repeatability: Vec<ChannelRepeatability>) -> BiasJson {
+pub fn bias_json(
+    tests: Vec<TestReport>,
+    repeatability: Vec<ChannelRepeatability>,
+    warmup: &[WarmupReport],
+) -> BiasJson {
     let single = repeatability.len() == 1;
     BiasJson {
         gyrolab_version: env!("CARGO_PKG_VERSION").into(),
         bias_repeatability_dph: if single { repeatability[0].repeatability.bias_repeatability_dph } else { None },
         tests,
         repeatability,
+        warmup: warmup.iter().map(WarmupJson::new).collect(),
     }
 }
 

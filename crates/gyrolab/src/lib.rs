@@ -35,4 +35,5 @@ pub mod static_test;
 pub mod triad;
 pub mod units;
 pub mod validate;
+pub mod warmup;
 pub mod window_means;

@@ -53,6 +53,13 @@ pub struct BiasArgs {
     /// Print every figure as JSON (keys in docs/JSON.md).
     #[arg(long)]
     pub json: bool,
+    /// Also evaluate the warm-up (records that start at power-on): turn-on bias, the time the
+    /// bias takes to stay within +-BAND deg/h of its final value, an exponential settling model.
+    #[arg(long, value_name = "BAND")]
+    pub warmup_band_dph: Option<f64>,
+    /// Window of the warm-up's window means, s (default 10).
+    #[arg(long, value_name = "S", requires = "warmup_band_dph")]
+    pub warmup_window_s: Option<f64>,
 }
 
 /// Runs `gyrolab bias`.
@@ -70,6 +77,10 @@ pub fn run(args: &BiasArgs) -> CliResult {
         tolerant: args.tolerant,
         layout: args.layout.layout(),
         topics: args.topics.clone(),
+        warmup: args.warmup_band_dph.map(|b| gyrolab::warmup::WarmupConfig {
+            window_s: args.warmup_window_s.unwrap_or(10.0),
+            ..gyrolab::warmup::WarmupConfig::new(b)
+        }),
     };
     let outcome = evaluate_static_tests(&request)?;
     for f in &outcome.files {
@@ -96,10 +107,11 @@ pub fn run(args: &BiasArgs) -> CliResult {
         }
     }
     if args.json {
-        return print(&to_json(&bias_json(tests, outcome.repeatability))?);
+        return print(&to_json(&bias_json(tests, outcome.repeatability, &outcome.warmup))?);
     }
     let mut text = bias_table(&tests, &outcome.repeatability);
     text.push('\n');
+    text.push_str(&gyrolab_report::bias::warmup_text(&outcome.warmup));
     if tests.iter().any(|t| t.result.earth_rate_subtracted) {
         text.push_str("The earth-rate component for a vertical input axis was subtracted from the bias.\n");
     } else if args.latitude.is_none() && tests.iter().any(|t| t.result.bias_dph.is_some()) {

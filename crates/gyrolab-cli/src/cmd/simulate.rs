@@ -67,6 +67,12 @@ pub struct CommonArgs {
     /// Rate ramp R, deg/h per hour.
     #[arg(long, value_name = "R", allow_hyphen_values = true)]
     pub rate_ramp_dph_per_h: Option<f64>,
+    /// Warm-up transient: bias B + A exp(-t/tau) after power-on (the record's start), A in deg/h.
+    #[arg(long, value_name = "A", allow_hyphen_values = true, requires = "warmup_time_constant_s")]
+    pub warmup_amplitude_dph: Option<f64>,
+    /// Warm-up time constant tau, s.
+    #[arg(long, value_name = "TAU", allow_hyphen_values = true)]
+    pub warmup_time_constant_s: Option<f64>,
     /// Output quantization step, output units.
     #[arg(long, value_name = "STEP", allow_hyphen_values = true)]
     pub output_quantization_step: Option<f64>,
@@ -172,6 +178,8 @@ fn overrides(c: &CommonArgs) -> SimOverrides {
         bias_instability_dph: c.bias_instability_dph,
         rrw_deg_h_rt_h: c.rrw_deg_h_rt_h,
         rate_ramp_dph_per_h: c.rate_ramp_dph_per_h,
+        warmup_amplitude_dph: c.warmup_amplitude_dph,
+        warmup_time_constant_s: c.warmup_time_constant_s,
         output_quantization_step: c.output_quantization_step,
         bias_temp_coeff_dph_per_c: c.bias_temp_coeff_dph_per_c,
         temp_c: c.temp_c,

@@ -169,6 +169,8 @@ struct Engine {
     rrw_sigma_dps: f64,
     rrw_state_dps: f64,
     ramp_dps_per_s: f64,
+    warmup_amplitude_dps: f64,
+    warmup_time_constant_s: f64,
     output_step: f64,
     angle_step_deg: f64,
     angle_residue_deg: f64,
@@ -267,6 +269,8 @@ impl Engine {
             rrw_sigma_dps: units::rrw_dph_rt_h_to_increment_sigma_dps(model.rrw_deg_h_rt_h, dt_s),
             rrw_state_dps: 0.0,
             ramp_dps_per_s: units::rate_ramp_dph_per_h_to_dps_per_s(model.rate_ramp_dph_per_h),
+            warmup_amplitude_dps: units::dph_to_dps(model.warmup_amplitude_dph),
+            warmup_time_constant_s: model.warmup_time_constant_s,
             output_step: model.output_quantization_step,
             angle_step_deg: model.angle_quantization_deg,
             angle_residue_deg: 0.0,
@@ -316,7 +320,7 @@ impl Engine {
                 let w = self.quantize_angle(input + self.bias_dps_at(t_s, d_temp) + *o);
                 *o = self.output_stage(self.run_scale_factor_at(d_temp)).output(w);
             }
-        } else if let Some(temp_c) = constant_temp_c {
+        } else if let Some(temp_c) = constant_temp_c.filter(|_| self.warmup_amplitude_dps == 0.0) {
             let d_temp = temp_c - self.reference_temp_c;
             let bias_base = self.temperature_bias_dps(d_temp);
             let stage = self.output_stage(self.run_scale_factor_at(d_temp));
@@ -377,7 +381,12 @@ impl Engine {
     /// The bias at time t_s and temperature offset d_temp, deg/s.
     #[inline(always)]
     fn bias_dps_at(&self, t_s: f64, d_temp: f64) -> f64 {
-        self.temperature_bias_dps(d_temp) + self.ramp_dps_per_s * t_s
+        let b = self.temperature_bias_dps(d_temp) + self.ramp_dps_per_s * t_s;
+        if self.warmup_amplitude_dps == 0.0 {
+            b
+        } else {
+            b + self.warmup_amplitude_dps * (-t_s / self.warmup_time_constant_s).exp()
+        }
     }
 
     /// Constant, run-to-run and temperature bias at temperature offset d_temp, deg/s.

@@ -167,6 +167,11 @@ sensor_model! {
     rrw_deg_h_rt_h: f64,
     /// Rate ramp R, deg/h per hour.
     rate_ramp_dph_per_h: f64,
+    /// Warm-up transient amplitude A, deg/h: the bias at time t after power-on (the record's
+    /// start) is B + A exp(-t / tau); 0 for none.
+    warmup_amplitude_dph: f64,
+    /// Warm-up time constant tau, s (positive when `warmup_amplitude_dph` is not 0).
+    warmup_time_constant_s: f64,
     /// Output quantization step (ADC resolution), output units; 0 for none.
     output_quantization_step: f64,
     /// Angle quantization step of the sensed angle, deg; 0 for none.
@@ -202,6 +207,8 @@ impl Default for SensorModel {
             flicker_tau_max_s: 10_000.0,
             rrw_deg_h_rt_h: 0.0,
             rate_ramp_dph_per_h: 0.0,
+            warmup_amplitude_dph: 0.0,
+            warmup_time_constant_s: 0.0,
             output_quantization_step: 0.0,
             angle_quantization_deg: 0.0,
             bias_temp_coeff_dph_per_c: 0.0,
@@ -360,6 +367,12 @@ impl SensorModel {
         )?;
         non_negative("rrw_deg_h_rt_h", self.rrw_deg_h_rt_h)?;
         finite("rate_ramp_dph_per_h", self.rate_ramp_dph_per_h)?;
+        finite("warmup_amplitude_dph", self.warmup_amplitude_dph)?;
+        if self.warmup_amplitude_dph != 0.0 {
+            positive("warmup_time_constant_s", self.warmup_time_constant_s)?;
+        } else {
+            non_negative("warmup_time_constant_s", self.warmup_time_constant_s)?;
+        }
         non_negative("output_quantization_step", self.output_quantization_step)?;
         non_negative("angle_quantization_deg", self.angle_quantization_deg)?;
         finite("bias_temp_coeff_dph_per_c", self.bias_temp_coeff_dph_per_c)?;
