@@ -293,6 +293,15 @@ fn wrong_topics_and_files_without_imu_data_are_clear_errors() {
     let out = gyrolab().args(["inspect", no_imu.to_str().unwrap()]).output().unwrap();
     assert!(out.status.success());
     assert!(String::from_utf8_lossy(&out.stdout).contains("no IMU topic"));
+    // A ROS 2 bag in the older SQLite3 storage: recognised and refused with the way out.
+    let db3 = f.dir.join("old_bag.db3");
+    let script = "import sqlite3, sys\nc = sqlite3.connect(sys.argv[1])\nc.execute('create table messages (id integer)')\nc.commit()\n";
+    let st = std::process::Command::new(&py).args(["-c", script, db3.to_str().unwrap()]).status().unwrap();
+    assert!(st.success());
+    let out = gyrolab().args(["allan", db3.to_str().unwrap()]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("older .db3 storage") && err.contains("ros2 bag convert"), "{err}");
 }
 
 #[test]

@@ -36,6 +36,8 @@ pub enum FileFormat {
     ULog,
     /// Apache Parquet.
     Parquet,
+    /// An SQLite database (a ROS 2 bag in the older `.db3` storage): recognised, not read.
+    Sqlite,
 }
 
 impl FileFormat {
@@ -47,6 +49,7 @@ impl FileFormat {
             FileFormat::RosBag => "ROS 1 bag",
             FileFormat::ULog => "PX4 ULog",
             FileFormat::Parquet => "Parquet",
+            FileFormat::Sqlite => "SQLite database",
         }
     }
 
@@ -85,6 +88,8 @@ pub fn format_of(head: &[u8]) -> FileFormat {
         FileFormat::ULog
     } else if head.starts_with(b"PAR1") {
         FileFormat::Parquet
+    } else if head.starts_with(b"SQLite format 3\0") {
+        FileFormat::Sqlite
     } else {
         FileFormat::Text
     }
@@ -229,6 +234,9 @@ pub fn read_records(path: &Path, options: &SeriesOptions, topics: &[String]) -> 
         ));
     }
     let table = |data| FileRecords { format, records: vec![FileRecord { topic: None, data }], truncated: None };
+    if format == FileFormat::Sqlite {
+        return Err(sqlite_refused(path));
+    }
     match format {
         FileFormat::Text => Ok(table(crate::series::read_series_all(path, options)?)),
         FileFormat::Parquet => Ok(table(crate::parquet_table::read_parquet(path, options)?)),
@@ -274,9 +282,20 @@ pub struct Recording {
     pub truncated: Option<String>,
 }
 
+/// The error for an SQLite file: a ROS 2 bag in the older storage, which gyrolab does not read.
+fn sqlite_refused(path: &Path) -> DataError {
+    DataError::new(
+        path,
+        "an SQLite database (a ROS 2 bag in the older .db3 storage?): not read; convert the bag to MCAP, rosbag2's default storage (`ros2 bag convert`), and give the .mcap file",
+    )
+}
+
 /// Reads a recording (MCAP, ROS 1 bag, ULog) in one pass.
 pub fn read_recording(path: &Path, options: &RecordingOptions) -> Result<Recording, DataError> {
     let format = sniff_format(path)?;
+    if format == FileFormat::Sqlite {
+        return Err(sqlite_refused(path));
+    }
     let mut c = Collector::new(options);
     let end = match format {
         FileFormat::Mcap => mcap_file::read(path, &mut c),
@@ -580,6 +599,7 @@ mod tests {
         assert_eq!(format_of(b"#ROSBAG V2.0\n"), FileFormat::RosBag);
         assert_eq!(format_of(b"ULog\x01\x12\x35\x01"), FileFormat::ULog);
         assert_eq!(format_of(b"PAR1\x15"), FileFormat::Parquet);
+        assert_eq!(format_of(b"SQLite format 3\0"), FileFormat::Sqlite);
         assert_eq!(format_of(b"time_s,rate_dps\n"), FileFormat::Text);
         assert_eq!(format_of(b""), FileFormat::Text);
     }
