@@ -94,30 +94,37 @@ fn choose_columns(input: &Path, given: &[String], axis_names: &[String], skip: &
 
 /// The model of a calibration file: its `[triad]` (unless an axis is named) or the named (or
 /// only) `[[axis]]`, with its output unit and the names of the axes it gives rates for.
+#[allow(clippy::type_complexity)]
 fn model_of(
     calibration: &Path,
     axis: Option<&str>,
-) -> EvalResult<(ApplyModel, gyrolab::units::OutputUnit, Vec<String>)> {
+) -> EvalResult<(ApplyModel, gyrolab::units::OutputUnit, Vec<String>, Option<gyrolab::thermal::Compensation>)> {
     let cal = read_calibration(calibration)?;
     let cal_err = |msg: String| EvalError::Data(DataError::new(calibration, msg));
     Ok(match (&cal.triad, axis) {
         (Some(t), None) => {
             let model = TriadApplier::new(&t.calibration()).map_err(|e| cal_err(format!("[triad]: {e}")))?;
-            (ApplyModel::Triad(model), t.output_unit, t.axes.to_vec())
+            (ApplyModel::Triad(model), t.output_unit, t.axes.to_vec(), None)
         }
         (_, name) => {
             let axis = cal.axis(name).map_err(cal_err)?;
             let model =
                 SingleAxisCalibration::polynomial(&axis.polynomial.coefficients, axis.rate_min_dps, axis.rate_max_dps)
                     .map_err(|e| cal_err(format!("axis '{}': {e}", axis.name)))?;
-            (ApplyModel::Single(model), axis.output_unit, vec![axis.name.clone()])
+            let temperature = axis
+                .temperature
+                .as_ref()
+                .map(|t| t.compensation())
+                .transpose()
+                .map_err(|e| cal_err(format!("axis '{}', [axis.temperature]: {e}", axis.name)))?;
+            (ApplyModel::Single(model), axis.output_unit, vec![axis.name.clone()], temperature)
         }
     })
 }
 
 /// The streaming plan of a request: the model, the columns it reads and writes.
 pub fn prepare_apply(request: &ApplyRequest) -> EvalResult<ApplyPlan> {
-    let (model, output_unit, axes) = model_of(&request.calibration, request.calibration_axis.as_deref())?;
+    let (model, output_unit, axes, temperature) = model_of(&request.calibration, request.calibration_axis.as_deref())?;
     let names = header_names(&request.input)?;
     // A raw log's table rate is passed through (as table_rate_dps), beside the calibrated rate.
     let table_rate = detect_raw_log(&names);
@@ -132,6 +139,7 @@ pub fn prepare_apply(request: &ApplyRequest) -> EvalResult<ApplyPlan> {
         columns: choose_columns(&request.input, &request.columns, &axes, &skip)?,
         rate_names,
         table_rate_column: table_rate,
+        temperature,
     })
 }
 
@@ -143,7 +151,14 @@ pub fn apply_arrays(
     axis: Option<&str>,
     outputs: &[&[f64]],
 ) -> EvalResult<(Vec<Vec<f64>>, Vec<gyrolab::apply::RangeStatus>)> {
-    let (model, _, axes) = model_of(calibration, axis)?;
+    let (model, _, axes, temperature) = model_of(calibration, axis)?;
+    if temperature.is_some() {
+        return Err(EvalError::conflict(format!(
+            "{}: the calibration compensates for temperature; arrays without temperatures cannot be applied \
+             (apply a file with a temperature column)",
+            calibration.display()
+        )));
+    }
     let n = outputs.first().map_or(0, |o| o.len());
     if outputs.len() != axes.len() || outputs.iter().any(|o| o.len() != n) {
         return Err(EvalError::conflict(format!(

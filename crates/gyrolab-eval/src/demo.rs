@@ -244,6 +244,7 @@ pub fn paper_report_folder(request: &PaperReportRequest, progress: &dyn Progress
         extra_json: json,
         extra_files: parts.files,
         triad: None,
+        temperature_models: Vec::new(),
     };
     assemble_report(inputs, progress)
 }

@@ -124,6 +124,7 @@ impl EvaluatedAxis {
                 order: e.polynomial.order(),
                 coefficients: e.polynomial.coefficients.clone(),
             },
+            temperature: None,
         }
     }
 }

@@ -56,6 +56,8 @@ pub struct ReportInputs<'a> {
     pub extra_files: Vec<(String, Vec<u8>)>,
     /// A three-axis calibration, written into calibration.toml's `[triad]`.
     pub triad: Option<TriadReport<'a>>,
+    /// Temperature compensation per axis, written into calibration.toml's `[axis.temperature]`.
+    pub temperature_models: Vec<(String, gyrolab_io::calibration::TemperatureSection)>,
 }
 
 fn json<T: serde::Serialize>(value: &T) -> EvalResult<String> {
@@ -123,6 +125,11 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
     ];
     if !inputs.axes.is_empty() || inputs.triad.is_some() {
         let mut cal = calibration_file(inputs.axes);
+        for (axis, model) in &inputs.temperature_models {
+            if let Some(a) = cal.axes.iter_mut().find(|a| a.name == *axis) {
+                a.temperature = Some(model.clone());
+            }
+        }
         if let Some(t) = &inputs.triad {
             cal.triad = Some(gyrolab_io::calibration::TriadSection::from_calibration(
                 &t.fit.calibration,

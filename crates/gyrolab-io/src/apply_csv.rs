@@ -6,7 +6,8 @@
 //! through from a raw log's table-rate column, when asked for), then `rate_dps` (single axis) or
 //! `rate_<axis>_dps` for each of three axes, then `flag`: `ok`, `below` / `above` (outside the
 //! calibrated range: continued along the end tangent, or some |rate| above a triad's limit) or
-//! `not_finite` (a NaN or empty output cell; the rate is NaN).
+//! `not_finite` (a NaN or empty output cell, or an empty temperature cell when the calibration
+//! compensates for temperature; the rate is NaN).
 
 use crate::error::DataError;
 use crate::series::{SeriesOptions, SeriesReader};
@@ -37,6 +38,10 @@ pub struct ApplyPlan {
     pub rate_names: Vec<String>,
     /// A table-rate column to pass through as `table_rate_dps` (raw logs).
     pub table_rate_column: Option<String>,
+    /// Temperature compensation of a single axis (the calibration's `[axis.temperature]`): the
+    /// input needs a temperature column, and each output is brought to the reference temperature
+    /// before the rate model.
+    pub temperature: Option<gyrolab::thermal::Compensation>,
 }
 
 /// Counts of a finished application.
@@ -50,6 +55,10 @@ pub struct ApplySummary {
     pub above: u64,
     /// Rows with a non-finite output.
     pub not_finite: u64,
+    /// Rows whose temperature lay outside the compensation model's range (the range's end used).
+    pub temperature_outside: u64,
+    /// Rows compensated for temperature.
+    pub temperature_compensated: u64,
 }
 
 /// Why a streamed application stopped.
@@ -111,6 +120,15 @@ pub fn apply_file(
     };
     let mut reader = SeriesReader::open(path, &options)?;
     let header = reader.header().clone();
+    if plan.temperature.is_some() && header.temperature_column.is_none() {
+        return Err(DataError::new(
+            path,
+            "the calibration compensates this axis for temperature, but the file has no temperature column \
+             (expected a column named temp_c or temperature_c, degC)",
+        )
+        .at_line(header.header_line)
+        .into());
+    }
     // Channel slot and unit factor of each wanted column, in the plan's order.
     let mut slots = Vec::with_capacity(n);
     for want in &plan.columns {
@@ -151,6 +169,18 @@ pub fn apply_file(
         for (i, &(k, factor)) in slots.iter().enumerate() {
             scaled[i].clear();
             scaled[i].extend(b.channels[k].iter().map(|v| v * factor));
+        }
+        if let (Some(comp), Some(temp)) = (&plan.temperature, b.temp) {
+            for (u, &t) in scaled[0].iter_mut().zip(temp) {
+                if !t.is_finite() {
+                    *u = f64::NAN;
+                    continue;
+                }
+                let (v, outside) = comp.to_reference(*u, t);
+                *u = v;
+                summary.temperature_outside += outside as u64;
+                summary.temperature_compensated += 1;
+            }
         }
         statuses.clear();
         match &plan.model {

@@ -96,6 +96,42 @@ pub struct AxisCalibration {
     pub rate_max_dps: f64,
     /// Polynomial model.
     pub polynomial: PolynomialModel,
+    /// Temperature compensation (`[axis.temperature]`, from a plan's temperature points).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperature: Option<TemperatureSection>,
+}
+
+/// Temperature compensation of an axis: the output at temperature T is brought to the reference
+/// temperature, u_ref = (u - F(T)) K(T_ref) / K(T) + F(T_ref), before the rate model
+/// (`gyrolab::thermal::Compensation`). Written by `gyrolab eval` from `[temperature.<axis>]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TemperatureSection {
+    /// Reference temperature T_ref, degC.
+    pub reference_temp_c: f64,
+    /// Lowest temperature of the model's points, degC (colder samples use the model there).
+    pub temp_min_c: f64,
+    /// Highest temperature of the model's points, degC.
+    pub temp_max_c: f64,
+    /// K(T) = sum_k c_k (T - T_ref)^k: output units per deg/s per degC^k.
+    pub scale_factor_coefficients: Vec<f64>,
+    /// Null F(T) = sum_k d_k (T - T_ref)^k: output units per degC^k.
+    pub null_coefficients: Vec<f64>,
+}
+
+impl TemperatureSection {
+    /// The core compensation model.
+    pub fn compensation(&self) -> Result<gyrolab::thermal::Compensation, gyrolab::thermal::CompensationError> {
+        let model = |c: &Vec<f64>| gyrolab::thermal::TemperatureModel {
+            reference_temp_c: self.reference_temp_c,
+            coefficients: c.clone(),
+            temp_min_c: self.temp_min_c,
+            temp_max_c: self.temp_max_c,
+            rms_residual: 0.0,
+            residual_dof: 0,
+        };
+        gyrolab::thermal::Compensation::new(model(&self.scale_factor_coefficients), model(&self.null_coefficients))
+    }
 }
 
 /// A polynomial output model in the input rate.
@@ -247,6 +283,19 @@ pub fn parse_calibration(path: &Path, text: &str) -> Result<CalibrationFile, Dat
                 }
             }
         }
+        if let Some(t) = &a.temperature {
+            let n_ok = |c: &Vec<f64>| (1..=MAX_POLYNOMIAL_ORDER + 1).contains(&c.len());
+            if !(n_ok(&t.scale_factor_coefficients) && n_ok(&t.null_coefficients)) {
+                return Err(at(
+                    "[axis.temperature]",
+                    "scale_factor_coefficients",
+                    format!("expected 1 to {} coefficients in each model", MAX_POLYNOMIAL_ORDER + 1),
+                ));
+            }
+            if let Err(e) = t.compensation() {
+                return Err(at("[axis.temperature]", "scale_factor_coefficients", e.to_string()));
+            }
+        }
         if a.polynomial.order == 1 {
             let slope = a.polynomial.coefficients[1];
             if (slope - a.scale_factor).abs() > SLOPE_TOLERANCE * a.scale_factor.abs() {
@@ -358,6 +407,7 @@ mod tests {
                 rate_min_dps: -300.0,
                 rate_max_dps: 300.0,
                 polynomial: PolynomialModel { order: 1, coefficients: vec![2.5, 0.0075] },
+                temperature: None,
             }],
             triad: None,
         }

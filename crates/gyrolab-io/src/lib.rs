@@ -10,7 +10,8 @@
 //! - [`decimal`]: exact fast reading of plain decimal numbers and rows of them;
 //! - [`series`]: streaming reader of time-series files, and the static test of a file;
 //! - [`sim_csv`]: fast CSV writer for simulated static records and rate-table tests;
-//! - [`test_plan`]: test plans (TOML) for `gyrolab eval`.
+//! - [`test_plan`]: test plans (TOML) for `gyrolab eval`;
+//! - [`plan_temperature`]: the plan's temperature tests at soaked points (`[temperature.<axis>]`).
 
 pub mod apply_csv;
 pub mod atomic;
@@ -18,6 +19,7 @@ pub mod calibration;
 pub mod decimal;
 pub mod error;
 pub mod parquet_table;
+pub mod plan_temperature;
 pub mod rate_table;
 pub mod raw_log;
 pub mod recording;

@@ -34,6 +34,8 @@ struct RawPlan {
     test: RawTest,
     #[serde(default)]
     equipment: Vec<Spanned<RawEquipment>>,
+    #[serde(default)]
+    temperature: BTreeMap<String, Spanned<crate::plan_temperature::RawTemperature>>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -337,6 +339,8 @@ pub struct TestPlan {
     pub test: TestInfo,
     /// The equipment used (`[[equipment]]`), in plan order.
     pub equipment: Vec<Equipment>,
+    /// Temperature tests at soaked points (`[temperature.<axis>]`), in device axis order.
+    pub temperature: Vec<crate::plan_temperature::TemperaturePlan>,
 }
 
 /// Reads and checks a plan file; `known_figure` tells which `[limits]` names exist.
@@ -345,19 +349,19 @@ pub fn read_plan(path: &Path, known_figure: &dyn Fn(&str) -> bool) -> Result<Tes
     parse_plan(path, &text, known_figure)
 }
 
-struct Ctx<'a> {
-    path: &'a Path,
-    text: &'a str,
-    base: PathBuf,
+pub(crate) struct Ctx<'a> {
+    pub(crate) path: &'a Path,
+    pub(crate) text: &'a str,
+    pub(crate) base: PathBuf,
 }
 
 impl Ctx<'_> {
-    fn err(&self, span: std::ops::Range<usize>, key: &str, msg: impl std::fmt::Display) -> DataError {
+    pub(crate) fn err(&self, span: std::ops::Range<usize>, key: &str, msg: impl std::fmt::Display) -> DataError {
         let (line, col) = line_col(self.text, span.start);
         DataError::new(self.path, format!("{key}: {msg}")).at_line(line).at_column(col, None)
     }
 
-    fn existing_file(&self, key: &str, value: &Spanned<String>) -> Result<PathBuf, DataError> {
+    pub(crate) fn existing_file(&self, key: &str, value: &Spanned<String>) -> Result<PathBuf, DataError> {
         let p = self.base.join(value.get_ref());
         if p.is_file() {
             Ok(p)
@@ -375,7 +379,12 @@ impl Ctx<'_> {
     }
 
     /// Checks a value with a core validator; the error names `key` and its line.
-    fn check<T>(&self, span: std::ops::Range<usize>, key: &str, r: Result<T, InvalidOption>) -> Result<T, DataError> {
+    pub(crate) fn check<T>(
+        &self,
+        span: std::ops::Range<usize>,
+        key: &str,
+        r: Result<T, InvalidOption>,
+    ) -> Result<T, DataError> {
         r.map_err(|e| self.err(span, key, e.message))
     }
 
@@ -404,7 +413,7 @@ impl Ctx<'_> {
         })
     }
 
-    fn output_unit(&self, key: &str, v: &Option<Spanned<String>>) -> Result<Option<OutputUnit>, DataError> {
+    pub(crate) fn output_unit(&self, key: &str, v: &Option<Spanned<String>>) -> Result<Option<OutputUnit>, DataError> {
         v.as_ref()
             .map(|s| {
                 OutputUnit::parse(s.get_ref()).ok_or_else(|| {
@@ -457,6 +466,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
     for (table, keys) in [
         ("rate", raw.rate.iter().map(|(k, v)| (k, v.span())).collect::<Vec<_>>()),
         ("static", raw.static_tests.iter().map(|(k, v)| (k, v.span())).collect()),
+        ("temperature", raw.temperature.iter().map(|(k, v)| (k, v.span())).collect()),
     ] {
         for (k, span) in keys {
             if !axes.contains(k) {
@@ -469,7 +479,11 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         }
     }
     for a in &axes {
-        if !raw.rate.contains_key(a) && !raw.static_tests.contains_key(a) && raw.triad.is_none() {
+        if !raw.rate.contains_key(a)
+            && !raw.static_tests.contains_key(a)
+            && !raw.temperature.contains_key(a)
+            && raw.triad.is_none()
+        {
             return Err(cx.err(
                 raw.device.axes.span(),
                 "device.axes",
@@ -657,6 +671,13 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         });
     }
 
+    let mut temperature = Vec::new();
+    for axis in &axes {
+        if let Some(t) = raw.temperature.get(axis) {
+            temperature.push(crate::plan_temperature::parse(&cx, axis, t)?);
+        }
+    }
+
     let triad = match &raw.triad {
         None => None,
         Some(t) => {
@@ -703,6 +724,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         triad,
         test,
         equipment,
+        temperature,
     })
 }
 

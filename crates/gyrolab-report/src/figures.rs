@@ -14,6 +14,8 @@ pub enum FigureGroup {
     Static,
     /// Allan variance noise terms.
     Allan,
+    /// Temperature tests at soaked points.
+    Temperature,
 }
 
 impl FigureGroup {
@@ -23,6 +25,7 @@ impl FigureGroup {
             FigureGroup::RateTable => "Rate-table test",
             FigureGroup::Static => "Static (bias) test",
             FigureGroup::Allan => "Allan variance",
+            FigureGroup::Temperature => "Temperature tests",
         }
     }
 }
@@ -40,7 +43,7 @@ pub struct FigureDef {
     pub group: FigureGroup,
     /// Formula in plain text.
     pub formula: &'static str,
-    /// Source label ([P], [GJB], [IEEE], [T], [SP1065]).
+    /// Source label ([P], [GJB], [IEEE], [GB/T 18459], [SP1065]).
     pub source: &'static str,
 }
 
@@ -55,7 +58,7 @@ const fn def(
     FigureDef { key, label, unit, group, formula, source }
 }
 
-use FigureGroup::{Allan, RateTable, Static};
+use FigureGroup::{Allan, RateTable, Static, Temperature};
 
 /// Every figure gyrolab reports, in report order.
 #[rustfmt::skip]
@@ -64,11 +67,11 @@ pub const FIGURES: &[FigureDef] = &[
     def("zero_offset", "zero offset F0", "output", RateTable, "F0 = mean(ȳ) − K mean(Ω)", "[P] eq. 3"),
     def("nonlinearity_pct", "nonlinearity K_a", "%", RateTable, "K_a = max_j |a_j|, a_j = (K Ω_j + F0 − F_r − (ȳ_j − F_r)) / F_m, F_m = max_j |ȳ_j − F_r|", "[P] eq. 7-9, [GJB]"),
     def("nonlinearity_ppm", "nonlinearity K_a", "ppm", RateTable, "as nonlinearity_pct, in parts per million", "[P] eq. 9"),
-    def("linearity_pct", "linearity δ_L", "% FS", RateTable, "max_j |ȳ_j − (K Ω_j + F0)| / Y_FS, Y_FS = |K| (Ω_max − Ω_min)", "[T]"),
-    def("hysteresis_pct", "hysteresis δ_H", "% FS", RateTable, "max_j |ȳ_j,fwd − ȳ_j,rev| / Y_FS (half of it with half_hysteresis)", "[T]"),
-    def("repeatability_pct", "repeatability δ_R", "% FS", RateTable, "k σ_max / Y_FS, σ_max the largest std (n − 1) across runs at any point and stroke", "[T]"),
-    def("accuracy_pct", "accuracy (sum)", "% FS", RateTable, "δ_L + δ_H + δ_R (the paper's rule)", "[P], [T]"),
-    def("accuracy_rss_pct", "accuracy (RSS)", "% FS", RateTable, "√(δ_L² + δ_H² + δ_R²)", "[T]"),
+    def("linearity_pct", "linearity δ_L", "% FS", RateTable, "max_j |ȳ_j − (K Ω_j + F0)| / Y_FS, Y_FS = |K| (Ω_max − Ω_min)", "[GB/T 18459]"),
+    def("hysteresis_pct", "hysteresis δ_H", "% FS", RateTable, "max_j |ȳ_j,fwd − ȳ_j,rev| / Y_FS (half of it with half_hysteresis)", "[GB/T 18459]"),
+    def("repeatability_pct", "repeatability δ_R", "% FS", RateTable, "k σ_max / Y_FS, σ_max the largest std (n − 1) across runs at any point and stroke", "[GB/T 18459]"),
+    def("accuracy_pct", "accuracy (sum)", "% FS", RateTable, "δ_L + δ_H + δ_R (the paper's rule)", "[P], [GB/T 18459]"),
+    def("accuracy_rss_pct", "accuracy (RSS)", "% FS", RateTable, "√(δ_L² + δ_H² + δ_R²)", "[GB/T 18459]"),
     def("asymmetry_pct", "scale-factor asymmetry K_as", "%", RateTable, "|K+ − K−| / |(K+ + K−)/2|, K± fitted on Ω ≥ 0 and Ω ≤ 0", "[GJB], [IEEE 528]"),
     def("scale_factor_repeatability_ppm", "scale-factor repeatability K_r", "ppm", RateTable, "std(K_i, n − 1) / |mean(K_i)|, K_i fitted per run on both strokes", "[GJB]"),
     def("scale_factor_repeatability_pct", "scale-factor repeatability K_r", "%", RateTable, "as scale_factor_repeatability_ppm, in percent", "[GJB]"),
@@ -76,7 +79,7 @@ pub const FIGURES: &[FigureDef] = &[
     def("bias_stability_dph_<T>s", "bias stability B_s(T)", "deg/h", Static, "std(means of consecutive T-second windows, n − 1) / K; the summary quotes the worst test", "[P] eq. 11, [GJB]"),
     def("bias_repeatability_dph", "bias repeatability B_r", "deg/h", Static, "std(B_0i, n − 1) over the Q tests", "[P] eq. 12, [GJB]"),
     def("drift_dph_per_h", "drift", "deg/h per h", Static, "least-squares slope of bias against time; the summary quotes the test of largest magnitude", "[GJB]"),
-    def("temp_sensitivity_dph_per_c", "bias temperature sensitivity", "(deg/h)/degC", Static, "least-squares slope of 10-s window-mean bias against window-mean temperature; the test of largest magnitude", "[GJB], [T]"),
+    def("temp_sensitivity_dph_per_c", "bias temperature sensitivity", "(deg/h)/degC", Static, "least-squares slope of 10-s window-mean bias against window-mean temperature; the test of largest magnitude", "[GJB], [GB/T 18459]"),
     def("arw_deg_rt_h", "angle random walk N", "deg/√h", Allan, "ADEV supported slope −1/2 region nearest τ = 1 s, line read at 1 s, × 60", "[IEEE 952], [SP1065]"),
     def("bias_instability_dph", "bias instability B", "deg/h", Allan, "IEEE 952 B = ADEV minimum of a supported flat region / 0.6643 (only when resolved)", "[IEEE 952]"),
     def("allan_minimum_dph", "Allan minimum", "deg/h", Allan, "ADEV minimum of a supported flat region (the ADI / Sensonor datasheet figure; 0.6643 B)", "[IEEE 952]"),
@@ -84,6 +87,10 @@ pub const FIGURES: &[FigureDef] = &[
     def("rrw_deg_h_rt_h", "rate random walk K", "deg/h/√h", Allan, "K = √(3 (σ² − other terms) / τ) on the rising side where σ exceeds them beyond its bounds, × 216000", "[IEEE 952]"),
     def("quantization_deg", "quantization noise Q", "deg", Allan, "ADEV slope −1 line: Q = σ(τ) τ / √3", "[IEEE 952]"),
     def("rate_ramp_dph_per_h", "rate ramp R", "deg/h per h", Allan, "ADEV slope +1 line: R = √2 σ(τ) / τ, × 3600²", "[IEEE 952]"),
+    def("scale_factor_temp_sensitivity_ppm_per_c", "scale-factor temperature sensitivity", "ppm/degC", Temperature, "least-squares slope of K_i on T_i over the soaked points / K(T_ref) × 10⁶", "[IEEE 952] annex B, [GJB]"),
+    def("bias_temp_sensitivity_dph_per_c", "bias temperature sensitivity (soaked points)", "(deg/h)/degC", Temperature, "least-squares slope of B_i on T_i over the soaked points, B_i = (static mean − null) / K", "[IEEE 952] annex B, [GJB]"),
+    def("scale_factor_thermal_hysteresis_ppm", "scale-factor thermal hysteresis", "ppm", Temperature, "max |K_heating − K_cooling| / K(T_ref) × 10⁶ at temperatures visited both ways (within 1 degC)", "[GJB]"),
+    def("bias_thermal_hysteresis_dph", "bias thermal hysteresis", "deg/h", Temperature, "max |B_heating − B_cooling| at temperatures visited both ways (within 1 degC)", "[GJB]"),
 ];
 
 /// The names a `[limits]` table may use (`<T>` stands for a smoothing time in seconds).

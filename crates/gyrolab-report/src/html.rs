@@ -433,9 +433,16 @@ fn write_methods(h: &mut String) {
     h.push_str("<section class=\"page-break\">\n<h2>Appendix: methods</h2>\n<p class=\"note\">Each figure with its formula, unit and source. \
         Notation: Ω_j table rates (deg/s), ȳ_j point means, ȳ_j,fwd and ȳ_j,rev stroke means, K scale factor, \
         F0 zero offset, F_r rest reference, Y_FS full-scale output. Sources: [P] Cheng et al. 2014 (the paper), \
-        [GJB] GJB 2426A-2004 / JJF 1535-2015, [IEEE] IEEE Std 952-1997 / 528, [SP1065] NIST SP 1065, [T] sensor textbooks. \
+        [GJB] GJB 2426A-2004 / JJF 1535-2015, [IEEE] IEEE Std 952-1997 / 528, [SP1065] NIST SP 1065, [GB/T 18459] GB/T 18459-2001 (methods for calculating the main static performance specifications of transducers: Y_FS, linearity, hysteresis, repeatability). \
         Full definitions: docs/METHODS.md of gyrolab.</p>\n");
-    for group in [FigureGroup::RateTable, FigureGroup::Static, FigureGroup::Allan] {
+    // Every group in catalogue order.
+    let mut groups: Vec<FigureGroup> = Vec::new();
+    for d in FIGURES {
+        if !groups.contains(&d.group) {
+            groups.push(d.group);
+        }
+    }
+    for group in groups {
         let _ = writeln!(h, "<h3>{}</h3>", group.title());
         h.push_str("<table><thead><tr><th class=\"name\">figure</th><th class=\"name\">key</th><th class=\"name\">formula</th><th class=\"name\">unit</th><th class=\"name\">source</th></tr></thead><tbody>\n");
         for d in FIGURES.iter().filter(|d| d.group == group) {

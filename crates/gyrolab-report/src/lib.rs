@@ -10,6 +10,7 @@
 //! - [`inventory`]: the topics of a recording (`gyrolab inspect`);
 //! - [`results`]: the results.json document of `gyrolab eval`;
 //! - [`segments`]: segmentation summaries of raw rate-table logs;
+//! - [`thermal`]: the temperature-test section (soaked points, K(T), bias(T), sensitivities);
 //! - [`triad`]: three-axis calibration tables and JSON;
 //! - [`paper`]: the paper's printed tables beside the recomputation, for `gyrolab demo`;
 //! - [`tables_csv`]: the CSV tables of a report folder (points, runs, summary);
@@ -30,4 +31,5 @@ pub mod results;
 pub mod segments;
 pub mod static_report;
 pub mod tables_csv;
+pub mod thermal;
 pub mod triad;

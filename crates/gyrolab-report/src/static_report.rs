@@ -429,7 +429,9 @@ pub fn allan_plot(a: &StaticAxisReport) -> Option<Result<String, PlotError>> {
     Some(fig.to_svg())
 }
 
-fn figure_rows(figs: &AxisFigures, limits: &[Limit], keys: &[(String, String)]) -> Vec<FigureRow> {
+/// The figure rows of a section: each key's value with its unit, limit and verdict (keys without a
+/// value are left out).
+pub fn figure_rows(figs: &AxisFigures, limits: &[Limit], keys: &[(String, String)]) -> Vec<FigureRow> {
     let checks = check_limits(limits, std::slice::from_ref(figs));
     keys.iter()
         .filter_map(|(key, label)| {

@@ -107,4 +107,11 @@ fn report(s: &ApplySummary, out: Option<&Path>) {
             s.rows, s.below, s.above, s.not_finite
         );
     }
+    if s.temperature_compensated > 0 {
+        eprintln!(
+            "note: {} rows compensated for temperature (the calibration's [axis.temperature]); {} of them outside \
+             the model's temperature range, where the range's end was used",
+            s.temperature_compensated, s.temperature_outside
+        );
+    }
 }

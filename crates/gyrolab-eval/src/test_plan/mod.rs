@@ -3,6 +3,7 @@
 //! then the static (bias) and Allan part of every `[static.<axis>]` table.
 
 pub mod static_part;
+pub mod temperature;
 
 use crate::error::EvalResult;
 use crate::progress::Progress;
@@ -53,7 +54,11 @@ pub fn segmentation_request(p: &SegmentationPlan) -> SegmentationRequest {
 
 /// Number of progress steps of a plan's evaluation.
 pub fn progress_steps(plan: &TestPlan) -> u64 {
-    2 * plan.rate.len() as u64 + 6 + 2 * static_part::progress_steps(&plan.static_tests) + plan.triad.is_some() as u64
+    2 * plan.rate.len() as u64
+        + 6
+        + 2 * static_part::progress_steps(&plan.static_tests)
+        + plan.triad.is_some() as u64
+        + temperature::progress_steps(&plan.temperature)
 }
 
 /// The rate-table part of a plan: the evaluated axes in device axis order, and the raw logs they
@@ -175,6 +180,22 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         simulated: None,
     };
     let mut parts = static_part::evaluate_static(&plan.static_tests, &ctx, progress)?;
+    let thermal =
+        temperature::evaluate_temperature(&plan.temperature, &plan_settings(plan).options()?, &ctx, progress)?;
+    if !thermal.reports.is_empty() {
+        let plot_err = |e: gyrolab_report::plot::PlotError| EvalError::Output(e.to_string());
+        let mut json = serde_json::Map::new();
+        for r in &thermal.reports {
+            parts.sections.push(gyrolab_report::thermal::temperature_section(r, &limits).map_err(plot_err)?);
+            parts.figures.push(r.figures());
+            json.insert(r.axis.clone(), r.json());
+        }
+        parts.json.insert("temperature".into(), serde_json::Value::Object(json));
+        parts.files.push((
+            "temperature_points.csv".into(),
+            gyrolab_report::thermal::temperature_points_csv(&thermal.reports).into_bytes(),
+        ));
+    }
     if !logs.is_empty() {
         let mut seg = serde_json::Map::new();
         for (axis, log) in &logs {
@@ -220,6 +241,7 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         extra_json: parts.json,
         extra_files: parts.files,
         triad: triad_report,
+        temperature_models: thermal.compensation,
     };
     assemble_report(inputs, progress)
 }
