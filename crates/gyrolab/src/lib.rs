@@ -33,6 +33,7 @@ pub mod segment;
 pub mod sim;
 pub mod static_test;
 pub mod triad;
+pub mod uncertainty;
 pub mod units;
 pub mod validate;
 pub mod warmup;
