@@ -34,6 +34,8 @@ struct RawPlan {
     test: RawTest,
     #[serde(default)]
     equipment: Vec<Spanned<RawEquipment>>,
+    #[serde(default)]
+    uncertainty: Option<crate::plan_uncertainty::RawUncertainty>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -337,6 +339,8 @@ pub struct TestPlan {
     pub test: TestInfo,
     /// The equipment used (`[[equipment]]`), in plan order.
     pub equipment: Vec<Equipment>,
+    /// Measurement-uncertainty inputs (`[uncertainty]`); `None`: no uncertainty budgets.
+    pub uncertainty: Option<crate::plan_uncertainty::UncertaintyPlan>,
 }
 
 /// Reads and checks a plan file; `known_figure` tells which `[limits]` names exist.
@@ -688,6 +692,11 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         }
     };
 
+    let uncertainty = raw
+        .uncertainty
+        .as_ref()
+        .map(|u| crate::plan_uncertainty::parse_uncertainty(u, &|span, key, msg| cx.err(span, key, msg)))
+        .transpose()?;
     Ok(TestPlan {
         file: path.to_path_buf(),
         device: DevicePlan {
@@ -703,6 +712,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         triad,
         test,
         equipment,
+        uncertainty,
     })
 }
 

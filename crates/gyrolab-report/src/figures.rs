@@ -14,6 +14,8 @@ pub enum FigureGroup {
     Static,
     /// Allan variance noise terms.
     Allan,
+    /// Measurement uncertainty (GUM expanded uncertainties).
+    Uncertainty,
 }
 
 impl FigureGroup {
@@ -23,6 +25,7 @@ impl FigureGroup {
             FigureGroup::RateTable => "Rate-table test",
             FigureGroup::Static => "Static (bias) test",
             FigureGroup::Allan => "Allan variance",
+            FigureGroup::Uncertainty => "Measurement uncertainty",
         }
     }
 }
@@ -55,7 +58,7 @@ const fn def(
     FigureDef { key, label, unit, group, formula, source }
 }
 
-use FigureGroup::{Allan, RateTable, Static};
+use FigureGroup::{Allan, RateTable, Static, Uncertainty};
 
 /// Every figure gyrolab reports, in report order.
 #[rustfmt::skip]
@@ -84,6 +87,13 @@ pub const FIGURES: &[FigureDef] = &[
     def("rrw_deg_h_rt_h", "rate random walk K", "deg/h/√h", Allan, "K = √(3 (σ² − other terms) / τ) on the rising side where σ exceeds them beyond its bounds, × 216000", "[IEEE 952]"),
     def("quantization_deg", "quantization noise Q", "deg", Allan, "ADEV slope −1 line: Q = σ(τ) τ / √3", "[IEEE 952]"),
     def("rate_ramp_dph_per_h", "rate ramp R", "deg/h per h", Allan, "ADEV slope +1 line: R = √2 σ(τ) / τ, × 3600²", "[IEEE 952]"),
+    def("scale_factor_expanded_uncertainty_ppm", "expanded uncertainty of K", "ppm", Uncertainty, "U(K)/|K|, U = k √(u_A² + u_B²): u_A slope standard error, u_B = |K| u_rel(rate)", "[GUM] 4.2, 4.3, 5.1, 6"),
+    def("zero_offset_expanded_uncertainty", "expanded uncertainty of F0", "output", Uncertainty, "U = k √(u_A² + u_B²): u_A intercept standard error, u_B output accuracy", "[GUM] 4.2, 4.3, 5.1, 6"),
+    def("bias_expanded_uncertainty_dph", "expanded uncertainty of B_0", "deg/h", Uncertainty, "U = k u_c: record mean (OADEV σ(τ)√(τ/T)), null, output accuracy and K propagated", "[GUM] 5.1, 6"),
+    def("bias_stability_expanded_uncertainty_dph", "expanded uncertainty of B_s", "deg/h", Uncertainty, "U = k u_c: s/√(2(n − 1)) and K propagated", "[GUM] E.4.3, 6"),
+    def("arw_expanded_uncertainty_deg_rt_h", "expanded uncertainty of N", "deg/√h", Uncertainty, "U = k u_c: the wider side of the 68.3 % Allan interval at the reading τ, and K", "[GUM] 6, [SP1065]"),
+    def("bias_instability_expanded_uncertainty_dph", "expanded uncertainty of B", "deg/h", Uncertainty, "U = k u_c: the wider side of the 68.3 % Allan interval at the reading τ, and K", "[GUM] 6, [SP1065]"),
+    def("rrw_expanded_uncertainty_deg_h_rt_h", "expanded uncertainty of K (RRW)", "deg/h/√h", Uncertainty, "U = k u_c: the wider side of the 68.3 % Allan interval at the reading τ, and K", "[GUM] 6, [SP1065]"),
 ];
 
 /// The names a `[limits]` table may use (`<T>` stands for a smoothing time in seconds).

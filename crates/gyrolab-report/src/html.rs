@@ -433,9 +433,9 @@ fn write_methods(h: &mut String) {
     h.push_str("<section class=\"page-break\">\n<h2>Appendix: methods</h2>\n<p class=\"note\">Each figure with its formula, unit and source. \
         Notation: Ω_j table rates (deg/s), ȳ_j point means, ȳ_j,fwd and ȳ_j,rev stroke means, K scale factor, \
         F0 zero offset, F_r rest reference, Y_FS full-scale output. Sources: [P] Cheng et al. 2014 (the paper), \
-        [GJB] GJB 2426A-2004 / JJF 1535-2015, [IEEE] IEEE Std 952-1997 / 528, [SP1065] NIST SP 1065, [T] sensor textbooks. \
+        [GJB] GJB 2426A-2004 / JJF 1535-2015, [IEEE] IEEE Std 952-1997 / 528, [SP1065] NIST SP 1065, [GUM] JCGM 100:2008 = JJF 1059.1-2012, [T] sensor textbooks. \
         Full definitions: docs/METHODS.md of gyrolab.</p>\n");
-    for group in [FigureGroup::RateTable, FigureGroup::Static, FigureGroup::Allan] {
+    for group in [FigureGroup::RateTable, FigureGroup::Static, FigureGroup::Allan, FigureGroup::Uncertainty] {
         let _ = writeln!(h, "<h3>{}</h3>", group.title());
         h.push_str("<table><thead><tr><th class=\"name\">figure</th><th class=\"name\">key</th><th class=\"name\">formula</th><th class=\"name\">unit</th><th class=\"name\">source</th></tr></thead><tbody>\n");
         for d in FIGURES.iter().filter(|d| d.group == group) {

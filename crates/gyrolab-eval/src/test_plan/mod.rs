@@ -3,6 +3,7 @@
 //! then the static (bias) and Allan part of every `[static.<axis>]` table.
 
 pub mod static_part;
+pub mod uncertainty;
 
 use crate::error::EvalResult;
 use crate::progress::Progress;
@@ -175,6 +176,12 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         simulated: None,
     };
     let mut parts = static_part::evaluate_static(&plan.static_tests, &ctx, progress)?;
+    if let Some(u) = &plan.uncertainty {
+        let un = uncertainty::evaluate_uncertainty(u, &axes, &parts.reports);
+        parts.sections.extend(un.sections);
+        parts.figures.extend(un.figures);
+        parts.json.insert("uncertainty".into(), un.json);
+    }
     if !logs.is_empty() {
         let mut seg = serde_json::Map::new();
         for (axis, log) in &logs {
