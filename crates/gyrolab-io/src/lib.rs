@@ -20,6 +20,7 @@ pub mod decimal;
 pub mod error;
 pub mod parquet_table;
 pub mod plan_temperature;
+pub mod plan_uncertainty;
 pub mod rate_table;
 pub mod raw_log;
 pub mod recording;

@@ -36,6 +36,7 @@ struct RawPlan {
     equipment: Vec<Spanned<RawEquipment>>,
     #[serde(default)]
     temperature: BTreeMap<String, Spanned<crate::plan_temperature::RawTemperature>>,
+    uncertainty: Option<crate::plan_uncertainty::RawUncertainty>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -341,6 +342,8 @@ pub struct TestPlan {
     pub equipment: Vec<Equipment>,
     /// Temperature tests at soaked points (`[temperature.<axis>]`), in device axis order.
     pub temperature: Vec<crate::plan_temperature::TemperaturePlan>,
+    /// Measurement-uncertainty inputs (`[uncertainty]`); `None`: no uncertainty budgets.
+    pub uncertainty: Option<crate::plan_uncertainty::UncertaintyPlan>,
 }
 
 /// Reads and checks a plan file; `known_figure` tells which `[limits]` names exist.
@@ -709,6 +712,11 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         }
     };
 
+    let uncertainty = raw
+        .uncertainty
+        .as_ref()
+        .map(|u| crate::plan_uncertainty::parse_uncertainty(u, &|span, key, msg| cx.err(span, key, msg)))
+        .transpose()?;
     Ok(TestPlan {
         file: path.to_path_buf(),
         device: DevicePlan {
@@ -725,6 +733,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         test,
         equipment,
         temperature,
+        uncertainty,
     })
 }
 

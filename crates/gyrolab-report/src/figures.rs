@@ -16,6 +16,8 @@ pub enum FigureGroup {
     Allan,
     /// Temperature tests at soaked points.
     Temperature,
+    /// Measurement uncertainty (GUM expanded uncertainties).
+    Uncertainty,
 }
 
 impl FigureGroup {
@@ -26,6 +28,7 @@ impl FigureGroup {
             FigureGroup::Static => "Static (bias) test",
             FigureGroup::Allan => "Allan variance",
             FigureGroup::Temperature => "Temperature tests",
+            FigureGroup::Uncertainty => "Measurement uncertainty",
         }
     }
 }
@@ -58,7 +61,7 @@ const fn def(
     FigureDef { key, label, unit, group, formula, source }
 }
 
-use FigureGroup::{Allan, RateTable, Static, Temperature};
+use FigureGroup::{Allan, RateTable, Static, Temperature, Uncertainty};
 
 /// Every figure gyrolab reports, in report order.
 #[rustfmt::skip]
@@ -91,6 +94,13 @@ pub const FIGURES: &[FigureDef] = &[
     def("bias_temp_sensitivity_dph_per_c", "bias temperature sensitivity (soaked points)", "(deg/h)/degC", Temperature, "least-squares slope of B_i on T_i over the soaked points, B_i = (static mean − null) / K", "[IEEE 952] annex B, [GJB]"),
     def("scale_factor_thermal_hysteresis_ppm", "scale-factor thermal hysteresis", "ppm", Temperature, "max |K_heating − K_cooling| / K(T_ref) × 10⁶ at temperatures visited both ways (within 1 degC)", "[GJB]"),
     def("bias_thermal_hysteresis_dph", "bias thermal hysteresis", "deg/h", Temperature, "max |B_heating − B_cooling| at temperatures visited both ways (within 1 degC)", "[GJB]"),
+    def("scale_factor_expanded_uncertainty_ppm", "expanded uncertainty of K", "ppm", Uncertainty, "U(K)/|K|, U = k √(u_A² + u_B²): u_A slope standard error, u_B = |K| u_rel(rate)", "[GUM] 4.2, 4.3, 5.1, 6"),
+    def("zero_offset_expanded_uncertainty", "expanded uncertainty of F0", "output", Uncertainty, "U = k √(u_A² + u_B²): u_A intercept standard error, u_B output accuracy", "[GUM] 4.2, 4.3, 5.1, 6"),
+    def("bias_expanded_uncertainty_dph", "expanded uncertainty of B_0", "deg/h", Uncertainty, "U = k u_c: record mean (OADEV σ(τ)√(τ/T)), null, output accuracy and K propagated", "[GUM] 5.1, 6"),
+    def("bias_stability_expanded_uncertainty_dph", "expanded uncertainty of B_s", "deg/h", Uncertainty, "U = k u_c: s/√(2(n − 1)) and K propagated", "[GUM] E.4.3, 6"),
+    def("arw_expanded_uncertainty_deg_rt_h", "expanded uncertainty of N", "deg/√h", Uncertainty, "U = k u_c: the wider side of the 68.3 % Allan interval at the reading τ, and K", "[GUM] 6, [SP1065]"),
+    def("bias_instability_expanded_uncertainty_dph", "expanded uncertainty of B", "deg/h", Uncertainty, "U = k u_c: the wider side of the 68.3 % Allan interval at the reading τ, and K", "[GUM] 6, [SP1065]"),
+    def("rrw_expanded_uncertainty_deg_h_rt_h", "expanded uncertainty of K (RRW)", "deg/h/√h", Uncertainty, "U = k u_c: the wider side of the 68.3 % Allan interval at the reading τ, and K", "[GUM] 6, [SP1065]"),
 ];
 
 /// The names a `[limits]` table may use (`<T>` stands for a smoothing time in seconds).

@@ -433,7 +433,7 @@ fn write_methods(h: &mut String) {
     h.push_str("<section class=\"page-break\">\n<h2>Appendix: methods</h2>\n<p class=\"note\">Each figure with its formula, unit and source. \
         Notation: Ω_j table rates (deg/s), ȳ_j point means, ȳ_j,fwd and ȳ_j,rev stroke means, K scale factor, \
         F0 zero offset, F_r rest reference, Y_FS full-scale output. Sources: [P] Cheng et al. 2014 (the paper), \
-        [GJB] GJB 2426A-2004 / JJF 1535-2015, [IEEE] IEEE Std 952-1997 / 528, [SP1065] NIST SP 1065, [GB/T 18459] GB/T 18459-2001 (methods for calculating the main static performance specifications of transducers: Y_FS, linearity, hysteresis, repeatability). \
+        [GJB] GJB 2426A-2004 / JJF 1535-2015, [IEEE] IEEE Std 952-1997 / 528, [SP1065] NIST SP 1065, [GUM] JCGM 100:2008 = JJF 1059.1-2012, [GB/T 18459] GB/T 18459-2001 (methods for calculating the main static performance specifications of transducers: Y_FS, linearity, hysteresis, repeatability). \
         Full definitions: docs/METHODS.md of gyrolab.</p>\n");
     // Every group in catalogue order.
     let mut groups: Vec<FigureGroup> = Vec::new();

@@ -35,6 +35,7 @@ pub mod sim;
 pub mod static_test;
 pub mod thermal;
 pub mod triad;
+pub mod uncertainty;
 pub mod units;
 pub mod validate;
 pub mod warmup;

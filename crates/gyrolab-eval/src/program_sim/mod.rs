@@ -3,3 +3,4 @@
 //! tests, the example plan with every test and `gyrolab demo --out`.
 
 pub mod temperature;
+pub mod uncertainty;

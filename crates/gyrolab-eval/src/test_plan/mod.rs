@@ -4,6 +4,7 @@
 
 pub mod static_part;
 pub mod temperature;
+pub mod uncertainty;
 
 use crate::error::EvalResult;
 use crate::progress::Progress;
@@ -195,6 +196,12 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
             "temperature_points.csv".into(),
             gyrolab_report::thermal::temperature_points_csv(&thermal.reports).into_bytes(),
         ));
+    }
+    if let Some(u) = &plan.uncertainty {
+        let un = uncertainty::evaluate_uncertainty(u, &axes, &parts.reports);
+        parts.sections.extend(un.sections);
+        parts.figures.extend(un.figures);
+        parts.json.insert("uncertainty".into(), un.json);
     }
     if !logs.is_empty() {
         let mut seg = serde_json::Map::new();

@@ -41,6 +41,8 @@ pub struct StaticParts {
     pub json: BTreeMap<String, serde_json::Value>,
     /// CSV files (name, content).
     pub files: Vec<(String, Vec<u8>)>,
+    /// The evaluated axes (their numbers feed the measurement-uncertainty budgets).
+    pub reports: Vec<StaticAxisReport>,
 }
 
 /// Inputs of the static part besides the plan's `[static.*]` tables.
@@ -387,5 +389,6 @@ pub fn evaluate_static(
     if !allan_json.is_empty() {
         parts.json.insert("allan".into(), serde_json::Value::Object(allan_json));
     }
+    parts.reports = reports;
     Ok(parts)
 }
