@@ -10,6 +10,7 @@
 //! - [`decimal`]: exact fast reading of plain decimal numbers and rows of them;
 //! - [`series`]: streaming reader of time-series files, and the static test of a file;
 //! - [`sim_csv`]: fast CSV writer for simulated static records and rate-table tests;
+//! - [`threshold_record`]: threshold and resolution records (rate, output per sample);
 //! - [`test_plan`]: test plans (TOML) for `gyrolab eval`.
 
 pub mod apply_csv;
@@ -24,6 +25,7 @@ pub mod recording;
 pub mod series;
 pub mod sim_csv;
 pub mod text;
+pub mod threshold_record;
 
 pub use error::DataError;
 pub mod test_plan;

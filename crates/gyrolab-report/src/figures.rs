@@ -14,6 +14,8 @@ pub enum FigureGroup {
     Static,
     /// Allan variance noise terms.
     Allan,
+    /// Threshold and resolution tests.
+    ThresholdResolution,
 }
 
 impl FigureGroup {
@@ -23,6 +25,7 @@ impl FigureGroup {
             FigureGroup::RateTable => "Rate-table test",
             FigureGroup::Static => "Static (bias) test",
             FigureGroup::Allan => "Allan variance",
+            FigureGroup::ThresholdResolution => "Threshold and resolution",
         }
     }
 }
@@ -55,7 +58,7 @@ const fn def(
     FigureDef { key, label, unit, group, formula, source }
 }
 
-use FigureGroup::{Allan, RateTable, Static};
+use FigureGroup::{Allan, RateTable, Static, ThresholdResolution};
 
 /// Every figure gyrolab reports, in report order.
 #[rustfmt::skip]
@@ -84,6 +87,8 @@ pub const FIGURES: &[FigureDef] = &[
     def("rrw_deg_h_rt_h", "rate random walk K", "deg/h/√h", Allan, "K = √(3 (σ² − other terms) / τ) on the rising side where σ exceeds them beyond its bounds, × 216000", "[IEEE 952]"),
     def("quantization_deg", "quantization noise Q", "deg", Allan, "ADEV slope −1 line: Q = σ(τ) τ / √3", "[IEEE 952]"),
     def("rate_ramp_dph_per_h", "rate ramp R", "deg/h per h", Allan, "ADEV slope +1 line: R = √2 σ(τ) / τ, × 3600²", "[IEEE 952]"),
+    def("threshold_dps", "threshold", "deg/s", ThresholdResolution, "smallest tried |Ω| such that it and every larger tried |Ω| give (ȳ_Ω − ȳ_0) / (K Ω) ≥ 0.5 for +Ω and −Ω; at most the smallest tried when it passes; none (above the largest tried) when that fails", "[GJB], [IEEE 528]"),
+    def("resolution_dps", "resolution", "deg/s", ThresholdResolution, "at base rate Ω_b: smallest tried |δ| such that it and every larger tried |δ| give (ȳ_{Ω_b+δ} − ȳ_{Ω_b}) / (K δ) ≥ 0.5 for +δ and −δ; bounds as for threshold_dps", "[GJB], [IEEE 528]"),
 ];
 
 /// The names a `[limits]` table may use (`<T>` stands for a smoothing time in seconds).

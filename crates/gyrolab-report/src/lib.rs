@@ -13,6 +13,7 @@
 //! - [`triad`]: three-axis calibration tables and JSON;
 //! - [`paper`]: the paper's printed tables beside the recomputation, for `gyrolab demo`;
 //! - [`tables_csv`]: the CSV tables of a report folder (points, runs, summary);
+//! - [`threshold`]: threshold and resolution tests (section, figures, JSON);
 //! - [`format`]: number formatting.
 
 pub mod allan;
@@ -30,4 +31,5 @@ pub mod results;
 pub mod segments;
 pub mod static_report;
 pub mod tables_csv;
+pub mod threshold;
 pub mod triad;

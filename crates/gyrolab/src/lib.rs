@@ -16,6 +16,7 @@
 //! - [`apply`]: calibrations applied to output samples (output to rate);
 //! - [`sampling`]: the sampling interval of a record from its time stamps (one estimator);
 //! - [`validate`]: validators of option values (errors name the request field);
+//! - [`threshold`]: threshold and resolution from small-rate plateaus and rate steps;
 //! - [`window_means`]: streaming means of consecutive windows (bias time series).
 //!
 //! Formulas and their sources are listed in `docs/METHODS.md`.
@@ -32,6 +33,7 @@ pub mod sampling;
 pub mod segment;
 pub mod sim;
 pub mod static_test;
+pub mod threshold;
 pub mod triad;
 pub mod units;
 pub mod validate;

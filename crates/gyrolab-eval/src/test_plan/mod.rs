@@ -3,6 +3,7 @@
 //! then the static (bias) and Allan part of every `[static.<axis>]` table.
 
 pub mod static_part;
+pub mod threshold;
 
 use crate::error::EvalResult;
 use crate::progress::Progress;
@@ -53,7 +54,11 @@ pub fn segmentation_request(p: &SegmentationPlan) -> SegmentationRequest {
 
 /// Number of progress steps of a plan's evaluation.
 pub fn progress_steps(plan: &TestPlan) -> u64 {
-    2 * plan.rate.len() as u64 + 6 + 2 * static_part::progress_steps(&plan.static_tests) + plan.triad.is_some() as u64
+    2 * plan.rate.len() as u64
+        + 6
+        + 2 * static_part::progress_steps(&plan.static_tests)
+        + plan.triad.is_some() as u64
+        + threshold::progress_steps(&plan.threshold, &plan.resolution)
 }
 
 /// The rate-table part of a plan: the evaluated axes in device axis order, and the raw logs they
@@ -175,6 +180,11 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         simulated: None,
     };
     let mut parts = static_part::evaluate_static(&plan.static_tests, &ctx, progress)?;
+    let steps = threshold::evaluate_threshold(&plan.file, &plan.threshold, &plan.resolution, &axes, &limits, progress)?;
+    parts.sections.extend(steps.sections);
+    parts.figures.extend(steps.figures);
+    parts.json.extend(steps.json);
+    parts.files.extend(steps.files);
     if !logs.is_empty() {
         let mut seg = serde_json::Map::new();
         for (axis, log) in &logs {
