@@ -395,7 +395,7 @@ mod tests {
     #[test]
     fn bad_inputs_are_typed_errors() {
         let z = g(0.0, &[0.0, 0.0]);
-        assert_eq!(threshold(&[z.clone()], 1.0).unwrap_err(), ThresholdError::NoSteps);
+        assert_eq!(threshold(std::slice::from_ref(&z), 1.0).unwrap_err(), ThresholdError::NoSteps);
         assert_eq!(
             threshold(&[g(0.1, &[0.1, 0.1]), g(-0.1, &[0.0, 0.0])], 1.0).unwrap_err(),
             ThresholdError::NoReference { rate_dps: 0.0 }
@@ -408,7 +408,7 @@ mod tests {
             threshold(&[z.clone(), g(0.1, &[0.1])], 1.0).unwrap_err(),
             ThresholdError::TooFewSamples { rate_dps: 0.1, samples: 1 }
         );
-        assert_eq!(threshold(&[z.clone()], 0.0).unwrap_err(), ThresholdError::BadScaleFactor(0.0));
+        assert_eq!(threshold(std::slice::from_ref(&z), 0.0).unwrap_err(), ThresholdError::BadScaleFactor(0.0));
         assert_eq!(threshold(&[z, g(0.1, &[f64::NAN, 0.0])], 1.0).unwrap_err(), ThresholdError::NotFinite);
         assert_eq!(
             resolution(&[g(1.0, &[1.0, 1.0])], 2.0, 1.0).unwrap_err(),
