@@ -12,6 +12,8 @@
 //! - [`sim_csv`]: fast CSV writer for simulated static records and rate-table tests;
 //! - [`test_plan`]: test plans (TOML) for `gyrolab eval`;
 //! - [`plan_temperature`]: the plan's temperature tests at soaked points (`[temperature.<axis>]`).
+//! - [`threshold_record`]: threshold and resolution records (rate, output per sample);
+//! - [`test_plan`]: test plans (TOML) for `gyrolab eval`.
 
 pub mod apply_csv;
 pub mod atomic;
@@ -27,6 +29,7 @@ pub mod recording;
 pub mod series;
 pub mod sim_csv;
 pub mod text;
+pub mod threshold_record;
 
 pub use error::DataError;
 pub mod test_plan;

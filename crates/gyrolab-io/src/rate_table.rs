@@ -90,14 +90,19 @@ pub fn parse_rate_table(path: &Path, text: &str, columns: &RateColumns) -> Resul
     }
 }
 
-fn find_column(table: &TextTable, explicit: Option<&str>, base: &str) -> Option<usize> {
+pub(crate) fn find_column(table: &TextTable, explicit: Option<&str>, base: &str) -> Option<usize> {
     match explicit {
         Some(n) => table.column(n),
         None => table.header.iter().position(|h| split_unit_suffix(h).0 == base || h.eq_ignore_ascii_case(base)),
     }
 }
 
-fn rate_unit_of(path: &Path, table: &TextTable, col: usize, given: Option<RateUnit>) -> Result<RateUnit, DataError> {
+pub(crate) fn rate_unit_of(
+    path: &Path,
+    table: &TextTable,
+    col: usize,
+    given: Option<RateUnit>,
+) -> Result<RateUnit, DataError> {
     if let Some(u) = given {
         return Ok(u);
     }
@@ -125,7 +130,7 @@ fn bracketed_unit(name: &str) -> Option<String> {
     Some(inner.replace('°', "deg").replace("deg/sec", "deg/s"))
 }
 
-fn output_unit_of_name(name: &str) -> Result<Option<OutputUnit>, String> {
+pub(crate) fn output_unit_of_name(name: &str) -> Result<Option<OutputUnit>, String> {
     if let Some(b) = bracketed_unit(name) {
         if let Some(u) = OutputUnit::parse_gyro_output(&b) {
             return Ok(Some(u));

@@ -16,6 +16,10 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
+#[path = "plan_threshold.rs"]
+mod plan_threshold;
+pub use plan_threshold::{NominalScaleFactor, StepTestPlan};
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawPlan {
@@ -37,6 +41,10 @@ struct RawPlan {
     #[serde(default)]
     temperature: BTreeMap<String, Spanned<crate::plan_temperature::RawTemperature>>,
     uncertainty: Option<crate::plan_uncertainty::RawUncertainty>,
+    #[serde(default)]
+    threshold: BTreeMap<String, Spanned<plan_threshold::RawThreshold>>,
+    #[serde(default)]
+    resolution: BTreeMap<String, Spanned<plan_threshold::RawResolution>>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -344,6 +352,10 @@ pub struct TestPlan {
     pub temperature: Vec<crate::plan_temperature::TemperaturePlan>,
     /// Measurement-uncertainty inputs (`[uncertainty]`); `None`: no uncertainty budgets.
     pub uncertainty: Option<crate::plan_uncertainty::UncertaintyPlan>,
+    /// Threshold tests (`[threshold.<axis>]`) in device axis order.
+    pub threshold: Vec<StepTestPlan>,
+    /// Resolution tests (`[resolution.<axis>]`) in device axis order.
+    pub resolution: Vec<StepTestPlan>,
 }
 
 /// Reads and checks a plan file; `known_figure` tells which `[limits]` names exist.
@@ -470,6 +482,8 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         ("rate", raw.rate.iter().map(|(k, v)| (k, v.span())).collect::<Vec<_>>()),
         ("static", raw.static_tests.iter().map(|(k, v)| (k, v.span())).collect()),
         ("temperature", raw.temperature.iter().map(|(k, v)| (k, v.span())).collect()),
+        ("threshold", raw.threshold.iter().map(|(k, v)| (k, v.span())).collect()),
+        ("resolution", raw.resolution.iter().map(|(k, v)| (k, v.span())).collect()),
     ] {
         for (k, span) in keys {
             if !axes.contains(k) {
@@ -482,15 +496,20 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         }
     }
     for a in &axes {
+        let step_test = raw.threshold.contains_key(a) || raw.resolution.contains_key(a);
         if !raw.rate.contains_key(a)
             && !raw.static_tests.contains_key(a)
             && !raw.temperature.contains_key(a)
             && raw.triad.is_none()
+            && !step_test
         {
             return Err(cx.err(
                 raw.device.axes.span(),
                 "device.axes",
-                format!("axis '{a}' has neither a [rate.{a}] nor a [static.{a}] table (nor is there a [triad])"),
+                format!(
+                    "axis '{a}' has neither a [rate.{a}] nor a [static.{a}] table (nor [threshold.{a}], \
+                     [resolution.{a}] or a [triad])"
+                ),
             ));
         }
     }
@@ -717,6 +736,14 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         .as_ref()
         .map(|u| crate::plan_uncertainty::parse_uncertainty(u, &|span, key, msg| cx.err(span, key, msg)))
         .transpose()?;
+    let (threshold, resolution) = plan_threshold::parse_step_tests(
+        &cx,
+        &axes,
+        &plan_threshold::RawStepTables { threshold: &raw.threshold, resolution: &raw.resolution },
+        &|a| raw.rate.contains_key(a),
+        options.calibration.as_ref(),
+    )?;
+
     Ok(TestPlan {
         file: path.to_path_buf(),
         device: DevicePlan {
@@ -734,6 +761,8 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         equipment,
         temperature,
         uncertainty,
+        threshold,
+        resolution,
     })
 }
 

@@ -18,6 +18,8 @@ pub enum FigureGroup {
     Temperature,
     /// Measurement uncertainty (GUM expanded uncertainties).
     Uncertainty,
+    /// Threshold and resolution tests.
+    ThresholdResolution,
 }
 
 impl FigureGroup {
@@ -29,6 +31,7 @@ impl FigureGroup {
             FigureGroup::Allan => "Allan variance",
             FigureGroup::Temperature => "Temperature tests",
             FigureGroup::Uncertainty => "Measurement uncertainty",
+            FigureGroup::ThresholdResolution => "Threshold and resolution",
         }
     }
 }
@@ -61,7 +64,7 @@ const fn def(
     FigureDef { key, label, unit, group, formula, source }
 }
 
-use FigureGroup::{Allan, RateTable, Static, Temperature, Uncertainty};
+use FigureGroup::{Allan, RateTable, Static, Temperature, ThresholdResolution, Uncertainty};
 
 /// Every figure gyrolab reports, in report order.
 #[rustfmt::skip]
@@ -101,6 +104,8 @@ pub const FIGURES: &[FigureDef] = &[
     def("arw_expanded_uncertainty_deg_rt_h", "expanded uncertainty of N", "deg/√h", Uncertainty, "U = k u_c: the wider side of the 68.3 % Allan interval at the reading τ, and K", "[GUM] 6, [SP1065]"),
     def("bias_instability_expanded_uncertainty_dph", "expanded uncertainty of B", "deg/h", Uncertainty, "U = k u_c: the wider side of the 68.3 % Allan interval at the reading τ, and K", "[GUM] 6, [SP1065]"),
     def("rrw_expanded_uncertainty_deg_h_rt_h", "expanded uncertainty of K (RRW)", "deg/h/√h", Uncertainty, "U = k u_c: the wider side of the 68.3 % Allan interval at the reading τ, and K", "[GUM] 6, [SP1065]"),
+    def("threshold_dps", "threshold", "deg/s", ThresholdResolution, "smallest tried |Ω| such that it and every larger tried |Ω| give (ȳ_Ω − ȳ_0) / (K Ω) ≥ 0.5 for +Ω and −Ω; at most the smallest tried when it passes; none (above the largest tried) when that fails", "[GJB], [IEEE 528]"),
+    def("resolution_dps", "resolution", "deg/s", ThresholdResolution, "at base rate Ω_b: smallest tried |δ| such that it and every larger tried |δ| give (ȳ_{Ω_b+δ} − ȳ_{Ω_b}) / (K δ) ≥ 0.5 for +δ and −δ; bounds as for threshold_dps", "[GJB], [IEEE 528]"),
 ];
 
 /// The names a `[limits]` table may use (`<T>` stands for a smoothing time in seconds).

@@ -14,6 +14,7 @@
 //! - [`triad`]: three-axis calibration tables and JSON;
 //! - [`paper`]: the paper's printed tables beside the recomputation, for `gyrolab demo`;
 //! - [`tables_csv`]: the CSV tables of a report folder (points, runs, summary);
+//! - [`threshold`]: threshold and resolution tests (section, figures, JSON);
 //! - [`format`]: number formatting.
 
 pub mod allan;
@@ -32,4 +33,5 @@ pub mod segments;
 pub mod static_report;
 pub mod tables_csv;
 pub mod thermal;
+pub mod threshold;
 pub mod triad;

@@ -17,6 +17,7 @@
 //! - [`sampling`]: the sampling interval of a record from its time stamps (one estimator);
 //! - [`validate`]: validators of option values (errors name the request field);
 //! - [`thermal`]: temperature tests at soaked points: K(T), bias(T), sensitivities, compensation;
+//! - [`threshold`]: threshold and resolution from small-rate plateaus and rate steps;
 //! - [`window_means`]: streaming means of consecutive windows (bias time series).
 //!
 //! Formulas and their sources are listed in `docs/METHODS.md`.
@@ -34,6 +35,7 @@ pub mod segment;
 pub mod sim;
 pub mod static_test;
 pub mod thermal;
+pub mod threshold;
 pub mod triad;
 pub mod uncertainty;
 pub mod units;

@@ -3,4 +3,5 @@
 //! tests, the example plan with every test and `gyrolab demo --out`.
 
 pub mod temperature;
+pub mod threshold;
 pub mod uncertainty;

@@ -4,6 +4,7 @@
 
 pub mod static_part;
 pub mod temperature;
+pub mod threshold;
 pub mod uncertainty;
 
 use crate::error::EvalResult;
@@ -60,6 +61,7 @@ pub fn progress_steps(plan: &TestPlan) -> u64 {
         + 2 * static_part::progress_steps(&plan.static_tests)
         + plan.triad.is_some() as u64
         + temperature::progress_steps(&plan.temperature)
+        + threshold::progress_steps(&plan.threshold, &plan.resolution)
 }
 
 /// The rate-table part of a plan: the evaluated axes in device axis order, and the raw logs they
@@ -181,6 +183,11 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         simulated: None,
     };
     let mut parts = static_part::evaluate_static(&plan.static_tests, &ctx, progress)?;
+    let steps = threshold::evaluate_threshold(&plan.file, &plan.threshold, &plan.resolution, &axes, &limits, progress)?;
+    parts.sections.extend(steps.sections);
+    parts.figures.extend(steps.figures);
+    parts.json.extend(steps.json);
+    parts.files.extend(steps.files);
     let thermal =
         temperature::evaluate_temperature(&plan.temperature, &plan_settings(plan).options()?, &ctx, progress)?;
     if !thermal.reports.is_empty() {

@@ -160,6 +160,7 @@ struct Engine {
     rail_low: f64,
     rail_high: f64,
     hysteresis_half_dps: f64,
+    dead_zone_dps: f64,
     bias_dps: f64,
     run_bias_sigma_dps: f64,
     run_scale_factor_sigma: f64,
@@ -260,6 +261,7 @@ impl Engine {
             rail_low: model.output_rail_low.unwrap_or(f64::NEG_INFINITY),
             rail_high: model.output_rail_high.unwrap_or(f64::INFINITY),
             hysteresis_half_dps: model.hysteresis_dps / 2.0,
+            dead_zone_dps: model.dead_zone_dps,
             bias_dps: units::dph_to_dps(model.bias_dph),
             run_bias_sigma_dps: units::dph_to_dps(model.run_to_run_bias_sigma_dph),
             run_scale_factor_sigma: units::ppm_to_ratio(model.run_to_run_scale_factor_sigma_ppm),
@@ -372,10 +374,16 @@ impl Engine {
         self.input_offset_dps(table_dps, stroke_sign) + self.bias_dps_at(t_s, d_temp) + noise
     }
 
-    /// Table rate plus earth rate plus the stroke's hysteresis offset, deg/s.
+    /// Table rate plus earth rate plus the stroke's hysteresis offset, deg/s; zero when its
+    /// magnitude is below the dead zone.
     #[inline(always)]
     fn input_offset_dps(&self, table_dps: f64, stroke_sign: f64) -> f64 {
-        table_dps + self.earth_dps + stroke_sign * self.hysteresis_half_dps
+        let w = table_dps + self.earth_dps + stroke_sign * self.hysteresis_half_dps;
+        if w.abs() < self.dead_zone_dps {
+            0.0
+        } else {
+            w
+        }
     }
 
     /// The bias at time t_s and temperature offset d_temp, deg/s.

@@ -147,6 +147,11 @@ sensor_model! {
     output_rail_low: Option<f64>,
     /// Upper output rail (saturation), output units; none for no rail.
     output_rail_high: Option<f64>,
+    /// Dead zone (threshold), deg/s: an input rate (table rate plus earth rate plus the
+    /// hysteresis offset, before bias and noise are added) of magnitude below it is not sensed
+    /// (contributes no output change); at or above it, it is sensed in full (a gap dead zone,
+    /// so the simulated threshold is exactly this value); 0 for none.
+    dead_zone_dps: f64,
     /// Hysteresis: forward-minus-reverse stroke difference of the sensed rate, deg/s (+h/2 forward, -h/2 reverse).
     hysteresis_dps: f64,
     /// Constant bias (turn-on bias), deg/h.
@@ -197,6 +202,7 @@ impl Default for SensorModel {
             nonlinearity_cubic_per_dps2: 0.0,
             output_rail_low: None,
             output_rail_high: None,
+            dead_zone_dps: 0.0,
             hysteresis_dps: 0.0,
             bias_dph: 0.0,
             run_to_run_bias_sigma_dph: 0.0,
@@ -351,6 +357,7 @@ impl SensorModel {
         if !(low < self.null && self.null < high) {
             return Err(SimError::RailsMustEncloseNull { low, high, null: self.null });
         }
+        non_negative("dead_zone_dps", self.dead_zone_dps)?;
         finite("hysteresis_dps", self.hysteresis_dps)?;
         finite("bias_dph", self.bias_dph)?;
         non_negative("run_to_run_bias_sigma_dph", self.run_to_run_bias_sigma_dph)?;
