@@ -29,6 +29,7 @@ pub mod demo;
 pub mod error;
 pub mod layout;
 pub mod paper;
+pub mod program_sim;
 pub mod progress;
 pub mod rate;
 pub mod raw_log;

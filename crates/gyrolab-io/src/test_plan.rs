@@ -16,6 +16,10 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
+#[path = "plan_power_ups.rs"]
+mod plan_power_ups;
+pub use plan_power_ups::{PowerUpsPlan, WarmupPlan, DEFAULT_WARMUP_WINDOW_S};
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawPlan {
@@ -34,6 +38,10 @@ struct RawPlan {
     test: RawTest,
     #[serde(default)]
     equipment: Vec<Spanned<RawEquipment>>,
+    #[serde(default)]
+    power_ups: BTreeMap<String, Spanned<plan_power_ups::RawPowerUps>>,
+    #[serde(default)]
+    warmup: BTreeMap<String, Spanned<plan_power_ups::RawWarmup>>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -337,6 +345,10 @@ pub struct TestPlan {
     pub test: TestInfo,
     /// The equipment used (`[[equipment]]`), in plan order.
     pub equipment: Vec<Equipment>,
+    /// Records of repeated power-ups (`[power_ups.<axis>]`), in device axis order.
+    pub power_ups: Vec<PowerUpsPlan>,
+    /// Warm-up records from power-on (`[warmup.<axis>]`), in device axis order.
+    pub warmup: Vec<WarmupPlan>,
 }
 
 /// Reads and checks a plan file; `known_figure` tells which `[limits]` names exist.
@@ -469,11 +481,19 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         }
     }
     for a in &axes {
-        if !raw.rate.contains_key(a) && !raw.static_tests.contains_key(a) && raw.triad.is_none() {
+        if !raw.rate.contains_key(a)
+            && !raw.static_tests.contains_key(a)
+            && !raw.power_ups.contains_key(a)
+            && !raw.warmup.contains_key(a)
+            && raw.triad.is_none()
+        {
             return Err(cx.err(
                 raw.device.axes.span(),
                 "device.axes",
-                format!("axis '{a}' has neither a [rate.{a}] nor a [static.{a}] table (nor is there a [triad])"),
+                format!(
+                    "axis '{a}' has neither a [rate.{a}] nor a [static.{a}] table (nor [power_ups.{a}], \
+                     [warmup.{a}] or a [triad])"
+                ),
             ));
         }
     }
@@ -688,6 +708,8 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         }
     };
 
+    let power_ups = plan_power_ups::power_ups(&cx, &raw.power_ups, &axes)?;
+    let warmup = plan_power_ups::warmups(&cx, &raw.warmup, &axes)?;
     Ok(TestPlan {
         file: path.to_path_buf(),
         device: DevicePlan {
@@ -703,6 +725,8 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         triad,
         test,
         equipment,
+        power_ups,
+        warmup,
     })
 }
 

@@ -2,6 +2,7 @@
 //! report folder: the rate-table records per axis (long, wide or raw logs), a three-axis set,
 //! then the static (bias) and Allan part of every `[static.<axis>]` table.
 
+pub mod power_ups;
 pub mod static_part;
 
 use crate::error::EvalResult;
@@ -53,7 +54,11 @@ pub fn segmentation_request(p: &SegmentationPlan) -> SegmentationRequest {
 
 /// Number of progress steps of a plan's evaluation.
 pub fn progress_steps(plan: &TestPlan) -> u64 {
-    2 * plan.rate.len() as u64 + 6 + 2 * static_part::progress_steps(&plan.static_tests) + plan.triad.is_some() as u64
+    2 * plan.rate.len() as u64
+        + 6
+        + 2 * static_part::progress_steps(&plan.static_tests)
+        + plan.triad.is_some() as u64
+        + power_ups::progress_steps(plan)
 }
 
 /// The rate-table part of a plan: the evaluated axes in device axis order, and the raw logs they
@@ -175,6 +180,11 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         simulated: None,
     };
     let mut parts = static_part::evaluate_static(&plan.static_tests, &ctx, progress)?;
+    let more = power_ups::evaluate_power_ups(plan, &ctx, progress)?;
+    parts.sections.extend(more.sections);
+    parts.figures.extend(more.figures);
+    parts.json.extend(more.json);
+    parts.files.extend(more.files);
     if !logs.is_empty() {
         let mut seg = serde_json::Map::new();
         for (axis, log) in &logs {
