@@ -4,7 +4,7 @@
 
 use crate::bias::{warmup_text, WarmupJson, WarmupReport};
 use crate::figures::{known_figure, AxisFigures};
-use crate::format::sig;
+use crate::format::{short, sig};
 use crate::html::{DataTable, FigureRow, PlotBlock, ReportSection};
 use crate::limits::{check_limits, Limit};
 use crate::plot::{Axis, Figure, LegendCorner, Panel, PlotError, Series, SeriesStyle};
@@ -175,6 +175,17 @@ fn figure_rows(figs: &AxisFigures, limits: &[Limit], keys: &[&str]) -> Vec<Figur
         .collect()
 }
 
+/// The reference in words; with none, outputs that are rates are converted by their own unit.
+fn reference_text(r: &ReferenceJson) -> String {
+    if r.source == "none" {
+        "Reference: none (no rate-table record of this axis in the plan and no calibration file): the outputs \
+         are rates in their own unit (deg/s, rad/s), converted to deg/h with K = 1 in that unit and null 0."
+            .to_string()
+    } else {
+        format!("Reference: {}", r.text)
+    }
+}
+
 fn support_text(what: &str, f: &PowerUpFigure) -> String {
     match &f.spread {
         Err(e) => format!("{what}: no value ({e})."),
@@ -237,7 +248,7 @@ pub fn power_ups_section(r: &PowerUpsReport, limits: &[Limit]) -> ReportSection 
     if let Some(f) = &r.bias {
         paragraphs.push(support_text("Bias repeatability across power-ups (std(B0_i))", f));
         if let Some(re) = &r.reference {
-            paragraphs.push(format!("B0_i = (mean output − null) / K per record; reference: {}", re.text));
+            paragraphs.push(format!("B0_i = (mean output − null) / K per record. {}", reference_text(re)));
         }
         tables.push(table(format!("Bias B0_i per power-up, axis {} (deg/h)", r.axis), "deg/h", "deg/h", f, &|d, _| d));
     }
@@ -319,7 +330,7 @@ pub fn warmup_plot(w: &WarmupAxisReport) -> Result<String, PlotError> {
     let band = r.config.band;
     let mut p = Panel::new(Axis::linear("time from power-on (s)"), Axis::linear("bias, window mean (deg/h)"));
     p.series.push(Series::new(
-        format!("{}-s window means", sig(r.config.window_s, 4)),
+        format!("{}-s window means", short(r.config.window_s, 6)),
         r.windows.clone(),
         SeriesStyle::Markers,
         0,
@@ -328,7 +339,7 @@ pub fn warmup_plot(w: &WarmupAxisReport) -> Result<String, PlotError> {
     let hi = r.final_bias + band;
     let lo = r.final_bias - band;
     p.series.push(Series::new(
-        format!("band ±{} deg/h about the final bias", sig(band, 3)),
+        format!("band ±{} deg/h about the final bias", short(band, 6)),
         vec![(0.0, hi), (t_end, hi)],
         SeriesStyle::Dashed,
         6,
@@ -367,7 +378,7 @@ pub fn warmup_section(w: &WarmupAxisReport, limits: &[Limit]) -> Result<ReportSe
             "Warm-up from power-on (IEEE Std 952 / 1431 turn-on bias and warm-up time, GJB 2426A-2004): bias window \
              means from power-on, the settling time to ±{} deg/h about the final bias (mean of the last 20 % of the \
              record), and the model B(t) = B_inf + A exp(−t/τ) fitted to the window means. docs/METHODS.md, \"Warm-up\".",
-            sig(r.config.band, 4)
+            short(r.config.band, 6)
         ),
         if w.timed {
             format!(
@@ -379,7 +390,7 @@ pub fn warmup_section(w: &WarmupAxisReport, limits: &[Limit]) -> Result<ReportSe
             "The record has no time column: its first sample is taken as power-on.".to_string()
         },
         warmup_text(std::slice::from_ref(&w.report)).trim_end().to_string(),
-        format!("Reference: {}", w.reference.text),
+        reference_text(&w.reference),
     ];
     if r.settling_time_s.is_none() {
         paragraphs.push(format!(
