@@ -19,6 +19,9 @@ use toml::Spanned;
 #[path = "plan_threshold.rs"]
 mod plan_threshold;
 pub use plan_threshold::{NominalScaleFactor, StepTestPlan};
+#[path = "plan_power_ups.rs"]
+mod plan_power_ups;
+pub use plan_power_ups::{PowerUpsPlan, WarmupPlan, DEFAULT_WARMUP_WINDOW_S};
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -45,6 +48,10 @@ struct RawPlan {
     threshold: BTreeMap<String, Spanned<plan_threshold::RawThreshold>>,
     #[serde(default)]
     resolution: BTreeMap<String, Spanned<plan_threshold::RawResolution>>,
+    #[serde(default)]
+    power_ups: BTreeMap<String, Spanned<plan_power_ups::RawPowerUps>>,
+    #[serde(default)]
+    warmup: BTreeMap<String, Spanned<plan_power_ups::RawWarmup>>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -356,6 +363,10 @@ pub struct TestPlan {
     pub threshold: Vec<StepTestPlan>,
     /// Resolution tests (`[resolution.<axis>]`) in device axis order.
     pub resolution: Vec<StepTestPlan>,
+    /// Records of repeated power-ups (`[power_ups.<axis>]`), in device axis order.
+    pub power_ups: Vec<PowerUpsPlan>,
+    /// Warm-up records from power-on (`[warmup.<axis>]`), in device axis order.
+    pub warmup: Vec<WarmupPlan>,
 }
 
 /// Reads and checks a plan file; `known_figure` tells which `[limits]` names exist.
@@ -500,6 +511,8 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         if !raw.rate.contains_key(a)
             && !raw.static_tests.contains_key(a)
             && !raw.temperature.contains_key(a)
+            && !raw.power_ups.contains_key(a)
+            && !raw.warmup.contains_key(a)
             && raw.triad.is_none()
             && !step_test
         {
@@ -507,8 +520,8 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
                 raw.device.axes.span(),
                 "device.axes",
                 format!(
-                    "axis '{a}' has neither a [rate.{a}] nor a [static.{a}] table (nor [threshold.{a}], \
-                     [resolution.{a}] or a [triad])"
+                    "axis '{a}' has neither a [rate.{a}] nor a [static.{a}] table (nor [temperature.{a}], \
+                     [threshold.{a}], [resolution.{a}], [power_ups.{a}], [warmup.{a}] or a [triad])"
                 ),
             ));
         }
@@ -744,6 +757,8 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         options.calibration.as_ref(),
     )?;
 
+    let power_ups = plan_power_ups::power_ups(&cx, &raw.power_ups, &axes)?;
+    let warmup = plan_power_ups::warmups(&cx, &raw.warmup, &axes)?;
     Ok(TestPlan {
         file: path.to_path_buf(),
         device: DevicePlan {
@@ -763,6 +778,8 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         uncertainty,
         threshold,
         resolution,
+        power_ups,
+        warmup,
     })
 }
 

@@ -26,6 +26,7 @@ pub mod inventory;
 pub mod limits;
 pub mod paper;
 pub mod plot;
+pub mod power_ups;
 pub mod rate;
 pub mod rate_plots;
 pub mod results;

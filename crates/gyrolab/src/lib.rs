@@ -27,6 +27,7 @@ pub mod apply;
 pub mod dropout;
 pub mod fit;
 pub mod noise;
+pub mod power_ups;
 pub mod published;
 pub mod rate_test;
 pub mod record_length;

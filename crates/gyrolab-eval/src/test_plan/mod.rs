@@ -2,6 +2,7 @@
 //! report folder: the rate-table records per axis (long, wide or raw logs), a three-axis set,
 //! then the static (bias) and Allan part of every `[static.<axis>]` table.
 
+pub mod power_ups;
 pub mod static_part;
 pub mod temperature;
 pub mod threshold;
@@ -62,6 +63,7 @@ pub fn progress_steps(plan: &TestPlan) -> u64 {
         + plan.triad.is_some() as u64
         + temperature::progress_steps(&plan.temperature)
         + threshold::progress_steps(&plan.threshold, &plan.resolution)
+        + power_ups::progress_steps(plan)
 }
 
 /// The rate-table part of a plan: the evaluated axes in device axis order, and the raw logs they
@@ -183,6 +185,11 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         simulated: None,
     };
     let mut parts = static_part::evaluate_static(&plan.static_tests, &ctx, progress)?;
+    let more = power_ups::evaluate_power_ups(plan, &ctx, progress)?;
+    parts.sections.extend(more.sections);
+    parts.figures.extend(more.figures);
+    parts.json.extend(more.json);
+    parts.files.extend(more.files);
     let steps = threshold::evaluate_threshold(&plan.file, &plan.threshold, &plan.resolution, &axes, &limits, progress)?;
     parts.sections.extend(steps.sections);
     parts.figures.extend(steps.figures);

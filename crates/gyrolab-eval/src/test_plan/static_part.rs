@@ -59,7 +59,7 @@ pub struct StaticContext<'a> {
     pub simulated: Option<&'a dyn Fn(&str) -> String>,
 }
 
-fn shown(path: &Path, base: &Path) -> String {
+pub(crate) fn shown(path: &Path, base: &Path) -> String {
     path.strip_prefix(base).unwrap_or(path).display().to_string()
 }
 
