@@ -13,6 +13,7 @@
 //! - [`record_length`]: the record length a noise term's precision needs;
 //! - [`recording`]: recordings (MCAP, ROS 1 bags, ULog): inventories and conversion to CSV/Parquet;
 //! - [`test_plan`]: TOML test plans evaluated into a report folder;
+//! - [`program_sim`]: simulated records with known truth for the tests of a plan;
 //! - [`demo`]: the paper's worked example and its report folder ([`paper`]: its data);
 //! - [`report_folder`]: a report folder as named outputs the caller writes;
 //! - [`reference`]: the output-to-rate reference (K, null, unit): the one place outputs become rates;
@@ -29,6 +30,7 @@ pub mod demo;
 pub mod error;
 pub mod layout;
 pub mod paper;
+pub mod program_sim;
 pub mod progress;
 pub mod rate;
 pub mod raw_log;

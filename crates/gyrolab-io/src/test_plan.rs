@@ -16,6 +16,10 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
+#[path = "plan_g_sensitivity.rs"]
+mod plan_g_sensitivity;
+pub use plan_g_sensitivity::{GRecordPlan, GSensitivityAxisPlan};
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawPlan {
@@ -34,6 +38,8 @@ struct RawPlan {
     test: RawTest,
     #[serde(default)]
     equipment: Vec<Spanned<RawEquipment>>,
+    #[serde(default)]
+    g_sensitivity: BTreeMap<String, Spanned<plan_g_sensitivity::RawGSensitivity>>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -337,6 +343,8 @@ pub struct TestPlan {
     pub test: TestInfo,
     /// The equipment used (`[[equipment]]`), in plan order.
     pub equipment: Vec<Equipment>,
+    /// g-sensitivity records (`[g_sensitivity.<axis>]`) in device axis order.
+    pub g_sensitivity: Vec<GSensitivityAxisPlan>,
 }
 
 /// Reads and checks a plan file; `known_figure` tells which `[limits]` names exist.
@@ -457,6 +465,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
     for (table, keys) in [
         ("rate", raw.rate.iter().map(|(k, v)| (k, v.span())).collect::<Vec<_>>()),
         ("static", raw.static_tests.iter().map(|(k, v)| (k, v.span())).collect()),
+        ("g_sensitivity", raw.g_sensitivity.iter().map(|(k, v)| (k, v.span())).collect()),
     ] {
         for (k, span) in keys {
             if !axes.contains(k) {
@@ -469,11 +478,18 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         }
     }
     for a in &axes {
-        if !raw.rate.contains_key(a) && !raw.static_tests.contains_key(a) && raw.triad.is_none() {
+        if !raw.rate.contains_key(a)
+            && !raw.static_tests.contains_key(a)
+            && !raw.g_sensitivity.contains_key(a)
+            && raw.triad.is_none()
+        {
             return Err(cx.err(
                 raw.device.axes.span(),
                 "device.axes",
-                format!("axis '{a}' has neither a [rate.{a}] nor a [static.{a}] table (nor is there a [triad])"),
+                format!(
+                    "axis '{a}' has neither a [rate.{a}] nor a [static.{a}] nor a [g_sensitivity.{a}] table (nor is \
+                     there a [triad])"
+                ),
             ));
         }
     }
@@ -688,6 +704,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         }
     };
 
+    let g_sensitivity = plan_g_sensitivity::parse_g_sensitivity(&cx, &raw.g_sensitivity, &axes)?;
     Ok(TestPlan {
         file: path.to_path_buf(),
         device: DevicePlan {
@@ -703,6 +720,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         triad,
         test,
         equipment,
+        g_sensitivity,
     })
 }
 

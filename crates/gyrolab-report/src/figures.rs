@@ -14,6 +14,8 @@ pub enum FigureGroup {
     Static,
     /// Allan variance noise terms.
     Allan,
+    /// g-sensitivity (static records in several orientations).
+    GSensitivity,
 }
 
 impl FigureGroup {
@@ -23,6 +25,7 @@ impl FigureGroup {
             FigureGroup::RateTable => "Rate-table test",
             FigureGroup::Static => "Static (bias) test",
             FigureGroup::Allan => "Allan variance",
+            FigureGroup::GSensitivity => "g-sensitivity",
         }
     }
 }
@@ -55,7 +58,7 @@ const fn def(
     FigureDef { key, label, unit, group, formula, source }
 }
 
-use FigureGroup::{Allan, RateTable, Static};
+use FigureGroup::{Allan, GSensitivity, RateTable, Static};
 
 /// Every figure gyrolab reports, in report order.
 #[rustfmt::skip]
@@ -84,6 +87,7 @@ pub const FIGURES: &[FigureDef] = &[
     def("rrw_deg_h_rt_h", "rate random walk K", "deg/h/√h", Allan, "K = √(3 (σ² − other terms) / τ) on the rising side where σ exceeds them beyond its bounds, × 216000", "[IEEE 952]"),
     def("quantization_deg", "quantization noise Q", "deg", Allan, "ADEV slope −1 line: Q = σ(τ) τ / √3", "[IEEE 952]"),
     def("rate_ramp_dph_per_h", "rate ramp R", "deg/h per h", Allan, "ADEV slope +1 line: R = √2 σ(τ) / τ, × 3600²", "[IEEE 952]"),
+    def("g_sensitivity_dph_per_g", "g-sensitivity |G|", "(deg/h)/g", GSensitivity, "|G| of the resolved components of B_i = B_0 + G · f_i, least squares over static records in several orientations (one resolved component: its absolute value)", "IEEE Std 1431-2004, [IEEE 952], [GJB]"),
 ];
 
 /// The names a `[limits]` table may use (`<T>` stands for a smoothing time in seconds).

@@ -435,7 +435,7 @@ fn write_methods(h: &mut String) {
         F0 zero offset, F_r rest reference, Y_FS full-scale output. Sources: [P] Cheng et al. 2014 (the paper), \
         [GJB] GJB 2426A-2004 / JJF 1535-2015, [IEEE] IEEE Std 952-1997 / 528, [SP1065] NIST SP 1065, [T] sensor textbooks. \
         Full definitions: docs/METHODS.md of gyrolab.</p>\n");
-    for group in [FigureGroup::RateTable, FigureGroup::Static, FigureGroup::Allan] {
+    for group in [FigureGroup::RateTable, FigureGroup::Static, FigureGroup::Allan, FigureGroup::GSensitivity] {
         let _ = writeln!(h, "<h3>{}</h3>", group.title());
         h.push_str("<table><thead><tr><th class=\"name\">figure</th><th class=\"name\">key</th><th class=\"name\">formula</th><th class=\"name\">unit</th><th class=\"name\">source</th></tr></thead><tbody>\n");
         for d in FIGURES.iter().filter(|d| d.group == group) {

@@ -198,13 +198,14 @@ pub enum NoStdError {
 /// What `g_sensitivity_dph_per_g` is.
 #[derive(Debug, Clone, PartialEq)]
 pub enum MagnitudeKind {
-    /// The single resolved component (signed).
+    /// The single resolved component (its absolute value).
     Single(SensorAxis),
     /// The magnitude of the vector of the resolved components.
     Vector(Vec<SensorAxis>),
 }
 
-/// The summary figure: the magnitude of the resolved G, or the single resolved component.
+/// The summary figure: the magnitude of the resolved G (for a single resolved component, its
+/// absolute value).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Magnitude {
     /// Value, (deg/h)/g.
@@ -400,7 +401,7 @@ pub fn fit_g_sensitivity(
     let magnitude = match resolved.as_slice() {
         [] => None,
         [one] => Some(Magnitude {
-            value: x[one.index() + 1],
+            value: x[one.index() + 1].abs(),
             std_error: cov(one.index() + 1, one.index() + 1).map(|v| v.max(0.0).sqrt()),
             kind: MagnitudeKind::Single(*one),
         }),
@@ -478,6 +479,10 @@ mod tests {
         let m = f.magnitude.unwrap();
         assert_eq!(m.kind, MagnitudeKind::Single(SensorAxis::X));
         assert!((m.value - 3.0).abs() < 1e-12);
+        // Swapped: G_x = (7 - 13)/2 = -3, the summary figure its absolute value 3.
+        let f = fit_g_sensitivity(&[rec("+x up", 7.0), rec("-x up", 13.0)], &cfg()).unwrap();
+        assert!((f.g_dph_per_g[0].estimate().unwrap().value + 3.0).abs() < 1e-12);
+        assert!((f.magnitude.unwrap().value - 3.0).abs() < 1e-12);
         assert_eq!((f.rank, f.residual_dof), (2, 0));
     }
 
@@ -582,12 +587,12 @@ mod tests {
         }
         let fit = fit_g_sensitivity(&recs, &cfg()).unwrap();
         assert_eq!(fit.residual_dof, 18 - 4);
-        for j in 0..3 {
-            let e = fit.g_dph_per_g[j].estimate().unwrap();
+        for (j, (c, truth)) in fit.g_dph_per_g.iter().zip(truth_g).enumerate() {
+            let e = c.estimate().unwrap();
             let se = e.std_error.unwrap();
             // The design's standard error is sigma / sqrt(6) (6 records at +-1 g per axis).
             assert!(se > 0.4 * sigma / 6f64.sqrt() && se < 2.0 * sigma / 6f64.sqrt(), "{se}");
-            assert!((e.value - truth_g[j]).abs() < 3.0 * se, "G_{j} = {} +- {se}, truth {}", e.value, truth_g[j]);
+            assert!((e.value - truth).abs() < 3.0 * se, "G_{j} = {} +- {se}, truth {truth}", e.value);
         }
         let b0 = fit.bias_at_zero_g.estimate().unwrap();
         assert!((b0.value - truth_b0).abs() < 3.0 * b0.std_error.unwrap());

@@ -1,7 +1,9 @@
 //! Evaluation of a TOML test plan ([`gyrolab_io::test_plan`], keys in docs/PLAN.md) into a
 //! report folder: the rate-table records per axis (long, wide or raw logs), a three-axis set,
-//! then the static (bias) and Allan part of every `[static.<axis>]` table.
+//! then the static (bias) and Allan part of every `[static.<axis>]` table, then the g-sensitivity
+//! of every `[g_sensitivity.<axis>]` table.
 
+pub mod g_sensitivity;
 pub mod static_part;
 
 use crate::error::EvalResult;
@@ -53,7 +55,11 @@ pub fn segmentation_request(p: &SegmentationPlan) -> SegmentationRequest {
 
 /// Number of progress steps of a plan's evaluation.
 pub fn progress_steps(plan: &TestPlan) -> u64 {
-    2 * plan.rate.len() as u64 + 6 + 2 * static_part::progress_steps(&plan.static_tests) + plan.triad.is_some() as u64
+    2 * plan.rate.len() as u64
+        + 6
+        + 2 * static_part::progress_steps(&plan.static_tests)
+        + plan.triad.is_some() as u64
+        + g_sensitivity::progress_steps(&plan.g_sensitivity)
 }
 
 /// The rate-table part of a plan: the evaluated axes in device axis order, and the raw logs they
@@ -175,6 +181,13 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         simulated: None,
     };
     let mut parts = static_part::evaluate_static(&plan.static_tests, &ctx, progress)?;
+    let g = g_sensitivity::evaluate_g_sensitivity(&plan.g_sensitivity, &ctx, &plan.file, progress)?;
+    parts.sections.extend(g.sections);
+    parts.figures.extend(g.figures);
+    parts.files.extend(g.files);
+    if let Some(j) = g.json {
+        parts.json.insert("g_sensitivity".into(), j);
+    }
     if !logs.is_empty() {
         let mut seg = serde_json::Map::new();
         for (axis, log) in &logs {

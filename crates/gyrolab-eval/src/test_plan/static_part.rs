@@ -109,7 +109,7 @@ pub fn static_null_of(axis: &EvaluatedAxis) -> f64 {
 
 /// The output-to-rate reference of an axis: this plan's rate-table K and static null, else the
 /// plan's calibration file, else none (output units only).
-fn reference_of(axis: &str, ctx: &StaticContext<'_>) -> EvalResult<(Reference, ReferenceJson)> {
+pub(crate) fn reference_of(axis: &str, ctx: &StaticContext<'_>) -> EvalResult<(Reference, ReferenceJson)> {
     let sig = gyrolab_report::format::sig;
     let found = match ctx.rate_axes.iter().find(|a| a.name == axis) {
         Some(r) => {
