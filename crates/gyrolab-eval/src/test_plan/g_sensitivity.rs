@@ -45,6 +45,8 @@ struct AxisResult<'a> {
     fit: GSensitivityFit,
     reference: ReferenceJson,
     simulated: Option<String>,
+    /// Notes (e.g. which of several output columns was evaluated).
+    notes: Vec<String>,
 }
 
 /// Number of progress steps of the g-sensitivity part.
@@ -86,9 +88,18 @@ fn evaluate_axis<'a>(
     // The earth rate is handled by the fit (its projection differs between orientations).
     let config = StaticTestConfig { latitude_deg: None, ..StaticTestConfig::default() };
     let mut records = Vec::new();
+    let mut notes = Vec::new();
     for r in &g.records {
         progress.message(&format!("axis {axis}: g-sensitivity record {}", shown(&r.file, ctx.base)));
         let (results, _) = evaluate_file(&r.file, &options, &reference, &config)?;
+        if results.len() > 1 {
+            notes.push(format!(
+                "{}: {} output columns; the first, '{}', is evaluated (name one with g_sensitivity.{axis}.channel).",
+                shown(&r.file, ctx.base),
+                results.len(),
+                results[0].channel
+            ));
+        }
         let Some(result) = results.into_iter().next() else {
             return Err(EvalError::Data(DataError::new(&r.file, "no output channel to evaluate")));
         };
@@ -118,7 +129,7 @@ fn evaluate_axis<'a>(
     let fit = fit_g_sensitivity(&records, &cfg).map_err(|e| {
         EvalError::Data(DataError::new(plan_file, format!("g_sensitivity.{axis}.records: {e}")).at_line(g.line))
     })?;
-    Ok(AxisResult { plan: g, fit, reference: reference_json, simulated: ctx.simulated.map(|f| f(axis)) })
+    Ok(AxisResult { plan: g, fit, reference: reference_json, simulated: ctx.simulated.map(|f| f(axis)), notes })
 }
 
 fn estimate_text(c: &Coefficient) -> String {
@@ -254,6 +265,7 @@ fn section(a: &AxisResult<'_>, figures: &AxisFigures, limits: &[Limit], base: &P
         ]
         .into_iter()
         .flatten()
+        .chain(a.notes.iter().cloned())
         .collect(),
         figures: rows,
         tables: vec![DataTable {
@@ -342,6 +354,7 @@ fn axis_json(a: &AxisResult<'_>, base: &Path) -> Value {
         })
         .collect();
     o.insert("records".into(), Value::Array(records));
+    o.insert("notes".into(), json!(a.notes));
     o.insert("simulated".into(), json!(a.simulated));
     Value::Object(o)
 }
