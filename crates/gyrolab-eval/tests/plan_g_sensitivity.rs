@@ -38,6 +38,8 @@ fn evaluate(dir: &Path, plan: &str) -> Result<serde_json::Value, EvalError> {
     let mut v: serde_json::Value = serde_json::from_slice(output(&folder, "results.json")).unwrap();
     let html = String::from_utf8(output(&folder, "report.html").to_vec()).unwrap_or_default();
     v["html_has_section"] = serde_json::json!(html.contains("g-sensitivity, axis x"));
+    v["html_unresolved_y"] =
+        serde_json::json!(html.contains("not resolved: no record has a specific force along this axis"));
     v["verdict"] = serde_json::json!(folder.verdict.map(|v| v == Verdict::Pass));
     v["csv_lines"] =
         serde_json::json!(std::str::from_utf8(output(&folder, "g_sensitivity.csv")).unwrap().lines().count());
@@ -122,6 +124,8 @@ fn two_orientations_resolve_one_component_and_report_the_others_absent() {
     assert_eq!(g["unresolved_components"]["y"]["reason"], "no_specific_force");
     assert_eq!(g["unresolved_components"]["z"]["reason"], "no_specific_force");
     assert_eq!(g["g_sensitivity_kind"], "single_component");
+    // The report shows the absent components with the reason, not as 0.
+    assert_eq!(v["html_unresolved_y"], true);
     assert!((f(&g["g_sensitivity_dph_per_g"]) - gx.abs()).abs() < 1e-12);
 }
 
