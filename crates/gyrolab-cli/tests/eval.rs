@@ -208,6 +208,7 @@ fn write_static_records(dir: &Path) {
         temperature: TemperatureProfile::Ramp { start_c: 20.0, rate_c_per_h: 10.0 },
         latitude_deg: None,
         record_temperature: true,
+        ..StaticSpec::default()
     };
     let opts = gyrolab_io::sim_csv::SimCsvOptions::default();
     for (name, seed, len) in

@@ -139,6 +139,7 @@ fn simulated_static_and_allan(
         temperature: temperature.clone(),
         latitude_deg: None,
         record_temperature: true,
+        ..StaticSpec::default()
     };
     let allan_spec = StaticSpec { duration_s: request.sim_allan_s, ..test_spec.clone() };
     let mut plans = Vec::new();

@@ -100,6 +100,7 @@ fn apply_compensates_a_record_whose_temperature_steps_through_the_range() {
         temperature: TemperatureProfile::Steps { start_c: -30.0, steps: steps.to_vec() },
         latitude_deg: None,
         record_temperature: true,
+        ..StaticSpec::default()
     };
     let input = dir.path().join("steps.csv");
     let f = std::fs::File::create(&input).unwrap();

@@ -22,6 +22,9 @@ pub use plan_threshold::{NominalScaleFactor, StepTestPlan};
 #[path = "plan_power_ups.rs"]
 mod plan_power_ups;
 pub use plan_power_ups::{PowerUpsPlan, WarmupPlan, DEFAULT_WARMUP_WINDOW_S};
+#[path = "plan_g_sensitivity.rs"]
+mod plan_g_sensitivity;
+pub use plan_g_sensitivity::{GRecordPlan, GSensitivityAxisPlan};
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -52,6 +55,8 @@ struct RawPlan {
     power_ups: BTreeMap<String, Spanned<plan_power_ups::RawPowerUps>>,
     #[serde(default)]
     warmup: BTreeMap<String, Spanned<plan_power_ups::RawWarmup>>,
+    #[serde(default)]
+    g_sensitivity: BTreeMap<String, Spanned<plan_g_sensitivity::RawGSensitivity>>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -367,6 +372,8 @@ pub struct TestPlan {
     pub power_ups: Vec<PowerUpsPlan>,
     /// Warm-up records from power-on (`[warmup.<axis>]`), in device axis order.
     pub warmup: Vec<WarmupPlan>,
+    /// g-sensitivity records (`[g_sensitivity.<axis>]`) in device axis order.
+    pub g_sensitivity: Vec<GSensitivityAxisPlan>,
 }
 
 /// Reads and checks a plan file; `known_figure` tells which `[limits]` names exist.
@@ -495,6 +502,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         ("temperature", raw.temperature.iter().map(|(k, v)| (k, v.span())).collect()),
         ("threshold", raw.threshold.iter().map(|(k, v)| (k, v.span())).collect()),
         ("resolution", raw.resolution.iter().map(|(k, v)| (k, v.span())).collect()),
+        ("g_sensitivity", raw.g_sensitivity.iter().map(|(k, v)| (k, v.span())).collect()),
     ] {
         for (k, span) in keys {
             if !axes.contains(k) {
@@ -513,6 +521,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
             && !raw.temperature.contains_key(a)
             && !raw.power_ups.contains_key(a)
             && !raw.warmup.contains_key(a)
+            && !raw.g_sensitivity.contains_key(a)
             && raw.triad.is_none()
             && !step_test
         {
@@ -521,7 +530,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
                 "device.axes",
                 format!(
                     "axis '{a}' has neither a [rate.{a}] nor a [static.{a}] table (nor [temperature.{a}], \
-                     [threshold.{a}], [resolution.{a}], [power_ups.{a}], [warmup.{a}] or a [triad])"
+                     [threshold.{a}], [resolution.{a}], [power_ups.{a}], [warmup.{a}], [g_sensitivity.{a}] or a [triad])"
                 ),
             ));
         }
@@ -759,6 +768,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
 
     let power_ups = plan_power_ups::power_ups(&cx, &raw.power_ups, &axes)?;
     let warmup = plan_power_ups::warmups(&cx, &raw.warmup, &axes)?;
+    let g_sensitivity = plan_g_sensitivity::parse_g_sensitivity(&cx, &raw.g_sensitivity, &axes)?;
     Ok(TestPlan {
         file: path.to_path_buf(),
         device: DevicePlan {
@@ -780,6 +790,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         resolution,
         power_ups,
         warmup,
+        g_sensitivity,
     })
 }
 

@@ -20,6 +20,8 @@ pub enum FigureGroup {
     Uncertainty,
     /// Threshold and resolution tests.
     ThresholdResolution,
+    /// g-sensitivity (static records in several orientations).
+    GSensitivity,
 }
 
 impl FigureGroup {
@@ -32,6 +34,7 @@ impl FigureGroup {
             FigureGroup::Temperature => "Temperature tests",
             FigureGroup::Uncertainty => "Measurement uncertainty",
             FigureGroup::ThresholdResolution => "Threshold and resolution",
+            FigureGroup::GSensitivity => "g-sensitivity",
         }
     }
 }
@@ -64,7 +67,7 @@ const fn def(
     FigureDef { key, label, unit, group, formula, source }
 }
 
-use FigureGroup::{Allan, RateTable, Static, Temperature, ThresholdResolution, Uncertainty};
+use FigureGroup::{Allan, GSensitivity, RateTable, Static, Temperature, ThresholdResolution, Uncertainty};
 
 /// Every figure gyrolab reports, in report order.
 #[rustfmt::skip]
@@ -101,6 +104,9 @@ pub const FIGURES: &[FigureDef] = &[
     def("bias_temp_sensitivity_dph_per_c", "bias temperature sensitivity (soaked points)", "(deg/h)/degC", Temperature, "least-squares slope of B_i on T_i over the soaked points, B_i = (static mean − null) / K", "[IEEE 952] annex B, [GJB]"),
     def("scale_factor_thermal_hysteresis_ppm", "scale-factor thermal hysteresis", "ppm", Temperature, "max |K_heating − K_cooling| / K(T_ref) × 10⁶ at temperatures visited both ways (within 1 degC)", "[GJB]"),
     def("bias_thermal_hysteresis_dph", "bias thermal hysteresis", "deg/h", Temperature, "max |B_heating − B_cooling| at temperatures visited both ways (within 1 degC)", "[GJB]"),
+    def("threshold_dps", "threshold", "deg/s", ThresholdResolution, "smallest tried |Ω| such that it and every larger tried |Ω| give (ȳ_Ω − ȳ_0) / (K Ω) ≥ 0.5 for +Ω and −Ω; at most the smallest tried when it passes; none (above the largest tried) when that fails", "[GJB], [IEEE 528]"),
+    def("resolution_dps", "resolution", "deg/s", ThresholdResolution, "at base rate Ω_b: smallest tried |δ| such that it and every larger tried |δ| give (ȳ_{Ω_b+δ} − ȳ_{Ω_b}) / (K δ) ≥ 0.5 for +δ and −δ; bounds as for threshold_dps", "[GJB], [IEEE 528]"),
+    def("g_sensitivity_dph_per_g", "g-sensitivity |G|", "(deg/h)/g", GSensitivity, "|G| of the resolved components of B_i = B_0 + G · f_i, least squares over static records in several orientations (one resolved component: its absolute value)", "IEEE Std 1431-2004, [IEEE 952], [GJB]"),
     def("scale_factor_expanded_uncertainty_ppm", "expanded uncertainty of K", "ppm", Uncertainty, "U(K)/|K|, U = k √(u_A² + u_B²): u_A slope standard error, u_B = |K| u_rel(rate)", "[GUM] 4.2, 4.3, 5.1, 6"),
     def("zero_offset_expanded_uncertainty", "expanded uncertainty of F0", "output", Uncertainty, "U = k √(u_A² + u_B²): u_A intercept standard error, u_B output accuracy", "[GUM] 4.2, 4.3, 5.1, 6"),
     def("bias_expanded_uncertainty_dph", "expanded uncertainty of B_0", "deg/h", Uncertainty, "U = k u_c: record mean (OADEV σ(τ)√(τ/T)), null, output accuracy and K propagated", "[GUM] 5.1, 6"),
@@ -108,8 +114,6 @@ pub const FIGURES: &[FigureDef] = &[
     def("arw_expanded_uncertainty_deg_rt_h", "expanded uncertainty of N", "deg/√h", Uncertainty, "U = k u_c: the wider side of the 68.3 % Allan interval at the reading τ, and K", "[GUM] 6, [SP1065]"),
     def("bias_instability_expanded_uncertainty_dph", "expanded uncertainty of B", "deg/h", Uncertainty, "U = k u_c: the wider side of the 68.3 % Allan interval at the reading τ, and K", "[GUM] 6, [SP1065]"),
     def("rrw_expanded_uncertainty_deg_h_rt_h", "expanded uncertainty of K (RRW)", "deg/h/√h", Uncertainty, "U = k u_c: the wider side of the 68.3 % Allan interval at the reading τ, and K", "[GUM] 6, [SP1065]"),
-    def("threshold_dps", "threshold", "deg/s", ThresholdResolution, "smallest tried |Ω| such that it and every larger tried |Ω| give (ȳ_Ω − ȳ_0) / (K Ω) ≥ 0.5 for +Ω and −Ω; at most the smallest tried when it passes; none (above the largest tried) when that fails", "[GJB], [IEEE 528]"),
-    def("resolution_dps", "resolution", "deg/s", ThresholdResolution, "at base rate Ω_b: smallest tried |δ| such that it and every larger tried |δ| give (ȳ_{Ω_b+δ} − ȳ_{Ω_b}) / (K δ) ≥ 0.5 for +δ and −δ; bounds as for threshold_dps", "[GJB], [IEEE 528]"),
 ];
 
 /// The names a `[limits]` table may use (`<T>` stands for a smoothing time in seconds).

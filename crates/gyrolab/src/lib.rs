@@ -5,6 +5,7 @@
 //! - [`units`]: units of rates, outputs and noise coefficients, and every conversion;
 //! - [`allan`]: the Allan-variance family with noise identification and confidence intervals;
 //! - [`fit`]: least-squares lines and polynomials;
+//! - [`g_sensitivity`]: g-sensitivity (acceleration-sensitive bias) from records in several orientations;
 //! - [`noise`]: IEEE 952 noise terms (ARW, bias instability, RRW, ...) from an Allan curve;
 //! - [`rate_test`]: rate-table (scale-factor) test figures;
 //! - [`static_test`]: static (bias) test figures, accumulated block by block;
@@ -26,6 +27,7 @@ pub mod allan;
 pub mod apply;
 pub mod dropout;
 pub mod fit;
+pub mod g_sensitivity;
 pub mod noise;
 pub mod power_ups;
 pub mod published;

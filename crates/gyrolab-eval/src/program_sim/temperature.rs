@@ -104,6 +104,7 @@ pub fn write_temperature_records(dir: &Path, axis: &str, seed: u64) -> EvalResul
             temperature: TemperatureProfile::Constant { temp_c: *t },
             latitude_deg: None,
             record_temperature: true,
+            ..StaticSpec::default()
         };
         write(&dir.join(&stat), |w| {
             write_static_csv(w, &model, &spec, s + 1, &options).map(|_| ()).map_err(|e| e.to_string())

@@ -1,7 +1,9 @@
 //! Evaluation of a TOML test plan ([`gyrolab_io::test_plan`], keys in docs/PLAN.md) into a
 //! report folder: the rate-table records per axis (long, wide or raw logs), a three-axis set,
-//! then the static (bias) and Allan part of every `[static.<axis>]` table.
+//! then the static (bias) and Allan part of every `[static.<axis>]` table, then the g-sensitivity
+//! of every `[g_sensitivity.<axis>]` table.
 
+pub mod g_sensitivity;
 pub mod power_ups;
 pub mod static_part;
 pub mod temperature;
@@ -64,6 +66,7 @@ pub fn progress_steps(plan: &TestPlan) -> u64 {
         + temperature::progress_steps(&plan.temperature)
         + threshold::progress_steps(&plan.threshold, &plan.resolution)
         + power_ups::progress_steps(plan)
+        + g_sensitivity::progress_steps(&plan.g_sensitivity)
 }
 
 /// The rate-table part of a plan: the evaluated axes in device axis order, and the raw logs they
@@ -210,6 +213,13 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
             "temperature_points.csv".into(),
             gyrolab_report::thermal::temperature_points_csv(&thermal.reports).into_bytes(),
         ));
+    }
+    let g = g_sensitivity::evaluate_g_sensitivity(&plan.g_sensitivity, &ctx, &plan.file, progress)?;
+    parts.sections.extend(g.sections);
+    parts.figures.extend(g.figures);
+    parts.files.extend(g.files);
+    if let Some(j) = g.json {
+        parts.json.insert("g_sensitivity".into(), j);
     }
     if let Some(u) = &plan.uncertainty {
         let un = uncertainty::evaluate_uncertainty(u, &axes, &parts.reports);

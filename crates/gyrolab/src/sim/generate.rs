@@ -512,6 +512,12 @@ impl StaticGenerator {
         spec.validate()?;
         let mut engine = Engine::new(model, spec.sample_rate_hz, spec.latitude_deg, seed)?;
         engine.start_run();
+        // The orientation: the g-sensitive bias G · f and the input axis's share of the earth rate.
+        if let Some(f) = spec.specific_force_g {
+            let g = model.g_sensitivity_dph_per_g;
+            engine.bias_dps += units::dph_to_dps(g[0] * f[0] + g[1] * f[1] + g[2] * f[2]);
+        }
+        engine.earth_dps *= spec.input_axis_up;
         Ok(StaticGenerator {
             engine,
             sample_rate_hz: spec.sample_rate_hz,

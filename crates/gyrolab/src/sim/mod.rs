@@ -10,6 +10,8 @@
 //! Model, per sample k at time t (sensed rate w in deg/s, output F in the output unit):
 //!   w = Omega_table + Omega_e sin(lat) + (+-h/2) + b0 + b_run + c_b (T - T_ref) + R t
 //!       + n_white + sum_i x_i + b_rrw                     (then optional angle quantization)
+//!   (static records in an orientation: + G · f, and u Omega_e sin(lat) with u the input axis's
+//!   up component; `g_sensitivity_dph_per_g`, `StaticSpec::specific_force_g`, `input_axis_up`)
 //!   F = clamp(null + K (1 + e_sf + e_run + c_k (T - T_ref)) (1 +- a/2) (w + k2 w^2 + k3 w^3),
 //!             rail_low, rail_high)                        (then optional output quantization)
 //!

@@ -88,6 +88,12 @@ impl ParameterText for Option<f64> {
     }
 }
 
+impl ParameterText for [f64; 3] {
+    fn parameter_text(&self) -> String {
+        format!("{:?} {:?} {:?}", self[0], self[1], self[2])
+    }
+}
+
 impl ParameterText for OutputUnit {
     fn parameter_text(&self) -> String {
         self.symbol().to_string()
@@ -187,6 +193,9 @@ sensor_model! {
     scale_factor_temp_coeff_ppm_per_c: f64,
     /// Temperature at which bias and scale factor take their nominal values, degC.
     reference_temp_c: f64,
+    /// g-sensitivity G along sensor x, y, z, (deg/h)/g: a static record with specific force f
+    /// (`StaticSpec::specific_force_g`) has the added bias G · f (IEEE 1431 / 952 D_g · a).
+    g_sensitivity_dph_per_g: [f64; 3],
 }
 
 impl Default for SensorModel {
@@ -220,6 +229,7 @@ impl Default for SensorModel {
             bias_temp_coeff_dph_per_c: 0.0,
             scale_factor_temp_coeff_ppm_per_c: 0.0,
             reference_temp_c: 25.0,
+            g_sensitivity_dph_per_g: [0.0; 3],
         }
     }
 }
@@ -385,6 +395,9 @@ impl SensorModel {
         finite("bias_temp_coeff_dph_per_c", self.bias_temp_coeff_dph_per_c)?;
         finite("scale_factor_temp_coeff_ppm_per_c", self.scale_factor_temp_coeff_ppm_per_c)?;
         finite("reference_temp_c", self.reference_temp_c)?;
+        for g in self.g_sensitivity_dph_per_g {
+            finite("g_sensitivity_dph_per_g", g)?;
+        }
         Ok(())
     }
 
@@ -530,7 +543,8 @@ fn validate_latitude(latitude_deg: Option<f64>) -> Result<(), SimError> {
     }
 }
 
-/// A static (zero table rate) record: input axis vertical, so the earth rate's vertical part is sensed.
+/// A static (zero table rate) record: input axis vertical, so the earth rate's vertical part is
+/// sensed (scaled by `input_axis_up` when the sensor is turned to another orientation).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct StaticSpec {
@@ -544,6 +558,14 @@ pub struct StaticSpec {
     pub latitude_deg: Option<f64>,
     /// Whether samples carry the temperature (a `temp_c` column).
     pub record_temperature: bool,
+    /// Specific force along sensor x, y, z in this record's orientation, g (the reaction to
+    /// gravity: `[1, 0, 0]` with +x up); adds the bias G · f of `g_sensitivity_dph_per_g`.
+    /// None: no g-sensitive bias (as before).
+    pub specific_force_g: Option<[f64; 3]>,
+    /// Up component of the input axis (cosine of its angle to the vertical), scaling the sensed
+    /// vertical earth rate: 1 input axis up (the default), -1 down, 0 horizontal (pointing
+    /// east-west, where the earth rate's projection is zero).
+    pub input_axis_up: f64,
 }
 
 impl Default for StaticSpec {
@@ -555,6 +577,8 @@ impl Default for StaticSpec {
             temperature: TemperatureProfile::default(),
             latitude_deg: None,
             record_temperature: false,
+            specific_force_g: None,
+            input_axis_up: 1.0,
         }
     }
 }
@@ -572,18 +596,33 @@ impl StaticSpec {
         let n = self.duration_s * self.sample_rate_hz;
         check("duration_s", self.duration_s, (0.5..9e18).contains(&n), "at least one sample interval long")?;
         self.temperature.validate()?;
+        if let Some(f) = self.specific_force_g {
+            for v in f {
+                finite("specific_force_g", v)?;
+            }
+        }
+        let u = self.input_axis_up;
+        check("input_axis_up", u, (-1.0..=1.0).contains(&u), "finite and within [-1, 1]")?;
         validate_latitude(self.latitude_deg)
     }
 
-    /// Each parameter's name and value as text, for a record's comment lines.
+    /// Each parameter's name and value as text, for a record's comment lines (the orientation
+    /// lines only when an orientation is set).
     pub fn parameter_lines(&self) -> Vec<(&'static str, String)> {
-        vec![
+        let mut lines = vec![
             ("sample_rate_hz", self.sample_rate_hz.parameter_text()),
             ("duration_s", self.duration_s.parameter_text()),
             ("samples", self.samples().to_string()),
             ("temperature", self.temperature.describe()),
             ("latitude_deg", self.latitude_deg.parameter_text()),
-        ]
+        ];
+        if let Some(f) = self.specific_force_g {
+            lines.push(("specific_force_g", f.parameter_text()));
+        }
+        if self.input_axis_up != 1.0 {
+            lines.push(("input_axis_up", self.input_axis_up.parameter_text()));
+        }
+        lines
     }
 }
 
