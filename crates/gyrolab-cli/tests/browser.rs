@@ -71,6 +71,76 @@ fn is_plot_colour(p: [u8; 3]) -> bool {
     PLOT_COLOURS.iter().any(|c| c.iter().zip(p).all(|(a, b)| (i32::from(*a) - i32::from(b)).abs() <= 30))
 }
 
+/// Bands of 200 px of a screenshot: (bands holding plot colours, plot-coloured pixels).
+fn plot_bands(w: u32, h: u32, px: &[[u8; 3]]) -> (u32, usize) {
+    let band = 200;
+    let mut plot_bands = 0;
+    let mut total_plot_px = 0;
+    for b in 0..h / band {
+        let rows = &px[(b * band * w) as usize..((b + 1) * band * w) as usize];
+        let coloured = rows.iter().filter(|p| is_plot_colour(**p)).count();
+        let non_white = rows.iter().filter(|p| p.iter().any(|c| *c < 235)).count();
+        total_plot_px += coloured;
+        if coloured > 150 {
+            plot_bands += 1;
+            assert!(non_white > coloured, "band {b}: plot colours but nothing else drawn");
+        }
+    }
+    (plot_bands, total_plot_px)
+}
+
+/// The example plan with every test of a lab's program (examples/test_program/plan.toml, its
+/// SIMULATED records written here by the example's generator), evaluated by `gyrolab eval` and
+/// looked at in headless Chromium: the page holds the plots of every section that draws one.
+#[test]
+fn the_test_program_report_renders_in_headless_chromium() {
+    if std::env::var("GYROLAB_SKIP_BROWSER").is_ok_and(|v| v == "1") {
+        eprintln!("GYROLAB_SKIP_BROWSER=1: browser test skipped");
+        return;
+    }
+    assert!(
+        Path::new(CHROMIUM).exists(),
+        "{CHROMIUM} not found: run `bash scripts/install-test-deps.sh`, or set GYROLAB_SKIP_BROWSER=1"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("program");
+    std::fs::create_dir_all(&data).unwrap();
+    gyrolab_eval::program_sim::write_test_program(&data, 2026).unwrap();
+    let out = dir.path().join("report");
+    gyrolab().arg("eval").arg(data.join("plan.toml")).arg("--out").arg(&out).arg("--quiet").assert().code(0);
+    let png = dir.path().join("shot.png");
+    let tall = 24_000;
+    let url_html = out.join("report.html");
+    let mut child = Command::new(CHROMIUM)
+        .args(["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run"])
+        .args(["--disable-background-networking", "--disable-component-update", "--disable-sync", "--hide-scrollbars"])
+        .arg(format!("--user-data-dir={}", dir.path().join("profile").display()))
+        .arg(format!("--screenshot={}", png.display()))
+        .arg(format!("--window-size={WIDTH},{tall}"))
+        .arg(format!("file://{}", url_html.display()))
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("cannot start chromium");
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > Duration::from_secs(180) {
+            let _ = child.kill();
+            panic!("chromium did not finish within 180 s");
+        }
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    if let Ok(keep) = std::env::var("GYROLAB_KEEP_SCREENSHOT") {
+        let _ = std::fs::copy(&png, format!("{keep}-program.png"));
+    }
+    let (w, h, px) = load_rgb(&png);
+    assert_eq!((w, h), (WIDTH, tall), "screenshot size");
+    let (bands, total) = plot_bands(w, h, &px);
+    eprintln!("test program report: plot-coloured pixels {total} in {bands} bands");
+    // Rate-table plots, bias and Allan plots, warm-up, K(T) and B(T): plots across many bands.
+    assert!(bands >= 10 && total > 10_000, "plots found in only {bands} bands ({total} pixels)");
+}
+
 #[test]
 fn report_renders_with_plots_in_headless_chromium() {
     if std::env::var("GYROLAB_SKIP_BROWSER").is_ok_and(|v| v == "1") {
@@ -101,18 +171,7 @@ fn report_renders_with_plots_in_headless_chromium() {
 
     // Bands of 200 px: how many hold plot-coloured pixels, and how non-blank they are.
     let band = 200;
-    let mut plot_bands = 0;
-    let mut total_plot_px = 0;
-    for b in 0..h / band {
-        let rows = &px[(b * band * w) as usize..((b + 1) * band * w) as usize];
-        let coloured = rows.iter().filter(|p| is_plot_colour(**p)).count();
-        let non_white = rows.iter().filter(|p| p.iter().any(|c| *c < 235)).count();
-        total_plot_px += coloured;
-        if coloured > 150 {
-            plot_bands += 1;
-            assert!(non_white > coloured, "band {b}: plot colours but nothing else drawn");
-        }
-    }
+    let (plot_bands, total_plot_px) = plot_bands(w, h, &px);
     eprintln!("plot-coloured pixels: {total_plot_px} in {plot_bands} bands");
     assert!(total_plot_px > 2_000, "too few plot-coloured pixels ({total_plot_px}): are the SVGs drawn?");
     assert!(plot_bands >= 4, "plots found in only {plot_bands} bands of {band} px");

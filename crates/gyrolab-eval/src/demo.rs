@@ -246,6 +246,7 @@ pub fn paper_report_folder(request: &PaperReportRequest, progress: &dyn Progress
         extra_files: parts.files,
         triad: None,
         temperature_models: Vec::new(),
+        simulated_rate: None,
     };
     assemble_report(inputs, progress)
 }

@@ -58,6 +58,8 @@ pub struct ReportInputs<'a> {
     pub triad: Option<TriadReport<'a>>,
     /// Temperature compensation per axis, written into calibration.toml's `[axis.temperature]`.
     pub temperature_models: Vec<(String, gyrolab_io::calibration::TemperatureSection)>,
+    /// The rate-table records are SIMULATED: how (their sections and summary rows say so).
+    pub simulated_rate: Option<String>,
 }
 
 fn json<T: serde::Serialize>(value: &T) -> EvalResult<String> {
@@ -71,6 +73,11 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
     let reports: Vec<AxisReport<'_>> = inputs.axes.iter().map(EvaluatedAxis::report).collect();
     let axis_json: Vec<AxisJson> = reports.iter().map(AxisJson::new).collect();
     let mut figures: Vec<AxisFigures> = axis_json.iter().map(rate_figures).collect();
+    if inputs.simulated_rate.is_some() {
+        for f in &mut figures {
+            f.simulated = f.values.iter().map(|(k, _)| k.clone()).collect();
+        }
+    }
     for extra in inputs.extra_figures {
         match figures.iter_mut().find(|f| f.axis == extra.axis) {
             Some(f) => {
@@ -84,7 +91,12 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
     progress.message("drawing plots");
     let mut sections = Vec::new();
     for r in &reports {
-        sections.push(rate_section(r, &inputs.limits).map_err(|e| EvalError::Output(e.to_string()))?);
+        let mut s = rate_section(r, &inputs.limits).map_err(|e| EvalError::Output(e.to_string()))?;
+        if let Some(text) = &inputs.simulated_rate {
+            s.simulated = true;
+            s.paragraphs.insert(0, format!("SIMULATED: {text}"));
+        }
+        sections.push(s);
         progress.advance(1);
     }
     sections.extend(inputs.extra_sections);

@@ -125,6 +125,8 @@ struct RawDevice {
     axes: Spanned<Vec<String>>,
     #[serde(default)]
     description: Option<String>,
+    #[serde(default)]
+    simulated: Option<String>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -186,6 +188,9 @@ pub struct DevicePlan {
     pub axes: Vec<String>,
     /// Free description.
     pub description: Option<String>,
+    /// The plan's records are SIMULATED: how they were made (every section, table and summary row
+    /// of the report is then labelled SIMULATED with it).
+    pub simulated: Option<String>,
 }
 
 /// Who tested, where, under which conditions and to which procedure (`[test]`), for the
@@ -776,6 +781,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
             serial: raw.device.serial,
             axes,
             description: raw.device.description,
+            simulated: raw.device.simulated,
         },
         options,
         rate,

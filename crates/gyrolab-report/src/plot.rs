@@ -192,6 +192,66 @@ impl Panel {
             legend: LegendCorner::UpperLeft,
         }
     }
+
+    /// Puts the legend in the corner whose box (the outer 40 % of the width and 30 % of the height
+    /// of the data's extent) holds the fewest points and line segments, so that it covers no data
+    /// where some corner is free; ties keep the order upper left, upper right, lower left, lower
+    /// right. When every corner holds data, the vertical range is widened by a third above the
+    /// data and the legend goes to the upper left, over the added headroom.
+    pub fn place_legend(&mut self) {
+        let tf = |s: Scale, v: f64| match s {
+            Scale::Linear => Some(v),
+            Scale::Log if v > 0.0 => Some(v.log10()),
+            Scale::Log => None,
+        };
+        let mut pts: Vec<(f64, f64)> = Vec::new();
+        for s in &self.series {
+            let p: Vec<(f64, f64)> =
+                s.points.iter().filter_map(|&(x, y)| Some((tf(self.x.scale, x)?, tf(self.y.scale, y)?))).collect();
+            // Lines: also their midpoints, so a line through a corner counts there.
+            if matches!(s.style, SeriesStyle::Line | SeriesStyle::Dashed | SeriesStyle::LineMarkers) {
+                for w in p.windows(2) {
+                    for k in 1..8 {
+                        let f = k as f64 / 8.0;
+                        pts.push((w[0].0 + f * (w[1].0 - w[0].0), w[0].1 + f * (w[1].1 - w[0].1)));
+                    }
+                }
+            }
+            pts.extend(p);
+        }
+        let finite: Vec<(f64, f64)> = pts.into_iter().filter(|p| p.0.is_finite() && p.1.is_finite()).collect();
+        if finite.is_empty() {
+            return;
+        }
+        let ext = |f: fn(&(f64, f64)) -> f64| {
+            finite.iter().map(f).fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)))
+        };
+        let ((x0, x1), (y0, y1)) = (ext(|p| p.0), ext(|p| p.1));
+        let (xs, ys) = ((x1 - x0).max(f64::MIN_POSITIVE), (y1 - y0).max(f64::MIN_POSITIVE));
+        let count = |left: bool, upper: bool| {
+            finite
+                .iter()
+                .filter(|p| {
+                    let fx = (p.0 - x0) / xs;
+                    let fy = (p.1 - y0) / ys;
+                    (if left { fx <= 0.4 } else { fx >= 0.6 }) && (if upper { fy >= 0.7 } else { fy <= 0.3 })
+                })
+                .count()
+        };
+        let corners = [
+            (LegendCorner::UpperLeft, count(true, true)),
+            (LegendCorner::UpperRight, count(false, true)),
+            (LegendCorner::LowerLeft, count(true, false)),
+            (LegendCorner::LowerRight, count(false, false)),
+        ];
+        let best = corners.iter().min_by_key(|c| c.1).copied().unwrap_or((LegendCorner::UpperLeft, 0));
+        if best.1 == 0 || self.y.range.is_some() || self.y.scale != Scale::Linear {
+            self.legend = best.0;
+        } else {
+            self.y.range = Some((y0 - 0.05 * ys, y1 + 0.45 * ys));
+            self.legend = LegendCorner::UpperLeft;
+        }
+    }
 }
 
 /// A figure: stacked panels under a title.
@@ -541,6 +601,25 @@ mod tests {
         p.series.push(Series::new("points", vec![(-1.0, 1.0), (0.0, 2.0), (1.0, 3.1)], SeriesStyle::Markers, 0));
         p.series.push(Series::new("line", vec![(-1.0, 0.95), (1.0, 3.05)], SeriesStyle::Line, 1));
         Figure::single("test figure", p)
+    }
+
+    #[test]
+    fn legend_goes_to_a_corner_without_data() {
+        let panel = |pts: Vec<(f64, f64)>| {
+            let mut p = Panel::new(Axis::linear("x"), Axis::linear("y"));
+            p.series.push(Series::new("d", pts, SeriesStyle::Markers, 0));
+            p.place_legend();
+            p
+        };
+        // Rising points fill the lower left and upper right: the upper left is free.
+        let rising: Vec<(f64, f64)> = (0..11).map(|i| (i as f64, i as f64)).collect();
+        assert_eq!(panel(rising).legend, LegendCorner::UpperLeft);
+        // Points in every corner but the lower right.
+        let p = panel(vec![(0.0, 0.0), (0.0, 10.0), (10.0, 10.0), (5.0, 5.0)]);
+        assert_eq!(p.legend, LegendCorner::LowerRight);
+        // Data in all four corners: headroom above (range widened by 45 % of the span) and upper left.
+        let p = panel(vec![(0.0, 0.0), (0.0, 10.0), (10.0, 10.0), (10.0, 0.0)]);
+        assert_eq!((p.legend, p.y.range), (LegendCorner::UpperLeft, Some((-0.5, 14.5))));
     }
 
     #[test]

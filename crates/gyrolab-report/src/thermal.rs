@@ -6,7 +6,7 @@ use crate::figures::AxisFigures;
 use crate::format::{sig, sig_opt};
 use crate::html::{DataTable, PlotBlock, ReportSection};
 use crate::limits::Limit;
-use crate::plot::{Axis, Figure, LegendCorner, Panel, PlotError, Series, SeriesStyle};
+use crate::plot::{Axis, Figure, Panel, PlotError, Series, SeriesStyle};
 use crate::static_report::figure_rows;
 use gyrolab::thermal::{Hysteresis, NotResolved, Phase, Sensitivity, TemperatureModel};
 use serde::Serialize;
@@ -214,7 +214,7 @@ fn plot(
     if curve.len() > 1 {
         p.series.push(Series::new(curve_name, curve, SeriesStyle::Line, 3));
     }
-    p.legend = LegendCorner::UpperRight;
+    p.place_legend();
     Figure::single(title, p).to_svg().map(Some)
 }
 

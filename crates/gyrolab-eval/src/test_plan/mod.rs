@@ -237,6 +237,20 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         }
         parts.json.insert("segmentation".into(), serde_json::Value::Object(seg));
     }
+    if let Some(text) = &plan.device.simulated {
+        // Every section, figure and table of a simulated plan is labelled so.
+        let label = format!("SIMULATED: {text}");
+        for s in &mut parts.sections {
+            s.simulated = true;
+            if !s.paragraphs.iter().any(|p| p.starts_with("SIMULATED")) {
+                s.paragraphs.insert(0, label.clone());
+            }
+        }
+        for f in &mut parts.figures {
+            f.simulated = f.values.iter().map(|(k, _)| k.clone()).collect();
+        }
+        notes.insert(0, format!("{label}. Every figure of this report comes from simulated records."));
+    }
     let triad_report = triad.as_ref().map(|t| t.report());
     if let Some(t) = &triad_report {
         parts.sections.insert(0, triad_section(t));
@@ -273,6 +287,7 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         extra_files: parts.files,
         triad: triad_report,
         temperature_models: thermal.compensation,
+        simulated_rate: plan.device.simulated.clone(),
     };
     assemble_report(inputs, progress)
 }
