@@ -223,6 +223,10 @@ pub fn paper_report_folder(request: &PaperReportRequest, progress: &dyn Progress
         gyrolab_version: env!("CARGO_PKG_VERSION").into(),
         plan_file: "built-in: the paper's Tables 1, 3, 4 (data/paper/*.csv)".into(),
         notes: vec![
+            "The whole test program of a lab (temperature points, repeated power-ups, warm-up, threshold and \
+             resolution, g-sensitivity, measurement uncertainty) is shown on SIMULATED records of this gyro class in \
+             program_report.html beside this report (its plan: program_plan.toml; results: program_results.json)."
+                .into(),
             "Rate-table part: the paper's published data. Static (bias) and Allan sections: SIMULATED records of the \
              paper's gyro family (ADXRS646 preset), because the paper did not publish its raw static records; every \
              such section, table and summary row is labelled SIMULATED."
@@ -248,5 +252,32 @@ pub fn paper_report_folder(request: &PaperReportRequest, progress: &dyn Progress
         temperature_models: Vec::new(),
         simulated_rate: None,
     };
-    assemble_report(inputs, progress)
+    let mut folder = assemble_report(inputs, progress)?;
+    folder.outputs.extend(program_outputs(progress)?);
+    Ok(folder)
+}
+
+/// Seed of the demo's simulated test program (the example's: examples/test_program).
+const PROGRAM_SEED: u64 = 2026;
+
+/// The whole test program of a lab on SIMULATED records ([`crate::program_sim`]): its plan and
+/// records written to a temporary folder, evaluated as `gyrolab eval` does, and its report folder's
+/// files named `program_<file>` (the plan itself as `program_plan.toml`).
+fn program_outputs(progress: &dyn Progress) -> EvalResult<Vec<crate::report_folder::NamedOutput>> {
+    progress.message("simulating and evaluating a whole test program");
+    let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.subsec_nanos());
+    let dir = TempDir(std::env::temp_dir().join(format!("gyrolab-program-{}-{nanos}", std::process::id())));
+    std::fs::create_dir_all(&dir.0).map_err(|e| sim_error(&dir.0, e))?;
+    let plan_text = crate::program_sim::write_test_program(&dir.0, PROGRAM_SEED)?;
+    let plan = crate::test_plan::read_test_plan(&dir.0.join("plan.toml"))?;
+    let folder = crate::test_plan::evaluate_test_plan(&plan, "program_plan.toml", &crate::progress::Silent)?;
+    let mut outputs =
+        vec![crate::report_folder::NamedOutput { name: "program_plan.toml".into(), bytes: plan_text.into_bytes() }];
+    outputs.extend(
+        folder
+            .outputs
+            .into_iter()
+            .map(|o| crate::report_folder::NamedOutput { name: format!("program_{}", o.name), bytes: o.bytes }),
+    );
+    Ok(outputs)
 }

@@ -68,3 +68,25 @@ fn axis_x_scale_factor_is_the_independent_lsq_slope() {
     let got = x.evaluation.scale_factor();
     assert!((got - k).abs() <= 1e-10 * k.abs(), "K = {got}, LSQ {k}");
 }
+
+/// `gyrolab demo --out`: beside the paper's report, the whole test program of a lab on SIMULATED
+/// records (program_report.html), every data section labelled so.
+#[test]
+fn demo_folder_shows_the_test_program_simulated() {
+    use gyrolab_eval::demo::{paper_report_folder, PaperReportRequest};
+    let request = PaperReportRequest { sim_static_s: 60.0, sim_allan_s: 600.0 };
+    let folder = paper_report_folder(&request, &gyrolab_eval::progress::Silent).unwrap();
+    let get = |name: &str| {
+        let o = folder.outputs.iter().find(|o| o.name == name).unwrap_or_else(|| panic!("no {name}"));
+        String::from_utf8(o.bytes.clone()).unwrap()
+    };
+    assert!(get("report.html").contains("program_report.html"), "the paper's report points to the program");
+    let html = get("program_report.html");
+    for title in ["Temperature tests, axis x", "Threshold and resolution", "g-sensitivity, axis x", "Warm-up"] {
+        assert!(html.contains(title), "no section {title}");
+    }
+    assert_eq!(html.matches("SIMULATED DATA").count(), 9, "every data section labelled");
+    let json: serde_json::Value = serde_json::from_str(&get("program_results.json")).unwrap();
+    assert!(json["sections"]["power_ups"]["x"].is_object() && json["sections"]["uncertainty"]["x"].is_object());
+    assert!(get("program_plan.toml").contains("[temperature.x]"));
+}
