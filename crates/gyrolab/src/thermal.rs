@@ -28,6 +28,11 @@ use serde::{Deserialize, Serialize};
 /// slope is dominated by the noise of the points and by drift (a sensor held at one temperature).
 pub const MIN_SPAN_C: f64 = 5.0;
 
+/// Smallest span of a static record's own temperature column over which its within-record bias
+/// temperature slope is quoted, degC (a record held near one temperature measures drift, not a
+/// temperature coefficient: 0.04 degC of span once gave 1 790 (deg/h)/degC).
+pub const MIN_WITHIN_RECORD_SPAN_C: f64 = 1.0;
+
 /// Two points within this many degC are the same temperature (for thermal hysteresis).
 pub const SAME_TEMPERATURE_C: f64 = 1.0;
 

@@ -812,6 +812,15 @@ pub(super) fn temperature_fit(
     }
     let temps: Vec<f64> = points.iter().map(|p| p.0).collect();
     let outs: Vec<f64> = points.iter().map(|p| p.1).collect();
+    let span =
+        temps.iter().copied().fold(f64::NEG_INFINITY, f64::max) - temps.iter().copied().fold(f64::INFINITY, f64::min);
+    if span < crate::thermal::MIN_WITHIN_RECORD_SPAN_C {
+        return Err(format!(
+            "the record's temperature spans only {span:.3} degC (at least {} degC needed for a bias temperature \
+             slope: below it drift and noise dominate; soaked temperature points in a plan measure the sensitivity)",
+            crate::thermal::MIN_WITHIN_RECORD_SPAN_C
+        ));
+    }
     let line = fit::fit_line(&temps, &outs).map_err(|e| e.to_string())?;
     let n = points.len() as f64;
     let window_std = fit::sample_std(&outs).unwrap_or(0.0); // ok: len >= 3
@@ -846,6 +855,19 @@ pub(super) fn temperature_fit(
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn a_tiny_temperature_span_gives_no_temperature_slope() {
+        // Four windows over 0.04 degC whose outputs rise by 0.1: a slope of 2.5 output/degC that
+        // is noise, not temperature; refused with the span named. Over 4 degC it is fitted.
+        let cfg = StaticTestConfig::default();
+        let tiny: Vec<(f64, f64)> = (0..4).map(|i| (25.0 + 0.01 * i as f64, 0.1 * i as f64 / 3.0)).collect();
+        let e = temperature_fit(&tiny, 0.0, &cfg, Some(1.0)).unwrap_err();
+        assert!(e.contains("spans only 0.030 degC"), "{e}");
+        let wide: Vec<(f64, f64)> = (0..4).map(|i| (25.0 + i as f64, 0.1 * i as f64)).collect();
+        let r = temperature_fit(&wide, 0.0, &cfg, Some(1.0)).unwrap();
+        assert!((r.slope_output_per_c - 0.1).abs() < 1e-12);
+    }
 
     /// Feeds blocks through the sample-by-sample path only (the reference for the block path).
     fn each_path(config: &StaticTestConfig, blocks: &[SampleBlock]) -> StaticTestResult {
