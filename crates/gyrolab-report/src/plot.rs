@@ -193,12 +193,15 @@ impl Panel {
         }
     }
 
-    /// Puts the legend in the corner whose box (the outer 40 % of the width and 30 % of the height
+    /// Puts the legend (when any series has a name) in the corner whose box (the outer 40 % of the width and 30 % of the height
     /// of the data's extent) holds the fewest points and line segments, so that it covers no data
     /// where some corner is free; ties keep the order upper left, upper right, lower left, lower
     /// right. When every corner holds data, the vertical range is widened by a third above the
     /// data and the legend goes to the upper left, over the added headroom.
     pub fn place_legend(&mut self) {
+        if self.series.iter().all(|s| s.name.is_empty()) {
+            return;
+        }
         let tf = |s: Scale, v: f64| match s {
             Scale::Linear => Some(v),
             Scale::Log if v > 0.0 => Some(v.log10()),
@@ -219,6 +222,7 @@ impl Panel {
             }
             pts.extend(p);
         }
+        pts.extend(self.annotations.iter().filter_map(|a| Some((tf(self.x.scale, a.x)?, tf(self.y.scale, a.y)?))));
         let finite: Vec<(f64, f64)> = pts.into_iter().filter(|p| p.0.is_finite() && p.1.is_finite()).collect();
         if finite.is_empty() {
             return;
@@ -296,7 +300,10 @@ impl Figure {
                     rest = bottom;
                     top
                 };
-                draw_panel(&area, panel).map_err(err)?;
+                // Every legend goes where it covers no data (when some corner is free).
+                let mut placed = panel.clone();
+                placed.place_legend();
+                draw_panel(&area, &placed).map_err(err)?;
             }
             root_present(&rest).map_err(err)?;
         }
