@@ -5,7 +5,8 @@
 # (python/tests), rosbags, mcap and pyarrow as independent writers of the recordings the readers
 # are tested on (scripts/write_recordings.py, crates/gyrolab-cli/tests/recordings.rs), and
 # Chromium for the browser test of
-# the HTML report (crates/gyrolab-cli/tests/browser.rs). Does nothing that is already done.
+# the HTML report (crates/gyrolab-cli/tests/browser.rs) and the PDF test of `--pdf`
+# (crates/gyrolab-cli/tests/pdf.rs). Does nothing that is already done.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! .venv/bin/python -c "import allantools, scipy, pytest, matplotlib, maturin, rosbags, mcap, pyarrow" 2>/dev/null; then

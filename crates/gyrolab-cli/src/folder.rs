@@ -1,5 +1,6 @@
-//! Writing a report folder and ending the run: the files written, the verdict of the spec
-//! limits, and exit code 3 when a limit failed (`gyrolab eval`, `gyrolab demo --out`).
+//! Writing a report folder and ending the run: the files written, the PDF when asked for
+//! (`--pdf`), the verdict of the spec limits, and exit code 3 when a limit failed (`gyrolab eval`,
+//! `gyrolab demo --out`), or 1 when the PDF was asked for and could not be made.
 
 use crate::error::{CliError, CliResult};
 use crate::output::{print, write_folder};
@@ -7,9 +8,13 @@ use gyrolab_eval::report_folder::ReportFolder;
 use gyrolab_report::limits::Verdict;
 use std::path::Path;
 
-/// Writes the folder whole, prints what was written (unless quiet) and turns a failed limit
-/// into exit code 3.
-pub fn write_and_finish(out: &Path, folder: &ReportFolder, quiet: bool) -> CliResult {
+/// Writes the folder whole, prints what was written (unless quiet), prints report.html to
+/// report.pdf when `pdf` is set, and turns a failed limit into exit code 3.
+///
+/// When `pdf` is set and no PDF can be made (no browser, or the browser failed), the rest of the
+/// folder stays written, an older report.pdf (which shows an earlier report) is removed, and the
+/// run ends with exit code 1 and a message saying how to get the PDF.
+pub fn write_and_finish(out: &Path, folder: &ReportFolder, quiet: bool, pdf: bool) -> CliResult {
     let files = write_folder(out, &folder.outputs)?;
     if !quiet {
         let mut s = format!("Wrote {} files to {}:\n", files.len(), out.display());
@@ -27,6 +32,32 @@ pub fn write_and_finish(out: &Path, folder: &ReportFolder, quiet: bool) -> CliRe
             s.push_str(&format!("  FAIL {f}\n"));
         }
         print(&s)?;
+    }
+    if pdf {
+        match crate::pdf::print_report(out) {
+            Ok((path, size)) => {
+                if !quiet {
+                    print(&format!("Printed report.html to {} ({} kB)\n", path.display(), size.div_ceil(1024)))?;
+                }
+            }
+            Err(e) => {
+                let mut message = e.message(out);
+                let stale = out.join("report.pdf");
+                if stale.exists() && std::fs::remove_file(&stale).is_ok() {
+                    message.push_str(
+                        " (The older report.pdf of this folder, which showed an earlier report, was removed.)",
+                    );
+                }
+                if folder.verdict == Some(Verdict::Fail) {
+                    message.push_str(&format!(
+                        " Also {} spec limit check(s) failed: {}",
+                        folder.failures.len(),
+                        folder.failures.join("; ")
+                    ));
+                }
+                return Err(CliError::Output(message));
+            }
+        }
     }
     if folder.verdict == Some(Verdict::Fail) {
         return Err(CliError::LimitFailed(format!(

@@ -286,13 +286,16 @@ figcaption { font-size: 9.5pt; color: #333; margin-top: 3px; }
 section.page-break { break-before: page; page-break-before: always; }
 table.conditions, table.equipment { margin-top: 8px; }
 table.sign-off td.sign { min-width: 180px; height: 40px; }
+table.conditions td { min-width: 260px; }
+table.methods { width: 100%; }
+table.sign-off td:nth-child(2) { min-width: 160px; }
 section.sign-off { break-inside: avoid; page-break-inside: avoid; }
 tr { break-inside: avoid; page-break-inside: avoid; }
 @page { size: A4; margin: 14mm 12mm; }
 @media print {
   body { max-width: none; padding: 0; font-size: 10pt; }
   * { -webkit-print-color-adjust: exact; print-color-adjust: exact; }
-  figure.plot svg { max-width: 100%; max-height: 240mm; }
+  figure.plot svg { max-width: 165mm; max-height: 240mm; }
   h2, h3 { break-after: avoid; page-break-after: avoid; }
 }
 "#;
@@ -444,7 +447,7 @@ fn write_methods(h: &mut String) {
     }
     for group in groups {
         let _ = writeln!(h, "<h3>{}</h3>", group.title());
-        h.push_str("<table><thead><tr><th class=\"name\">figure</th><th class=\"name\">key</th><th class=\"name\">formula</th><th class=\"name\">unit</th><th class=\"name\">source</th></tr></thead><tbody>\n");
+        h.push_str("<table class=\"methods\"><thead><tr><th class=\"name\">figure</th><th class=\"name\">key</th><th class=\"name\">formula</th><th class=\"name\">unit</th><th class=\"name\">source</th></tr></thead><tbody>\n");
         for d in FIGURES.iter().filter(|d| d.group == group) {
             let _ = writeln!(
                 h,

@@ -30,6 +30,12 @@ pub struct DemoArgs {
     /// shorter records run faster but end the Allan curve at a quarter of their length.
     #[arg(long, value_name = "S", default_value_t = 7200.0, requires = "out")]
     pub sim_allan_s: f64,
+    /// With --out: also print report.html to report.pdf with headless Chromium (/usr/bin/chromium, or
+    /// chromium, chromium-browser or google-chrome on PATH, or the path in GYROLAB_CHROMIUM; at
+    /// most 120 s). Without a browser, or when printing fails, the other files are still written
+    /// and the exit code is 1 with a message saying how to get the PDF.
+    #[arg(long, requires = "out")]
+    pub pdf: bool,
 }
 
 /// Runs `gyrolab demo`.
@@ -39,7 +45,7 @@ pub fn run(args: &DemoArgs) -> CliResult {
         let request = PaperReportRequest { sim_static_s: args.sim_static_s, sim_allan_s: args.sim_allan_s };
         let folder = paper_report_folder(&request, &bar);
         bar.finish();
-        return write_and_finish(out, &folder?, args.quiet);
+        return write_and_finish(out, &folder?, args.quiet, args.pdf);
     }
     let demo = evaluate_paper()?;
     let reports: Vec<AxisReport<'_>> = demo.axes.iter().map(EvaluatedAxis::report).collect();

@@ -1,5 +1,6 @@
 //! `gyrolab eval PLAN.toml --out DIR`: evaluate a test plan and write the report folder
-//! (report.html, results.json, calibration.toml, CSV tables). Exit code 3 when a limit fails.
+//! (report.html, results.json, calibration.toml, CSV tables; report.pdf with `--pdf`). Exit code 3
+//! when a limit fails, 1 when `--pdf` could not make the PDF.
 
 use crate::error::CliResult;
 use crate::folder::write_and_finish;
@@ -21,6 +22,12 @@ pub struct EvalArgs {
     /// No progress bar and no summary on standard output (errors still go to stderr).
     #[arg(long, short)]
     pub quiet: bool,
+    /// Also print report.html to report.pdf with headless Chromium (/usr/bin/chromium, or
+    /// chromium, chromium-browser or google-chrome on PATH, or the path in GYROLAB_CHROMIUM; at
+    /// most 120 s). Without a browser, or when printing fails, the other files are still written
+    /// and the exit code is 1 with a message saying how to get the PDF.
+    #[arg(long)]
+    pub pdf: bool,
 }
 
 /// Runs `gyrolab eval`.
@@ -29,5 +36,5 @@ pub fn run(args: &EvalArgs) -> CliResult {
     let bar = Bar::new(args.quiet);
     let folder = evaluate_test_plan(&plan, &args.plan.display().to_string(), &bar);
     bar.finish();
-    write_and_finish(&args.out, &folder?, args.quiet)
+    write_and_finish(&args.out, &folder?, args.quiet, args.pdf)
 }
