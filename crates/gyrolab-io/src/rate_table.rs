@@ -170,6 +170,35 @@ fn data_error_from_grid(path: &Path, e: RateTestError, first_line_of_rate: impl 
     }
 }
 
+/// The unit of an output column: `given`, else its name's suffix; an error located at the header
+/// names the option (`give`) that sets it.
+pub(crate) fn output_unit_of_column(
+    path: &Path,
+    table: &TextTable,
+    output_col: usize,
+    given: Option<OutputUnit>,
+    give: &str,
+) -> Result<OutputUnit, DataError> {
+    let hl = table.header_line;
+    let out_name = &table.header[output_col];
+    match given {
+        Some(u) => Ok(u),
+        None => output_unit_of_name(out_name)
+            .map_err(|m| DataError::new(path, m).at_line(hl).at_column(output_col + 1, Some(out_name)))?
+            .ok_or_else(|| {
+                DataError::new(
+                    path,
+                    format!(
+                        "the output column has no unit: name it output_v, output_mv, output_lsb or output_dps, or \
+                         give {give}"
+                    ),
+                )
+                .at_line(hl)
+                .at_column(output_col + 1, Some(out_name))
+            }),
+    }
+}
+
 fn read_long(
     path: &Path,
     table: &TextTable,
@@ -206,20 +235,7 @@ fn read_long(
         }
     };
     let rate_unit = rate_unit_of(path, table, rate_col, columns.rate_unit)?;
-    let out_name = &table.header[output_col];
-    let output_unit = match columns.output_unit {
-        Some(u) => u,
-        None => output_unit_of_name(out_name)
-            .map_err(|m| DataError::new(path, m).at_line(hl).at_column(output_col + 1, Some(out_name)))?
-            .ok_or_else(|| {
-                DataError::new(
-                    path,
-                    "the output column has no unit: name it output_v, output_mv, output_lsb or output_dps, or give --output-unit",
-                )
-                .at_line(hl)
-                .at_column(output_col + 1, Some(out_name))
-            })?,
-    };
+    let output_unit = output_unit_of_column(path, table, output_col, columns.output_unit, "--output-unit")?;
     let width = table.header.len();
     let mut obs = Vec::with_capacity(table.rows.len());
     let mut first_lines: Vec<(f64, u64)> = Vec::new();

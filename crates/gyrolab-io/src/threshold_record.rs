@@ -4,7 +4,7 @@
 //! (zero-rate rows included for a threshold record, base-rate rows for a resolution record).
 //! Other columns (time, run, temperature) are ignored. Errors name file, line and column.
 
-use crate::rate_table::{find_column, output_unit_of_name, rate_unit_of};
+use crate::rate_table::{find_column, output_unit_of_column, rate_unit_of};
 use crate::text::{parse_number, parse_text_table};
 use crate::DataError;
 use gyrolab::threshold::{group_by_rate, RateSamples};
@@ -77,20 +77,7 @@ pub fn parse_step_record(path: &Path, text: &str, columns: &StepColumns) -> Resu
         }
     };
     let rate_unit = rate_unit_of(path, &table, rate_col, None)?;
-    let out_name = &table.header[output_col];
-    let output_unit = match columns.output_unit {
-        Some(u) => u,
-        None => output_unit_of_name(out_name)
-            .map_err(|m| DataError::new(path, m).at_line(hl).at_column(output_col + 1, Some(out_name)))?
-            .ok_or_else(|| {
-                DataError::new(
-                    path,
-                    "the output column has no unit: name it output_v, output_mv, output_lsb or output_dps, or give output_unit",
-                )
-                .at_line(hl)
-                .at_column(output_col + 1, Some(out_name))
-            })?,
-    };
+    let output_unit = output_unit_of_column(path, &table, output_col, columns.output_unit, "output_unit")?;
     let width = table.header.len();
     let mut rates = Vec::with_capacity(table.rows.len());
     let mut outputs = Vec::with_capacity(table.rows.len());
