@@ -14,6 +14,7 @@
 //! [`ReaderQuality`].
 
 use crate::error::DataError;
+use gyrolab::dropout::{DropoutKind, DropoutMarker, DropoutVerdict};
 use gyrolab::static_test::{OutlierScan, SampleBlock, StaticTestAccumulator, StaticTestConfig, StaticTestResult};
 use gyrolab::units::{is_celsius, parse_column_name, OutputUnit, Quantity, RateUnit, TimeUnit};
 use serde::{Deserialize, Serialize};
@@ -66,6 +67,11 @@ pub struct SeriesOptions {
     /// Rows whose output channels are all exactly zero (dropouts, as the caller decided with
     /// [`gyrolab::dropout`]) are passed on as NaN in every channel and counted.
     pub zero_rows_missing: bool,
+    /// Rows whose output channels all equal the row before (repeated-row dropouts, as the
+    /// caller decided with [`gyrolab::dropout`]; not the row after an all-zero row when
+    /// `zero_rows_missing` is set) are passed on as NaN in every channel and counted. Read
+    /// sequentially (the row before crosses blocks).
+    pub repeated_rows_missing: bool,
     /// Bytes read from the file at once.
     pub chunk_bytes: usize,
     /// Rows per block handed to the caller.
@@ -89,6 +95,7 @@ impl Default for SeriesOptions {
             table_rate_column: None,
             tolerant: false,
             zero_rows_missing: false,
+            repeated_rows_missing: false,
             max_rows: None,
             chunk_bytes: DEFAULT_CHUNK_BYTES,
             block_rows: DEFAULT_BLOCK_ROWS,
@@ -296,6 +303,31 @@ pub struct ReaderQuality {
     pub zero_rows: u64,
     /// Lines of the first of them (at most [`FIRST_MISSING`]).
     pub first_zero_rows: Vec<u64>,
+    /// Rows whose channels all repeated the row before, passed on as NaN
+    /// ([`SeriesOptions::repeated_rows_missing`]).
+    pub repeated_rows: u64,
+    /// Lines of the first of them (at most [`FIRST_MISSING`]).
+    pub first_repeated_rows: Vec<u64>,
+}
+
+impl ReaderQuality {
+    /// Counts a dropout row passed on as NaN (and lists its line among the first ones).
+    pub fn count_dropout(&mut self, kind: DropoutKind, line: u64) {
+        let (count, first) = match kind {
+            DropoutKind::AllZero => (&mut self.zero_rows, &mut self.first_zero_rows),
+            DropoutKind::Repeated => (&mut self.repeated_rows, &mut self.first_repeated_rows),
+        };
+        *count += 1;
+        if first.len() < FIRST_MISSING {
+            first.push(line);
+        }
+    }
+}
+
+/// The reader's dropout marker for the options' two flags (none when neither is set).
+fn dropout_marker(zero_rows: bool, repeated_rows: bool) -> Option<DropoutMarker> {
+    let verdict = DropoutVerdict { all_zero: zero_rows, repeated: repeated_rows };
+    verdict.any().then(|| DropoutMarker::new(verdict))
 }
 
 /// The source line of every row of a record, stored as runs of consecutive lines (a record
@@ -477,7 +509,8 @@ pub struct SeriesReader<R: Read> {
     src: R,
     header: SeriesHeader,
     tolerant: bool,
-    zero_rows_missing: bool,
+    /// Marks dropout rows (all zero, repeated) as NaN, when the caller asked for it.
+    dropouts: Option<DropoutMarker>,
     max_rows: Option<u64>,
     fast_rows: bool,
     block_rows: usize,
@@ -550,7 +583,7 @@ impl<R: Read> SeriesReader<R> {
                 rows: RowKind::Line,
             },
             tolerant: options.tolerant,
-            zero_rows_missing: options.zero_rows_missing,
+            dropouts: dropout_marker(options.zero_rows_missing, options.repeated_rows_missing),
             max_rows: options.max_rows,
             fast_rows: options.fast_rows,
             block_rows: options.block_rows.max(1),
@@ -1096,15 +1129,13 @@ impl<R: Read> SeriesReader<R> {
             }
         }
         let nch = self.header.channels.len();
-        if self.zero_rows_missing && nch > 0 {
-            for i in 0..self.lines.len() {
-                if self.cols[..nch].iter().all(|c| c[i] == 0.0) {
-                    self.cols[..nch].iter_mut().for_each(|c| c[i] = f64::NAN);
-                    self.quality.zero_rows += 1;
-                    if self.quality.first_zero_rows.len() < FIRST_MISSING {
-                        self.quality.first_zero_rows.push(self.lines[i]);
-                    }
-                }
+        if let Some(marker) = self.dropouts.as_mut() {
+            let mut rows = Vec::new();
+            let refs: Vec<&[f64]> = self.cols[..nch].iter().map(|c| &c[..]).collect();
+            marker.mark_block(&refs, |i, kind| rows.push((i, kind)));
+            for (i, kind) in rows {
+                self.cols[..nch].iter_mut().for_each(|c| c[i] = f64::NAN);
+                self.quality.count_dropout(kind, self.lines[i]);
             }
         }
         Ok(Some(SeriesBlock {
@@ -1415,7 +1446,7 @@ impl<R: Read> SeriesReader<R> {
             src: std::io::empty(),
             header: self.header.clone(),
             tolerant: self.tolerant,
-            zero_rows_missing: self.zero_rows_missing,
+            dropouts: self.dropouts.as_ref().map(|m| DropoutMarker::new(m.verdict())),
             max_rows: None,
             fast_rows: self.fast_rows,
             block_rows: rows.max(1),
@@ -1469,6 +1500,10 @@ fn collect_series_parallel<R: Read>(
     batch_bytes: usize,
 ) -> Result<SeriesData, DataError> {
     use rayon::prelude::*;
+    if r.dropouts.as_ref().is_some_and(|m| m.verdict().repeated) {
+        // Repeated rows compare each row with the one before, across pieces: read in order.
+        return collect_series(r);
+    }
     let header = r.header.clone();
     let nch = header.channels.len();
     let nslots = r.cols.len();
@@ -1539,6 +1574,11 @@ fn collect_series_parallel<R: Read>(
             quality.zero_rows += p.quality.zero_rows;
             let zroom = FIRST_MISSING.saturating_sub(quality.first_zero_rows.len());
             quality.first_zero_rows.extend(std::mem::take(&mut p.quality.first_zero_rows).into_iter().take(zroom));
+            quality.repeated_rows += p.quality.repeated_rows;
+            let rroom = FIRST_MISSING.saturating_sub(quality.first_repeated_rows.len());
+            quality
+                .first_repeated_rows
+                .extend(std::mem::take(&mut p.quality.first_repeated_rows).into_iter().take(rroom));
             let room = FIRST_MISSING.saturating_sub(quality.first_missing.len());
             quality.first_missing.extend(std::mem::take(&mut p.quality.first_missing).into_iter().take(room));
             pool[k] = p;
@@ -1671,27 +1711,24 @@ pub fn evaluate_static_file(
 }
 
 /// Evaluates the static (bias) test of every channel of a record held in memory (a Parquet
-/// table, a recording's topic) as [`evaluate_static_file`] does for a file; with
-/// `zero_rows_missing`, rows whose channels are all exactly zero are left out as missing
+/// table, a recording's topic) as [`evaluate_static_file`] does for a file; the dropout rows of
+/// the kinds `dropouts` names (all zero, repeated; [`gyrolab::dropout`]) are left out as missing
 /// (counted in the summary's quality).
 pub fn evaluate_static_data(
     data: &mut SeriesData,
-    zero_rows_missing: bool,
+    dropouts: DropoutVerdict,
     mut config_for: impl FnMut(&ChannelInfo) -> StaticTestConfig,
 ) -> Result<(Vec<StaticTestResult>, SeriesSummary), DataError> {
     let header = data.header.clone();
     let path = header.file.clone();
     let nch = data.channels.len();
-    if zero_rows_missing && nch > 0 {
-        let n = data.lines.len();
-        for i in 0..n {
-            if data.channels.iter().all(|c| c[i] == 0.0) {
-                data.channels.iter_mut().for_each(|c| c[i] = f64::NAN);
-                data.quality.zero_rows += 1;
-                if data.quality.first_zero_rows.len() < FIRST_MISSING {
-                    data.quality.first_zero_rows.push(data.lines.get(i).unwrap_or(0));
-                }
-            }
+    if dropouts.any() && nch > 0 {
+        let mut rows = Vec::new();
+        let refs: Vec<&[f64]> = data.channels.iter().map(|c| &c[..]).collect();
+        DropoutMarker::new(dropouts).mark_block(&refs, |i, kind| rows.push((i, kind)));
+        for (i, kind) in rows {
+            data.channels.iter_mut().for_each(|c| c[i] = f64::NAN);
+            data.quality.count_dropout(kind, data.lines.get(i).unwrap_or(0));
         }
     }
     let configs = channel_configs(&header, &mut config_for);
