@@ -321,7 +321,11 @@ mod tests {
         // 49 levels per channel; channel 0 never zero by chance.
         let mut ch: Vec<Vec<f64>> = (0..3)
             .map(|c| {
-                quantized(n, 300 + c as u64).iter().zip(quantized(n, 400 + c as u64)).map(|(a, b)| a * 7.0 + b).collect()
+                quantized(n, 300 + c as u64)
+                    .iter()
+                    .zip(quantized(n, 400 + c as u64))
+                    .map(|(a, b)| a * 7.0 + b)
+                    .collect()
             })
             .collect();
         ch[0].iter_mut().for_each(|v| *v += 0.5);

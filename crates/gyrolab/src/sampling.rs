@@ -423,10 +423,7 @@ fn find_gaps<S: Stamps + ?Sized>(t: &S, dt: f64) -> Vec<Gap> {
                 // hold the delay over a burst).
                 let end = (i + WINDOW / 2).min(n);
                 let intervals: Vec<(usize, f64)> = (i..end).map(|a| (a, c.get(a) - c.get(a - 1))).collect();
-                let at = intervals
-                    .iter()
-                    .max_by(|x, y| x.1.total_cmp(&y.1).then(y.0.cmp(&x.0)))
-                    .map_or(i, |x| x.0);
+                let at = intervals.iter().max_by(|x, y| x.1.total_cmp(&y.1).then(y.0.cmp(&x.0))).map_or(i, |x| x.0);
                 gaps.push(Gap { index: at, missing, interval_s: c.get(at) - c.get(at - 1) });
                 previous = at;
                 i = at + 1;
