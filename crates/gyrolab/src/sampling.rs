@@ -187,7 +187,7 @@ impl CompactStamps {
         } else {
             self.codes.push(d2 as i8);
         }
-        if n % CHECK == 0 {
+        if n.is_multiple_of(CHECK) {
             self.checks.push((bits, d1, self.escaped.len()));
         }
         self.prev_bits = bits;
@@ -309,7 +309,9 @@ pub fn estimate_interval_of<S: Stamps + ?Sized>(t: &S) -> Result<IntervalEstimat
     // BLOCK-th stamp for the block means.
     let mut first_non_increasing = None;
     let mut non_increasing = 0usize;
-    let (mut first, mut last): (Option<(usize, f64)>, Option<(usize, f64)>) = (None, None);
+    // (index, stamp) of the first and the last finite stamp.
+    let mut first: Option<(usize, f64)> = None;
+    let mut last: Option<(usize, f64)> = None;
     let mut marks = Vec::with_capacity(n / BLOCK + 1);
     {
         let mut c = Cursor::new(t);
@@ -324,7 +326,7 @@ pub fn estimate_interval_of<S: Stamps + ?Sized>(t: &S) -> Result<IntervalEstimat
                 non_increasing += 1;
                 first_non_increasing.get_or_insert(IrregularInterval { index: i, interval_s: v - prev });
             }
-            if i % BLOCK == 0 {
+            if i.is_multiple_of(BLOCK) {
                 marks.push(v);
             }
             prev = v;
