@@ -198,3 +198,33 @@ fn warmup_figures_recover_the_simulated_transient() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("late.csv") && err.contains("not at power-on"), "{err}");
 }
+
+/// Repeated-row dropouts (every 250th row written again, 16 of them) in a two-channel deg/s
+/// log: `gyrolab bias` warns with their count and first line, and the mean is that of the other
+/// rows (computed here).
+#[test]
+fn repeated_rows_are_left_out_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 4000;
+    let mut s = String::from("time_s,gx_dps,gy_dps\n");
+    let mut rows: Vec<[f64; 2]> = Vec::new();
+    let mut kept = Vec::new();
+    for i in 0..n {
+        let r = if i % 250 == 249 {
+            rows[i - 1]
+        } else {
+            kept.push(i);
+            [0.01 + ((i * 37) % 101) as f64 * 1e-4, -0.02 + ((i * 53) % 97) as f64 * 1e-4]
+        };
+        s.push_str(&format!("{},{:.6},{:.6}\n", i as f64 * 0.1, r[0], r[1]));
+        rows.push([(r[0] * 1e6).round() / 1e6, (r[1] * 1e6).round() / 1e6]);
+    }
+    let file = write(dir.path(), "rep.csv", &s);
+    let out = gyrolab().args(["bias", "--json"]).arg(&file).assert().success().get_output().clone();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    // Row 249 is on line 251 (header on line 1).
+    assert!(stderr.contains("rep.csv:251: 16 dropout row(s) (every channel equal to the row before"), "{stderr}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let mean = kept.iter().map(|&i| rows[i][0]).sum::<f64>() / kept.len() as f64;
+    assert_relative_eq!(v["tests"][0]["mean_output"].as_f64().unwrap(), mean, max_relative = 1e-12);
+}

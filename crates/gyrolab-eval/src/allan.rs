@@ -7,7 +7,7 @@ use crate::layout::LogLayout;
 use crate::reference::{Reference, ReferenceRequest};
 use gyrolab::allan::{deviation_from_rate_with_gaps, AllanCurve, AllanError, AllanOptions, DeviationKind, TauList};
 use gyrolab::noise::{fit_noise_model, slope_line_terms};
-use gyrolab::sampling::{estimate_interval, SamplingError};
+use gyrolab::sampling::{estimate_interval, estimate_interval_of, SamplingError};
 use gyrolab::units::{OutputUnit, Quantity, TimeUnit};
 use gyrolab::validate::{self, InvalidOption};
 use gyrolab_io::recording::{read_records, TopicMeta};
@@ -316,7 +316,11 @@ pub const RATE_TOLERANCE: f64 = 0.01;
 /// [`RATE_TOLERANCE`], the message saying so (`option` names the given rate: a flag placeholder
 /// or a plan key); `None` when they agree or the stamps give no rate.
 pub fn rate_disagreement(t: &[f64], given_hz: f64, option: &str, path: &Path) -> Option<String> {
-    let est = estimate_interval(t).ok()?;
+    disagreement(&estimate_interval(t).ok()?, given_hz, option, path)
+}
+
+/// The message of [`rate_disagreement`] for an estimate already made.
+fn disagreement(est: &gyrolab::sampling::IntervalEstimate, given_hz: f64, option: &str, path: &Path) -> Option<String> {
     let stamps_hz = est.rate_hz();
     if !stamps_hz.is_finite() || (given_hz * est.interval_s - 1.0).abs() <= RATE_TOLERANCE {
         return None;
@@ -360,15 +364,18 @@ pub struct Timing {
 /// that does not increase is an error naming its line; gaps are an error under
 /// [`GapPolicy::Error`].
 pub fn record_timing(data: &SeriesData, path: &Path, given_hz: Option<f64>, policy: GapPolicy) -> EvalResult<Timing> {
+    // The stamps as read, or kept compactly by the reader (the same estimate either way).
     let estimate = match &data.time {
-        Some(t) => Some(estimate_interval(t).map_err(|e| match e {
-            SamplingError::TooShort => DataError::new(path, "fewer than two samples: nothing to analyse"),
-            SamplingError::NotIncreasing => {
-                DataError::new(path, "the time stamps do not increase: expected increasing time stamps")
-            }
-        })?),
-        None => None,
-    };
+        Some(t) => Some(estimate_interval(t)),
+        None => data.time_compact.as_ref().map(estimate_interval_of),
+    }
+    .transpose()
+    .map_err(|e| match e {
+        SamplingError::TooShort => DataError::new(path, "fewer than two samples: nothing to analyse"),
+        SamplingError::NotIncreasing => {
+            DataError::new(path, "the time stamps do not increase: expected increasing time stamps")
+        }
+    })?;
     if let Some(e) = &estimate {
         if let Some(g) = e.first_non_increasing {
             let line = data.lines.get(g.index).unwrap_or(0);
@@ -400,10 +407,8 @@ pub fn record_timing(data: &SeriesData, path: &Path, given_hz: Option<f64>, poli
     let (gaps, missing) = estimate.as_ref().map_or((Vec::new(), 0), |e| (e.gaps.clone(), e.missing));
     match (given_hz, &estimate) {
         (Some(f), Some(e)) => {
-            if let Some(t) = &data.time {
-                if let Some(msg) = rate_disagreement(t, f, "{sample_rate_hz}", path) {
-                    return Err(EvalError::conflict_on(&["sample_rate_hz"], msg));
-                }
+            if let Some(msg) = disagreement(e, f, "{sample_rate_hz}", path) {
+                return Err(EvalError::conflict_on(&["sample_rate_hz"], msg));
             }
             Ok(Timing {
                 tau0_s: 1.0 / f,
@@ -583,6 +588,8 @@ pub fn analyse_records(request: &AllanRequest) -> EvalResult<Vec<AllanOutcome>> 
         sample_rate_hz: request.sample_rate_hz,
         channels: if request.columns.is_empty() { None } else { Some(request.columns.clone()) },
         tolerant: true,
+        // Only the interval and gap search reads the stamps: kept compactly.
+        compact_time: true,
         ..SeriesOptions::default()
     })?;
     let records = read_records(path, &options, &request.topics)?;
@@ -681,6 +688,7 @@ pub fn analyse_data(
         });
     }
     data.time = None;
+    data.time_compact = None;
     let opts = AllanOptions {
         kind: request.kind,
         taus: request.taus.clone(),

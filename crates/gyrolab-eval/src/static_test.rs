@@ -4,6 +4,7 @@
 
 use crate::error::{EvalError, EvalResult};
 use crate::reference::{Reference, ReferenceRequest};
+use gyrolab::dropout::{DropoutTally, DropoutVerdict};
 use gyrolab::static_test::{bias_repeatability, StaticTestConfig, StaticTestResult};
 use gyrolab::units::OutputUnit;
 use gyrolab::validate;
@@ -270,7 +271,9 @@ pub fn evaluate_file(
     config: &StaticTestConfig,
 ) -> EvalResult<(Vec<StaticTestResult>, SeriesSummary)> {
     let mut options = options.clone();
-    options.zero_rows_missing = zero_rows_are_dropouts(path, &options)?;
+    let verdict = dropout_verdict(path, &options)?;
+    options.zero_rows_missing = verdict.all_zero;
+    options.repeated_rows_missing = verdict.repeated;
     with_reference(path, reference, config, |config_for| evaluate_static_file(path, &options, config_for))
 }
 
@@ -298,22 +301,6 @@ fn with_reference<T>(
     }
 }
 
-/// Adds the exact zeros of `rows` rows of `channels` to `zeros` (per channel); returns the
-/// rows whose channels are all zero.
-fn tally_zeros(channels: &[Vec<f64>], rows: usize, zeros: &mut [u64]) -> u64 {
-    let mut all_zero = 0u64;
-    for i in 0..rows {
-        let mut all = true;
-        for (c, z) in channels.iter().zip(zeros.iter_mut()) {
-            let zero = c[i] == 0.0;
-            *z += u64::from(zero);
-            all &= zero;
-        }
-        all_zero += u64::from(all);
-    }
-    all_zero
-}
-
 /// Evaluates every channel of one record held in memory (a Parquet table, a recording's topic),
 /// as [`evaluate_file`] does for a text file.
 pub fn evaluate_record(
@@ -322,36 +309,29 @@ pub fn evaluate_record(
     config: &StaticTestConfig,
 ) -> EvalResult<(Vec<StaticTestResult>, SeriesSummary)> {
     let path = data.header.file.clone();
-    let zero_rows = if data.channels.len() >= 2 {
-        let n = data.lines.len();
-        let mut zeros = vec![0u64; data.channels.len()];
-        let all_zero = tally_zeros(&data.channels, n, &mut zeros);
-        gyrolab::dropout::beyond_chance(all_zero, n as u64, &zeros)
-    } else {
-        false
-    };
+    let mut tally = DropoutTally::new(data.channels.len());
+    tally.push_block(&data.channels.iter().map(|c| &c[..]).collect::<Vec<_>>());
+    let verdict = tally.verdict();
     with_reference(&path, reference, config, |config_for| {
-        gyrolab_io::series::evaluate_static_data(&mut data, zero_rows, config_for)
+        gyrolab_io::series::evaluate_static_data(&mut data, verdict, config_for)
     })
 }
 
-/// Whether the rows of `path` whose output channels are all exactly zero are dropouts, by the
-/// rule of [`gyrolab::dropout`] (far more of them than independent channels would give); read
-/// in a streaming pass that counts zeros, only for files of two channels or more.
-pub fn zero_rows_are_dropouts(path: &Path, options: &SeriesOptions) -> EvalResult<bool> {
-    let opts = SeriesOptions { zero_rows_missing: false, ..options.clone() };
+/// Which dropout rows `path` has (all zero, repeated), by the rule of [`gyrolab::dropout`]
+/// (far more of them than independent channels would give): a streaming pass over the file
+/// that tallies zeros and repeats, only for files of two channels or more.
+pub fn dropout_verdict(path: &Path, options: &SeriesOptions) -> EvalResult<DropoutVerdict> {
+    let opts = SeriesOptions { zero_rows_missing: false, repeated_rows_missing: false, ..options.clone() };
     let mut r = gyrolab_io::series::SeriesReader::open(path, &opts)?;
     let nch = r.header().channels.len();
     if nch < 2 {
-        return Ok(false);
+        return Ok(DropoutVerdict::default());
     }
-    let (mut rows, mut all_zero) = (0u64, 0u64);
-    let mut zeros = vec![0u64; nch];
+    let mut tally = DropoutTally::new(nch);
     while let Some(b) = r.next_block()? {
-        all_zero += tally_zeros(b.channels, b.len(), &mut zeros);
-        rows += b.len() as u64;
+        tally.push_block(&b.channels.iter().map(|c| &c[..]).collect::<Vec<_>>());
     }
-    Ok(gyrolab::dropout::beyond_chance(all_zero, rows, &zeros))
+    Ok(tally.verdict())
 }
 
 /// Bias repeatability of each channel present in two or more tests (paper eq. 12), in order of

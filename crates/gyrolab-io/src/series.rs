@@ -14,6 +14,8 @@
 //! [`ReaderQuality`].
 
 use crate::error::DataError;
+use gyrolab::dropout::{DropoutKind, DropoutMarker, DropoutVerdict};
+use gyrolab::sampling::CompactStamps;
 use gyrolab::static_test::{OutlierScan, SampleBlock, StaticTestAccumulator, StaticTestConfig, StaticTestResult};
 use gyrolab::units::{is_celsius, parse_column_name, OutputUnit, Quantity, RateUnit, TimeUnit};
 use serde::{Deserialize, Serialize};
@@ -66,6 +68,15 @@ pub struct SeriesOptions {
     /// Rows whose output channels are all exactly zero (dropouts, as the caller decided with
     /// [`gyrolab::dropout`]) are passed on as NaN in every channel and counted.
     pub zero_rows_missing: bool,
+    /// Rows whose output channels all equal the row before (repeated-row dropouts, as the
+    /// caller decided with [`gyrolab::dropout`]; not the row after an all-zero row when
+    /// `zero_rows_missing` is set) are passed on as NaN in every channel and counted. Read
+    /// sequentially (the row before crosses blocks).
+    pub repeated_rows_missing: bool,
+    /// [`read_series_all`] keeps the time stamps as [`CompactStamps`] (lossless, about 1.4
+    /// bytes a row instead of 8) in [`SeriesData::time_compact`], `time` left `None`: for
+    /// analyses that only search the stamps for the interval and gaps (the Allan analysis).
+    pub compact_time: bool,
     /// Bytes read from the file at once.
     pub chunk_bytes: usize,
     /// Rows per block handed to the caller.
@@ -89,6 +100,8 @@ impl Default for SeriesOptions {
             table_rate_column: None,
             tolerant: false,
             zero_rows_missing: false,
+            repeated_rows_missing: false,
+            compact_time: false,
             max_rows: None,
             chunk_bytes: DEFAULT_CHUNK_BYTES,
             block_rows: DEFAULT_BLOCK_ROWS,
@@ -296,6 +309,31 @@ pub struct ReaderQuality {
     pub zero_rows: u64,
     /// Lines of the first of them (at most [`FIRST_MISSING`]).
     pub first_zero_rows: Vec<u64>,
+    /// Rows whose channels all repeated the row before, passed on as NaN
+    /// ([`SeriesOptions::repeated_rows_missing`]).
+    pub repeated_rows: u64,
+    /// Lines of the first of them (at most [`FIRST_MISSING`]).
+    pub first_repeated_rows: Vec<u64>,
+}
+
+impl ReaderQuality {
+    /// Counts a dropout row passed on as NaN (and lists its line among the first ones).
+    pub fn count_dropout(&mut self, kind: DropoutKind, line: u64) {
+        let (count, first) = match kind {
+            DropoutKind::AllZero => (&mut self.zero_rows, &mut self.first_zero_rows),
+            DropoutKind::Repeated => (&mut self.repeated_rows, &mut self.first_repeated_rows),
+        };
+        *count += 1;
+        if first.len() < FIRST_MISSING {
+            first.push(line);
+        }
+    }
+}
+
+/// The reader's dropout marker for the options' two flags (none when neither is set).
+fn dropout_marker(zero_rows: bool, repeated_rows: bool) -> Option<DropoutMarker> {
+    let verdict = DropoutVerdict { all_zero: zero_rows, repeated: repeated_rows };
+    verdict.any().then(|| DropoutMarker::new(verdict))
 }
 
 /// The source line of every row of a record, stored as runs of consecutive lines (a record
@@ -477,7 +515,9 @@ pub struct SeriesReader<R: Read> {
     src: R,
     header: SeriesHeader,
     tolerant: bool,
-    zero_rows_missing: bool,
+    /// Marks dropout rows (all zero, repeated) as NaN, when the caller asked for it.
+    dropouts: Option<DropoutMarker>,
+    compact_time: bool,
     max_rows: Option<u64>,
     fast_rows: bool,
     block_rows: usize,
@@ -550,7 +590,8 @@ impl<R: Read> SeriesReader<R> {
                 rows: RowKind::Line,
             },
             tolerant: options.tolerant,
-            zero_rows_missing: options.zero_rows_missing,
+            dropouts: dropout_marker(options.zero_rows_missing, options.repeated_rows_missing),
+            compact_time: options.compact_time,
             max_rows: options.max_rows,
             fast_rows: options.fast_rows,
             block_rows: options.block_rows.max(1),
@@ -1096,15 +1137,13 @@ impl<R: Read> SeriesReader<R> {
             }
         }
         let nch = self.header.channels.len();
-        if self.zero_rows_missing && nch > 0 {
-            for i in 0..self.lines.len() {
-                if self.cols[..nch].iter().all(|c| c[i] == 0.0) {
-                    self.cols[..nch].iter_mut().for_each(|c| c[i] = f64::NAN);
-                    self.quality.zero_rows += 1;
-                    if self.quality.first_zero_rows.len() < FIRST_MISSING {
-                        self.quality.first_zero_rows.push(self.lines[i]);
-                    }
-                }
+        if let Some(marker) = self.dropouts.as_mut() {
+            let mut rows = Vec::new();
+            let refs: Vec<&[f64]> = self.cols[..nch].iter().map(|c| &c[..]).collect();
+            marker.mark_block(&refs, |i, kind| rows.push((i, kind)));
+            for (i, kind) in rows {
+                self.cols[..nch].iter_mut().for_each(|c| c[i] = f64::NAN);
+                self.quality.count_dropout(kind, self.lines[i]);
             }
         }
         Ok(Some(SeriesBlock {
@@ -1355,6 +1394,9 @@ pub struct SeriesData {
     pub lines: LineMap,
     /// Time stamps, seconds.
     pub time: Option<Vec<f64>>,
+    /// Time stamps, seconds, stored compactly ([`SeriesOptions::compact_time`]; then `time` is
+    /// `None`).
+    pub time_compact: Option<CompactStamps>,
     /// Temperature, degC.
     pub temperature: Option<Vec<f64>>,
     /// Table rate, deg/s (when a table-rate column was asked for).
@@ -1369,7 +1411,7 @@ pub struct SeriesData {
 const MAX_RESERVE_ROWS: usize = 1 << 30;
 
 /// Bytes read at once by the parallel path of [`read_series_all`].
-pub const PARALLEL_BATCH_BYTES: usize = 16 << 20;
+pub const PARALLEL_BATCH_BYTES: usize = 4 << 20;
 
 /// Reads a whole file (`-`: standard input) into memory, for analyses that need the whole
 /// record (such as the Allan variance). Large inputs are parsed in parallel: batches of
@@ -1415,7 +1457,8 @@ impl<R: Read> SeriesReader<R> {
             src: std::io::empty(),
             header: self.header.clone(),
             tolerant: self.tolerant,
-            zero_rows_missing: self.zero_rows_missing,
+            dropouts: self.dropouts.as_ref().map(|m| DropoutMarker::new(m.verdict())),
+            compact_time: false,
             max_rows: None,
             fast_rows: self.fast_rows,
             block_rows: rows.max(1),
@@ -1469,11 +1512,18 @@ fn collect_series_parallel<R: Read>(
     batch_bytes: usize,
 ) -> Result<SeriesData, DataError> {
     use rayon::prelude::*;
+    if r.dropouts.as_ref().is_some_and(|m| m.verdict().repeated) {
+        // Repeated rows compare each row with the one before, across pieces: read in order.
+        return collect_series(r);
+    }
     let header = r.header.clone();
     let nch = header.channels.len();
     let nslots = r.cols.len();
     // Slots in the parser's order: channels, then time, temperature, table rate.
     let mut slots: Vec<Vec<f64>> = vec![Vec::new(); nslots];
+    // The time stamps kept compactly instead of in their slot, when asked for.
+    let compact_slot = if r.compact_time { r.time_slot } else { None };
+    let mut compact = compact_slot.map(|_| CompactStamps::default());
     let mut lines = LineMap::default();
     let mut quality = ReaderQuality::default();
     if r.buf.len() < batch_bytes {
@@ -1525,20 +1575,32 @@ fn collect_series_parallel<R: Read>(
             // Reserve for the whole file from the first batch's bytes per line (no regrowth).
             let per_line = (batch.len() as f64 / (line_no - r.line_no).max(1) as f64).max(1.0);
             let estimate = (((size as f64 / per_line) * 1.02) as usize + 16).min(MAX_RESERVE_ROWS);
-            slots.iter_mut().for_each(|s| s.reserve_exact(estimate));
+            for (k, s) in slots.iter_mut().enumerate() {
+                if Some(k) != compact_slot {
+                    s.reserve_exact(estimate);
+                }
+            }
             reserved = true;
         }
         let pieces: Vec<Result<Piece, DataError>> = parsers.into_par_iter().map(parse_piece).collect();
         for (k, p) in pieces.into_iter().enumerate() {
             let mut p = p?;
             lines.extend_from_slice(&p.lines);
-            for (s, c) in slots.iter_mut().zip(&p.cols) {
-                s.extend_from_slice(c);
+            for (k, (s, c)) in slots.iter_mut().zip(&p.cols).enumerate() {
+                match compact.as_mut() {
+                    Some(stamps) if Some(k) == compact_slot => stamps.extend_from_slice(c),
+                    _ => s.extend_from_slice(c),
+                }
             }
             quality.missing_cells += p.quality.missing_cells;
             quality.zero_rows += p.quality.zero_rows;
             let zroom = FIRST_MISSING.saturating_sub(quality.first_zero_rows.len());
             quality.first_zero_rows.extend(std::mem::take(&mut p.quality.first_zero_rows).into_iter().take(zroom));
+            quality.repeated_rows += p.quality.repeated_rows;
+            let rroom = FIRST_MISSING.saturating_sub(quality.first_repeated_rows.len());
+            quality
+                .first_repeated_rows
+                .extend(std::mem::take(&mut p.quality.first_repeated_rows).into_iter().take(rroom));
             let room = FIRST_MISSING.saturating_sub(quality.first_missing.len());
             quality.first_missing.extend(std::mem::take(&mut p.quality.first_missing).into_iter().take(room));
             pool[k] = p;
@@ -1565,25 +1627,30 @@ fn collect_series_parallel<R: Read>(
     }
     let mut it = slots.into_iter();
     let channels: Vec<Vec<f64>> = it.by_ref().take(nch).collect();
-    let time = header.time_column.map(|_| it.next().unwrap_or_default());
+    let time = header.time_column.map(|_| it.next().unwrap_or_default()).filter(|_| compact.is_none());
     let temperature = header.temperature_column.map(|_| it.next().unwrap_or_default());
     let table_rate = header.table_rate_column.map(|_| it.next().unwrap_or_default());
     let mut channels = channels;
     channels.iter_mut().for_each(|c| c.shrink_to_fit());
-    Ok(SeriesData { header, lines, time, temperature, table_rate, channels, quality })
+    Ok(SeriesData { header, lines, time, time_compact: compact, temperature, table_rate, channels, quality })
 }
 
 /// Reads every block of an open reader into memory.
 pub fn collect_series<R: Read>(mut r: SeriesReader<R>) -> Result<SeriesData, DataError> {
     let header = r.header.clone();
     let mut lines = LineMap::default();
-    let mut time = header.time_column.map(|_| Vec::new());
+    let compact_time = r.compact_time;
+    let mut time = header.time_column.filter(|_| !compact_time).map(|_| Vec::new());
+    let mut time_compact = header.time_column.filter(|_| compact_time).map(|_| CompactStamps::default());
     let mut temperature = header.temperature_column.map(|_| Vec::new());
     let mut table_rate = header.table_rate_column.map(|_| Vec::new());
     let mut channels = vec![Vec::new(); header.channels.len()];
     while let Some(b) = r.next_block()? {
         lines.extend_from_slice(b.lines);
         if let (Some(t), Some(bt)) = (time.as_mut(), b.time) {
+            t.extend_from_slice(bt);
+        }
+        if let (Some(t), Some(bt)) = (time_compact.as_mut(), b.time) {
             t.extend_from_slice(bt);
         }
         if let (Some(t), Some(bt)) = (temperature.as_mut(), b.temp) {
@@ -1597,7 +1664,7 @@ pub fn collect_series<R: Read>(mut r: SeriesReader<R>) -> Result<SeriesData, Dat
         }
     }
     let quality = r.quality.clone();
-    Ok(SeriesData { header, lines, time, temperature, table_rate, channels, quality })
+    Ok(SeriesData { header, lines, time, time_compact, temperature, table_rate, channels, quality })
 }
 
 /// Each channel's static-test options: `config_for`'s, with the channel's name, unit and the
@@ -1671,27 +1738,24 @@ pub fn evaluate_static_file(
 }
 
 /// Evaluates the static (bias) test of every channel of a record held in memory (a Parquet
-/// table, a recording's topic) as [`evaluate_static_file`] does for a file; with
-/// `zero_rows_missing`, rows whose channels are all exactly zero are left out as missing
+/// table, a recording's topic) as [`evaluate_static_file`] does for a file; the dropout rows of
+/// the kinds `dropouts` names (all zero, repeated; [`gyrolab::dropout`]) are left out as missing
 /// (counted in the summary's quality).
 pub fn evaluate_static_data(
     data: &mut SeriesData,
-    zero_rows_missing: bool,
+    dropouts: DropoutVerdict,
     mut config_for: impl FnMut(&ChannelInfo) -> StaticTestConfig,
 ) -> Result<(Vec<StaticTestResult>, SeriesSummary), DataError> {
     let header = data.header.clone();
     let path = header.file.clone();
     let nch = data.channels.len();
-    if zero_rows_missing && nch > 0 {
-        let n = data.lines.len();
-        for i in 0..n {
-            if data.channels.iter().all(|c| c[i] == 0.0) {
-                data.channels.iter_mut().for_each(|c| c[i] = f64::NAN);
-                data.quality.zero_rows += 1;
-                if data.quality.first_zero_rows.len() < FIRST_MISSING {
-                    data.quality.first_zero_rows.push(data.lines.get(i).unwrap_or(0));
-                }
-            }
+    if dropouts.any() && nch > 0 {
+        let mut rows = Vec::new();
+        let refs: Vec<&[f64]> = data.channels.iter().map(|c| &c[..]).collect();
+        DropoutMarker::new(dropouts).mark_block(&refs, |i, kind| rows.push((i, kind)));
+        for (i, kind) in rows {
+            data.channels.iter_mut().for_each(|c| c[i] = f64::NAN);
+            data.quality.count_dropout(kind, data.lines.get(i).unwrap_or(0));
         }
     }
     let configs = channel_configs(&header, &mut config_for);
@@ -1846,7 +1910,7 @@ pub fn series_from_columns(
         lines.runs.push((0, 1));
         lines.len = n;
     }
-    Ok(SeriesData { header, lines, time, temperature, table_rate, channels, quality })
+    Ok(SeriesData { header, lines, time, time_compact: None, temperature, table_rate, channels, quality })
 }
 
 #[cfg(test)]
@@ -1866,5 +1930,69 @@ mod line_map_tests {
         }
         assert_eq!(m.get(6), None);
         assert_eq!(LineMap::default().get(0), None);
+    }
+}
+
+#[cfg(test)]
+mod compact_time_tests {
+    use super::*;
+
+    /// A record of `n` rows: jittered stamps with a gap of 7 samples, two channels, every 500th
+    /// row repeating the row before.
+    fn text(n: usize) -> String {
+        let mut s = String::from("time_s,a_dps,b_dps\n");
+        for i in 0..n {
+            let k = if i >= n / 2 { i + 7 } else { i };
+            let jitter = ((i * 7919) % 13) as f64 * 1e-4;
+            // Every 500th row repeats the row before (a logger's repeated-row dropout).
+            let src = if i % 500 == 499 { i - 1 } else { i };
+            let (a, b) = ((src % 17) as f64 * 0.1, (src % 23) as f64 * -0.2);
+            s.push_str(&format!("{:.4},{a},{b}\n", k as f64 * 0.01 + jitter));
+        }
+        s
+    }
+
+    fn read(text: &str, options: &SeriesOptions, parallel: bool) -> SeriesData {
+        let r = SeriesReader::from_reader("t.csv", text.as_bytes(), options).unwrap();
+        if parallel {
+            collect_series_in_parallel(r, 3, 4096).unwrap()
+        } else {
+            collect_series(r).unwrap()
+        }
+    }
+
+    #[test]
+    fn compact_stamps_hold_the_time_column_bit_for_bit() {
+        let text = text(20_000);
+        let plain = read(&text, &SeriesOptions::default(), false);
+        let t = plain.time.clone().unwrap();
+        for parallel in [false, true] {
+            let opts = SeriesOptions { compact_time: true, ..SeriesOptions::default() };
+            let d = read(&text, &opts, parallel);
+            assert!(d.time.is_none());
+            let back = d.time_compact.as_ref().unwrap().to_vec();
+            assert_eq!(
+                back.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                t.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+            );
+            assert_eq!(d.channels, plain.channels);
+        }
+    }
+
+    #[test]
+    fn repeated_rows_are_marked_across_blocks_and_pieces() {
+        let text = text(20_000);
+        let opts = SeriesOptions { repeated_rows_missing: true, block_rows: 333, ..SeriesOptions::default() };
+        for parallel in [false, true] {
+            let d = read(&text, &opts, parallel);
+            // Repeats: rows equal to the row before, found here from the values read plainly.
+            let plain = read(&text, &SeriesOptions::default(), false);
+            let expected: Vec<usize> =
+                (1..plain.channels[0].len()).filter(|&i| plain.channels.iter().all(|c| c[i] == c[i - 1])).collect();
+            let nan: Vec<usize> = (0..d.channels[0].len()).filter(|&i| d.channels[0][i].is_nan()).collect();
+            assert_eq!(expected, (499..20_000).step_by(500).collect::<Vec<_>>());
+            assert_eq!(nan, expected);
+            assert_eq!(d.quality.repeated_rows, expected.len() as u64);
+        }
     }
 }

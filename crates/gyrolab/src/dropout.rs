@@ -60,6 +60,161 @@ pub fn beyond_chance(hits: u64, rows: u64, per_channel: &[u64]) -> bool {
     hits as f64 > 10.0 * expected + 3.0
 }
 
+/// Which kinds of dropout rows a record has, by the module's rule (the verdict of a
+/// [`DropoutTally`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct DropoutVerdict {
+    /// All-zero rows are dropouts.
+    pub all_zero: bool,
+    /// Repeated rows are dropouts.
+    pub repeated: bool,
+}
+
+impl DropoutVerdict {
+    /// Whether any row can be a dropout.
+    pub fn any(&self) -> bool {
+        self.all_zero || self.repeated
+    }
+}
+
+/// The counts of the module's rule, fed row by row (or block by block) in one pass: each
+/// channel's zeros and the all-zero rows; each channel's values equal to the row before and the
+/// rows repeated on every channel, both over every row and over the rows that neither are
+/// all zero nor follow an all-zero row (the rows repeats are looked for among when all-zero
+/// rows are dropouts: a run of zeros repeats itself). The whole-record [`find_dropouts`] and
+/// the streaming readers use it, so both follow one rule.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DropoutTally {
+    rows: u64,
+    zeros: Vec<u64>,
+    all_zero: u64,
+    /// Repeats over every row: (rows considered, per channel, on every channel).
+    rep: (u64, Vec<u64>, u64),
+    /// Repeats over rows neither all zero nor after an all-zero row.
+    rep_skip: (u64, Vec<u64>, u64),
+    prev: Vec<f64>,
+    prev_zero: bool,
+    hits: Vec<bool>,
+}
+
+impl DropoutTally {
+    /// A tally of `channels` channels.
+    pub fn new(channels: usize) -> Self {
+        DropoutTally {
+            rows: 0,
+            zeros: vec![0; channels],
+            all_zero: 0,
+            rep: (0, vec![0; channels], 0),
+            rep_skip: (0, vec![0; channels], 0),
+            prev: Vec::new(),
+            prev_zero: false,
+            hits: vec![false; channels],
+        }
+    }
+
+    /// Adds the rows of a block, one slice per channel (equal lengths; the rows follow those
+    /// of the previous block).
+    pub fn push_block(&mut self, channels: &[&[f64]]) {
+        let nch = self.zeros.len();
+        if channels.len() != nch || nch == 0 {
+            return;
+        }
+        let n = channels.iter().map(|c| c.len()).min().unwrap_or(0);
+        for i in 0..n {
+            let mut all_zero = true;
+            for (c, z) in channels.iter().zip(self.zeros.iter_mut()) {
+                let zero = c[i] == 0.0;
+                *z += u64::from(zero);
+                all_zero &= zero;
+            }
+            self.all_zero += u64::from(all_zero);
+            let has_prev = !self.prev.is_empty();
+            let mut all_rep = has_prev;
+            for (k, c) in channels.iter().enumerate() {
+                let h = has_prev && c[i] == self.prev[k];
+                self.hits[k] = h;
+                all_rep &= h;
+            }
+            self.rep.0 += 1;
+            for (r, &h) in self.rep.1.iter_mut().zip(&self.hits) {
+                *r += u64::from(h);
+            }
+            self.rep.2 += u64::from(all_rep);
+            if !all_zero && !self.prev_zero {
+                self.rep_skip.0 += 1;
+                for (r, &h) in self.rep_skip.1.iter_mut().zip(&self.hits) {
+                    *r += u64::from(h);
+                }
+                self.rep_skip.2 += u64::from(all_rep);
+            }
+            self.prev.clear();
+            self.prev.extend(channels.iter().map(|c| c[i]));
+            self.prev_zero = all_zero;
+            self.rows += 1;
+        }
+    }
+
+    /// Rows tallied.
+    pub fn rows(&self) -> u64 {
+        self.rows
+    }
+
+    /// The verdict of the module's rule ([`beyond_chance`] for all-zero rows, then for repeated
+    /// rows among the rows that remain).
+    pub fn verdict(&self) -> DropoutVerdict {
+        let all_zero = beyond_chance(self.all_zero, self.rows, &self.zeros);
+        let (considered, per, hits) = if all_zero { &self.rep_skip } else { &self.rep };
+        DropoutVerdict { all_zero, repeated: beyond_chance(*hits, *considered, per) }
+    }
+}
+
+/// Marks the dropout rows of a record row by row (or block by block) once the verdict is known
+/// (from a first pass with [`DropoutTally`]), carrying the row before across blocks.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DropoutMarker {
+    verdict: DropoutVerdict,
+    prev: Vec<f64>,
+    prev_zero: bool,
+}
+
+impl DropoutMarker {
+    /// A marker for `verdict`.
+    pub fn new(verdict: DropoutVerdict) -> Self {
+        DropoutMarker { verdict, prev: Vec::new(), prev_zero: false }
+    }
+
+    /// The verdict it marks.
+    pub fn verdict(&self) -> DropoutVerdict {
+        self.verdict
+    }
+
+    /// The dropout kind of each row of a block (one slice per channel, equal lengths, the rows
+    /// following those of the previous block), calling `on_row(row in block, kind)` for each
+    /// dropout row. A row repeating an all-zero row is not a repeat when all-zero rows are
+    /// dropouts (the rule of [`DropoutTally`]).
+    pub fn mark_block(&mut self, channels: &[&[f64]], mut on_row: impl FnMut(usize, DropoutKind)) {
+        if !self.verdict.any() || channels.len() < 2 {
+            return;
+        }
+        let n = channels.iter().map(|c| c.len()).min().unwrap_or(0);
+        for i in 0..n {
+            let all_zero = channels.iter().all(|c| c[i] == 0.0);
+            if self.verdict.all_zero && all_zero {
+                on_row(i, DropoutKind::AllZero);
+            } else if self.verdict.repeated
+                && !(self.verdict.all_zero && self.prev_zero)
+                && !self.prev.is_empty()
+                && channels.iter().zip(&self.prev).all(|(c, &p)| c[i] == p)
+            {
+                on_row(i, DropoutKind::Repeated);
+            }
+            self.prev.clear();
+            self.prev.extend(channels.iter().map(|c| c[i]));
+            self.prev_zero = all_zero;
+        }
+    }
+}
+
 /// Finds the dropout rows of `channels` (equal lengths; NaN never counts as zero or equal).
 ///
 /// ```
@@ -78,50 +233,15 @@ pub fn find_dropouts(channels: &[&[f64]]) -> Dropouts {
     if channels.len() < 2 || n < 2 {
         return Dropouts::default();
     }
-    // One pass per test: each channel's hits and the rows hit on every channel; dropouts when
-    // those are far more than independent channels would give (`beyond_chance`).
-    fn scan(
-        channels: &[&[f64]],
-        n: usize,
-        hit: impl Fn(&[f64], usize) -> bool,
-        skip: impl Fn(usize) -> bool,
-    ) -> Vec<usize> {
-        let mut per = vec![0u64; channels.len()];
-        let mut rows = Vec::new();
-        let mut considered = 0u64;
-        for i in 0..n {
-            if skip(i) {
-                continue;
-            }
-            considered += 1;
-            let mut all = true;
-            for (c, count) in channels.iter().zip(per.iter_mut()) {
-                let h = hit(c, i);
-                *count += u64::from(h);
-                all &= h;
-            }
-            if all {
-                rows.push(i);
-            }
-        }
-        if beyond_chance(rows.len() as u64, considered, &per) {
-            rows
-        } else {
-            Vec::new()
-        }
-    }
-    let all_zero = scan(channels, n, |c, i| c[i] == 0.0, |_| false);
-    // Repeats are looked for among the other rows (a run of zeros repeats itself).
-    let mut zero_or_after = vec![false; if all_zero.is_empty() { 0 } else { n }];
-    for &i in &all_zero {
-        zero_or_after[i] = true;
-        if i + 1 < n {
-            zero_or_after[i + 1] = true;
-        }
-    }
-    let repeated =
-        scan(channels, n, |c, i| i > 0 && c[i] == c[i - 1], |i| zero_or_after.get(i).copied().unwrap_or(false));
-    Dropouts { all_zero, repeated }
+    let channels: Vec<&[f64]> = channels.iter().map(|c| &c[..n]).collect();
+    let mut tally = DropoutTally::new(channels.len());
+    tally.push_block(&channels);
+    let mut d = Dropouts::default();
+    DropoutMarker::new(tally.verdict()).mark_block(&channels, |i, kind| match kind {
+        DropoutKind::AllZero => d.all_zero.push(i),
+        DropoutKind::Repeated => d.repeated.push(i),
+    });
+    d
 }
 
 #[cfg(test)]
@@ -191,5 +311,54 @@ mod tests {
         let refs: Vec<&[f64]> = ch.iter().map(|c| &c[..]).collect();
         let d = find_dropouts(&refs);
         assert_eq!(d.repeated, (1_000..n).step_by(1_000).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn blocks_of_any_size_give_the_whole_record_answer() {
+        // Zero runs, single repeats and a repeat right after a zero run, fed in blocks of 1, 7
+        // and 1000 rows: the verdict and the marked rows are those of the whole record.
+        let n = 30_000;
+        // 49 levels per channel; channel 0 never zero by chance.
+        let mut ch: Vec<Vec<f64>> = (0..3)
+            .map(|c| {
+                quantized(n, 300 + c as u64)
+                    .iter()
+                    .zip(quantized(n, 400 + c as u64))
+                    .map(|(a, b)| a * 7.0 + b)
+                    .collect()
+            })
+            .collect();
+        ch[0].iter_mut().for_each(|v| *v += 0.5);
+        for r in (500..n).step_by(700) {
+            for c in &mut ch {
+                c[r] = c[r - 1];
+            }
+        }
+        for r in (1_000..n).step_by(3_000) {
+            for k in 0..5 {
+                ch.iter_mut().for_each(|c| c[r + k] = 0.0);
+            }
+        }
+        let refs: Vec<&[f64]> = ch.iter().map(|c| &c[..]).collect();
+        let whole = find_dropouts(&refs);
+        assert!(!whole.all_zero.is_empty() && !whole.repeated.is_empty());
+        for size in [1usize, 7, 1000] {
+            let mut tally = DropoutTally::new(3);
+            for from in (0..n).step_by(size) {
+                let to = (from + size).min(n);
+                tally.push_block(&refs.iter().map(|c| &c[from..to]).collect::<Vec<_>>());
+            }
+            assert_eq!(tally.rows(), n as u64);
+            let mut marker = DropoutMarker::new(tally.verdict());
+            let mut d = Dropouts::default();
+            for from in (0..n).step_by(size) {
+                let to = (from + size).min(n);
+                marker.mark_block(&refs.iter().map(|c| &c[from..to]).collect::<Vec<_>>(), |i, kind| match kind {
+                    DropoutKind::AllZero => d.all_zero.push(from + i),
+                    DropoutKind::Repeated => d.repeated.push(from + i),
+                });
+            }
+            assert_eq!(d, whole, "blocks of {size}");
+        }
     }
 }

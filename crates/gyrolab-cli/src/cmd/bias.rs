@@ -96,6 +96,12 @@ pub fn run(args: &BiasArgs) -> CliResult {
                 f.file, f.quality.zero_rows
             );
         }
+        if let Some(l) = f.quality.first_repeated_rows.first() {
+            eprintln!(
+                "warning: {}:{l}: {} dropout row(s) (every channel equal to the row before, far more often than chance) left out of every figure",
+                f.file, f.quality.repeated_rows
+            );
+        }
     }
     let tests = outcome.tests;
     for t in &tests {
