@@ -196,9 +196,11 @@ fn for_each_block(
                     *w = b - a;
                 }
             } else {
-                let mut z = s[j0 * m..=j1 * m].iter().step_by(m);
-                let mut prev = z.next().copied().unwrap_or(0.0);
-                for (w, &v) in w.iter_mut().zip(z) {
+                let z = &s[j0 * m..=j1 * m];
+                let (mut at, mut prev) = (0usize, z[0]);
+                for w in w.iter_mut() {
+                    at += m;
+                    let v = z[at];
                     *w = v - prev;
                     prev = v;
                 }
