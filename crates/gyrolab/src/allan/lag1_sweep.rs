@@ -259,9 +259,9 @@ fn residual_sums(w: &mut [f64], p0: f64, a0: f64, a1: f64, acc: &mut ResidualSum
     let chunks = w.chunks_exact(LANES);
     let rest = chunks.remainder();
     for c in chunks {
-        for l in 0..LANES {
-            acc.sum1[l] += c[l];
-            acc.sum2[l] += c[l] * c[l];
+        for (l, &v) in c.iter().enumerate() {
+            acc.sum1[l] += v;
+            acc.sum2[l] += v * v;
         }
     }
     for (l, &v) in rest.iter().enumerate() {
