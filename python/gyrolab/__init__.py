@@ -51,6 +51,10 @@ def _float_array(x: Any, name: str) -> np.ndarray:
         raise Error(f"{name}: expected a 1-D array, got {a.ndim} dimensions with shape {a.shape}")
     if a.size == 0:
         raise Error(f"{name}: the array is empty")
+    # A finite sum (one vectorised pass, no temporary) proves every sample finite; otherwise
+    # look for the bad sample (the sum of finite samples can also overflow).
+    if np.isfinite(np.add.reduce(a)):
+        return a
     bad = np.flatnonzero(~np.isfinite(a))
     if bad.size:
         raise Error(

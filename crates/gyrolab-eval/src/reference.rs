@@ -162,6 +162,8 @@ impl Reference {
             None => (unit.native_scale_factor_per_dps(), 0.0),
         };
         match k {
+            // x / 1 is x exactly: no pass over the record for data already in deg/s
+            Some(k) if null == 0.0 && k == 1.0 => {}
             Some(k) if null == 0.0 => values.iter_mut().for_each(|v| *v /= k),
             Some(k) => values.iter_mut().for_each(|v| *v = (*v - null) / k),
             None => return Ok(false),

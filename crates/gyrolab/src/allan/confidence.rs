@@ -30,7 +30,7 @@ pub(crate) const B1_MIN_TERMS: f64 = 8.0;
 
 /// Lag-1 autocorrelation r1 of a series (Riley & Greenhall eq. 2); `None` if it has no spread.
 #[cfg(test)]
-fn lag1_acf(z: &[f64]) -> Option<f64> {
+pub(super) fn lag1_acf(z: &[f64]) -> Option<f64> {
     if z.len() < 3 {
         return None;
     }
@@ -46,7 +46,7 @@ fn lag1_acf(z: &[f64]) -> Option<f64> {
 /// Removes the least-squares straight line from equally spaced values, in place, by projection
 /// on the orthogonal polynomials 1 and t - c: no matrix, exact to rounding.
 #[cfg(test)]
-fn detrend_linear(z: &mut [f64]) {
+pub(super) fn detrend_linear(z: &mut [f64]) {
     let n = z.len();
     if n < 2 {
         return;
@@ -181,7 +181,7 @@ pub(crate) fn lag1_noise_id(s: &[f64], m: usize, dmax: usize) -> Option<i32> {
 
 /// alpha = -round(2 delta) - 2d for frequency data, capped at 2 (Stable32 never reports more;
 /// r1 < -5/9 on a short white-PM series would otherwise give 3).
-fn lag1_alpha(delta: f64, d: usize) -> i32 {
+pub(crate) fn lag1_alpha(delta: f64, d: usize) -> i32 {
     (-(2.0 * delta).round() as i32 - 2 * d as i32).min(2)
 }
 

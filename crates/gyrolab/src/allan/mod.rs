@@ -31,6 +31,7 @@ mod confidence;
 mod fast;
 mod gaps;
 mod kernels;
+mod lag1_sweep;
 
 pub use gaps::deviation_from_rate_with_gaps;
 
@@ -630,8 +631,10 @@ fn attach_bounds(
     n_phase: impl Fn(&AllanPoint) -> usize,
 ) {
     if let Some(confidence) = confidence {
+        let ms: Vec<usize> = points.iter().map(|p| p.m).collect();
+        let lag1 = lag1_sweep::lag1_noise_ids(s, &ms, kind.difference_order() as usize);
         let ids: Vec<Option<(i32, NoiseIdMethod)>> =
-            points.par_iter().map(|p| identify_noise(s, p.m, kind, p.terms)).collect();
+            points.par_iter().zip(lag1).map(|(p, lag1)| identify_noise(s, p.m, kind, p.terms, lag1)).collect();
         let mut previous: Option<i32> = None;
         for (p, id) in points.iter_mut().zip(ids) {
             match id {
@@ -727,9 +730,16 @@ fn variance_at(s: &[f64], extended: Option<&[f64]>, kind: DeviationKind, m: usiz
 /// Noise identification at m, Stable32's rule: lag-1 ACF of the frequency averages when there
 /// are >= 30 of them; else the B1 ratio with R(n) (B1 theory at N = `terms`) when the estimator
 /// has at least [`confidence::B1_MIN_TERMS`] independent terms (its terms, divided by m for the
-/// overlapping ones); else `None` (the caller keeps the previous tau's alpha).
-fn identify_noise(s: &[f64], m: usize, kind: DeviationKind, terms: usize) -> Option<(i32, NoiseIdMethod)> {
-    if let Some(a) = confidence::lag1_noise_id(s, m, kind.difference_order() as usize) {
+/// overlapping ones); else `None` (the caller keeps the previous tau's alpha). `lag1` is the
+/// lag-1 identification at m (`lag1_sweep::lag1_noise_ids`).
+fn identify_noise(
+    s: &[f64],
+    m: usize,
+    kind: DeviationKind,
+    terms: usize,
+    lag1: Option<i32>,
+) -> Option<(i32, NoiseIdMethod)> {
+    if let Some(a) = lag1 {
         return Some((a, NoiseIdMethod::Lag1Autocorrelation));
     }
     let independent = match kind {
