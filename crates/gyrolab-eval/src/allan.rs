@@ -23,17 +23,18 @@ use std::path::{Path, PathBuf};
 /// ```
 /// use gyrolab_eval::allan::{analyse_file, AllanRequest};
 /// use gyrolab::allan::{DeviationKind, TauList};
-/// let dir = tempfile::tempdir().unwrap();
+/// let dir = tempfile::tempdir()?;
 /// let path = dir.path().join("rate.csv");
 /// let mut text = String::from("time_s,rate_dps\n");
 /// for i in 0..4000 {
 ///     text.push_str(&format!("{},{}\n", i as f64 * 0.01, ((i * 7919) % 13) as f64 * 1e-3));
 /// }
-/// std::fs::write(&path, text).unwrap();
+/// std::fs::write(&path, text)?;
 /// let request = AllanRequest::new(path);
-/// let outcome = analyse_file(&request).unwrap();
+/// let outcome = analyse_file(&request)?;
 /// assert_eq!(outcome.sample_interval_s, 0.01);
 /// assert_eq!(outcome.analyses[0].curve.points[0].m, 1);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct AllanRequest {

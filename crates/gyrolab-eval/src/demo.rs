@@ -25,11 +25,12 @@ use std::path::{Path, PathBuf};
 /// The paper's rate tables evaluated and its printed tables compared.
 ///
 /// ```
-/// let demo = gyrolab_eval::demo::evaluate_paper().unwrap();
+/// let demo = gyrolab_eval::demo::evaluate_paper()?;
 /// assert_eq!(demo.axes.len(), 3);
 /// // Rows 11 and 14 of the printed Table 2 do not reproduce from Table 1 (docs/METHODS.md).
 /// let slips: Vec<usize> = demo.table2.iter().filter(|r| !r.differs.is_empty()).map(|r| r.point).collect();
 /// assert_eq!(slips, [11, 14]);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone)]
 pub struct PaperDemo {

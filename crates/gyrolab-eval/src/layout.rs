@@ -28,10 +28,11 @@ impl LogLayout {
     /// use gyrolab_eval::layout::LogLayout;
     /// use gyrolab::units::{OutputUnit, TimeUnit};
     /// let l = LogLayout { units: vec!["gx=rad/s".into(), "m/s^2".into(), "stamp=ns".into()], ..Default::default() };
-    /// let o = l.apply(Default::default()).unwrap();
+    /// let o = l.apply(Default::default())?;
     /// assert_eq!(o.column_units, vec![("gx".to_string(), OutputUnit::RadPerSec)]);
     /// assert_eq!(o.default_units, vec![OutputUnit::MeterPerSec2]);
     /// assert_eq!((o.time_column.as_deref(), o.time_unit), (Some("stamp"), Some(TimeUnit::Nanosecond)));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn apply(&self, mut options: SeriesOptions) -> EvalResult<SeriesOptions> {
         let accepted = || {

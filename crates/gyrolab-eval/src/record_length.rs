@@ -21,8 +21,9 @@ use gyrolab::record_length::{
 ///     arw_deg_rt_h: None,
 ///     bias_instability_dph: None,
 /// };
-/// let plan = plan_record_length(&q).unwrap();
+/// let plan = plan_record_length(&q)?;
 /// assert!(plan.samples > 100 && plan.request.tau_s == 1.0);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecordLengthQuery {

@@ -32,10 +32,11 @@ impl ReferenceRequest {
     /// use gyrolab_eval::reference::{Reference, ReferenceRequest};
     /// use gyrolab::units::{OutputUnit, Quantity};
     /// let r = ReferenceRequest { scale_factor: Some(0.0075), null: Some(2.5), ..Default::default() };
-    /// let reference = r.resolve().unwrap();
+    /// let reference = r.resolve()?;
     /// let mut v = vec![2.5075, 2.5];
-    /// assert!(reference.to_rate(OutputUnit::Volt, &mut v).unwrap());
+    /// assert!(reference.to_rate(OutputUnit::Volt, &mut v)?);
     /// assert!((v[0] - 1.0).abs() < 1e-12 && v[1] == 0.0);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn resolve(&self) -> EvalResult<Reference> {
         if let Some(path) = &self.calibration {
