@@ -15,8 +15,9 @@ const CHROMIUM: &str = "/usr/bin/chromium";
 const WIDTH: u32 = 1200;
 const HEIGHT: u32 = 2400;
 
-/// Runs headless Chromium on `html`, writing a screenshot to `png`; at most 180 s.
-fn screenshot(html: &Path, png: &Path, profile: &Path) {
+/// Runs headless Chromium on `html`, writing a screenshot `height` pixels tall to `png`; at
+/// most 180 s.
+fn screenshot(html: &Path, png: &Path, profile: &Path, height: u32) {
     let url = format!("file://{}", html.display());
     let mut child = Command::new(CHROMIUM)
         .args([
@@ -32,7 +33,7 @@ fn screenshot(html: &Path, png: &Path, profile: &Path) {
         ])
         .arg(format!("--user-data-dir={}", profile.display()))
         .arg(format!("--screenshot={}", png.display()))
-        .arg(format!("--window-size={WIDTH},{HEIGHT}"))
+        .arg(format!("--window-size={WIDTH},{height}"))
         .arg(url)
         .stdout(Stdio::null())
         .stderr(Stdio::null())
@@ -71,6 +72,22 @@ fn is_plot_colour(p: [u8; 3]) -> bool {
     PLOT_COLOURS.iter().any(|c| c.iter().zip(p).all(|(a, b)| (i32::from(*a) - i32::from(b)).abs() <= 30))
 }
 
+/// Whether Chromium is there; `false` (with a loud SKIPPED line) only when GYROLAB_SKIP_BROWSER=1,
+/// else a missing browser fails the test.
+fn browser_available() -> bool {
+    if std::env::var("GYROLAB_SKIP_BROWSER").is_ok_and(|v| v == "1") {
+        eprintln!("\n*** SKIPPED: GYROLAB_SKIP_BROWSER=1: browser test skipped ***\n");
+        return false;
+    }
+    assert!(
+        Path::new(CHROMIUM).exists(),
+        "{CHROMIUM} not found: the browser test needs Chromium. Install it with \
+         `bash scripts/install-test-deps.sh` (or `apt-get install -y chromium`), \
+         or set GYROLAB_SKIP_BROWSER=1 to skip this test."
+    );
+    true
+}
+
 /// Bands of 200 px of a screenshot: (bands holding plot colours, plot-coloured pixels).
 fn plot_bands(w: u32, h: u32, px: &[[u8; 3]]) -> (u32, usize) {
     let band = 200;
@@ -94,14 +111,9 @@ fn plot_bands(w: u32, h: u32, px: &[[u8; 3]]) -> (u32, usize) {
 /// looked at in headless Chromium: the page holds the plots of every section that draws one.
 #[test]
 fn the_test_program_report_renders_in_headless_chromium() {
-    if std::env::var("GYROLAB_SKIP_BROWSER").is_ok_and(|v| v == "1") {
-        eprintln!("GYROLAB_SKIP_BROWSER=1: browser test skipped");
+    if !browser_available() {
         return;
     }
-    assert!(
-        Path::new(CHROMIUM).exists(),
-        "{CHROMIUM} not found: run `bash scripts/install-test-deps.sh`, or set GYROLAB_SKIP_BROWSER=1"
-    );
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("program");
     std::fs::create_dir_all(&data).unwrap();
@@ -110,26 +122,7 @@ fn the_test_program_report_renders_in_headless_chromium() {
     gyrolab().arg("eval").arg(data.join("plan.toml")).arg("--out").arg(&out).arg("--quiet").assert().code(0);
     let png = dir.path().join("shot.png");
     let tall = 24_000;
-    let url_html = out.join("report.html");
-    let mut child = Command::new(CHROMIUM)
-        .args(["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run"])
-        .args(["--disable-background-networking", "--disable-component-update", "--disable-sync", "--hide-scrollbars"])
-        .arg(format!("--user-data-dir={}", dir.path().join("profile").display()))
-        .arg(format!("--screenshot={}", png.display()))
-        .arg(format!("--window-size={WIDTH},{tall}"))
-        .arg(format!("file://{}", url_html.display()))
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("cannot start chromium");
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > Duration::from_secs(180) {
-            let _ = child.kill();
-            panic!("chromium did not finish within 180 s");
-        }
-        std::thread::sleep(Duration::from_millis(200));
-    }
+    screenshot(&out.join("report.html"), &png, &dir.path().join("profile"), tall);
     if let Ok(keep) = std::env::var("GYROLAB_KEEP_SCREENSHOT") {
         let _ = std::fs::copy(&png, format!("{keep}-program.png"));
     }
@@ -143,16 +136,9 @@ fn the_test_program_report_renders_in_headless_chromium() {
 
 #[test]
 fn report_renders_with_plots_in_headless_chromium() {
-    if std::env::var("GYROLAB_SKIP_BROWSER").is_ok_and(|v| v == "1") {
-        eprintln!("GYROLAB_SKIP_BROWSER=1: browser test skipped");
+    if !browser_available() {
         return;
     }
-    assert!(
-        Path::new(CHROMIUM).exists(),
-        "{CHROMIUM} not found: the browser test needs Chromium. Install it with \
-         `bash scripts/install-test-deps.sh` (or `apt-get install -y chromium`), \
-         or set GYROLAB_SKIP_BROWSER=1 to skip this test."
-    );
     let dir = tempfile::tempdir().unwrap();
     let out: PathBuf = dir.path().join("report");
     // Shorter simulated static tests than the default keep the debug-build test fast; the Allan
@@ -162,7 +148,7 @@ fn report_renders_with_plots_in_headless_chromium() {
         let _ = std::fs::copy(out.join("report.html"), format!("{keep}.html"));
     }
     let png = dir.path().join("shot.png");
-    screenshot(&out.join("report.html"), &png, &dir.path().join("profile"));
+    screenshot(&out.join("report.html"), &png, &dir.path().join("profile"), HEIGHT);
     if let Ok(keep) = std::env::var("GYROLAB_KEEP_SCREENSHOT") {
         let _ = std::fs::copy(&png, format!("{keep}.png"));
     }
