@@ -41,8 +41,10 @@ __all__ = [
 PathLike = Union[str, "os.PathLike[str]"]
 
 
-def _float_array(x: Any, name: str) -> np.ndarray:
-    """A 1-D float64 array (no copy when x already is one); a clear error otherwise."""
+def _float_array(x: Any, name: str, check_finite: bool = True) -> np.ndarray:
+    """A 1-D float64 array (no copy when x already is one); a clear error otherwise.
+    ``check_finite=False`` leaves the finiteness check to the native call (``allan`` refuses a
+    non-finite sample with its index in the pass that integrates the record)."""
     try:
         a = np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError) as e:
@@ -51,6 +53,8 @@ def _float_array(x: Any, name: str) -> np.ndarray:
         raise Error(f"{name}: expected a 1-D array, got {a.ndim} dimensions with shape {a.shape}")
     if a.size == 0:
         raise Error(f"{name}: the array is empty")
+    if not check_finite:
+        return a
     # A finite sum (one vectorised pass, no temporary) proves every sample finite; otherwise
     # look for the bad sample (the sum of finite samples can also overflow).
     if np.isfinite(np.add.reduce(a)):
@@ -153,7 +157,7 @@ def allan(
     (output units per deg/s) and ``null`` for noise terms in deg units. The computation runs
     with the interpreter released.
     """
-    a = _float_array(x, "x")
+    a = _float_array(x, "x", check_finite=False)
     doc_json, arrays = _gyrolab.allan(
         a,
         float(rate_hz),

@@ -9,7 +9,7 @@ import gyrolab
 @pytest.mark.parametrize(
     "x, fragment",
     [
-        (np.array([1.0, np.nan, 2.0, 3.0]), "x[1] = nan"),
+        (np.array([1.0, np.nan, 2.0, 3.0]), "x[1] = NaN"),
         (np.array([1.0, np.inf, 2.0, 3.0]), "x[1] = inf"),
         (np.array([], dtype=float), "empty"),
         (np.zeros((10, 2)), "1-D"),

@@ -4,8 +4,11 @@
 
 use crate::error::{EvalError, EvalResult};
 use crate::layout::LogLayout;
-use crate::reference::{Reference, ReferenceRequest};
-use gyrolab::allan::{deviation_from_rate_with_gaps, AllanCurve, AllanError, AllanOptions, DeviationKind, TauList};
+use crate::reference::{Conversion, Reference, ReferenceRequest};
+use gyrolab::allan::{
+    deviation_from_rate, deviation_from_rate_into, deviation_from_rate_with_gaps, deviation_from_rate_with_gaps_into,
+    AllanCurve, AllanError, AllanOptions, DeviationKind, TauList,
+};
 use gyrolab::noise::{fit_noise_model, slope_line_terms};
 use gyrolab::sampling::{estimate_interval, estimate_interval_of, SamplingError};
 use gyrolab::units::{OutputUnit, Quantity, TimeUnit};
@@ -459,20 +462,36 @@ pub fn channel_curve(
     tau0_s: f64,
     opts: &AllanOptions,
 ) -> EvalResult<AllanCurve> {
-    deviation_from_rate_with_gaps(values, tau0_s, opts).map_err(|e| match e {
-        AllanError::NonFinite { index, value } => EvalError::Data(
-            DataError::new(
+    deviation_from_rate_with_gaps(values, tau0_s, opts).map_err(|e| curve_error(path, info, lines, e))
+}
+
+/// The error of a channel's deviation curve, located: a non-finite sample names its file line
+/// and column.
+fn curve_error(path: &Path, info: &ChannelInfo, lines: &LineMap, e: AllanError) -> EvalError {
+    match e {
+        AllanError::NonFinite { index, value } => match lines.get(index) {
+            Some(line) => EvalError::Data(
+                DataError::new(
+                    path,
+                    format!("sample {value} is not a finite number: the Allan variance needs a complete record"),
+                )
+                .at_line(line)
+                .at_column(info.column, Some(&info.name)),
+            ),
+            // samples with no source lines (an array in memory): the index is the location
+            None => EvalError::Data(DataError::new(
                 path,
-                format!("sample {value} is not a finite number: the Allan variance needs a complete record"),
-            )
-            .at_line(lines.get(index).unwrap_or(0))
-            .at_column(info.column, Some(&info.name)),
-        ),
+                format!(
+                    "{}[{index}] = {value} is not a finite number: the Allan variance needs a complete record",
+                    gyrolab_io::text::excerpt(&info.name)
+                ),
+            )),
+        },
         other => EvalError::Data(DataError::new(
             path,
             format!("channel '{}': {other}", gyrolab_io::text::excerpt(&info.name)),
         )),
-    })
+    }
 }
 
 /// What one channel's analysis needs besides its samples.
@@ -504,21 +523,86 @@ pub fn analyse_channel(
     info: &ChannelInfo,
     mut values: Vec<f64>,
 ) -> EvalResult<ChannelAnalysis> {
-    let quantity = setup.reference.to_physical(info.unit, &mut values).map_err(|m| {
+    let (quantity, conversion) = physical_conversion(setup, info)?;
+    conversion.apply(&mut values);
+    values.reserve_exact(1);
+    let curve = channel_curve(setup.path, info, values, setup.lines, setup.tau0_s, setup.options)?;
+    Ok(channel_analysis(setup, info, quantity, curve))
+}
+
+/// [`analyse_channel`] of borrowed samples: samples that need no unit conversion are read where
+/// they are and the angle series is built in `buffer` (no copy of the record); others are
+/// copied into `buffer` and converted there. Give `buffer` capacity N + 1 (on the pages you
+/// want it on) to spare a reallocation. `missing`: [`GapPolicy::Analyse`] reads NaN samples as
+/// missing ones (as [`analyse_channel`] does), [`GapPolicy::Error`] refuses them as it refuses
+/// infinite ones.
+pub fn analyse_channel_borrowed(
+    setup: &ChannelSetup<'_>,
+    info: &ChannelInfo,
+    values: &[f64],
+    mut buffer: Vec<f64>,
+    missing: GapPolicy,
+) -> EvalResult<ChannelAnalysis> {
+    let (quantity, conversion) = physical_conversion(setup, info)?;
+    if conversion != Conversion::Identity {
+        buffer.clear();
+        buffer.reserve_exact(values.len() + 1);
+        buffer.extend_from_slice(values);
+        conversion.apply(&mut buffer);
+        let curve = match missing {
+            GapPolicy::Analyse => channel_curve(setup.path, info, buffer, setup.lines, setup.tau0_s, setup.options)?,
+            GapPolicy::Error => deviation_from_rate(buffer, setup.tau0_s, setup.options)
+                .map_err(|e| curve_error(setup.path, info, setup.lines, e))?,
+        };
+        return Ok(channel_analysis(setup, info, quantity, curve));
+    }
+    match missing {
+        GapPolicy::Analyse => {
+            let curve = deviation_from_rate_with_gaps_into(values, buffer, setup.tau0_s, setup.options)
+                .map_err(|e| curve_error(setup.path, info, setup.lines, e))?;
+            Ok(channel_analysis(setup, info, quantity, curve))
+        }
+        GapPolicy::Error => analyse_complete(setup, info, quantity, values, buffer),
+    }
+}
+
+/// The analysis of rate samples that must all be finite, the angle series built in `buffer`.
+fn analyse_complete(
+    setup: &ChannelSetup<'_>,
+    info: &ChannelInfo,
+    quantity: Quantity,
+    values: &[f64],
+    buffer: Vec<f64>,
+) -> EvalResult<ChannelAnalysis> {
+    let curve = deviation_from_rate_into(values, buffer, setup.tau0_s, setup.options)
+        .map_err(|e| curve_error(setup.path, info, setup.lines, e))?;
+    Ok(channel_analysis(setup, info, quantity, curve))
+}
+
+/// What the channel's samples are in physical terms, and the conversion that makes them so.
+fn physical_conversion(setup: &ChannelSetup<'_>, info: &ChannelInfo) -> EvalResult<(Quantity, Conversion)> {
+    setup.reference.physical_conversion(info.unit).map_err(|m| {
         EvalError::conflict(format!(
             "{}: channel '{}': {m}",
             setup.path.display(),
             gyrolab_io::text::excerpt(&info.name)
         ))
-    })?;
+    })
+}
+
+/// The noise terms of a channel's curve (when its data and kind allow them), with the curve.
+fn channel_analysis(
+    setup: &ChannelSetup<'_>,
+    info: &ChannelInfo,
+    quantity: Quantity,
+    curve: AllanCurve,
+) -> ChannelAnalysis {
     let calibrated = matches!(quantity, Quantity::AngularRate | Quantity::Acceleration);
     let rate_unit = match quantity {
         Quantity::AngularRate => "deg/s".to_string(),
         Quantity::Acceleration => "m/s^2".to_string(),
         _ => info.unit.symbol().to_string(),
     };
-    values.reserve_exact(1);
-    let curve = channel_curve(setup.path, info, values, setup.lines, setup.tau0_s, setup.options)?;
     let allan_kind = matches!(setup.options.kind, DeviationKind::Oadev | DeviationKind::Adev);
     let (slope_lines, model_fit, noise_note) = if quantity == Quantity::Unitless {
         (
@@ -536,7 +620,7 @@ pub fn analyse_channel(
     } else {
         (slope_line_terms(&curve).ok(), fit_noise_model(&curve, setup.fit_range_s).ok(), None)
     };
-    Ok(ChannelAnalysis {
+    ChannelAnalysis {
         file: setup.shown.clone(),
         topic: setup.topic.clone(),
         channel: info.name.clone(),
@@ -546,7 +630,7 @@ pub fn analyse_channel(
         slope_lines,
         model_fit,
         noise_note,
-    })
+    }
 }
 
 /// Analyses every selected channel of a file, in parallel: a delimited text or Parquet file,

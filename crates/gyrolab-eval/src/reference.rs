@@ -141,16 +141,36 @@ impl Reference {
     /// ([`Quantity::AngularRate`], by [`Reference::to_rate`]); anything else is left as it is
     /// ([`Quantity::SensorOutput`] or [`Quantity::Unitless`]).
     pub fn to_physical(&self, unit: OutputUnit, values: &mut [f64]) -> Result<Quantity, String> {
+        let (quantity, conversion) = self.physical_conversion(unit)?;
+        conversion.apply(values);
+        Ok(quantity)
+    }
+
+    /// What [`Reference::to_physical`] makes of samples in `unit`, and the conversion it
+    /// applies, without touching any sample (so that a caller can skip a copy when the
+    /// conversion is the identity).
+    pub fn physical_conversion(&self, unit: OutputUnit) -> Result<(Quantity, Conversion), String> {
         if let Some(f) = unit.per_m_s2() {
-            if f != 1.0 {
-                values.iter_mut().for_each(|v| *v /= f);
-            }
-            return Ok(Quantity::Acceleration);
+            return Ok((Quantity::Acceleration, Conversion::affine(0.0, f)));
         }
         if unit == OutputUnit::Unitless && self.is_none() {
-            return Ok(Quantity::Unitless);
+            return Ok((Quantity::Unitless, Conversion::Identity));
         }
-        Ok(if self.to_rate(unit, values)? { Quantity::AngularRate } else { unit.quantity() })
+        Ok(match self.rate_conversion(unit)? {
+            Some(c) => (Quantity::AngularRate, c),
+            None => (unit.quantity(), Conversion::Identity),
+        })
+    }
+
+    /// The conversion of output samples in `unit` to deg/s: `(x - null) / K` with the
+    /// reference (a missing null counts as 0: deviations do not depend on it), else the unit's
+    /// native factor (deg/s, rad/s); `None` when the samples cannot be turned into rates.
+    fn rate_conversion(&self, unit: OutputUnit) -> Result<Option<Conversion>, String> {
+        let (k, null) = match self.for_unit(unit)? {
+            Some((k, null)) => (Some(k), null.unwrap_or(0.0)),
+            None => (unit.native_scale_factor_per_dps(), 0.0),
+        };
+        Ok(k.map(|k| Conversion::affine(null, k)))
     }
 
     /// Turns output samples in `unit` into rates in deg/s, in place: `(x - null) / K` with the
@@ -158,17 +178,48 @@ impl Reference {
     /// unit's native factor (deg/s, rad/s). Returns whether the values are now rates; `false`
     /// leaves them in output units.
     pub fn to_rate(&self, unit: OutputUnit, values: &mut [f64]) -> Result<bool, String> {
-        let (k, null) = match self.for_unit(unit)? {
-            Some((k, null)) => (Some(k), null.unwrap_or(0.0)),
-            None => (unit.native_scale_factor_per_dps(), 0.0),
-        };
-        match k {
-            // x / 1 is x exactly: no pass over the record for data already in deg/s
-            Some(k) if null == 0.0 && k == 1.0 => {}
-            Some(k) if null == 0.0 => values.iter_mut().for_each(|v| *v /= k),
-            Some(k) => values.iter_mut().for_each(|v| *v = (*v - null) / k),
-            None => return Ok(false),
+        match self.rate_conversion(unit)? {
+            Some(c) => {
+                c.apply(values);
+                Ok(true)
+            }
+            None => Ok(false),
         }
-        Ok(true)
+    }
+}
+
+/// A conversion of samples to physical units: (x - null) / k, or nothing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Conversion {
+    /// The samples are already in the physical unit (x / 1 is x exactly: no pass over them).
+    Identity,
+    /// x / k.
+    Scale(f64),
+    /// (x - null) / k.
+    Affine {
+        /// Output at zero input, in the samples' unit.
+        null: f64,
+        /// Output units per physical unit.
+        k: f64,
+    },
+}
+
+impl Conversion {
+    /// (x - null) / k, with the identity and the pure scale told apart.
+    fn affine(null: f64, k: f64) -> Conversion {
+        match (null == 0.0, k == 1.0) {
+            (true, true) => Conversion::Identity,
+            (true, false) => Conversion::Scale(k),
+            _ => Conversion::Affine { null, k },
+        }
+    }
+
+    /// Applies the conversion in place.
+    pub fn apply(self, values: &mut [f64]) {
+        match self {
+            Conversion::Identity => {}
+            Conversion::Scale(k) => values.iter_mut().for_each(|v| *v /= k),
+            Conversion::Affine { null, k } => values.iter_mut().for_each(|v| *v = (*v - null) / k),
+        }
     }
 }

@@ -97,3 +97,53 @@ fn deviation_at_m1_is_the_direct_computation() {
     let direct = (0.5 * d2).sqrt();
     assert!((p.deviation - direct).abs() <= 1e-12 * direct, "{} vs {direct}", p.deviation);
 }
+
+/// `analyse_channel_borrowed` (the in-memory door of the Python package) against
+/// `analyse_channel` (the owned samples of a file): the same curve and noise terms for samples
+/// read where they are (deg/s) and for samples that need a conversion (rad/s); NaN read as a
+/// missing sample or refused with its index, as asked.
+#[test]
+fn borrowed_samples_give_the_curve_of_owned_ones() {
+    use gyrolab::allan::{AllanOptions, DeviationKind};
+    use gyrolab::units::OutputUnit;
+    use gyrolab_eval::allan::{analyse_channel, analyse_channel_borrowed, ChannelSetup};
+    use gyrolab_eval::reference::ReferenceRequest;
+    use gyrolab_io::series::{ChannelInfo, LineMap, UnitSource};
+    let reference = ReferenceRequest::default().resolve().unwrap();
+    let options = AllanOptions::new(DeviationKind::Oadev);
+    let lines = LineMap::default();
+    let setup = ChannelSetup {
+        path: Path::new("<array>"),
+        shown: "<array>".into(),
+        topic: None,
+        lines: &lines,
+        tau0_s: 0.01,
+        options: &options,
+        reference: &reference,
+        fit_range_s: None,
+        uncalibrated_hint: "",
+    };
+    let mut x = white(60_000, 0.05, 11);
+    for unit in [OutputUnit::DegPerSec, OutputUnit::RadPerSec] {
+        let info = ChannelInfo { name: "x".into(), column: 1, unit, unit_source: UnitSource::Column };
+        let owned = analyse_channel(&setup, &info, x.clone()).unwrap();
+        for policy in [GapPolicy::Analyse, GapPolicy::Error] {
+            let borrowed = analyse_channel_borrowed(&setup, &info, &x, Vec::new(), policy).unwrap();
+            assert_eq!(borrowed.curve, owned.curve, "{unit:?}");
+            assert_eq!(borrowed.slope_lines, owned.slope_lines, "{unit:?}");
+        }
+    }
+    x[123] = f64::NAN;
+    let info =
+        ChannelInfo { name: "x".into(), column: 1, unit: OutputUnit::DegPerSec, unit_source: UnitSource::Column };
+    let owned = analyse_channel(&setup, &info, x.clone()).unwrap();
+    let borrowed = analyse_channel_borrowed(&setup, &info, &x, Vec::new(), GapPolicy::Analyse).unwrap();
+    assert_eq!(borrowed.curve, owned.curve);
+    // N - 1 terms at m = 1, less the two whose window (y_k, y_k+1) holds the missing sample
+    assert_eq!(borrowed.curve.points[0].terms, 60_000 - 1 - 2);
+    for unit in [OutputUnit::DegPerSec, OutputUnit::RadPerSec] {
+        let info = ChannelInfo { name: "x".into(), column: 1, unit, unit_source: UnitSource::Column };
+        let e = analyse_channel_borrowed(&setup, &info, &x, Vec::new(), GapPolicy::Error).unwrap_err().to_string();
+        assert!(e.contains("x[123] = NaN is not a finite number"), "{unit:?}: {e}");
+    }
+}

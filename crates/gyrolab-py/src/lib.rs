@@ -11,7 +11,7 @@ use gyrolab::allan::{AllanOptions, DeviationKind};
 use gyrolab::rate_test::{RateObservation, Stroke};
 use gyrolab::static_test::{SampleBlock, StaticTestConfig};
 use gyrolab::units::OutputUnit;
-use gyrolab_eval::allan::{analyse_channel, parse_taus, ChannelSetup};
+use gyrolab_eval::allan::{analyse_channel_borrowed, parse_taus, ChannelSetup, GapPolicy};
 use gyrolab_eval::reference::ReferenceRequest;
 use gyrolab_eval::EvalError;
 use gyrolab_io::series::{ChannelInfo, SeriesOptions};
@@ -104,19 +104,20 @@ fn allan<'py>(
     let taus = parse_taus(taus).map_err(err)?;
     let reference = reference(scale_factor, null)?;
     let (unit, per_hour) = if unit == "dph" { (OutputUnit::DegPerSec, true) } else { (output_unit(unit)?, false) };
-    // The one copy: the working buffer the deviation integrates into the angle series in place
-    // (with room for its extra point, so it is never copied again); a contiguous array is copied
-    // as one block.
+    // The working buffer the angle series is built in (room for its extra point), on huge
+    // pages; a contiguous array is read where it is, never copied (the angle conversion reads
+    // it twice and writes the buffer once). Samples in deg/h and strided arrays are copied once.
     let view = x.as_array();
-    let mut values = Vec::with_capacity(view.len() + 1);
-    advise_huge_pages(&mut values);
-    match x.as_slice() {
-        Ok(s) => values.extend_from_slice(s),
-        Err(_) => values.extend(view.iter().copied()),
-    }
-    if per_hour {
-        values.iter_mut().for_each(|v| *v = gyrolab::units::dph_to_dps(*v));
-    }
+    let mut buffer = Vec::with_capacity(view.len() + 1);
+    advise_huge_pages(&mut buffer);
+    let slice = x.as_slice().ok();
+    let copied: Option<Vec<f64>> = match (slice, per_hour) {
+        (Some(_), false) => None,
+        (Some(s), true) => Some(s.iter().map(|&v| gyrolab::units::dph_to_dps(v)).collect()),
+        (None, true) => Some(view.iter().map(|&v| gyrolab::units::dph_to_dps(v)).collect()),
+        (None, false) => Some(view.iter().copied().collect()),
+    };
+    let values: &[f64] = copied.as_deref().or(slice).unwrap_or(&[]);
     let info =
         ChannelInfo { name: name.to_string(), column: 1, unit, unit_source: gyrolab_io::series::UnitSource::Column };
     let options = AllanOptions { kind, taus, confidence, max_factor: None };
@@ -133,7 +134,8 @@ fn allan<'py>(
                 fit_range_s,
                 uncalibrated_hint: "give scale_factor (and null), or unit='dps', for noise terms in deg units",
             };
-            analyse_channel(&setup, &info, values)
+            // NaN is refused like inf: an array is a complete record
+            analyse_channel_borrowed(&setup, &info, values, buffer, GapPolicy::Error)
         })
         .map_err(err)?;
     let doc = gyrolab_report::allan::allan_document(std::slice::from_ref(&analysis))

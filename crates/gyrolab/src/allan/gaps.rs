@@ -16,10 +16,32 @@
 //! (overlapping: terms + window; non-overlapping: (terms + 1 or 2) m + 1).
 
 use super::{
-    attach_bounds, averaging_factors, rate_to_sample_angle_in_place, validate_parameters, AllanCurve, AllanError,
-    AllanOptions, AllanPoint, DeviationKind,
+    attach_bounds, averaging_factors, compute, rate_to_sample_angle_in_place, rate_to_sample_angle_into,
+    validate_parameters, AllanCurve, AllanError, AllanOptions, AllanPoint, DeviationKind,
 };
 use rayon::prelude::*;
+
+/// [`deviation_from_rate_with_gaps`] of borrowed samples: a complete record is read where it is
+/// and its angle series built in `buffer` (see [`super::deviation_from_rate_into`]); a record
+/// with missing samples is copied into `buffer` first.
+pub fn deviation_from_rate_with_gaps_into(
+    rate: &[f64],
+    mut buffer: Vec<f64>,
+    tau0_s: f64,
+    options: &AllanOptions,
+) -> Result<AllanCurve, AllanError> {
+    validate_parameters(tau0_s, options)?;
+    match rate_to_sample_angle_into(rate, &mut buffer) {
+        Ok(()) => compute(&buffer, tau0_s, options),
+        Err(AllanError::NonFinite { value, .. }) if value.is_nan() => {
+            buffer.clear();
+            buffer.reserve_exact(rate.len() + 1);
+            buffer.extend_from_slice(rate);
+            deviation_from_rate_with_gaps(buffer, tau0_s, options)
+        }
+        Err(e) => Err(e),
+    }
+}
 
 /// Computes a deviation curve from rate samples where NaN marks a missing sample (see the
 /// module's rule); without NaN it is [`super::deviation_from_rate`]. Infinite samples are an
@@ -40,11 +62,15 @@ pub fn deviation_from_rate_with_gaps(
     tau0_s: f64,
     options: &AllanOptions,
 ) -> Result<AllanCurve, AllanError> {
-    // NaN check in pieces that vectorise (a plain `any` tests one value at a time)
-    if !rate.chunks(4096).any(|c| c.iter().fold(false, |nan, v| nan | v.is_nan())) {
-        return super::deviation_from_rate(rate, tau0_s, options);
-    }
     validate_parameters(tau0_s, options)?;
+    // A complete record is the common case: the angle conversion's first pass finds the first
+    // non-finite sample before anything is written, so no separate NaN scan is needed.
+    rate.reserve_exact(1);
+    match rate_to_sample_angle_in_place(&mut rate) {
+        Ok(()) => return compute(&rate, tau0_s, options),
+        Err(AllanError::NonFinite { value, .. }) if value.is_nan() => {}
+        Err(e) => return Err(e),
+    }
     let kind = options.kind;
     if let Some(index) = rate.iter().position(|v| v.is_infinite()) {
         return Err(AllanError::NonFinite { index, value: rate[index] });
@@ -78,7 +104,6 @@ pub fn deviation_from_rate_with_gaps(
     }
     let mean = (sum + carry) / valid as f64;
     rate.iter_mut().filter(|v| v.is_nan()).for_each(|v| *v = mean);
-    rate.reserve_exact(1);
     rate_to_sample_angle_in_place(&mut rate)?;
     let s = rate;
     let ms = averaging_factors(options, n, tau0_s)?;

@@ -49,7 +49,11 @@ fn lag1_noise_ids_with(s: &[f64], ms: &[usize], dmax: usize, min_averages: usize
     let mut swept: Vec<usize> = ms.iter().copied().filter(|&m| averages(m) >= min_averages).collect();
     swept.sort_unstable();
     swept.dedup();
-    let r1 = order0_r1(s, &swept, block);
+    let r1 = if swept.iter().all(|m| m.is_power_of_two()) {
+        octave_r1(s, &swept, block)
+    } else {
+        order0_r1(s, &swept, block)
+    };
     let can_difference = dmax.saturating_sub(1) > 0;
     ms.par_iter()
         .map(|&m| match swept.binary_search(&m) {
@@ -88,6 +92,237 @@ struct ResidualSums {
 
 /// The undifferenced lag-1 autocorrelation r1 of the detrended averages at every factor of
 /// `ms` (each with at least 3 averages); `None` where the residual has no spread.
+/// Raw moments of one factor's averages w_t over part of the record, in lanes: sum w,
+/// sum w (t - c), sum w^2, sum w_t w_{t+1}, with the first and last average of the part.
+#[derive(Clone, Copy, Default)]
+struct RawSums {
+    s0: [f64; LANES],
+    s1: [f64; LANES],
+    w2: [f64; LANES],
+    w11: [f64; LANES],
+    first: f64,
+    last: f64,
+    started: bool,
+}
+
+/// Cancellation allowed in the one-sweep residual sums: the residual's sum of squares must be
+/// at least this fraction of the raw magnitudes it is formed from, else the factor is summed
+/// again in two sweeps (six of sixteen digits lost at most, so r1 stays good to about 1e-9).
+const RAW_MIN_FRACTION: f64 = 1e-6;
+
+/// r1 of the order-0 residuals at power-of-two factors `ms` (sorted, each with at least
+/// [`PARTS`] averages) in ONE sweep: per block, the factor-1 averages are the first differences
+/// of the angle, and each factor's averages are the pair sums of the previous factor's
+/// (w^{2m}_j = w^m_{2j} + w^m_{2j+1}, exact in real arithmetic), all while the block is in cache.
+/// The residual sums of the least-squares line are formed from raw moments (sum w, sum w u,
+/// sum w^2, sum w_t w_{t+1} with u = t - c; the expansion in docs/METHODS.md section 3); a factor
+/// whose residual variance is a tiny part of its raw moments (a strong trend: the expansion
+/// would cancel) is summed again by [`order0_r1`]'s two sweeps.
+fn octave_r1(s: &[f64], ms: &[usize], block: usize) -> Vec<Option<f64>> {
+    let Some(&top_m) = ms.last() else { return Vec::new() };
+    let n_rate = s.len() - 1;
+    let levels = top_m.trailing_zeros() as usize + 1;
+    let mut wanted = vec![None; levels];
+    for (i, &m) in ms.iter().enumerate() {
+        wanted[m.trailing_zeros() as usize] = Some(i);
+    }
+    // blocks hold a whole number of the largest factor's averages
+    let block = block.next_power_of_two().max(top_m);
+    let bounds = |p: usize| {
+        let lo = n_rate * p / PARTS / block * block;
+        let hi = if p + 1 == PARTS { n_rate } else { n_rate * (p + 1) / PARTS / block * block };
+        (lo, hi)
+    };
+    let ns: Vec<usize> = (0..levels).map(|k| n_rate >> k).collect();
+    let cs: Vec<f64> = ns.iter().map(|&n| (n as f64 - 1.0) / 2.0).collect();
+    let parts: Vec<Vec<RawSums>> = (0..PARTS)
+        .into_par_iter()
+        .map(|p| {
+            let (lo, hi) = bounds(p);
+            octave_part(s, &wanted, &cs, lo, hi, block)
+        })
+        .collect();
+    let mut r1 = vec![None; ms.len()];
+    let mut again = Vec::new();
+    for k in 0..levels {
+        let Some(i) = wanted[k] else { continue };
+        match raw_r1(parts.iter().map(|p| &p[k]), ns[k], cs[k]) {
+            Ok(v) => r1[i] = v,
+            Err(()) => again.push(i),
+        }
+    }
+    if !again.is_empty() {
+        let again_ms: Vec<usize> = again.iter().map(|&i| ms[i]).collect();
+        for (&i, v) in again.iter().zip(order0_r1(s, &again_ms, block)) {
+            r1[i] = v;
+        }
+    }
+    r1
+}
+
+/// The raw sums of every wanted level over angle points `lo..hi` (see [`octave_r1`]); the AVX2
+/// copy of the same code is taken where the CPU has it (the sums vectorise four wide).
+fn octave_part(s: &[f64], wanted: &[Option<usize>], cs: &[f64], lo: usize, hi: usize, block: usize) -> Vec<RawSums> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU supports AVX2 and FMA (checked just above); the function is safe
+            // code compiled for those features.
+            return unsafe { octave_part_avx2(s, wanted, cs, lo, hi, block) };
+        }
+    }
+    octave_part_body(s, wanted, cs, lo, hi, block)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn octave_part_avx2(
+    s: &[f64],
+    wanted: &[Option<usize>],
+    cs: &[f64],
+    lo: usize,
+    hi: usize,
+    block: usize,
+) -> Vec<RawSums> {
+    octave_part_body(s, wanted, cs, lo, hi, block)
+}
+
+#[inline(always)]
+fn octave_part_body(
+    s: &[f64],
+    wanted: &[Option<usize>],
+    cs: &[f64],
+    lo: usize,
+    hi: usize,
+    block: usize,
+) -> Vec<RawSums> {
+    let levels = wanted.len();
+    let mut acc = vec![RawSums::default(); levels];
+    let mut cur = vec![0.0f64; block];
+    let mut next = vec![0.0f64; block];
+    let mut b0 = lo;
+    while b0 < hi {
+        let b1 = (b0 + block).min(hi);
+        let count = b1 - b0;
+        for ((w, a), b) in cur[..count].iter_mut().zip(&s[b0..b1]).zip(&s[b0 + 1..=b1]) {
+            *w = b - a;
+        }
+        for k in 0..levels {
+            let count_k = count >> k;
+            if count_k == 0 {
+                break;
+            }
+            if wanted[k].is_some() {
+                raw_sums(&cur[..count_k], (b0 >> k) as f64 - cs[k], &mut acc[k]);
+            }
+            if k + 1 < levels {
+                let half = count_k / 2;
+                for (v, pair) in next[..half].iter_mut().zip(cur[..2 * half].chunks_exact(2)) {
+                    *v = pair[0] + pair[1];
+                }
+                std::mem::swap(&mut cur, &mut next);
+            }
+        }
+        b0 = b1;
+    }
+    acc
+}
+
+/// Adds one block's averages `w` (the first at position t with t - c = `p0`) to the raw sums.
+#[inline(always)]
+fn raw_sums(w: &[f64], p0: f64, acc: &mut RawSums) {
+    let Some(&head) = w.first() else { return };
+    if acc.started {
+        acc.w11[0] += acc.last * head;
+    } else {
+        acc.first = head;
+        acc.started = true;
+    }
+    let mut p = ramp(p0);
+    let chunks = w.chunks_exact(LANES);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for l in 0..LANES {
+            acc.s0[l] += c[l];
+            acc.s1[l] += c[l] * p[l];
+            acc.w2[l] += c[l] * c[l];
+            p[l] += LANES as f64;
+        }
+    }
+    for (l, &v) in rest.iter().enumerate() {
+        acc.s0[l] += v;
+        acc.s1[l] += v * p[l];
+        acc.w2[l] += v * v;
+    }
+    let (a, b) = (&w[..w.len() - 1], &w[1..]);
+    let (ac, bc) = (a.chunks_exact(LANES), b.chunks_exact(LANES));
+    let (ar, br) = (ac.remainder(), bc.remainder());
+    for (x, y) in ac.zip(bc) {
+        for l in 0..LANES {
+            acc.w11[l] += x[l] * y[l];
+        }
+    }
+    for (l, (x, y)) in ar.iter().zip(br).enumerate() {
+        acc.w11[l] += x * y;
+    }
+    acc.last = w[w.len() - 1];
+}
+
+/// r1 of the residuals e_t = w_t - a0 - a1 u_t (u_t = t - c, n averages) from the parts' raw
+/// sums, combined in part order; `Err` when the expansion would cancel (see [`RAW_MIN_FRACTION`]).
+fn raw_r1<'a>(parts: impl Iterator<Item = &'a RawSums>, n: usize, c: f64) -> Result<Option<f64>, ()> {
+    let (mut s0, mut s1, mut w2, mut w11) = ([0.0f64; LANES], [0.0f64; LANES], [0.0f64; LANES], [0.0f64; LANES]);
+    let (mut wf, mut wl, mut started, mut joins) = (0.0f64, 0.0f64, false, 0.0f64);
+    for r in parts {
+        if !r.started {
+            continue;
+        }
+        if started {
+            joins += wl * r.first;
+        } else {
+            wf = r.first;
+            started = true;
+        }
+        wl = r.last;
+        for l in 0..LANES {
+            s0[l] += r.s0[l];
+            s1[l] += r.s1[l];
+            w2[l] += r.w2[l];
+            w11[l] += r.w11[l];
+        }
+    }
+    let (s0, s1, w2, w11) = (pairwise(&s0), pairwise(&s1), pairwise(&w2), pairwise(&w11) + joins);
+    let lf = n as f64;
+    if n < 3 {
+        return Ok(None);
+    }
+    let n1 = lf * (lf * lf - 1.0) / 12.0;
+    let (a0, a1) = (s0 / lf, s1 / n1);
+    // residual sums: e, e^2, e_t e_{t+1} (t < n - 1), first and last e
+    let se = s0 - lf * a0;
+    let see = w2 - a0 * s0 - a1 * s1;
+    let head = a0 * (s0 - wl) + a1 * (s1 - wl * c + s0 - wl);
+    let tail = a0 * (s0 - wf) + a1 * (s1 + wf * c - s0 + wf);
+    let lines = (lf - 1.0) * (a0 * a0 + a0 * a1) - c * (2.0 * a0 * a1 + a1 * a1) + a1 * a1 * (n1 - c * c);
+    let se11 = w11 - head - tail + lines;
+    let (ef, el) = (wf - a0 + a1 * c, wl - a0 - a1 * c);
+    let mu = se / lf;
+    let den = see - lf * mu * mu;
+    let magnitude = w2 + (a0 * s0).abs() + (a1 * s1).abs() + w11.abs() + head.abs() + tail.abs() + lines.abs();
+    if !magnitude.is_finite() {
+        return Ok(None);
+    }
+    if magnitude == 0.0 {
+        // a series of zeros: no identification, as in the two sweeps
+        return Ok(None);
+    }
+    if den < RAW_MIN_FRACTION * magnitude || !den.is_finite() {
+        return Err(());
+    }
+    let num = se11 - mu * ((se - el) + (se - ef)) + (lf - 1.0) * mu * mu;
+    Ok(Some(num / den))
+}
+
 fn order0_r1(s: &[f64], ms: &[usize], block: usize) -> Vec<Option<f64>> {
     if ms.is_empty() {
         return Vec::new();
@@ -354,6 +589,56 @@ mod tests {
         assert!(swept_count > 100);
     }
 
+    /// The one-sweep octave path (pair sums, raw moments) against the plain r1 of the
+    /// detrended averages and against the factor-by-factor identification, on white, random-walk
+    /// and integrated random-walk rates with an offset and a ramp, record lengths that are not
+    /// multiples of the block, and blocks smaller than the largest factor.
+    #[test]
+    fn octave_sweep_equals_the_factor_by_factor_identification() {
+        let mut checked = 0;
+        for (n, integrations, seed) in [(5000, 0, 1), (4999, 1, 2), (7777, 2, 3), (60_000, 0, 4), (60_001, 1, 5)] {
+            let s = angle(n, integrations, seed);
+            let ms: Vec<usize> = (0..12).map(|k| 1 << k).filter(|&m| (s.len() - 1) / m >= 30).collect();
+            for block in [7, 64, 1000, BLOCK] {
+                let octave = octave_r1(&s, &ms, block);
+                for (&m, r1) in ms.iter().zip(&octave) {
+                    let (r1, plain) = (r1.unwrap(), plain_r1(&s, m).unwrap());
+                    assert!((r1 - plain).abs() <= 1e-9, "n={n} m={m} block={block}: {r1} vs {plain}");
+                    checked += 1;
+                }
+                for dmax in [1, 2, 3] {
+                    let fast = lag1_noise_ids_with(&s, &ms, dmax, 30, block);
+                    let plain: Vec<Option<i32>> = ms.iter().map(|&m| lag1_noise_id(&s, m, dmax)).collect();
+                    assert_eq!(fast, plain, "n={n} integrations={integrations} dmax={dmax} block={block}");
+                }
+            }
+        }
+        assert!(checked > 100);
+    }
+
+    /// A pure line w_t = a + b t has no residual: the one-sweep path must not invent one from
+    /// rounding (it falls back to the two sweeps, which find den <= 0 or a tiny residual).
+    #[test]
+    fn octave_sweep_on_a_pure_trend_falls_back() {
+        let s: Vec<f64> = (0..20_001).map(|k| 0.5 * (k as f64) * (k as f64) * 1e-3 + 3.0 * k as f64).collect();
+        let ms = [1, 2, 4, 8];
+        // the expansion is refused for every factor: the residual is rounding only
+        for &m in &ms {
+            let n = (s.len() - 1) / m;
+            let c = (n as f64 - 1.0) / 2.0;
+            let w: Vec<f64> = (0..n).map(|j| s[(j + 1) * m] - s[j * m]).collect();
+            let mut r = RawSums::default();
+            raw_sums(&w, -c, &mut r);
+            assert!(raw_r1(std::iter::once(&r), n, c).is_err(), "m={m}");
+        }
+        let octave = octave_r1(&s, &ms, 64);
+        let two = order0_r1(&s, &ms, 64);
+        assert_eq!(octave.len(), 4);
+        for (a, b) in octave.iter().zip(&two) {
+            assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits));
+        }
+    }
+
     #[test]
     fn constant_and_short_series() {
         assert_eq!(lag1_noise_ids_with(&[1.0; 200], &[1, 2], 2, 30, 16), vec![None, None]);
@@ -379,6 +664,11 @@ mod tests {
             let ms: Vec<usize> = (1..=40).collect();
             let fast = lag1_noise_ids_with(&s, &ms, dmax, 30, block);
             let plain: Vec<Option<i32>> = ms.iter().map(|&m| lag1_noise_id(&s, m, dmax)).collect();
+            prop_assert_eq!(fast, plain);
+            // the one-sweep octave path
+            let octave: Vec<usize> = (0..6).map(|k| 1usize << k).collect();
+            let fast = lag1_noise_ids_with(&s, &octave, dmax, 30, block);
+            let plain: Vec<Option<i32>> = octave.iter().map(|&m| lag1_noise_id(&s, m, dmax)).collect();
             prop_assert_eq!(fast, plain);
         }
     }

@@ -33,7 +33,7 @@ mod gaps;
 mod kernels;
 mod lag1_sweep;
 
-pub use gaps::deviation_from_rate_with_gaps;
+pub use gaps::{deviation_from_rate_with_gaps, deviation_from_rate_with_gaps_into};
 
 pub use chi2::{chi_squared_cdf, chi_squared_quantile};
 use rayon::prelude::*;
@@ -370,20 +370,62 @@ fn chunk_sum_dd(values: &[f64]) -> (f64, f64, bool) {
 }
 
 /// Turns rate samples into the angle series in sample units (angle / tau0), in place:
-/// s_0 = 0, s_k = sum_{i<k} (y_i - mean y). The vector grows by one element.
+/// s_0 = 0, s_k = sum_{i<k} (y_i - mean y). The vector grows by one element. On an error (a
+/// non-finite sample, found before anything is written) the samples are left as they were.
 ///
-/// Two parallel passes. Pass 1: double-double sums of each chunk of [`PHASE_CHUNK`] samples
-/// (also the finiteness check); they give the mean (the record's double-double sum over n,
-/// rounded once) and each chunk's starting angle sum_{i<start} y_i - start * mean in
-/// double-double (the product by an exact FMA split). Pass 2: every chunk runs its own
-/// compensated (TwoSum) cumulative sum of y_i - mean from that start; four chunks are
-/// interleaved per thread so that the add latency chain does not bound the speed. The result
-/// is the compensated cumulative sum of the sequential version up to a few units of rounding.
+/// Two parallel passes. Pass 1 ([`angle_plan`]): double-double sums of each chunk of
+/// [`PHASE_CHUNK`] samples (also the finiteness check); they give the mean (the record's
+/// double-double sum over n, rounded once) and each chunk's starting angle
+/// sum_{i<start} y_i - start * mean in double-double (the product by an exact FMA split). Pass 2:
+/// every chunk runs its own compensated (TwoSum) cumulative sum of y_i - mean from that start;
+/// four chunks are interleaved per thread so that the add latency chain does not bound the
+/// speed. The result is the compensated cumulative sum of the sequential version up to a few
+/// units of rounding.
 fn rate_to_sample_angle_in_place(data: &mut Vec<f64>) -> Result<(), AllanError> {
+    let plan = angle_plan(data)?;
+    data.par_chunks_mut(PHASE_CHUNK)
+        .zip(plan.starts)
+        .for_each(|(chunk, start)| cumulative_chunk(chunk, plan.mean, start));
+    data.push(plan.end);
+    Ok(())
+}
+
+/// The angle series of borrowed rate samples written into `out` (cleared first): the same
+/// passes and the same numbers as [`rate_to_sample_angle_in_place`], but the samples are read
+/// where they are, so the record is never copied first (pass 2 reads the samples and writes
+/// the angle). Give `out` capacity N + 1 to spare a reallocation.
+fn rate_to_sample_angle_into(rate: &[f64], out: &mut Vec<f64>) -> Result<(), AllanError> {
+    let plan = angle_plan(rate)?;
+    out.clear();
+    out.reserve_exact(rate.len() + 1);
+    out.spare_capacity_mut()[..rate.len()]
+        .par_chunks_mut(PHASE_CHUNK)
+        .zip(rate.par_chunks(PHASE_CHUNK))
+        .zip(plan.starts)
+        .for_each(|((dst, src), start)| cumulative_chunk_into(src, dst, plan.mean, start));
+    // SAFETY: the loop above wrote every one of the first rate.len() elements (the chunks of
+    // the spare capacity and of `rate` pair one to one and have equal lengths).
+    unsafe { out.set_len(rate.len()) };
+    out.push(plan.end);
+    Ok(())
+}
+
+/// What pass 1 of the angle conversion gives pass 2.
+struct AnglePlan {
+    /// Mean of the rate samples.
+    mean: f64,
+    /// Double-double starting angle of each chunk of [`PHASE_CHUNK`] samples.
+    starts: Vec<(f64, f64)>,
+    /// The last angle point, s_N.
+    end: f64,
+}
+
+/// Pass 1 of the angle conversion (see [`rate_to_sample_angle_in_place`]); the first non-finite
+/// sample is an error.
+fn angle_plan(data: &[f64]) -> Result<AnglePlan, AllanError> {
     let n = data.len();
     if n == 0 {
-        data.push(0.0);
-        return Ok(());
+        return Ok(AnglePlan { mean: 0.0, starts: Vec::new(), end: 0.0 });
     }
     let sums: Vec<(f64, f64, bool)> = data.par_chunks(PHASE_CHUNK).map(chunk_sum_dd).collect();
     if sums.iter().any(|s| !s.2) {
@@ -409,29 +451,36 @@ fn rate_to_sample_angle_in_place(data: &mut Vec<f64>) -> Result<(), AllanError> 
         ah = s2;
         al += (e1 + e2) + (l - p_err);
     }
-    data.par_chunks_mut(PHASE_CHUNK).zip(starts).for_each(|(chunk, start)| cumulative_chunk(chunk, mean, start));
-    data.push(ah + al);
-    Ok(())
+    Ok(AnglePlan { mean, starts, end: ah + al })
+}
+
+/// Block of the cumulative sum: 8 samples get a plain local prefix sum (vectorisable; its
+/// rounding is that of at most 8 terms of the size of y).
+const PREFIX_BLOCK: usize = 8;
+
+/// The angles of one block of [`PREFIX_BLOCK`] samples from the running total (hi, lo), and the
+/// block's sum of y - mean.
+#[inline(always)]
+fn prefix_block(y: &[f64], mean: f64, hi: f64, lo: f64) -> ([f64; PREFIX_BLOCK], f64) {
+    let mut q = [0.0f64; PREFIX_BLOCK];
+    let mut run = 0.0f64;
+    for l in 0..PREFIX_BLOCK {
+        q[l] = run;
+        run += y[l] - mean;
+    }
+    (std::array::from_fn(|l| hi + (lo + q[l])), run)
 }
 
 /// In-place exclusive cumulative sum of y - mean over one chunk, starting from the double-double
-/// `start`: blocks of 8 get a plain local prefix sum (vectorisable; its rounding is that of at
-/// most 8 terms of the size of y), which is added to the compensated running total (hi, lo).
+/// `start`: each block's local prefix sum ([`prefix_block`]) is added to the compensated running
+/// total (hi, lo).
 #[inline]
 fn cumulative_chunk(chunk: &mut [f64], mean: f64, start: (f64, f64)) {
-    const B: usize = 8;
     let (mut hi, mut lo) = start;
-    let mut blocks = chunk.chunks_exact_mut(B);
+    let mut blocks = chunk.chunks_exact_mut(PREFIX_BLOCK);
     for block in &mut blocks {
-        let mut q = [0.0f64; B];
-        let mut run = 0.0f64;
-        for l in 0..B {
-            q[l] = run;
-            run += block[l] - mean;
-        }
-        for l in 0..B {
-            block[l] = hi + (lo + q[l]);
-        }
+        let (angles, run) = prefix_block(block, mean, hi, lo);
+        block.copy_from_slice(&angles);
         let (s, e) = two_sum(hi, run);
         hi = s;
         lo += e;
@@ -439,6 +488,30 @@ fn cumulative_chunk(chunk: &mut [f64], mean: f64, start: (f64, f64)) {
     for v in blocks.into_remainder() {
         let y = *v - mean;
         *v = hi + lo;
+        let (s, e) = two_sum(hi, y);
+        hi = s;
+        lo += e;
+    }
+}
+
+/// [`cumulative_chunk`] from the samples `src` into `dst` (of equal length).
+#[inline]
+fn cumulative_chunk_into(src: &[f64], dst: &mut [std::mem::MaybeUninit<f64>], mean: f64, start: (f64, f64)) {
+    let (mut hi, mut lo) = start;
+    let mut blocks = dst.chunks_exact_mut(PREFIX_BLOCK);
+    let mut sources = src.chunks_exact(PREFIX_BLOCK);
+    for (block, y) in (&mut blocks).zip(&mut sources) {
+        let (angles, run) = prefix_block(y, mean, hi, lo);
+        for (d, a) in block.iter_mut().zip(angles) {
+            d.write(a);
+        }
+        let (s, e) = two_sum(hi, run);
+        hi = s;
+        lo += e;
+    }
+    for (d, &v) in blocks.into_remainder().iter_mut().zip(sources.remainder()) {
+        let y = v - mean;
+        d.write(hi + lo);
         let (s, e) = two_sum(hi, y);
         hi = s;
         lo += e;
@@ -456,12 +529,26 @@ pub fn deviation_from_rate(mut rate: Vec<f64>, tau0_s: f64, options: &AllanOptio
     compute(&rate, tau0_s, options)
 }
 
-/// Computes a deviation curve from borrowed gyro rate samples (copies them once).
+/// Computes a deviation curve from borrowed gyro rate samples (the angle series is built in a
+/// new vector; the samples are not copied first).
 pub fn deviation_from_rate_slice(rate: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve, AllanError> {
+    deviation_from_rate_into(rate, Vec::new(), tau0_s, options)
+}
+
+/// Computes a deviation curve from borrowed gyro rate samples, building the angle series in
+/// `buffer` (its contents are discarded; its allocation is reused when it holds N + 1 values):
+/// the samples are read twice where they are and never copied (see
+/// [`deviation_from_rate_slice`]). A caller that wants the buffer on particular pages (huge
+/// pages, say) allocates it so.
+pub fn deviation_from_rate_into(
+    rate: &[f64],
+    mut buffer: Vec<f64>,
+    tau0_s: f64,
+    options: &AllanOptions,
+) -> Result<AllanCurve, AllanError> {
     validate_parameters(tau0_s, options)?;
-    let mut v = Vec::with_capacity(rate.len() + 1);
-    v.extend_from_slice(rate);
-    deviation_from_rate(v, tau0_s, options)
+    rate_to_sample_angle_into(rate, &mut buffer)?;
+    compute(&buffer, tau0_s, options)
 }
 
 /// Computes a deviation curve from angle (phase) samples at interval `tau0_s`, consuming them.

@@ -302,3 +302,42 @@ fn bounds_exist_at_every_tau_of_a_long_white_record() {
         assert!((up / half - 1.0).abs() < 0.05, "{kind:?} upper {up:e} vs {half:e}");
     }
 }
+
+/// The borrowed entry points build the angle series in a buffer from the samples where they
+/// are; the owned ones build it in place. Both must give the same curve, bit for bit, with and
+/// without missing samples, and refuse the same non-finite sample.
+#[test]
+fn borrowed_and_owned_records_give_the_same_curve() {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    // longer than one angle-conversion chunk, not a multiple of it
+    let y: Vec<f64> = (0..3 * PHASE_CHUNK + 1234)
+        .map(|_| {
+            0.3 + 1e-2 * {
+                let z: f64 = StandardNormal.sample(&mut rng);
+                z
+            }
+        })
+        .collect();
+    let opts = AllanOptions::new(DeviationKind::Oadev);
+    let owned = deviation_from_rate(y.clone(), 0.01, &opts).unwrap();
+    for buffer in [Vec::new(), Vec::with_capacity(10), vec![5.0; 3 * PHASE_CHUNK + 1235]] {
+        let borrowed = deviation_from_rate_into(&y, buffer, 0.01, &opts).unwrap();
+        assert_eq!(borrowed, owned);
+    }
+    assert_eq!(deviation_from_rate_with_gaps_into(&y, Vec::new(), 0.01, &opts).unwrap(), owned);
+    let mut gappy = y.clone();
+    gappy[100] = f64::NAN;
+    gappy[40_000] = f64::NAN;
+    let owned = deviation_from_rate_with_gaps(gappy.clone(), 0.01, &opts).unwrap();
+    assert_eq!(deviation_from_rate_with_gaps_into(&gappy, Vec::new(), 0.01, &opts).unwrap(), owned);
+    assert!(owned.points[0].terms < y.len() - 2, "the gaps were not left out");
+    assert!(matches!(
+        deviation_from_rate_into(&gappy, Vec::new(), 0.01, &opts),
+        Err(AllanError::NonFinite { index: 100, .. })
+    ));
+    gappy[50] = f64::INFINITY;
+    assert!(matches!(
+        deviation_from_rate_with_gaps_into(&gappy, Vec::new(), 0.01, &opts),
+        Err(AllanError::NonFinite { index: 50, .. })
+    ));
+}
