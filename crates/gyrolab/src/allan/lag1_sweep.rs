@@ -254,17 +254,7 @@ fn raw_sums(w: &[f64], p0: f64, acc: &mut RawSums) {
         acc.s1[l] += v * p[l];
         acc.w2[l] += v * v;
     }
-    let (a, b) = (&w[..w.len() - 1], &w[1..]);
-    let (ac, bc) = (a.chunks_exact(LANES), b.chunks_exact(LANES));
-    let (ar, br) = (ac.remainder(), bc.remainder());
-    for (x, y) in ac.zip(bc) {
-        for l in 0..LANES {
-            acc.w11[l] += x[l] * y[l];
-        }
-    }
-    for (l, (x, y)) in ar.iter().zip(br).enumerate() {
-        acc.w11[l] += x * y;
-    }
+    neighbour_products(w, &mut acc.w11);
     acc.last = w[w.len() - 1];
 }
 
@@ -503,18 +493,24 @@ fn residual_sums(w: &mut [f64], p0: f64, a0: f64, a1: f64, acc: &mut ResidualSum
         acc.sum1[l] += v;
         acc.sum2[l] += v * v;
     }
+    neighbour_products(w, &mut acc.sum11);
+    acc.last = w[w.len() - 1];
+}
+
+/// Adds the products of neighbours w_t w_{t+1} within `w` to the lanes.
+#[inline(always)]
+fn neighbour_products(w: &[f64], lanes: &mut [f64; LANES]) {
     let (a, b) = (&w[..w.len() - 1], &w[1..]);
     let (ac, bc) = (a.chunks_exact(LANES), b.chunks_exact(LANES));
     let (ar, br) = (ac.remainder(), bc.remainder());
     for (x, y) in ac.zip(bc) {
         for l in 0..LANES {
-            acc.sum11[l] += x[l] * y[l];
+            lanes[l] += x[l] * y[l];
         }
     }
     for (l, (x, y)) in ar.iter().zip(br).enumerate() {
-        acc.sum11[l] += x * y;
+        lanes[l] += x * y;
     }
-    acc.last = w[w.len() - 1];
 }
 
 /// Pairwise sum of the lanes.
