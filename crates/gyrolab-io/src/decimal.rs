@@ -1,10 +1,12 @@
-//! Fast, exact reading of plain decimal numbers (`-12.3456`, `+0.5`, `7`) from text rows.
+//! Fast, exact reading of the numbers logs are written with (`-12.3456`, `+0.5`, `7`,
+//! `-1.2345670e-02`, nanosecond stamps `1700000000002500096`) from text rows.
 //!
-//! Exactness: a decimal with at most 15 significant digits and no exponent has a significand
-//! w < 10^15 and a power 10^k (k <= 22), both exact in f64, so w / 10^k is one correctly
-//! rounded operation: the value every correct parser returns (Clinger 1990, "How to read
-//! floating point numbers accurately", the fast path). Anything else is left to the full parser
-//! (`fast-float2`) by returning `None`.
+//! Exactness: a decimal with at most 15 significant digits has a significand w < 10^15, exact in
+//! f64; with a power 10^p, |p| <= 22 (the point and the exponent together), also exact, w x 10^p
+//! is one correctly rounded multiplication or division: the value every correct parser returns
+//! (Clinger 1990, "How to read floating point numbers accurately", the fast path). An integer of
+//! at most 19 digits is below 2^64, and its conversion to f64 is one correctly rounded operation
+//! too. Anything else is left to the full parser (`fast-float2`) by returning `None`.
 //!
 //! Speed: digits are read eight at a time (SWAR: "SIMD within a register", one `u64` per eight
 //! bytes), and the rows of a long record, which nearly always repeat the layout of the row
@@ -85,8 +87,9 @@ fn digits_value(v: u64, n: usize) -> u64 {
 }
 
 /// Reads a run of digits from `i`, eight at a time, appending them to `w` (the value of the
-/// digits before, w < 10^(15 - limit)): returns (value, digits read, next index), or `None` when
-/// more than `limit` digits follow (leading zeros count), so the value stays below 10^15.
+/// digits before, with at most 19 - `limit` digits): returns (value, digits read, next index), or
+/// `None` when more than `limit` digits follow (leading zeros count), so the value keeps at most
+/// 19 digits (below 10^19 < 2^64).
 #[inline(always)]
 fn digit_run(b: &[u8], mut i: usize, mut w: u64, limit: usize) -> Option<(u64, usize, usize)> {
     let mut digits = 0;
@@ -97,7 +100,7 @@ fn digit_run(b: &[u8], mut i: usize, mut w: u64, limit: usize) -> Option<(u64, u
         if digits > limit {
             return None;
         }
-        // No overflow: w has at most `limit - n` digits before, so w < 10^limit after.
+        // No overflow: w has at most 19 - n digits before, so w < 10^19 after.
         w = w * POW10_U64[n] + digits_value(v, n);
         i += n;
         if n < 8 {
@@ -121,12 +124,8 @@ fn exact_quotient(w: u64, decimals: usize, negative: bool) -> f64 {
 struct ScannedDecimal {
     /// The digits as an integer (< 10^15).
     significand: u64,
-    /// Digits before the point.
-    int_digits: usize,
     /// Digits after the point.
     frac_digits: usize,
-    /// Whether there is a point.
-    has_point: bool,
     /// Whether the sign is `-`.
     negative: bool,
     /// Index of the first byte after the number.
@@ -141,20 +140,9 @@ impl ScannedDecimal {
         let negative = c0 == Some(b'-');
         let q = start + usize::from(negative || c0 == Some(b'+'));
         let (int_w, int_digits, i) = digit_run(b, q, 0, MAX_DIGITS)?;
-        let (significand, frac_digits, end, has_point) = if b.get(i) == Some(&b'.') {
-            let (w, nf, i) = digit_run(b, i + 1, int_w, MAX_DIGITS - int_digits)?;
-            (w, nf, i, true)
-        } else {
-            (int_w, 0, i, false)
-        };
-        (int_digits + frac_digits > 0).then_some(ScannedDecimal {
-            significand,
-            int_digits,
-            frac_digits,
-            has_point,
-            negative,
-            end,
-        })
+        let (significand, frac_digits, end) =
+            if b.get(i) == Some(&b'.') { digit_run(b, i + 1, int_w, MAX_DIGITS - int_digits)? } else { (int_w, 0, i) };
+        (int_digits + frac_digits > 0).then_some(ScannedDecimal { significand, frac_digits, negative, end })
     }
 
     /// The value: one correctly rounded division.
@@ -217,8 +205,20 @@ fn exponent_decimal(b: &[u8], d: &ScannedDecimal) -> Option<(f64, usize)> {
     Some((if d.negative { -v } else { v }, i))
 }
 
+/// Bytes of the window a shape is checked in, from the first byte after the sign (three words
+/// for the masks, and room for an eight-byte load at any digit of them).
+const WINDOW: usize = 32;
+
+/// Most bytes a shape covers after the sign, its end character included (three words).
+const SHAPE_BYTES: usize = 24;
+
+/// Most digits of an integer without a point or exponent: w < 10^19 < 2^64, and `w as f64` is
+/// one correctly rounded conversion.
+const MAX_INTEGER_DIGITS: usize = 19;
+
 /// The layout of a number after its sign: digits before the point, whether there is a point,
-/// digits after it; with the byte masks that check a field against it in two words.
+/// digits after it, the exponent's sign and digits; with the byte masks that check a field
+/// against it in three words.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct FieldShape {
     /// Digits before the point.
@@ -227,44 +227,57 @@ pub struct FieldShape {
     frac_digits: u8,
     /// Whether the number has a point.
     has_point: bool,
+    /// Digits of the exponent (0: no exponent).
+    exp_digits: u8,
+    /// Whether the exponent has a sign (`e-05`, `e+05`; else `e05`).
+    exp_signed: bool,
     /// Bytes from the first digit to the end character (the field's length after its sign).
     len: u8,
-    /// Which bytes of the two words the shape covers (up to and including the end character).
-    care: [u64; 2],
-    /// The non-digit bytes expected among them: the point and the end character.
-    expected: [u64; 2],
+    /// Which bytes of the three words the shape covers (up to and including the end character).
+    care: [u64; 3],
+    /// The non-digit bytes expected among them: the point, the exponent's `e` and sign, and the
+    /// end character.
+    expected: [u64; 3],
 }
 
 impl FieldShape {
-    /// The shape of `int_digits[.frac_digits]`; `None` when it does not fit the fast path (more
-    /// than 15 digits, or more than 15 bytes before the end character).
-    fn new(int_digits: usize, has_point: bool, frac_digits: usize) -> Option<FieldShape> {
+    /// The shape of `int_digits[.frac_digits][e[+-]exp_digits]`; `None` when it does not fit the
+    /// fast path (more than 15 digits, or 19 for an integer; more than 23 bytes before the end
+    /// character).
+    fn new(int_digits: usize, has_point: bool, frac_digits: usize, exp: Option<(bool, usize)>) -> Option<FieldShape> {
         let digits = int_digits + frac_digits;
-        let len = digits + usize::from(has_point);
-        if digits == 0 || digits > MAX_DIGITS || len > 15 {
+        let integer = !has_point && exp.is_none();
+        let most = if integer { MAX_INTEGER_DIGITS } else { MAX_DIGITS };
+        let mantissa = digits + usize::from(has_point);
+        let (exp_signed, exp_digits) = exp.unwrap_or((false, 0));
+        let exp_len = if exp.is_some() { 1 + usize::from(exp_signed) + exp_digits } else { 0 };
+        let len = mantissa + exp_len;
+        if digits == 0 || digits > most || len >= SHAPE_BYTES || (exp.is_some() && !(1..=3).contains(&exp_digits)) {
             return None;
         }
-        let byte_bit = |k: usize| -> [u64; 2] {
-            let mut m = [0u64; 2];
+        let byte_bit = |k: usize| -> [u64; 3] {
+            let mut m = [0u64; 3];
             m[k / 8] = 0x80 << (8 * (k % 8));
             m
         };
-        let mut care = [0u64; 2];
-        for k in 0..=len {
-            let b = byte_bit(k);
-            care[0] |= b[0];
-            care[1] |= b[1];
-        }
+        let or = |a: [u64; 3], b: [u64; 3]| [a[0] | b[0], a[1] | b[1], a[2] | b[2]];
+        let care = (0..=len).fold([0u64; 3], |m, k| or(m, byte_bit(k)));
         let mut expected = byte_bit(len);
         if has_point {
-            let b = byte_bit(int_digits);
-            expected[0] |= b[0];
-            expected[1] |= b[1];
+            expected = or(expected, byte_bit(int_digits));
+        }
+        if exp.is_some() {
+            expected = or(expected, byte_bit(mantissa));
+            if exp_signed {
+                expected = or(expected, byte_bit(mantissa + 1));
+            }
         }
         Some(FieldShape {
             int_digits: int_digits as u8,
             frac_digits: frac_digits as u8,
             has_point,
+            exp_digits: exp_digits as u8,
+            exp_signed,
             len: len as u8,
             care,
             expected,
@@ -281,52 +294,128 @@ pub struct RowLayout {
     pub crlf: bool,
 }
 
+/// The eight bytes of `w` from `k` as a little-endian word.
+#[inline(always)]
+fn word_at(w: &[u8; WINDOW], k: usize) -> u64 {
+    let mut a = [0u8; 8];
+    if let Some(s) = w.get(k..k + 8) {
+        a.copy_from_slice(s);
+    }
+    u64::from_le_bytes(a)
+}
+
+/// The value of the `n` (0 to 19) ASCII digits of `w` from `k` (k + 16 + 8 <= 32 when n > 16).
+#[inline(always)]
+fn digits_at(w: &[u8; WINDOW], k: usize, n: usize) -> u64 {
+    if n <= 8 {
+        digits_value(word_at(w, k), n)
+    } else if n <= 16 {
+        digits_value(word_at(w, k), 8) * POW10_U64[n - 8] + digits_value(word_at(w, k + 8), n - 8)
+    } else {
+        let first = digits_value(word_at(w, k), 8) * 100_000_000 + digits_value(word_at(w, k + 8), 8);
+        first * POW10_U64[n - 16] + digits_value(word_at(w, k + 16), n - 16)
+    }
+}
+
+/// w x 10^p with its sign, for w < 10^15 (exact in f64) and |p| <= 22 (10^|p| exact): one
+/// correctly rounded multiplication or division (Clinger's fast path); `None` for other powers.
+#[inline(always)]
+fn scaled(w: u64, p: i32, negative: bool) -> Option<f64> {
+    let k = p.unsigned_abs() as usize;
+    let m = *POW10.get(k)?;
+    let v = if p >= 0 { w as f64 * m } else { w as f64 / m };
+    Some(if negative { -v } else { v })
+}
+
 /// Reads the field at `p` against `shape`, ending in `end_char`: the value and the index of the
-/// end character, or `None` when the field does not have that shape (or 17 bytes from its first
-/// digit are not available).
+/// end character, or `None` when the field does not have that shape (or 32 bytes from its first
+/// digit are not available), or its exponent is outside the exact range.
 #[inline(always)]
 fn shaped_field(b: &[u8], p: usize, shape: &FieldShape, end_char: u8) -> Option<(f64, usize)> {
     let c0 = *b.get(p)?;
     let negative = c0 == b'-';
     let q = p + usize::from(negative || c0 == b'+');
-    let field: &[u8; 16] = b.get(q..q + 16)?.try_into().ok()?;
-    let x = u128::from_le_bytes(*field);
-    let (w0, w1) = (x as u64, (x >> 64) as u64);
-    let misfit = ((non_digit_bytes(w0) & shape.care[0]) ^ shape.expected[0])
-        | ((non_digit_bytes(w1) & shape.care[1]) ^ shape.expected[1]);
+    let w: &[u8; WINDOW] = b.get(q..q + WINDOW)?.try_into().ok()?;
+    let misfit = ((non_digit_bytes(word_at(w, 0)) & shape.care[0]) ^ shape.expected[0])
+        | ((non_digit_bytes(word_at(w, 8)) & shape.care[1]) ^ shape.expected[1])
+        | ((non_digit_bytes(word_at(w, 16)) & shape.care[2]) ^ shape.expected[2]);
     let len = usize::from(shape.len);
     let ni = usize::from(shape.int_digits);
     let nf = usize::from(shape.frac_digits);
-    // The byte at `len` is inside the 16 (len <= 15); so is the point (ni < len).
-    let byte = |k: usize| field.get(k).copied();
+    // Every index below is under `len` < 24, inside the window.
+    let byte = |k: usize| w.get(k).copied();
     if misfit != 0 || byte(len) != Some(end_char) || (shape.has_point && byte(ni) != Some(b'.')) {
         return None;
     }
-    // Digits before the point: bytes 0..ni (ni <= 14); after it: bytes ni + 1 .. len.
-    let int =
-        if ni <= 8 { digits_value(w0, ni) } else { digits_value(w0, 8) * POW10_U64[ni - 8] + digits_value(w1, ni - 8) };
-    // In two steps: ni + 1 can be 16 (fifteen digits, no point), a shift by the full width.
-    let f0 = ((x >> (8 * ni)) >> 8) as u64;
-    let frac = if nf <= 8 {
-        digits_value(f0, nf)
-    } else {
-        digits_value(f0, 8) * POW10_U64[nf - 8] + digits_value((x >> (8 * (ni + 9))) as u64, nf - 8)
+    let int = digits_at(w, 0, ni);
+    let significand = if shape.has_point { int * POW10_U64[nf] + digits_at(w, ni + 1, nf) } else { int };
+    if shape.exp_digits == 0 {
+        let v = exact_quotient(significand, nf, negative);
+        return Some((v, q + len));
+    }
+    // The exponent: `e` or `E`, the sign if the shape has one, its digits.
+    let e_at = ni + nf + usize::from(shape.has_point);
+    let negative_exp = match (shape.exp_signed, byte(e_at + 1)) {
+        (true, Some(b'-')) => true,
+        (true, Some(b'+')) | (false, _) => false,
+        _ => return None,
     };
-    Some((exact_quotient(int * POW10_U64[nf] + frac, nf, negative), q + len))
+    if byte(e_at).map(|c| c | 0x20) != Some(b'e') {
+        return None;
+    }
+    let e = digits_at(w, e_at + 1 + usize::from(shape.exp_signed), usize::from(shape.exp_digits)) as i32;
+    let v = scaled(significand, if negative_exp { -e } else { e } - nf as i32, negative)?;
+    Some((v, q + len))
 }
 
 /// Reads the field at `p` by scanning for `end_char`: the value, the index of the end character
-/// and the field's shape; `None` when it is not a plain decimal of at most 15 digits ending there.
+/// and the field's shape; `None` when it is not a number the fast path takes ending there: a
+/// plain decimal of at most 15 digits, an integer of at most 19, or a decimal of at most 15
+/// digits with an exponent of 1 to 3 digits that leaves w x 10^p with |p| <= 22.
 #[inline(always)]
 fn scanned_field(b: &[u8], p: usize, end_char: u8) -> Option<(f64, usize, Option<FieldShape>)> {
-    let d = ScannedDecimal::scan(b, p)?;
-    if b.get(d.end) != Some(&end_char) {
+    let c0 = b.get(p).copied();
+    let negative = c0 == Some(b'-');
+    let q = p + usize::from(negative || c0 == Some(b'+'));
+    let (int_w, ni, i) = digit_run(b, q, 0, MAX_INTEGER_DIGITS)?;
+    let at = b.get(i).copied();
+    if at == Some(end_char) && ni > 0 {
+        // An integer of up to 19 digits: one correctly rounded conversion.
+        return Some((exact_quotient(int_w, 0, negative), i, FieldShape::new(ni, false, 0, None)));
+    }
+    if ni > MAX_DIGITS {
         return None;
     }
-    Some((d.value(), d.end, FieldShape::new(d.int_digits, d.has_point, d.frac_digits)))
+    let (significand, nf, i, has_point) = if at == Some(b'.') {
+        let (w, nf, i) = digit_run(b, i + 1, int_w, MAX_DIGITS - ni)?;
+        (w, nf, i, true)
+    } else {
+        (int_w, 0, i, false)
+    };
+    if ni + nf == 0 {
+        return None;
+    }
+    match b.get(i).copied() {
+        Some(c) if c == end_char => {
+            Some((exact_quotient(significand, nf, negative), i, FieldShape::new(ni, has_point, nf, None)))
+        }
+        Some(b'e' | b'E') => {
+            let sign = b.get(i + 1).copied();
+            let signed = matches!(sign, Some(b'-' | b'+'));
+            let s = i + 1 + usize::from(signed);
+            let (e, ne, end) = digit_run(b, s, 0, 3)?;
+            if ne == 0 || b.get(end) != Some(&end_char) {
+                return None;
+            }
+            let e = if sign == Some(b'-') { -(e as i32) } else { e as i32 };
+            let v = scaled(significand, e - nf as i32, negative)?;
+            Some((v, end, FieldShape::new(ni, has_point, nf, Some((signed, ne)))))
+        }
+        _ => None,
+    }
 }
 
-/// Reads one row of plain decimals (see [`read_rows`]); `None` leaves `cols` as it was.
+/// Reads one row of numbers (see [`read_rows`]); `None` leaves `cols` as it was.
 #[inline(always)]
 fn read_row(
     b: &[u8],
@@ -379,9 +468,10 @@ fn read_row(
 /// The target slot of a column that is not kept.
 pub const SKIP_COLUMN: u32 = u32::MAX;
 
-/// Reads rows of plain decimals from `start` (each: fields separated by `layout.delim`, the last
-/// ending in `\n` or, with `layout.crlf`, `\r\n`; no spaces, empty cells, exponents; at most 15 digits a
-/// number), pushing field `ci`'s value onto `cols[targets[ci]]` (none for [`SKIP_COLUMN`]), until
+/// Reads rows of numbers from `start` (each: fields separated by `layout.delim`, the last ending
+/// in `\n` or, with `layout.crlf`, `\r\n`; no spaces or empty cells; each number a plain decimal of
+/// at most 15 digits, an integer of at most 19, or at most 15 digits with an exponent that
+/// leaves a power of ten within 10^±22, as [`scanned_field`] takes them), pushing field `ci`'s value onto `cols[targets[ci]]` (none for [`SKIP_COLUMN`]), until
 /// a row does not fit, `b` ends, or `room` rows are read. `shapes` (one per field, carried from
 /// call to call) remembers each column's last layout. Returns where it stopped and the rows read.
 pub fn read_rows(
@@ -436,13 +526,13 @@ mod tests {
     fn rows_by_shape_and_by_scan() {
         // The second row changes the time's width and the sign of the output: scanned, then
         // the third row fits the new shape.
-        let text = b"9.99,2.5000001\n10.00,-0.0000003\n10.01,-0.0000004\n10.02,1e5\n";
+        let text = b"9.99,2.5000001\n10.00,-0.0000003\n10.01,-0.0000004\n10.02,1e30\n";
         let mut shapes = vec![None; 2];
         let mut cols = vec![Vec::new(), Vec::new()];
         let (p, rows) =
             read_rows(text, 0, RowLayout { delim: b',', crlf: false }, &[0, 1], &mut shapes, &mut cols, 100);
         assert_eq!(rows, 3);
-        assert_eq!(&text[p..], b"10.02,1e5\n");
+        assert_eq!(&text[p..], b"10.02,1e30\n");
         assert_eq!(cols[0], vec![9.99, 10.0, 10.01]);
         assert_eq!(cols[1], vec![2.5000001, -0.0000003, -0.0000004]);
         // The rejected row left nothing behind.
@@ -466,6 +556,29 @@ mod tests {
     }
 
     #[test]
+    fn exponents_and_nanosecond_stamps_by_shape() {
+        // np.savetxt's `%.7e` and a Kalibr stamp in ns (19 digits): shapes are taken on the
+        // second row; the last row's exponent leaves 10^-27, outside the exact range.
+        let text = b"1700000000000000000,3.2996040e-04,-9.1236815E+00\n\
+1700000000002500096,-4.2611644e-03,9.8125078e+00\n\
+1700000000005000192,0.0000000e+00,1e5\n\
+1700000000007500288,1.0000000e-20,1e5\n";
+        let mut shapes = vec![None; 3];
+        let mut cols = vec![Vec::new(); 3];
+        let (p, rows) =
+            read_rows(text, 0, RowLayout { delim: b',', crlf: false }, &[0, 1, 2], &mut shapes, &mut cols, 100);
+        assert_eq!((rows, &text[p..]), (3, &b"1700000000007500288,1.0000000e-20,1e5\n"[..]));
+        let full = |t: &str| fast_float2::parse::<f64, _>(t).unwrap();
+        assert_eq!(
+            cols[0],
+            vec![full("1700000000000000000"), full("1700000000002500096"), full("1700000000005000192")]
+        );
+        assert_eq!(cols[1], vec![3.2996040e-04, -4.2611644e-03, 0.0]);
+        assert_eq!(cols[2], vec![-9.1236815, 9.8125078, 1e5]);
+        assert_eq!(shapes[1].map(|s| (s.exp_digits, s.exp_signed)), Some((2, true)));
+    }
+
+    #[test]
     fn crlf_rows() {
         let text = b"1.5,2\r\n-3,4.25\r\n5,6\n";
         let mut shapes = vec![None; 2];
@@ -476,27 +589,66 @@ mod tests {
         assert_eq!(cols, vec![vec![1.5, -3.0], vec![2.0, 4.25]]);
     }
 
-    /// Whether a field is a plain decimal the fast path must take: `[+-]digits[.digits]` with
-    /// 1 to 15 digits (either side of the point may be empty, not both).
+    /// Whether a field is a number the fast path must take: `[+-]digits[.digits]` with 1 to 15
+    /// digits (either side of the point may be empty, not both), or 1 to 19 without a point;
+    /// or 1 to 15 digits with an exponent `[eE][+-]d{1,3}` for which exponent - (digits after
+    /// the point) is within -22..=22.
     fn is_plain(f: &str) -> bool {
         let body = f.strip_prefix(['-', '+']).unwrap_or(f);
-        let (int, frac) = body.split_once('.').unwrap_or((body, ""));
+        let (mantissa, exp) = match body.split_once(['e', 'E']) {
+            Some((m, e)) => (m, Some(e)),
+            None => (body, None),
+        };
+        let (int, frac) = mantissa.split_once('.').unwrap_or((mantissa, ""));
         let digits = int.len() + frac.len();
-        int.bytes().all(|c| c.is_ascii_digit())
-            && frac.bytes().all(|c| c.is_ascii_digit())
-            && (1..=15).contains(&digits)
+        let is_digits = |t: &str| t.bytes().all(|c| c.is_ascii_digit());
+        if !is_digits(int) || !is_digits(frac) || digits == 0 {
+            return false;
+        }
+        match exp {
+            None if !mantissa.contains('.') => digits <= 19,
+            None => digits <= 15,
+            Some(e) => {
+                let e_digits = e.strip_prefix(['-', '+']).unwrap_or(e);
+                if digits > 15 || !is_digits(e_digits) || !(1..=3).contains(&e_digits.len()) {
+                    return false;
+                }
+                let p: i64 = e.parse::<i64>().unwrap() - frac.len() as i64;
+                (-22..=22).contains(&p)
+            }
+        }
     }
 
-    /// A number as text: sign, 0 to 16 digits before the point, 0 to 9 after it.
-    fn number_text((sign, int_digits, int, width, frac): (u8, u32, u64, usize, u64)) -> String {
+    /// A random number's parts: sign, digits before the point and their value, digits after it
+    /// and their value, exponent (sign, case, value).
+    type NumberParts = (u8, u32, u64, usize, u64, Option<(u8, bool, u32)>);
+
+    /// A number as text: sign, 0 to 20 digits before the point, 0 to 9 after it, and an
+    /// exponent (`e`/`E`, an optional sign, 1 to 4 digits) when `exp` says so.
+    fn number_text((sign, int_digits, int, width, frac, exp): NumberParts) -> String {
         let sign = ["", "-", "+"][sign as usize];
-        let int = if int_digits == 0 { String::new() } else { format!("{}", int % 10u64.pow(int_digits)) };
+        let int = if int_digits == 0 {
+            String::new()
+        } else if int_digits <= 19 {
+            format!("{}", int % 10u64.pow(int_digits))
+        } else {
+            format!("{int}{}", int % 10)
+        };
         let int = if int.is_empty() && width == 0 { "0".to_string() } else { int };
         let frac = format!("{frac:09}");
-        if width == 0 {
-            format!("{sign}{int}")
-        } else {
-            format!("{sign}{int}.{}", &frac[..width.min(9)])
+        let mantissa =
+            if width == 0 { format!("{sign}{int}") } else { format!("{sign}{int}.{}", &frac[..width.min(9)]) };
+        match exp {
+            None => mantissa,
+            Some((s, upper, e)) => {
+                let e_sign = ["", "-", "+"][s as usize % 3];
+                let width = 1 + (e % 4) as usize;
+                format!(
+                    "{mantissa}{}{e_sign}{:0width$}",
+                    if upper { 'E' } else { 'e' },
+                    e / 4 % 10u32.pow(width as u32)
+                )
+            }
         }
     }
 
@@ -542,13 +694,14 @@ mod tests {
         Ok(())
     }
 
-    fn number() -> impl Strategy<Value = (u8, u32, u64, usize, u64)> {
+    fn number() -> impl Strategy<Value = NumberParts> {
         (
             0u8..3,
-            prop_oneof![0u32..9, 9u32..17],
+            prop_oneof![0u32..9, 9u32..17, 17u32..21],
             any::<u64>(),
             prop_oneof![0usize..10, Just(0usize)],
             0u64..1_000_000_000,
+            prop_oneof![Just(None), (0u8..3, any::<bool>(), 0u32..400).prop_map(Some)],
         )
     }
 

@@ -32,6 +32,9 @@ pub use crate::text::MAX_LINE_BYTES;
 /// How many missing cells the reader lists individually (all are counted).
 pub const FIRST_MISSING: usize = 100;
 
+mod ranges;
+pub use ranges::{read_series_in_ranges, RANGE_CHUNK_BYTES};
+
 pub use crate::decimal::plain_decimal;
 use crate::decimal::{read_rows, FieldShape, RowLayout, SKIP_COLUMN};
 pub use crate::text::Delimiter;
@@ -317,6 +320,21 @@ pub struct ReaderQuality {
 }
 
 impl ReaderQuality {
+    /// Adds the findings of the rows that follow (`other`, whose lines are counted from
+    /// `line_offset` lines before), keeping the first [`FIRST_MISSING`] of each list.
+    pub fn append(&mut self, other: ReaderQuality, line_offset: u64) {
+        fn take_first<T>(into: &mut Vec<T>, from: Vec<T>, shift: impl Fn(T) -> T) {
+            let room = FIRST_MISSING.saturating_sub(into.len());
+            into.extend(from.into_iter().take(room).map(shift));
+        }
+        self.missing_cells += other.missing_cells;
+        take_first(&mut self.first_missing, other.first_missing, |c| MissingCell { line: c.line + line_offset, ..c });
+        self.zero_rows += other.zero_rows;
+        take_first(&mut self.first_zero_rows, other.first_zero_rows, |l| l + line_offset);
+        self.repeated_rows += other.repeated_rows;
+        take_first(&mut self.first_repeated_rows, other.first_repeated_rows, |l| l + line_offset);
+    }
+
     /// Counts a dropout row passed on as NaN (and lists its line among the first ones).
     pub fn count_dropout(&mut self, kind: DropoutKind, line: u64) {
         let (count, first) = match kind {
@@ -357,9 +375,28 @@ impl LineMap {
         self.len += 1;
     }
 
-    /// Appends the lines of the next rows.
+    /// Appends the lines of the next rows, strictly increasing as a reader gives them (so a
+    /// block whose last line is its first plus its length less one is a run of consecutive
+    /// lines, the usual case, appended in one step).
     pub fn extend_from_slice(&mut self, lines: &[u64]) {
-        lines.iter().for_each(|&l| self.push(l));
+        debug_assert!(lines.windows(2).all(|w| w[0] < w[1]), "lines must increase");
+        match (lines.first(), lines.last()) {
+            (Some(&a), Some(&b)) if b.checked_sub(a) == Some(lines.len() as u64 - 1) => {
+                self.push(a);
+                self.len += lines.len() - 1;
+            }
+            _ => lines.iter().for_each(|&l| self.push(l)),
+        }
+    }
+
+    /// Appends the rows of `other`, whose lines are counted from `line_offset` lines before
+    /// (a piece of a file read apart).
+    pub fn append(&mut self, other: &LineMap, line_offset: u64) {
+        for (k, &(row, line)) in other.runs.iter().enumerate() {
+            let end = other.runs.get(k + 1).map_or(other.len, |r| r.0);
+            self.push(line + line_offset);
+            self.len += end - row - 1;
+        }
     }
 
     /// The line of row `row`.
@@ -543,6 +580,8 @@ pub struct SeriesReader<R: Read> {
     /// A piece of a file parsed by [`read_series_all`]'s parallel path: no header, and no rows
     /// is not an error.
     piece: bool,
+    /// Bytes read from the source so far (the file offset of `buf[filled]`).
+    consumed: u64,
 }
 
 /// The byte source of [`SeriesReader::open`]: a file, or standard input for the path `-`.
@@ -614,6 +653,7 @@ impl<R: Read> SeriesReader<R> {
             lines: Vec::new(),
             quality: ReaderQuality::default(),
             piece: false,
+            consumed: 0,
         };
         if let Some(f) = options.sample_rate_hz {
             if !(f.is_finite() && f > 0.0) {
@@ -1051,6 +1091,7 @@ impl<R: Read> SeriesReader<R> {
                 Ok(n) => {
                     self.check_new_bytes(self.filled, self.filled + n)?;
                     self.filled += n;
+                    self.consumed += n as u64;
                 }
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
                 Err(e) => return Err(DataError::io(&self.header.file, &e)),
@@ -1414,17 +1455,22 @@ const MAX_RESERVE_ROWS: usize = 1 << 30;
 pub const PARALLEL_BATCH_BYTES: usize = 4 << 20;
 
 /// Reads a whole file (`-`: standard input) into memory, for analyses that need the whole
-/// record (such as the Allan variance). Large inputs are parsed in parallel: batches of
-/// [`PARALLEL_BATCH_BYTES`] are read in turn, split at line ends into one piece per thread,
-/// and the pieces parsed at once by the same row parser as [`SeriesReader::next_block`] (same
-/// values, same errors with their lines; the first error in file order is returned).
+/// record (such as the Allan variance). Large inputs are parsed in parallel by the same row
+/// parser as [`SeriesReader::next_block`] (same values, same errors with their lines; the first
+/// error in file order is returned): a regular file in one byte range per thread, each read and
+/// parsed on its own ([`read_series_in_ranges`]); a stream (standard input, a pipe) in batches
+/// of [`PARALLEL_BATCH_BYTES`] read in turn and split at line ends into one piece per thread.
 pub fn read_series_all(path: impl AsRef<Path>, options: &SeriesOptions) -> Result<SeriesData, DataError> {
     let path = path.as_ref();
     let r = SeriesReader::open(path, options)?;
     let threads = rayon::current_num_threads();
-    let size = std::fs::metadata(path).map(|m| m.len()).unwrap_or(u64::MAX);
+    let meta = std::fs::metadata(path).ok().filter(|_| path != Path::new("-"));
+    let size = meta.as_ref().map_or(u64::MAX, |m| m.len());
     if threads < 2 || size < (4 << 20) {
         return collect_series(r);
+    }
+    if meta.is_some_and(|m| m.is_file()) {
+        return ranges::collect_series_ranges(r, path, size, threads, RANGE_CHUNK_BYTES);
     }
     collect_series_parallel(r, threads, size, PARALLEL_BATCH_BYTES)
 }
@@ -1481,6 +1527,7 @@ impl<R: Read> SeriesReader<R> {
             lines,
             quality: ReaderQuality::default(),
             piece: true,
+            consumed: 0,
         }
     }
 }
@@ -1592,17 +1639,7 @@ fn collect_series_parallel<R: Read>(
                     _ => s.extend_from_slice(c),
                 }
             }
-            quality.missing_cells += p.quality.missing_cells;
-            quality.zero_rows += p.quality.zero_rows;
-            let zroom = FIRST_MISSING.saturating_sub(quality.first_zero_rows.len());
-            quality.first_zero_rows.extend(std::mem::take(&mut p.quality.first_zero_rows).into_iter().take(zroom));
-            quality.repeated_rows += p.quality.repeated_rows;
-            let rroom = FIRST_MISSING.saturating_sub(quality.first_repeated_rows.len());
-            quality
-                .first_repeated_rows
-                .extend(std::mem::take(&mut p.quality.first_repeated_rows).into_iter().take(rroom));
-            let room = FIRST_MISSING.saturating_sub(quality.first_missing.len());
-            quality.first_missing.extend(std::mem::take(&mut p.quality.first_missing).into_iter().take(room));
+            quality.append(std::mem::take(&mut p.quality), 0);
             pool[k] = p;
         }
         r.line_no = line_no;

@@ -431,3 +431,78 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    /// Reading a file in parallel byte ranges changes nothing: on random files (as above, with
+    /// the time stamps kept plainly or compactly) it gives the same values (to the bit), lines
+    /// and findings as the sequential reader, or the same error, whatever the number of ranges
+    /// and the chunk size (small chunks: lines cross chunk and range bounds everywhere).
+    #[test]
+    fn reading_in_ranges_changes_nothing(
+        rows in prop::collection::vec(prop::collection::vec(cell(), 2..4), 1..60),
+        sep in prop::sample::select(vec![",", "\t", " ", ";"]),
+        crlf in any::<bool>(),
+        comments in any::<bool>(),
+        tolerant in any::<bool>(),
+        compact_time in any::<bool>(),
+        zero_rows in any::<bool>(),
+        no_last_eol in any::<bool>(),
+        ranges in 1usize..6,
+        chunk in 64usize..400,
+    ) {
+        let mut text = random_file(&rows, sep, crlf, comments);
+        if no_last_eol {
+            text = text.trim_end_matches(['\r', '\n']).to_string();
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.csv");
+        std::fs::write(&path, &text).unwrap();
+        let opts = SeriesOptions { tolerant, compact_time, zero_rows_missing: zero_rows, chunk_bytes: 64, ..SeriesOptions::default() };
+        let plain = SeriesOptions { compact_time: false, ..opts.clone() };
+        let sequential = SeriesReader::open(&path, &plain).and_then(collect_series);
+        match (read_series_in_ranges(&path, &opts, ranges, chunk), sequential) {
+            (Ok(a), Ok(b)) => {
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                prop_assert_eq!(&a.lines, &b.lines);
+                let time = match (a.time, a.time_compact) {
+                    (Some(t), None) => t,
+                    (None, Some(c)) => c.to_vec(),
+                    other => panic!("time kept as {other:?}"),
+                };
+                prop_assert_eq!(bits(&time), bits(&b.time.unwrap()));
+                prop_assert_eq!(a.channels.len(), b.channels.len());
+                for (ca, cb) in a.channels.iter().zip(&b.channels) {
+                    prop_assert_eq!(bits(ca), bits(cb));
+                }
+                prop_assert_eq!(a.quality, b.quality);
+            }
+            (Err(a), Err(b)) => prop_assert_eq!(a.to_string(), b.to_string()),
+            (a, b) => prop_assert!(false, "ranges {:?} vs sequential {:?}\n{:?}", a.map(|d| d.lines.to_vec()), b.map(|d| d.lines.to_vec()), text),
+        }
+    }
+}
+
+/// A file larger than the reader's sample of bytes per line, whose later lines are much shorter
+/// than its first ones: the ranges' rows outrun their regions and are kept apart, with the same
+/// values as the sequential reader.
+#[test]
+fn ranges_whose_rows_outrun_their_regions() {
+    let mut text = String::from("time_s,output_v\n");
+    for i in 0..60_000 {
+        text.push_str(&format!("{:.6},{:.12}\n", i as f64 * 0.01 + 1000.0, (i % 97) as f64 * 0.123456789));
+    }
+    for i in 60_000..400_000 {
+        text.push_str(&format!("{},{}\n", i, i % 7));
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("t.csv");
+    std::fs::write(&path, &text).unwrap();
+    // The reader's first chunk (its sample of bytes per line) holds long lines only.
+    let opts = SeriesOptions { chunk_bytes: 1 << 16, ..SeriesOptions::default() };
+    let a = read_series_in_ranges(&path, &opts, 3, 4096).unwrap();
+    let b = read_str(&text, &SeriesOptions::default()).unwrap();
+    assert_eq!(a.lines, b.lines);
+    assert_eq!(a.time, b.time);
+    assert_eq!(a.channels, b.channels);
+    assert_eq!(a.channels[0].len(), 400_000);
+}

@@ -159,20 +159,33 @@ const ESCAPE: i8 = i8::MIN;
 /// Time stamps stored losslessly in about 1.4 bytes each instead of 8, for the gap search of a
 /// long record: the second difference of consecutive stamps' bit patterns in one byte (it is
 /// within a few units for stamps written with a fixed number of decimals or by a steady
-/// clock), the whole bit pattern where it is not, and every 64th stamp's state for access at
-/// any row. Every stamp reads back bit for bit as pushed (NaN and infinities too).
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+/// clock), the whole bit pattern where it is not, and the state at every 64th stamp (and at
+/// the start of every appended part) for access at any row. Every stamp reads back bit for bit
+/// as pushed (NaN and infinities too). Parts encoded apart (the pieces of a file read in
+/// parallel) are joined by [`CompactStamps::append`]; equality compares the stamps, not the
+/// encoding.
+#[derive(Debug, Clone, Default)]
 pub struct CompactStamps {
     /// Per stamp: its second difference, or [`ESCAPE`].
     codes: Vec<i8>,
     /// The bit patterns of the escaped stamps, in order.
     escaped: Vec<u64>,
-    /// Per 64 stamps: the bit pattern of the first, its first difference, and the escaped
-    /// stamps up to it.
-    checks: Vec<(u64, u64, usize)>,
+    /// Access points, by increasing row: the row, its stamp's bit pattern, its first
+    /// difference, and the escaped stamps up to and including it.
+    checks: Vec<(usize, u64, u64, usize)>,
     prev_bits: u64,
     prev_d1: u64,
 }
+
+impl PartialEq for CompactStamps {
+    /// The same stamps, bit for bit (however they were encoded and joined).
+    fn eq(&self, other: &Self) -> bool {
+        let bits = |c: &CompactStamps| c.to_vec().iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        self.codes.len() == other.codes.len() && bits(self) == bits(other)
+    }
+}
+
+impl Eq for CompactStamps {}
 
 impl CompactStamps {
     /// Appends a stamp.
@@ -188,7 +201,7 @@ impl CompactStamps {
             self.codes.push(d2 as i8);
         }
         if n.is_multiple_of(CHECK) {
-            self.checks.push((bits, d1, self.escaped.len()));
+            self.checks.push((n, bits, d1, self.escaped.len()));
         }
         self.prev_bits = bits;
         self.prev_d1 = d1;
@@ -200,9 +213,50 @@ impl CompactStamps {
         t.iter().for_each(|&v| self.push(v));
     }
 
+    /// Appends the stamps of `other` (encoded on its own, as a piece of a file read in
+    /// parallel): the result reads back as if every stamp had been pushed here. Only `other`'s
+    /// first two stamps are encoded again (its first difference now follows this part's last
+    /// stamp), so the cost is a copy of its codes.
+    pub fn append(&mut self, mut other: CompactStamps) {
+        if other.codes.is_empty() {
+            return;
+        }
+        if self.codes.is_empty() {
+            *self = other;
+            return;
+        }
+        let base = self.codes.len();
+        // Other's first stamp is stored whole; its first difference becomes the real one.
+        let bits0 = other.escaped[0];
+        let d1_0 = bits0.wrapping_sub(self.prev_bits);
+        // Its second stamp's code was taken against a first difference of zero.
+        let mut inserted = false;
+        if other.codes.len() > 1 && other.codes[1] != ESCAPE {
+            let d1_1 = other.codes[1] as i64 as u64;
+            let d2 = d1_1.wrapping_sub(d1_0) as i64;
+            if (-127..=127).contains(&d2) {
+                other.codes[1] = d2 as i8;
+            } else {
+                other.codes[1] = ESCAPE;
+                other.escaped.insert(1, bits0.wrapping_add(d1_1));
+                inserted = true;
+            }
+        }
+        let ebase = self.escaped.len();
+        self.checks.extend(other.checks.iter().map(|&(row, bits, d1, e)| {
+            let d1 = if row == 0 { d1_0 } else { d1 };
+            let e = e + ebase + usize::from(inserted && row >= 1);
+            (row + base, bits, d1, e)
+        }));
+        self.codes.extend_from_slice(&other.codes);
+        self.escaped.extend_from_slice(&other.escaped);
+        self.prev_bits = other.prev_bits;
+        self.prev_d1 = if other.codes.len() == 1 { d1_0 } else { other.prev_d1 };
+    }
+
     /// Bytes held (capacity of the three parts).
     pub fn bytes(&self) -> usize {
-        self.codes.capacity() + 8 * self.escaped.capacity() + 24 * self.checks.capacity()
+        self.codes.capacity() + 8 * self.escaped.capacity() + 32 * self.checks.capacity()
     }
 
     /// Every stamp.
@@ -225,9 +279,9 @@ impl Stamps for CompactStamps {
         if from >= to {
             return;
         }
-        let k = from / CHECK;
-        let (mut bits, mut d1, mut e) = self.checks[k];
-        let start = k * CHECK;
+        // The last access point at or before `from` (the first is at row 0).
+        let k = self.checks.partition_point(|c| c.0 <= from).saturating_sub(1);
+        let (start, mut bits, mut d1, mut e) = self.checks[k];
         if start >= from {
             out.push(f64::from_bits(bits));
         }
@@ -625,6 +679,47 @@ mod tests {
                 let whole = estimate_interval(&t);
                 let compact = estimate_interval_of(&c);
                 prop_assert_eq!(format!("{whole:?}"), format!("{compact:?}"));
+            }
+
+            /// Parts encoded apart and appended read back bit for bit, at any row (the access
+            /// points of a part start at its own first row), and stamps pushed after the join
+            /// follow on as if all had been pushed to one.
+            #[test]
+            fn appended_parts_read_back_bit_for_bit(
+                kind in 0u8..5,
+                n in 1usize..2000,
+                seed in 0u64..1000,
+                dt in prop_oneof![Just(0.01), Just(0.0025), 1e-4..2.0f64],
+                t0 in prop_oneof![Just(0.0), Just(1.7e9), -1e5..1e5f64],
+                cuts in proptest::collection::vec(0usize..2000, 0..5),
+                from in 0usize..2000,
+            ) {
+                let t = stamps_case(kind, n + 5, seed, dt, t0);
+                let (body, tail) = t.split_at(n);
+                let mut cuts: Vec<usize> = cuts.into_iter().map(|c| c % (n + 1)).collect();
+                cuts.push(0);
+                cuts.push(n);
+                cuts.sort_unstable();
+                let mut joined = CompactStamps::default();
+                for w in cuts.windows(2) {
+                    let mut part = CompactStamps::default();
+                    part.extend_from_slice(&body[w[0]..w[1]]);
+                    joined.append(part);
+                }
+                joined.extend_from_slice(tail);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                prop_assert_eq!(bits(&joined.to_vec()), bits(&t));
+                // From any row, and from the first row of each part (its own access point).
+                for from in cuts.iter().copied().chain([from % t.len()]) {
+                    let to = (from + 131).min(t.len());
+                    let mut part = Vec::new();
+                    joined.copy_range(from, to, &mut part);
+                    prop_assert_eq!(bits(&part), bits(&t[from..to]));
+                }
+                let mut whole = CompactStamps::default();
+                whole.extend_from_slice(&t);
+                prop_assert_eq!(&joined, &whole);
+                prop_assert_eq!(format!("{:?}", estimate_interval_of(&joined)), format!("{:?}", estimate_interval(&t)));
             }
         }
     }
