@@ -207,10 +207,41 @@ impl CompactStamps {
         self.prev_d1 = d1;
     }
 
-    /// Appends stamps.
+    /// Appends stamps (the same codes as [`CompactStamps::push`] one by one, in a tighter loop:
+    /// the state in locals, an access point at the start of each run up to the next 64th row).
     pub fn extend_from_slice(&mut self, t: &[f64]) {
         self.codes.reserve(t.len());
-        t.iter().for_each(|&v| self.push(v));
+        let mut rest = t;
+        if self.codes.is_empty() {
+            let Some((&v, after)) = rest.split_first() else { return };
+            self.push(v);
+            rest = after;
+        }
+        let (mut prev_bits, mut prev_d1) = (self.prev_bits, self.prev_d1);
+        while !rest.is_empty() {
+            let n = self.codes.len();
+            let run = (CHECK - n % CHECK).min(rest.len());
+            let (now, after) = rest.split_at(run);
+            for (k, &v) in now.iter().enumerate() {
+                let bits = v.to_bits();
+                let d1 = bits.wrapping_sub(prev_bits);
+                let d2 = d1.wrapping_sub(prev_d1) as i64;
+                if (-127..=127).contains(&d2) {
+                    self.codes.push(d2 as i8);
+                } else {
+                    self.codes.push(ESCAPE);
+                    self.escaped.push(bits);
+                }
+                if k == 0 && n.is_multiple_of(CHECK) {
+                    self.checks.push((n, bits, d1, self.escaped.len()));
+                }
+                prev_bits = bits;
+                prev_d1 = d1;
+            }
+            rest = after;
+        }
+        self.prev_bits = prev_bits;
+        self.prev_d1 = prev_d1;
     }
 
     /// Appends the stamps of `other` (encoded on its own, as a piece of a file read in
@@ -282,11 +313,11 @@ impl Stamps for CompactStamps {
         // The last access point at or before `from` (the first is at row 0).
         let k = self.checks.partition_point(|c| c.0 <= from).saturating_sub(1);
         let (start, mut bits, mut d1, mut e) = self.checks[k];
+        out.reserve(to - from);
         if start >= from {
             out.push(f64::from_bits(bits));
         }
-        for r in start + 1..to {
-            let code = self.codes[r];
+        let mut step = |code: i8| {
             if code == ESCAPE {
                 let b = self.escaped[e];
                 e += 1;
@@ -296,10 +327,15 @@ impl Stamps for CompactStamps {
                 d1 = d1.wrapping_add(code as i64 as u64);
                 bits = bits.wrapping_add(d1);
             }
-            if r >= from {
-                out.push(f64::from_bits(bits));
-            }
+            bits
+        };
+        // Decode up to `from` (at most 63 stamps), then keep the stamps.
+        if start + 1 < from {
+            self.codes[start + 1..from].iter().for_each(|&c| {
+                step(c);
+            });
         }
+        out.extend(self.codes[from.max(start + 1)..to].iter().map(|&c| f64::from_bits(step(c))));
     }
 }
 
@@ -311,8 +347,9 @@ struct Cursor<'a, S: Stamps + ?Sized> {
     from: usize,
 }
 
-/// Stamps per chunk of a [`Cursor`].
-const CHUNK: usize = 8192;
+/// Stamps per chunk of a [`Cursor`] and of the passes over the stamps (small in tests, so
+/// that chunk bounds fall everywhere).
+const CHUNK: usize = if cfg!(test) { 97 } else { 8192 };
 
 impl<'a, S: Stamps + ?Sized> Cursor<'a, S> {
     fn new(t: &'a S) -> Self {
@@ -366,25 +403,35 @@ pub fn estimate_interval_of<S: Stamps + ?Sized>(t: &S) -> Result<IntervalEstimat
     // (index, stamp) of the first and the last finite stamp.
     let mut first: Option<(usize, f64)> = None;
     let mut last: Option<(usize, f64)> = None;
-    let mut marks = Vec::with_capacity(n / BLOCK + 1);
+    let mut marks: Vec<f64> = Vec::with_capacity(n / BLOCK + 1);
     {
-        let mut c = Cursor::new(t);
         let mut prev = f64::NAN;
-        for i in 0..n {
-            let v = c.get(i);
-            if v.is_finite() {
-                first.get_or_insert((i, v));
-                last = Some((i, v));
+        for_each_chunk(t, 0, n, |at, chunk| {
+            if first.is_none() {
+                first = chunk.iter().position(|v| v.is_finite()).map(|k| (at + k, chunk[k]));
             }
-            if i > 0 && !increasing(v - prev) {
-                non_increasing += 1;
-                first_non_increasing.get_or_insert(IrregularInterval { index: i, interval_s: v - prev });
+            if let Some(k) = chunk.iter().rposition(|v| v.is_finite()) {
+                last = Some((at + k, chunk[k]));
             }
-            if i.is_multiple_of(BLOCK) {
-                marks.push(v);
+            // Intervals that do not increase: counted in one branch-free sweep, then found
+            // (rare) one by one. The interval across the chunk bound comes first.
+            let bound = usize::from(at > 0 && !increasing(chunk[0] - prev));
+            let inside = chunk.windows(2).map(|w| usize::from(!increasing(w[1] - w[0]))).sum::<usize>();
+            if bound + inside > 0 {
+                let mut p = prev;
+                for (k, &v) in chunk.iter().enumerate() {
+                    if at + k > 0 && !increasing(v - p) {
+                        first_non_increasing.get_or_insert(IrregularInterval { index: at + k, interval_s: v - p });
+                    }
+                    p = v;
+                }
+                non_increasing += bound + inside;
             }
-            prev = v;
-        }
+            let skip = (BLOCK - at % BLOCK) % BLOCK;
+            marks.extend(chunk.iter().skip(skip).step_by(BLOCK));
+            prev = chunk[chunk.len() - 1];
+            true
+        });
     }
     // First interval: the span over the count, or the median block mean when a long gap
     // stretches the span.
@@ -456,6 +503,53 @@ pub fn estimate_interval_of<S: Stamps + ?Sized>(t: &S) -> Result<IntervalEstimat
     })
 }
 
+/// Calls `f(first index, stamps)` on the stamps `from..to` in order, a chunk at a time (one
+/// slice when the stamps are held as one), until it returns `false`.
+fn for_each_chunk<S: Stamps + ?Sized>(t: &S, from: usize, to: usize, mut f: impl FnMut(usize, &[f64]) -> bool) {
+    if let Some(s) = t.as_slice() {
+        f(from, &s[from..to]);
+        return;
+    }
+    let mut buf = Vec::with_capacity(CHUNK);
+    let mut at = from;
+    while at < to {
+        let end = (at + CHUNK).min(to);
+        buf.clear();
+        t.copy_range(at, end, &mut buf);
+        if !f(at, &buf) {
+            return;
+        }
+        at = end;
+    }
+}
+
+/// The first index `i >= from` (from >= 1) whose interval `t[i] - t[i-1]` is finite and over
+/// `limit`.
+fn next_long_interval<S: Stamps + ?Sized>(t: &S, from: usize, limit: f64) -> Option<usize> {
+    let long = |a: f64, b: f64| {
+        let d = b - a;
+        d.is_finite() && d > limit
+    };
+    let mut found = None;
+    let mut prev: Option<f64> = None;
+    for_each_chunk(t, from - 1, t.len(), |at, chunk| {
+        // The interval across the chunk bound, then those inside the chunk.
+        if let (Some(p), Some(&v)) = (prev, chunk.first()) {
+            if long(p, v) {
+                found = Some(at);
+                return false;
+            }
+        }
+        if let Some(k) = chunk.windows(2).position(|w| long(w[0], w[1])) {
+            found = Some(at + k + 1);
+            return false;
+        }
+        prev = chunk.last().copied();
+        true
+    });
+    found
+}
+
 /// The gaps of `t` at interval `dt` (see the module's rule).
 fn find_gaps<S: Stamps + ?Sized>(t: &S, dt: f64) -> Vec<Gap> {
     let n = t.len();
@@ -468,6 +562,9 @@ fn find_gaps<S: Stamps + ?Sized>(t: &S, dt: f64) -> Vec<Gap> {
         (from..to).map(|j| c.get(j) - t0 - j as f64 * dt).filter(|e| e.is_finite()).fold(f64::INFINITY, f64::min)
     };
     while i < n {
+        // The next interval longer than 1.5 dt (read chunk by chunk).
+        let Some(next) = next_long_interval(t, i, 1.5 * dt) else { break };
+        i = next;
         let d = c.get(i) - c.get(i - 1);
         if d.is_finite() && d > 1.5 * dt {
             let before = floor(&mut c, previous.max(i.saturating_sub(WINDOW)), i);

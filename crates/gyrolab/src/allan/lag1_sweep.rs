@@ -14,11 +14,15 @@
 //! [`lag1_noise_id`]. The record is cut into [`PARTS`] pieces summed in parallel and combined in
 //! a fixed order, so the result does not depend on the number of threads.
 //!
-//! Only the undifferenced series (order 0) is swept: a factor whose delta = r1 / (1 + r1) is at
-//! least 0.25 and whose estimator allows differencing goes to [`lag1_noise_id`] as before. The
-//! sums are the same as [`lag1_noise_id`]'s in another order, so r1 differs from it by rounding
-//! only (tested: within 1e-12); alpha = -round(2 delta) could differ only if delta fell within
-//! that rounding of 0.25 or 0.75.
+//! The octave sweep also sums the first and second differences of each factor's averages (the
+//! residual's differences are those of the averages less a constant, a1, for the first, and
+//! equal for the second; r1 does not change with a constant), so a factor whose delta =
+//! r1 / (1 + r1) is at least 0.25 and whose estimator allows differencing is decided from the
+//! same sweep. Elsewhere (factors not powers of two), or where a difference's variance is a
+//! tiny part of its raw moments (a pure trend), it goes to [`lag1_noise_id`] as before. The sums
+//! are the same as [`lag1_noise_id`]'s in another order, so r1 differs from it by rounding only
+//! (tested: within 1e-12); alpha = -round(2 delta) could differ only if delta fell within that
+//! rounding of 0.25 or 0.75.
 
 use super::confidence::{lag1_alpha, lag1_noise_id, LAG1_MIN_AVERAGES};
 use rayon::prelude::*;
@@ -49,26 +53,49 @@ fn lag1_noise_ids_with(s: &[f64], ms: &[usize], dmax: usize, min_averages: usize
     let mut swept: Vec<usize> = ms.iter().copied().filter(|&m| averages(m) >= min_averages).collect();
     swept.sort_unstable();
     swept.dedup();
-    let r1 = if swept.iter().all(|m| m.is_power_of_two()) {
+    let r1: Vec<SweptR1> = if swept.iter().all(|m| m.is_power_of_two()) {
         octave_r1(s, &swept, block)
     } else {
-        order0_r1(s, &swept, block)
+        order0_r1(s, &swept, block).into_iter().map(|order0| SweptR1 { order0, diffs: None }).collect()
     };
-    let can_difference = dmax.saturating_sub(1) > 0;
+    let differences = dmax.saturating_sub(1).min(2);
     ms.par_iter()
         .map(|&m| match swept.binary_search(&m) {
             Ok(i) => {
-                let r1 = r1[i]?;
-                let delta = r1 / (1.0 + r1);
-                if delta < 0.25 || !can_difference {
+                let delta = r1[i].order0.map(|r| r / (1.0 + r))?;
+                if delta < 0.25 || differences == 0 {
                     Some(lag1_alpha(delta, 0))
                 } else {
-                    lag1_noise_id(s, m, dmax)
+                    match r1[i].diffs.map(|d| differenced_alpha(&d, differences)) {
+                        Some(Ok(alpha)) => alpha,
+                        _ => lag1_noise_id(s, m, dmax),
+                    }
                 }
             }
             Err(_) => lag1_noise_id(s, m, dmax),
         })
         .collect()
+}
+
+/// A factor's r1 from a sweep: of the detrended averages (`None`: no spread), and, from the
+/// octave sweep, of their first and second differences (`Err`: left to [`lag1_noise_id`]).
+#[derive(Clone, Copy, Debug)]
+struct SweptR1 {
+    order0: Option<f64>,
+    diffs: Option<[Result<Option<f64>, ()>; 2]>,
+}
+
+/// [`lag1_noise_id`]'s differencing steps (order 0 gave delta >= 0.25) from the differences'
+/// r1: difference while delta >= 0.25 and `differences` allow; `Err` where an r1 is unknown.
+fn differenced_alpha(diffs: &[Result<Option<f64>, ()>; 2], differences: usize) -> Result<Option<i32>, ()> {
+    for d in 1..=differences {
+        let Some(r1) = diffs[d - 1]? else { return Ok(None) };
+        let delta = r1 / (1.0 + r1);
+        if delta < 0.25 || d >= differences {
+            return Ok(Some(lag1_alpha(delta, d)));
+        }
+    }
+    Err(())
 }
 
 /// Per factor, per lane: sums of w and of w (t - c).
@@ -93,7 +120,9 @@ struct ResidualSums {
 /// The undifferenced lag-1 autocorrelation r1 of the detrended averages at every factor of
 /// `ms` (each with at least 3 averages); `None` where the residual has no spread.
 /// Raw moments of one factor's averages w_t over part of the record, in lanes: sum w,
-/// sum w (t - c), sum w^2, sum w_t w_{t+1}, with the first and last average of the part.
+/// sum w (t - c), sum w^2, sum w_t w_{t+1}, with the first and last average of the part; and
+/// the sums of the first and second differences (each difference counted in the part of its
+/// last average).
 #[derive(Clone, Copy, Default)]
 struct RawSums {
     s0: [f64; LANES],
@@ -103,6 +132,7 @@ struct RawSums {
     first: f64,
     last: f64,
     started: bool,
+    diffs: [ResidualSums; 2],
 }
 
 /// Cancellation allowed in the one-sweep residual sums: the residual's sum of squares must be
@@ -118,7 +148,7 @@ const RAW_MIN_FRACTION: f64 = 1e-6;
 /// sum w^2, sum w_t w_{t+1} with u = t - c; the expansion in docs/METHODS.md section 3); a factor
 /// whose residual variance is a tiny part of its raw moments (a strong trend: the expansion
 /// would cancel) is summed again by [`order0_r1`]'s two sweeps.
-fn octave_r1(s: &[f64], ms: &[usize], block: usize) -> Vec<Option<f64>> {
+fn octave_r1(s: &[f64], ms: &[usize], block: usize) -> Vec<SweptR1> {
     let Some(&top_m) = ms.last() else { return Vec::new() };
     let n_rate = s.len() - 1;
     let levels = top_m.trailing_zeros() as usize + 1;
@@ -142,19 +172,23 @@ fn octave_r1(s: &[f64], ms: &[usize], block: usize) -> Vec<Option<f64>> {
             octave_part(s, &wanted, &cs, lo, hi, block)
         })
         .collect();
-    let mut r1 = vec![None; ms.len()];
+    let mut r1 = vec![SweptR1 { order0: None, diffs: None }; ms.len()];
     let mut again = Vec::new();
     for k in 0..levels {
         let Some(i) = wanted[k] else { continue };
         match raw_r1(parts.iter().map(|p| &p[k]), ns[k], cs[k]) {
-            Ok(v) => r1[i] = v,
+            Ok(v) => r1[i].order0 = v,
             Err(()) => again.push(i),
         }
+        r1[i].diffs = Some(std::array::from_fn(|d| {
+            let sums = combine(parts.iter().map(|p| &p[k].diffs[d]));
+            moment_r1(&sums, ns[k].saturating_sub(d + 1), true)
+        }));
     }
     if !again.is_empty() {
         let again_ms: Vec<usize> = again.iter().map(|&i| ms[i]).collect();
         for (&i, v) in again.iter().zip(order0_r1(s, &again_ms, block)) {
-            r1[i] = v;
+            r1[i].order0 = v;
         }
     }
     r1
@@ -200,6 +234,21 @@ fn octave_part_body(
     let mut acc = vec![RawSums::default(); levels];
     let mut cur = vec![0.0f64; block];
     let mut next = vec![0.0f64; block];
+    // Per level: the two averages before the block (read straight from the angle at the start
+    // of a part after the first), and how many of them there are.
+    let mut carry: Vec<([f64; 2], usize)> = (0..levels)
+        .map(|k| {
+            let (m, j0) = (1usize << k, lo >> k);
+            let w = |j: usize| s[(j + 1) * m] - s[j * m];
+            match j0 {
+                0 => ([0.0; 2], 0),
+                1 => ([0.0, w(0)], 1),
+                _ => ([w(j0 - 2), w(j0 - 1)], 2),
+            }
+        })
+        .collect();
+    let mut d1 = vec![0.0f64; block + 2];
+    let mut d2 = vec![0.0f64; block + 2];
     let mut b0 = lo;
     while b0 < hi {
         let b1 = (b0 + block).min(hi);
@@ -213,7 +262,9 @@ fn octave_part_body(
                 break;
             }
             if wanted[k].is_some() {
-                raw_sums(&cur[..count_k], (b0 >> k) as f64 - cs[k], &mut acc[k]);
+                let w = &cur[..count_k];
+                raw_sums(w, (b0 >> k) as f64 - cs[k], &mut acc[k]);
+                difference_sums(w, &mut carry[k], &mut d1, &mut d2, &mut acc[k].diffs);
             }
             if k + 1 < levels {
                 let half = count_k / 2;
@@ -256,6 +307,89 @@ fn raw_sums(w: &[f64], p0: f64, acc: &mut RawSums) {
     }
     neighbour_products(w, &mut acc.w11);
     acc.last = w[w.len() - 1];
+}
+
+/// Adds the first and second differences that end in the block `w` (the two averages before it
+/// in `carry`, updated) to their sums; `d1` and `d2` are work buffers (len >= w.len() + 2).
+#[inline(always)]
+fn difference_sums(
+    w: &[f64],
+    carry: &mut ([f64; 2], usize),
+    d1: &mut [f64],
+    d2: &mut [f64],
+    acc: &mut [ResidualSums; 2],
+) {
+    let ([c2, c1], have) = *carry;
+    let k = w.len();
+    // d1[i] = (the average before w[i]) to w[i]: d1[0] = c1 - c2, d1[1] = w[0] - c1, ...
+    d1[0] = c1 - c2;
+    d1[1] = w[0] - c1;
+    for ((d, &a), &b) in d1[2..=k].iter_mut().zip(&w[..k - 1]).zip(&w[1..]) {
+        *d = b - a;
+    }
+    for ((d, &a), &b) in d2[..k].iter_mut().zip(&d1[..k]).zip(&d1[1..=k]) {
+        *d = b - a;
+    }
+    // The first differences ending in w[i] need one average before it, the second two.
+    let skip1 = 1usize.saturating_sub(have);
+    let skip2 = 2usize.saturating_sub(have);
+    if skip1 < k {
+        moment_sums(&d1[1 + skip1..=k], &mut acc[0]);
+    }
+    if skip2 < k {
+        moment_sums(&d2[skip2..k], &mut acc[1]);
+    }
+    *carry = match k {
+        1 => ([c1, w[0]], (have + 1).min(2)),
+        _ => ([w[k - 2], w[k - 1]], 2),
+    };
+}
+
+/// The parts' sums of one series in part order: (sum, sum of squares, sum of neighbour
+/// products across the joins too, first, last).
+fn combine<'a>(parts: impl Iterator<Item = &'a ResidualSums>) -> (f64, f64, f64, f64, f64) {
+    let (mut sum1, mut sum2, mut sum11) = ([0.0f64; LANES], [0.0f64; LANES], [0.0f64; LANES]);
+    let (mut first, mut last, mut started) = (0.0f64, 0.0f64, false);
+    let mut joins = 0.0f64;
+    for r in parts {
+        if !r.started {
+            continue;
+        }
+        if started {
+            joins += last * r.first;
+        } else {
+            first = r.first;
+            started = true;
+        }
+        last = r.last;
+        for l in 0..LANES {
+            sum1[l] += r.sum1[l];
+            sum2[l] += r.sum2[l];
+            sum11[l] += r.sum11[l];
+        }
+    }
+    (pairwise(&sum1), pairwise(&sum2), pairwise(&sum11) + joins, first, last)
+}
+
+/// r1 of a series of `len` values from its sums (as [`lag1_noise_id`]): `Ok(None)` for fewer
+/// than 3 values or no spread. With `guard`, a variance under [`RAW_MIN_FRACTION`] of the sum
+/// of squares (the mean is nearly all of it: cancellation) is `Err`.
+fn moment_r1(sums: &(f64, f64, f64, f64, f64), len: usize, guard: bool) -> Result<Option<f64>, ()> {
+    let &(sum1, sum2, sum11, first, last) = sums;
+    if len < 3 {
+        return Ok(None);
+    }
+    let lf = len as f64;
+    let mu = sum1 / lf;
+    let den = sum2 - lf * mu * mu;
+    if guard && sum2 > 0.0 && den < RAW_MIN_FRACTION * sum2 {
+        return Err(());
+    }
+    if den <= 0.0 || !den.is_finite() {
+        return Ok(None);
+    }
+    let num = sum11 - mu * ((sum1 - last) + (sum1 - first)) + (lf - 1.0) * mu * mu;
+    Ok(Some(num / den))
 }
 
 /// r1 of the residuals e_t = w_t - a0 - a1 u_t (u_t = t - c, n averages) from the parts' raw
@@ -358,40 +492,7 @@ fn order0_r1(s: &[f64], ms: &[usize], block: usize) -> Vec<Option<f64>> {
             acc
         })
         .collect();
-    (0..ms.len())
-        .map(|i| {
-            let (mut sum1, mut sum2, mut sum11) = ([0.0f64; LANES], [0.0f64; LANES], [0.0f64; LANES]);
-            let (mut first, mut last, mut started) = (0.0f64, 0.0f64, false);
-            let mut joins = 0.0f64;
-            for part in &resid {
-                let r = &part[i];
-                if !r.started {
-                    continue;
-                }
-                if started {
-                    joins += last * r.first;
-                } else {
-                    first = r.first;
-                    started = true;
-                }
-                last = r.last;
-                for l in 0..LANES {
-                    sum1[l] += r.sum1[l];
-                    sum2[l] += r.sum2[l];
-                    sum11[l] += r.sum11[l];
-                }
-            }
-            let (sum1, sum2, sum11) = (pairwise(&sum1), pairwise(&sum2), pairwise(&sum11) + joins);
-            let lf = ns[i] as f64;
-            let mu = sum1 / lf;
-            let den = sum2 - lf * mu * mu;
-            if den <= 0.0 || !den.is_finite() {
-                return None;
-            }
-            let num = sum11 - mu * ((sum1 - last) + (sum1 - first)) + (lf - 1.0) * mu * mu;
-            Some(num / den)
-        })
-        .collect()
+    (0..ms.len()).map(|i| moment_r1(&combine(resid.iter().map(|part| &part[i])), ns[i], false).ok().flatten()).collect()
 }
 
 /// Calls `f(factor index, j0, averages w_j0 ..)` for every block of angle points in
@@ -474,6 +575,13 @@ fn residual_sums(w: &mut [f64], p0: f64, a0: f64, a1: f64, acc: &mut ResidualSum
     for (l, v) in chunks.into_remainder().iter_mut().enumerate() {
         *v -= a0 + a1 * p[l];
     }
+    moment_sums(w, acc);
+}
+
+/// Adds v, v^2 and the products of neighbours (with the part's previous value) of `w` to the
+/// lanes.
+#[inline(always)]
+fn moment_sums(w: &[f64], acc: &mut ResidualSums) {
     let Some((&head, _)) = w.split_first() else { return };
     if acc.started {
         acc.sum11[0] += acc.last * head;
@@ -558,6 +666,17 @@ mod tests {
         super::super::confidence::lag1_acf(&w)
     }
 
+    /// The plain r1 of the d-th differences of the detrended averages.
+    fn plain_diff_r1(s: &[f64], m: usize, d: usize) -> Option<f64> {
+        let z: Vec<f64> = s.iter().step_by(m).copied().collect();
+        let mut w: Vec<f64> = z.windows(2).map(|p| p[1] - p[0]).collect();
+        super::super::confidence::detrend_linear(&mut w);
+        for _ in 0..d {
+            w = w.windows(2).map(|p| p[1] - p[0]).collect();
+        }
+        super::super::confidence::lag1_acf(&w)
+    }
+
     #[test]
     fn sweep_equals_the_factor_by_factor_identification() {
         let mut swept_count = 0;
@@ -598,8 +717,14 @@ mod tests {
             for block in [7, 64, 1000, BLOCK] {
                 let octave = octave_r1(&s, &ms, block);
                 for (&m, r1) in ms.iter().zip(&octave) {
-                    let (r1, plain) = (r1.unwrap(), plain_r1(&s, m).unwrap());
-                    assert!((r1 - plain).abs() <= 1e-9, "n={n} m={m} block={block}: {r1} vs {plain}");
+                    let (r1_0, plain) = (r1.order0.unwrap(), plain_r1(&s, m).unwrap());
+                    assert!((r1_0 - plain).abs() <= 1e-9, "n={n} m={m} block={block}: {r1_0} vs {plain}");
+                    // The differences' r1 against the plain r1 of the differenced residual.
+                    let diffs = r1.diffs.unwrap();
+                    for d in 1..=2 {
+                        let (r1_d, plain) = (diffs[d - 1].unwrap().unwrap(), plain_diff_r1(&s, m, d).unwrap());
+                        assert!((r1_d - plain).abs() <= 1e-9, "n={n} m={m} d={d} block={block}: {r1_d} vs {plain}");
+                    }
                     checked += 1;
                 }
                 for dmax in [1, 2, 3] {
@@ -631,7 +756,10 @@ mod tests {
         let two = order0_r1(&s, &ms, 64);
         assert_eq!(octave.len(), 4);
         for (a, b) in octave.iter().zip(&two) {
-            assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits));
+            assert_eq!(a.order0.map(f64::to_bits), b.map(f64::to_bits));
+            // The first differences of a line are a constant (refused: left to the factor-by-
+            // factor rule); the second differences are rounding only.
+            assert!(a.diffs.unwrap()[0].is_err());
         }
     }
 
