@@ -8,6 +8,7 @@
 //! - [`raw_log`]: raw rate-table logs (detection, reading, segment files);
 //! - [`apply_csv`]: streaming application of a calibration to a time-series file;
 //! - [`decimal`]: exact fast reading of plain decimal numbers and rows of them;
+//! - [`pages`]: how large in-memory records are backed (huge pages);
 //! - [`series`]: streaming reader of time-series files, and the static test of a file;
 //! - [`sim_csv`]: fast CSV writer for simulated static records and rate-table tests;
 //! - [`test_plan`]: test plans (TOML) for `gyrolab eval`;
@@ -20,6 +21,7 @@ pub mod atomic;
 pub mod calibration;
 pub mod decimal;
 pub mod error;
+pub mod pages;
 pub mod parquet_table;
 pub mod plan_temperature;
 pub mod plan_uncertainty;

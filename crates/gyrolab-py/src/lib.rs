@@ -52,32 +52,6 @@ fn reference(scale_factor: Option<f64>, null: Option<f64>) -> PyResult<gyrolab_e
     ReferenceRequest { scale_factor, null, ..Default::default() }.resolve().map_err(err)
 }
 
-/// Asks the kernel to back a large, not yet touched buffer with transparent huge pages
-/// (`madvise(MADV_HUGEPAGE)`; Linux's default THP mode "madvise" uses them only when asked):
-/// filling 80 MB then takes 40 page faults instead of 20 000, which cost about a tenth of a
-/// 10 M-sample `allan` call. Only the buffer's whole 2 MiB pages are advised; a failure (no THP,
-/// another OS) leaves ordinary pages.
-fn advise_huge_pages(values: &mut Vec<f64>) {
-    const HUGE: usize = 2 << 20;
-    let bytes = values.capacity() * std::mem::size_of::<f64>();
-    if bytes < 4 * HUGE {
-        return;
-    }
-    #[cfg(target_os = "linux")]
-    {
-        let start = values.as_mut_ptr() as usize;
-        let first = start.next_multiple_of(HUGE);
-        let end = (start + bytes) / HUGE * HUGE;
-        if end > first {
-            // SAFETY: the range lies inside the vector's own allocation (capacity, not yet
-            // initialised); MADV_HUGEPAGE changes how it is backed, never its contents.
-            unsafe {
-                libc::madvise(first as *mut libc::c_void, end - first, libc::MADV_HUGEPAGE);
-            }
-        }
-    }
-}
-
 /// Allan analysis of one array: returns (JSON document as `gyrolab allan --json`, taus_s, m,
 /// dev, ci_low, ci_high, n_terms, alpha); bounds are NaN where none exists.
 #[pyfunction]
@@ -109,7 +83,7 @@ fn allan<'py>(
     // it twice and writes the buffer once). Samples in deg/h and strided arrays are copied once.
     let view = x.as_array();
     let mut buffer = Vec::with_capacity(view.len() + 1);
-    advise_huge_pages(&mut buffer);
+    gyrolab_io::pages::advise_huge_pages(&mut buffer);
     let slice = x.as_slice().ok();
     let copied: Option<Vec<f64>> = match (slice, per_hour) {
         (Some(_), false) => None,
