@@ -4,8 +4,10 @@
 /// (`madvise(MADV_HUGEPAGE)`; Linux's default THP mode "madvise" uses them only when asked):
 /// filling 80 MB then takes 40 page faults instead of 20 000, which cost about a tenth of a
 /// 10 M-sample `allan` run. Only the buffer's whole 2 MiB pages are advised; a failure (no THP,
-/// another OS) leaves ordinary pages. Used for the columns of a record read whole and for the
-/// Python package's working buffer.
+/// another OS) leaves ordinary pages. The first fault of a process on huge pages may wait for the
+/// kernel to compact memory (measured at 0.2 s for 88 MB on a machine whose memory is mostly page
+/// cache): it is used only where `bench/python_allan.sh` shows it pays, the Python package's
+/// working buffer (calls repeated in one process find huge pages free).
 pub fn advise_huge_pages(values: &mut Vec<f64>) {
     const HUGE: usize = 2 << 20;
     let bytes = values.capacity() * std::mem::size_of::<f64>();

@@ -390,49 +390,16 @@ pub fn estimate_interval(t: &[f64]) -> Result<IntervalEstimate, SamplingError> {
 
 /// [`estimate_interval`] over stamps of either kind (a slice, or [`CompactStamps`] a reader
 /// filled block by block): the same rule, the same arithmetic, the same result.
-pub fn estimate_interval_of<S: Stamps + ?Sized>(t: &S) -> Result<IntervalEstimate, SamplingError> {
+pub fn estimate_interval_of<S: Stamps + Sync + ?Sized>(t: &S) -> Result<IntervalEstimate, SamplingError> {
     let n = t.len();
     if n < 2 {
         return Err(SamplingError::TooShort);
     }
     let increasing = |d: f64| d.is_finite() && d > 0.0;
-    // One pass: stamps that do not increase, the first and last finite stamps, and every
-    // BLOCK-th stamp for the block means.
-    let mut first_non_increasing = None;
-    let mut non_increasing = 0usize;
-    // (index, stamp) of the first and the last finite stamp.
-    let mut first: Option<(usize, f64)> = None;
-    let mut last: Option<(usize, f64)> = None;
-    let mut marks: Vec<f64> = Vec::with_capacity(n / BLOCK + 1);
-    {
-        let mut prev = f64::NAN;
-        for_each_chunk(t, 0, n, |at, chunk| {
-            if first.is_none() {
-                first = chunk.iter().position(|v| v.is_finite()).map(|k| (at + k, chunk[k]));
-            }
-            if let Some(k) = chunk.iter().rposition(|v| v.is_finite()) {
-                last = Some((at + k, chunk[k]));
-            }
-            // Intervals that do not increase: counted in one branch-free sweep, then found
-            // (rare) one by one. The interval across the chunk bound comes first.
-            let bound = usize::from(at > 0 && !increasing(chunk[0] - prev));
-            let inside = chunk.windows(2).map(|w| usize::from(!increasing(w[1] - w[0]))).sum::<usize>();
-            if bound + inside > 0 {
-                let mut p = prev;
-                for (k, &v) in chunk.iter().enumerate() {
-                    if at + k > 0 && !increasing(v - p) {
-                        first_non_increasing.get_or_insert(IrregularInterval { index: at + k, interval_s: v - p });
-                    }
-                    p = v;
-                }
-                non_increasing += bound + inside;
-            }
-            let skip = (BLOCK - at % BLOCK) % BLOCK;
-            marks.extend(chunk.iter().skip(skip).step_by(BLOCK));
-            prev = chunk[chunk.len() - 1];
-            true
-        });
-    }
+    // One pass, in parallel parts joined in order: stamps that do not increase, the first and
+    // last finite stamps, and every BLOCK-th stamp for the block means.
+    let pass = parallel_parts(n, |from, to| first_pass(t, from, to)).into_iter().reduce(FirstPass::join);
+    let FirstPass { first, last, non_increasing, first_non_increasing, marks } = pass.unwrap_or_default();
     // First interval: the span over the count, or the median block mean when a long gap
     // stretches the span.
     let (Some((first, t_first)), Some((last, t_last))) = (first, last) else {
@@ -503,9 +470,97 @@ pub fn estimate_interval_of<S: Stamps + ?Sized>(t: &S) -> Result<IntervalEstimat
     })
 }
 
+/// Stamps from which the passes over them run in parallel parts (few in tests, so that parts
+/// and their joins are tested).
+const PARALLEL_STAMPS: usize = if cfg!(test) { 300 } else { 1 << 20 };
+
+/// Parts of a parallel pass (fixed, so that results do not depend on the number of threads).
+const PASS_PARTS: usize = 8;
+
+/// `f(from, to)` on [`PASS_PARTS`] parts of `0..n` (cut at multiples of [`BLOCK`]) in parallel,
+/// the results in order; one part below [`PARALLEL_STAMPS`].
+fn parallel_parts<T: Send>(n: usize, f: impl Fn(usize, usize) -> T + Sync) -> Vec<T> {
+    use rayon::prelude::*;
+    if n < PARALLEL_STAMPS {
+        return vec![f(0, n)];
+    }
+    let cut = |k: usize| if k == PASS_PARTS { n } else { n * k / PASS_PARTS / BLOCK * BLOCK };
+    (0..PASS_PARTS).into_par_iter().map(|k| f(cut(k), cut(k + 1))).collect()
+}
+
+/// What the estimator's first pass finds in a run of stamps.
+#[derive(Debug, Default)]
+struct FirstPass {
+    /// (index, stamp) of the first finite stamp.
+    first: Option<(usize, f64)>,
+    /// (index, stamp) of the last finite stamp.
+    last: Option<(usize, f64)>,
+    /// Intervals (ending in the run) that do not increase.
+    non_increasing: usize,
+    /// The first of them.
+    first_non_increasing: Option<IrregularInterval>,
+    /// The stamps at multiples of [`BLOCK`].
+    marks: Vec<f64>,
+}
+
+impl FirstPass {
+    /// The pass over this run and the next.
+    fn join(mut self, next: FirstPass) -> FirstPass {
+        self.first = self.first.or(next.first);
+        self.last = next.last.or(self.last);
+        self.non_increasing += next.non_increasing;
+        self.first_non_increasing = self.first_non_increasing.or(next.first_non_increasing);
+        self.marks.extend(next.marks);
+        self
+    }
+}
+
+/// The first pass over stamps `from..to` (intervals ending in them, the one ending at `from`
+/// included when from > 0).
+fn first_pass<S: Stamps + ?Sized>(t: &S, from: usize, to: usize) -> FirstPass {
+    let increasing = |d: f64| d.is_finite() && d > 0.0;
+    let mut out = FirstPass { marks: Vec::with_capacity((to - from) / BLOCK + 1), ..FirstPass::default() };
+    let mut prev = f64::NAN;
+    if from > 0 {
+        let mut one = Vec::with_capacity(1);
+        t.copy_range(from - 1, from, &mut one);
+        prev = one[0];
+    }
+    for_each_chunk(t, from, to, |at, chunk| {
+        if out.first.is_none() {
+            out.first = chunk.iter().position(|v| v.is_finite()).map(|k| (at + k, chunk[k]));
+        }
+        if let Some(k) = chunk.iter().rposition(|v| v.is_finite()) {
+            out.last = Some((at + k, chunk[k]));
+        }
+        // Intervals that do not increase: counted in one branch-free sweep, then found (rare)
+        // one by one. The interval across the chunk bound comes first.
+        let bound = usize::from(at > 0 && !increasing(chunk[0] - prev));
+        let inside = chunk.windows(2).map(|w| usize::from(!increasing(w[1] - w[0]))).sum::<usize>();
+        if bound + inside > 0 {
+            let mut p = prev;
+            for (k, &v) in chunk.iter().enumerate() {
+                if at + k > 0 && !increasing(v - p) {
+                    out.first_non_increasing.get_or_insert(IrregularInterval { index: at + k, interval_s: v - p });
+                }
+                p = v;
+            }
+            out.non_increasing += bound + inside;
+        }
+        let skip = (BLOCK - at % BLOCK) % BLOCK;
+        out.marks.extend(chunk.iter().skip(skip).step_by(BLOCK));
+        prev = chunk[chunk.len() - 1];
+        true
+    });
+    out
+}
+
 /// Calls `f(first index, stamps)` on the stamps `from..to` in order, a chunk at a time (one
 /// slice when the stamps are held as one), until it returns `false`.
 fn for_each_chunk<S: Stamps + ?Sized>(t: &S, from: usize, to: usize, mut f: impl FnMut(usize, &[f64]) -> bool) {
+    if from >= to {
+        return;
+    }
     if let Some(s) = t.as_slice() {
         f(from, &s[from..to]);
         return;
@@ -524,15 +579,35 @@ fn for_each_chunk<S: Stamps + ?Sized>(t: &S, from: usize, to: usize, mut f: impl
 }
 
 /// The first index `i >= from` (from >= 1) whose interval `t[i] - t[i-1]` is finite and over
-/// `limit`.
-fn next_long_interval<S: Stamps + ?Sized>(t: &S, from: usize, limit: f64) -> Option<usize> {
+/// `limit`: the next [`CHUNK`] stamps first (where bursty stamps find one), then the rest in
+/// parallel parts.
+fn next_long_interval<S: Stamps + Sync + ?Sized>(t: &S, from: usize, limit: f64) -> Option<usize> {
+    use rayon::prelude::*;
+    let n = t.len();
+    let near = (from + CHUNK).min(n);
+    if let Some(i) = long_interval_in(t, from, near, limit) {
+        return Some(i);
+    }
+    let rest = n - near;
+    if rest < PARALLEL_STAMPS {
+        return long_interval_in(t, near, n, limit);
+    }
+    let cut = |k: usize| near + rest * k / PASS_PARTS;
+    (0..PASS_PARTS).into_par_iter().find_map_first(|k| long_interval_in(t, cut(k), cut(k + 1), limit))
+}
+
+/// The first index `i` in `from..to` (from >= 1) whose interval is finite and over `limit`.
+fn long_interval_in<S: Stamps + ?Sized>(t: &S, from: usize, to: usize, limit: f64) -> Option<usize> {
+    if from >= to {
+        return None;
+    }
     let long = |a: f64, b: f64| {
         let d = b - a;
         d.is_finite() && d > limit
     };
     let mut found = None;
     let mut prev: Option<f64> = None;
-    for_each_chunk(t, from - 1, t.len(), |at, chunk| {
+    for_each_chunk(t, from - 1, to, |at, chunk| {
         // The interval across the chunk bound, then those inside the chunk.
         if let (Some(p), Some(&v)) = (prev, chunk.first()) {
             if long(p, v) {
@@ -551,7 +626,7 @@ fn next_long_interval<S: Stamps + ?Sized>(t: &S, from: usize, limit: f64) -> Opt
 }
 
 /// The gaps of `t` at interval `dt` (see the module's rule).
-fn find_gaps<S: Stamps + ?Sized>(t: &S, dt: f64) -> Vec<Gap> {
+fn find_gaps<S: Stamps + Sync + ?Sized>(t: &S, dt: f64) -> Vec<Gap> {
     let n = t.len();
     let mut c = Cursor::new(t);
     let t0 = c.get(0);
@@ -776,6 +851,29 @@ mod tests {
                 let whole = estimate_interval(&t);
                 let compact = estimate_interval_of(&c);
                 prop_assert_eq!(format!("{whole:?}"), format!("{compact:?}"));
+            }
+
+            /// The first pass in parallel parts (from compact stamps, chunk by chunk) finds what
+            /// the plain loop over the slice finds.
+            #[test]
+            fn first_pass_in_parts_equals_the_plain_loop(
+                kind in 0u8..5,
+                n in 2usize..3000,
+                seed in 0u64..1000,
+                dt in prop_oneof![Just(0.01), 1e-4..2.0f64],
+            ) {
+                let t = stamps_case(kind, n, seed, dt, 0.0);
+                let mut c = CompactStamps::default();
+                c.extend_from_slice(&t);
+                let got = parallel_parts(n, |a, b| first_pass(&c, a, b)).into_iter().reduce(FirstPass::join).unwrap();
+                let finite: Vec<usize> = (0..n).filter(|&i| t[i].is_finite()).collect();
+                let bad: Vec<usize> = (1..n).filter(|&i| !((t[i] - t[i - 1]).is_finite() && t[i] - t[i - 1] > 0.0)).collect();
+                prop_assert_eq!(got.first.map(|f| f.0), finite.first().copied());
+                prop_assert_eq!(got.last.map(|f| f.0), finite.last().copied());
+                prop_assert_eq!(got.non_increasing, bad.len());
+                prop_assert_eq!(got.first_non_increasing.map(|g| g.index), bad.first().copied());
+                let marks: Vec<u64> = t.iter().step_by(BLOCK).map(|v| v.to_bits()).collect();
+                prop_assert_eq!(got.marks.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), marks);
             }
 
             /// Parts encoded apart and appended read back bit for bit, at any row (the access
