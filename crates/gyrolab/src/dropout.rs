@@ -90,8 +90,11 @@ pub struct DropoutTally {
     all_zero: u64,
     /// Repeats over every row: (rows considered, per channel, on every channel).
     rep: (u64, Vec<u64>, u64),
-    /// Repeats over rows neither all zero nor after an all-zero row.
-    rep_skip: (u64, Vec<u64>, u64),
+    /// Repeats over rows neither all zero nor after an all-zero row: (rows considered, on every
+    /// channel); per channel, the repeats over every row less `skipped`.
+    rep_skip: (u64, u64),
+    /// Per channel, the repeats on the rows the second count leaves out.
+    skipped: Vec<u64>,
     prev: Vec<f64>,
     prev_zero: bool,
     hits: Vec<bool>,
@@ -105,7 +108,8 @@ impl DropoutTally {
             zeros: vec![0; channels],
             all_zero: 0,
             rep: (0, vec![0; channels], 0),
-            rep_skip: (0, vec![0; channels], 0),
+            rep_skip: (0, 0),
+            skipped: vec![0; channels],
             prev: Vec::new(),
             prev_zero: false,
             hits: vec![false; channels],
@@ -113,12 +117,79 @@ impl DropoutTally {
     }
 
     /// Adds the rows of a block, one slice per channel (equal lengths; the rows follow those
-    /// of the previous block).
+    /// of the previous block). Column by column, a few thousand rows at a time: each channel's
+    /// zeros and repeats are counted in one vectorised sweep and marked in a per-row mask (one
+    /// bit a channel); the rows' verdicts (all zero, all repeated, and which rows the second
+    /// count skips) are read from the masks.
     pub fn push_block(&mut self, channels: &[&[f64]]) {
         let nch = self.zeros.len();
         if channels.len() != nch || nch == 0 {
             return;
         }
+        if nch > 64 {
+            return self.push_rows(channels);
+        }
+        const ROWS: usize = 4096;
+        let full = if nch == 64 { u64::MAX } else { (1u64 << nch) - 1 };
+        let n = channels.iter().map(|c| c.len()).min().unwrap_or(0);
+        let mut zero_mask = [0u64; ROWS];
+        let mut rep_mask = [0u64; ROWS];
+        let mut start = 0;
+        while start < n {
+            let end = (start + ROWS).min(n);
+            let len = end - start;
+            let (zm, rm) = (&mut zero_mask[..len], &mut rep_mask[..len]);
+            zm.fill(0);
+            rm.fill(0);
+            for (k, c) in channels.iter().enumerate() {
+                let bit = 1u64 << k;
+                let col = &c[start..end];
+                // The row before the chunk (none at the record's start: NaN repeats nothing).
+                let before = if start > 0 { c[start - 1] } else { self.prev.get(k).copied().unwrap_or(f64::NAN) };
+                // Masks (the counts are read from them below).
+                for (z, &v) in zm.iter_mut().zip(col) {
+                    *z |= bit & 0u64.wrapping_sub(u64::from(v == 0.0));
+                }
+                rm[0] |= bit & 0u64.wrapping_sub(u64::from(col[0] == before));
+                for ((r, &v), &p) in rm[1..].iter_mut().zip(&col[1..]).zip(&col[..len - 1]) {
+                    *r |= bit & 0u64.wrapping_sub(u64::from(v == p));
+                }
+            }
+            // Rows: all zero, all repeated; the second count leaves out all-zero rows and the
+            // rows after them (their repeats are taken back per channel).
+            for k in 0..nch {
+                self.zeros[k] += zm.iter().map(|&z| (z >> k) & 1).sum::<u64>();
+                self.rep.1[k] += rm.iter().map(|&r| (r >> k) & 1).sum::<u64>();
+            }
+            let mut prev_zero = self.prev_zero;
+            for (&z, &r) in zm.iter().zip(rm.iter()) {
+                let all_zero = z == full;
+                let all_rep = r == full;
+                self.all_zero += u64::from(all_zero);
+                self.rep.2 += u64::from(all_rep);
+                if !all_zero && !prev_zero {
+                    self.rep_skip.0 += 1;
+                    self.rep_skip.1 += u64::from(all_rep);
+                } else if r != 0 {
+                    for (k, skip) in self.skipped.iter_mut().enumerate() {
+                        *skip += (r >> k) & 1;
+                    }
+                }
+                prev_zero = all_zero;
+            }
+            self.rep.0 += len as u64;
+            self.prev_zero = prev_zero;
+            self.rows += len as u64;
+            start = end;
+        }
+        if n > 0 {
+            self.prev.clear();
+            self.prev.extend(channels.iter().map(|c| c[n - 1]));
+        }
+    }
+
+    /// [`DropoutTally::push_block`] row by row (for more than 64 channels).
+    fn push_rows(&mut self, channels: &[&[f64]]) {
         let n = channels.iter().map(|c| c.len()).min().unwrap_or(0);
         for i in 0..n {
             let mut all_zero = true;
@@ -142,16 +213,36 @@ impl DropoutTally {
             self.rep.2 += u64::from(all_rep);
             if !all_zero && !self.prev_zero {
                 self.rep_skip.0 += 1;
-                for (r, &h) in self.rep_skip.1.iter_mut().zip(&self.hits) {
-                    *r += u64::from(h);
+                self.rep_skip.1 += u64::from(all_rep);
+            } else {
+                for (skip, &h) in self.skipped.iter_mut().zip(&self.hits) {
+                    *skip += u64::from(h);
                 }
-                self.rep_skip.2 += u64::from(all_rep);
             }
             self.prev.clear();
             self.prev.extend(channels.iter().map(|c| c[i]));
             self.prev_zero = all_zero;
             self.rows += 1;
         }
+    }
+
+    /// The tally of this part and the part after it (tallied from the row before it).
+    fn join(mut self, next: DropoutTally) -> DropoutTally {
+        let add = |a: &mut Vec<u64>, b: &[u64]| a.iter_mut().zip(b).for_each(|(x, y)| *x += y);
+        self.rows += next.rows;
+        add(&mut self.zeros, &next.zeros);
+        self.all_zero += next.all_zero;
+        self.rep.0 += next.rep.0;
+        add(&mut self.rep.1, &next.rep.1);
+        self.rep.2 += next.rep.2;
+        self.rep_skip.0 += next.rep_skip.0;
+        self.rep_skip.1 += next.rep_skip.1;
+        add(&mut self.skipped, &next.skipped);
+        if next.rows > 0 {
+            self.prev = next.prev;
+            self.prev_zero = next.prev_zero;
+        }
+        self
     }
 
     /// Rows tallied.
@@ -163,8 +254,13 @@ impl DropoutTally {
     /// rows among the rows that remain).
     pub fn verdict(&self) -> DropoutVerdict {
         let all_zero = beyond_chance(self.all_zero, self.rows, &self.zeros);
-        let (considered, per, hits) = if all_zero { &self.rep_skip } else { &self.rep };
-        DropoutVerdict { all_zero, repeated: beyond_chance(*hits, *considered, per) }
+        let skip_per: Vec<u64> = self.rep.1.iter().zip(&self.skipped).map(|(r, s)| r - s).collect();
+        let (considered, per, hits) = if all_zero {
+            (self.rep_skip.0, &skip_per, self.rep_skip.1)
+        } else {
+            (self.rep.0, &self.rep.1, self.rep.2)
+        };
+        DropoutVerdict { all_zero, repeated: beyond_chance(hits, considered, per) }
     }
 }
 
@@ -234,14 +330,38 @@ pub fn find_dropouts(channels: &[&[f64]]) -> Dropouts {
         return Dropouts::default();
     }
     let channels: Vec<&[f64]> = channels.iter().map(|c| &c[..n]).collect();
-    let mut tally = DropoutTally::new(channels.len());
-    tally.push_block(&channels);
+    let tally = tally_in_parts(&channels);
     let mut d = Dropouts::default();
     DropoutMarker::new(tally.verdict()).mark_block(&channels, |i, kind| match kind {
         DropoutKind::AllZero => d.all_zero.push(i),
         DropoutKind::Repeated => d.repeated.push(i),
     });
     d
+}
+
+/// The tally of a whole record (channels of equal length), in parts tallied in parallel (each
+/// from the row before it) and joined in order: the same counts as one pass.
+fn tally_in_parts(channels: &[&[f64]]) -> DropoutTally {
+    let n = channels.iter().map(|c| c.len()).min().unwrap_or(0);
+    // Tallied in parts in parallel (each part starting from the row before it), joined in order.
+    use rayon::prelude::*;
+    const PARTS: usize = 4;
+    let parts = if n < (1 << 16) { 1 } else { PARTS };
+    (0..parts)
+        .into_par_iter()
+        .map(|k| {
+            let (a, b) = (n * k / parts, n * (k + 1) / parts);
+            let mut t = DropoutTally::new(channels.len());
+            if a > 0 {
+                t.prev = channels.iter().map(|c| c[a - 1]).collect();
+                t.prev_zero = t.prev.iter().all(|&v| v == 0.0);
+            }
+            let part: Vec<&[f64]> = channels.iter().map(|c| &c[a..b]).collect();
+            t.push_block(&part);
+            t
+        })
+        .reduce_with(DropoutTally::join)
+        .unwrap_or_else(|| DropoutTally::new(channels.len()))
 }
 
 #[cfg(test)]
@@ -261,6 +381,91 @@ mod tests {
                 ((z ^ (z >> 31)) % 7) as f64 - 3.0
             })
             .collect()
+    }
+
+    mod prop {
+        use super::super::*;
+        use proptest::prelude::*;
+
+        proptest! {
+            /// The column-wise tally equals the row-by-row one, fed the same blocks: records of
+            /// small integers (zeros and repeats on one channel common, on all of them in runs),
+            /// with NaN.
+            #[test]
+            fn column_wise_tally_equals_the_row_by_row_one(
+                nch in 2usize..6,
+                rows in proptest::collection::vec((0u8..4, 0u8..10), 1..9000),
+                blocks in proptest::collection::vec(1usize..5000, 1..6),
+            ) {
+                let mut ch: Vec<Vec<f64>> = vec![Vec::new(); nch];
+                let mut last = vec![0.0; nch];
+                for (i, &(kind, v)) in rows.iter().enumerate() {
+                    for (c, col) in ch.iter_mut().enumerate() {
+                        let x = match kind {
+                            0 => 0.0,                                        // all zero
+                            1 => last[c],                                    // all repeated
+                            _ if v == 9 && c == 0 => f64::NAN,
+                            _ => ((i * 7 + c * 3 + v as usize) % 5) as f64, // noise
+                        };
+                        col.push(x);
+                        last[c] = x;
+                    }
+                }
+                let n = rows.len();
+                let (mut a, mut b) = (DropoutTally::new(nch), DropoutTally::new(nch));
+                let mut at = 0;
+                for &len in blocks.iter().cycle() {
+                    if at >= n {
+                        break;
+                    }
+                    let end = (at + len).min(n);
+                    let refs: Vec<&[f64]> = ch.iter().map(|c| &c[at..end]).collect();
+                    a.push_block(&refs);
+                    b.push_rows(&refs);
+                    at = end;
+                }
+                prop_assert_eq!(&a.zeros, &b.zeros);
+                prop_assert_eq!(a.all_zero, b.all_zero);
+                prop_assert_eq!(&a.rep, &b.rep);
+                prop_assert_eq!(a.rep_skip, b.rep_skip);
+                prop_assert_eq!(&a.skipped, &b.skipped);
+                prop_assert_eq!(a.rows, b.rows);
+                prop_assert_eq!(a.prev_zero, b.prev_zero);
+                prop_assert_eq!(a.verdict(), b.verdict());
+            }
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(16))]
+            /// A long record tallied in parallel parts equals one row-by-row pass (runs of zeros
+            /// and repeats cross the parts' bounds).
+            #[test]
+            fn tally_in_parts_equals_one_pass(seed in 0u64..1000, run in 1usize..300) {
+                let n = 70_001 + seed as usize;
+                let ch: Vec<Vec<f64>> = (0..3)
+                    .map(|c| {
+                        (0..n)
+                            .map(|i| {
+                                let block = (i / run) as u64 ^ seed;
+                                match block % 5 {
+                                    0 => 0.0,
+                                    1 => (block * 3 + c) as f64,
+                                    _ => ((i as u64 * 2654435761 + c * 97 + seed) % 11) as f64,
+                                }
+                            })
+                            .collect()
+                    })
+                    .collect();
+                let refs: Vec<&[f64]> = ch.iter().map(|c| &c[..]).collect();
+                let mut a = tally_in_parts(&refs);
+                let mut b = DropoutTally::new(3);
+                b.push_rows(&refs);
+                // `hits` is the row-by-row pass's scratch, not a count.
+                a.hits.fill(false);
+                b.hits.fill(false);
+                prop_assert_eq!(a, b);
+            }
+        }
     }
 
     #[test]
