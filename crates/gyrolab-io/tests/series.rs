@@ -506,3 +506,32 @@ fn ranges_whose_rows_outrun_their_regions() {
     assert_eq!(a.channels, b.channels);
     assert_eq!(a.channels[0].len(), 400_000);
 }
+
+/// A line over the length limit and a NUL byte, each in a later range: the same error, at the
+/// same line, as the sequential reader (the message names the file's line, not the range's).
+#[test]
+fn ranges_report_long_lines_and_nul_bytes_at_the_files_line() {
+    let rows: Vec<String> =
+        (0..120_000).map(|i| format!("{:.2},{:.6}", i as f64 * 0.01, (i % 13) as f64 * 0.1)).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let mut long = rows.clone();
+    long[90_000] = format!("1.0,{}", "9".repeat(MAX_LINE_BYTES + 5));
+    let mut nul = rows.join("\n").into_bytes();
+    let at = nul.len() * 4 / 5;
+    nul[at] = 0;
+    for (name, text) in [
+        ("long.csv", format!("time_s,rate_dps\n{}\n", long.join("\n")).into_bytes()),
+        ("nul.csv", {
+            let mut t = b"time_s,rate_dps\n".to_vec();
+            t.extend_from_slice(&nul);
+            t
+        }),
+    ] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, &text).unwrap();
+        let ranges = read_series_in_ranges(&path, &SeriesOptions::default(), 3, 4096).unwrap_err();
+        let sequential = SeriesReader::open(&path, &SeriesOptions::default()).and_then(collect_series).unwrap_err();
+        assert_eq!(ranges.to_string(), sequential.to_string(), "{name}");
+        assert!(ranges.line.unwrap() > 80_000, "{name}: {ranges}");
+    }
+}

@@ -40,6 +40,22 @@ struct RangeOutput {
     quality: ReaderQuality,
 }
 
+/// Why a range stopped, with lines counted from the range's first line (shifted to the file's
+/// lines by the caller).
+enum RangeFailure {
+    /// An error located at a line of the range.
+    Data(DataError),
+    /// A line longer than [`MAX_LINE_BYTES`] (its message names the line, so it is made once
+    /// the line is known).
+    LongLine(u64),
+}
+
+impl From<DataError> for RangeFailure {
+    fn from(e: DataError) -> Self {
+        RangeFailure::Data(e)
+    }
+}
+
 /// One range of the file: its bytes, whether it starts at a line start (the first range), and
 /// its region of each slot (`None` for the compact time slot).
 struct Range<'a> {
@@ -97,7 +113,7 @@ pub(super) fn collect_series_ranges(
     // One zeroed allocation per slot: pages are mapped as the ranges write them.
     let mut columns: Vec<Vec<f64>> =
         (0..nslots).map(|s| if Some(s) == compact_slot { Vec::new() } else { vec![0.0; total_cap] }).collect();
-    let outputs: Vec<Result<RangeOutput, DataError>> = {
+    let outputs: Vec<Result<RangeOutput, RangeFailure>> = {
         let mut per_range: Vec<Vec<Option<&mut [f64]>>> = (0..ranges).map(|_| Vec::with_capacity(nslots)).collect();
         for (s, col) in columns.iter_mut().enumerate() {
             let mut rest: &mut [f64] = col;
@@ -130,9 +146,12 @@ pub(super) fn collect_series_ranges(
     let mut stamps = compact_slot.map(|_| CompactStamps::default());
     let mut done = Vec::with_capacity(ranges);
     for out in outputs {
-        let mut out = out.map_err(|mut e| {
-            e.line = e.line.map(|l| l + base);
-            e
+        let mut out = out.map_err(|f| match f {
+            RangeFailure::Data(mut e) => {
+                e.line = e.line.map(|l| l + base);
+                e
+            }
+            RangeFailure::LongLine(l) => crate::text::long_line(&header.file, l + base),
         })?;
         lines.append(&out.lines, base);
         quality.append(std::mem::take(&mut out.quality), base);
@@ -201,7 +220,7 @@ fn read_range(
     mut range: Range<'_>,
     compact_slot: Option<usize>,
     chunk_bytes: usize,
-) -> Result<RangeOutput, DataError> {
+) -> Result<RangeOutput, RangeFailure> {
     let file = parser.header.file.clone();
     let io = |e: std::io::Error| DataError::io(&file, &e);
     let nslots = range.regions.len();
@@ -229,7 +248,7 @@ fn read_range(
                 Ok(0) => eof = true,
                 Ok(n) => filled += n,
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-                Err(e) => return Err(io(e)),
+                Err(e) => return Err(io(e).into()),
             }
         }
         if !started {
@@ -279,9 +298,9 @@ fn read_range(
         if cut > pos {
             if let Some(i) = memchr::memchr(0, &buf[pos..cut]) {
                 let line = out.lines_read + memchr::memchr_iter(b'\n', &buf[pos..pos + i]).count() as u64 + 1;
-                return Err(
-                    DataError::new(&file, "binary data (a NUL byte): expected a text file of numbers").at_line(line)
-                );
+                return Err(DataError::new(&file, "binary data (a NUL byte): expected a text file of numbers")
+                    .at_line(line)
+                    .into());
             }
             buf = parse_chunk(&mut parser, buf, pos, cut, &mut out, &mut range, compact_slot, room)?;
             pos = cut;
@@ -297,7 +316,7 @@ fn read_range(
             pos = 0;
         } else if filled == buf.len() {
             if buf.len() > MAX_LINE_BYTES {
-                return Err(crate::text::long_line(&file, out.lines_read + 1));
+                return Err(RangeFailure::LongLine(out.lines_read + 1));
             }
             buf.resize((buf.len() * 2).min(MAX_LINE_BYTES + 1), 0);
         }
