@@ -14,11 +14,11 @@
 //! [`lag1_noise_id`]. The record is cut into [`PARTS`] pieces summed in parallel and combined in
 //! a fixed order, so the result does not depend on the number of threads.
 //!
-//! The octave sweep also sums the first and second differences of each factor's averages (the
+//! At the octave factors whose delta = r1 / (1 + r1) is at least 0.25 and whose estimator allows
+//! differencing, a second sweep sums the first and second differences of the averages (the
 //! residual's differences are those of the averages less a constant, a1, for the first, and
-//! equal for the second; r1 does not change with a constant), so a factor whose delta =
-//! r1 / (1 + r1) is at least 0.25 and whose estimator allows differencing is decided from the
-//! same sweep. Elsewhere (factors not powers of two), or where a difference's variance is a
+//! equal for the second; r1 does not change with a constant), so those factors are decided
+//! without two passes each over their averages (white data need no second sweep). Elsewhere (factors not powers of two), or where a difference's variance is a
 //! tiny part of its raw moments (a pure trend), it goes to [`lag1_noise_id`] as before. The sums
 //! are the same as [`lag1_noise_id`]'s in another order, so r1 differs from it by rounding only
 //! (tested: within 1e-12); alpha = -round(2 delta) could differ only if delta fell within that
@@ -54,7 +54,7 @@ fn lag1_noise_ids_with(s: &[f64], ms: &[usize], dmax: usize, min_averages: usize
     swept.sort_unstable();
     swept.dedup();
     let r1: Vec<SweptR1> = if swept.iter().all(|m| m.is_power_of_two()) {
-        octave_r1(s, &swept, block)
+        octave_r1(s, &swept, block, dmax.saturating_sub(1).min(2))
     } else {
         order0_r1(s, &swept, block).into_iter().map(|order0| SweptR1 { order0, diffs: None }).collect()
     };
@@ -148,7 +148,7 @@ const RAW_MIN_FRACTION: f64 = 1e-6;
 /// sum w^2, sum w_t w_{t+1} with u = t - c; the expansion in docs/METHODS.md section 3); a factor
 /// whose residual variance is a tiny part of its raw moments (a strong trend: the expansion
 /// would cancel) is summed again by [`order0_r1`]'s two sweeps.
-fn octave_r1(s: &[f64], ms: &[usize], block: usize) -> Vec<SweptR1> {
+fn octave_r1(s: &[f64], ms: &[usize], block: usize, differences: usize) -> Vec<SweptR1> {
     let Some(&top_m) = ms.last() else { return Vec::new() };
     let n_rate = s.len() - 1;
     let levels = top_m.trailing_zeros() as usize + 1;
@@ -165,13 +165,18 @@ fn octave_r1(s: &[f64], ms: &[usize], block: usize) -> Vec<SweptR1> {
     };
     let ns: Vec<usize> = (0..levels).map(|k| n_rate >> k).collect();
     let cs: Vec<f64> = ns.iter().map(|&n| (n as f64 - 1.0) / 2.0).collect();
-    let parts: Vec<Vec<RawSums>> = (0..PARTS)
-        .into_par_iter()
-        .map(|p| {
-            let (lo, hi) = bounds(p);
-            octave_part(s, &wanted, &cs, lo, hi, block)
-        })
-        .collect();
+    let sweep = |raw: &[bool], diff: &[bool]| -> Vec<Vec<RawSums>> {
+        (0..PARTS)
+            .into_par_iter()
+            .map(|p| {
+                let (lo, hi) = bounds(p);
+                octave_part(s, raw, diff, &cs, lo, hi, block)
+            })
+            .collect()
+    };
+    // The sweep of the averages (order 0) at every wanted factor.
+    let raw: Vec<bool> = wanted.iter().map(Option::is_some).collect();
+    let parts = sweep(&raw, &vec![false; levels]);
     let mut r1 = vec![SweptR1 { order0: None, diffs: None }; ms.len()];
     let mut again = Vec::new();
     for k in 0..levels {
@@ -180,10 +185,6 @@ fn octave_r1(s: &[f64], ms: &[usize], block: usize) -> Vec<SweptR1> {
             Ok(v) => r1[i].order0 = v,
             Err(()) => again.push(i),
         }
-        r1[i].diffs = Some(std::array::from_fn(|d| {
-            let sums = combine(parts.iter().map(|p| &p[k].diffs[d]));
-            moment_r1(&sums, ns[k].saturating_sub(d + 1), true)
-        }));
     }
     if !again.is_empty() {
         let again_ms: Vec<usize> = again.iter().map(|&i| ms[i]).collect();
@@ -191,47 +192,65 @@ fn octave_r1(s: &[f64], ms: &[usize], block: usize) -> Vec<SweptR1> {
             r1[i].order0 = v;
         }
     }
+    // A second sweep of the differences, at the factors that need them (delta >= 0.25 and the
+    // estimator allows differencing); white data need none.
+    let need: Vec<bool> = (0..levels)
+        .map(|k| differences > 0 && wanted[k].and_then(|i| r1[i].order0).is_some_and(|r| r / (1.0 + r) >= 0.25))
+        .collect();
+    if need.iter().any(|&b| b) {
+        let parts = sweep(&vec![false; levels], &need);
+        for k in (0..levels).filter(|&k| need[k]) {
+            let Some(i) = wanted[k] else { continue };
+            r1[i].diffs = Some(std::array::from_fn(|d| {
+                let sums = combine(parts.iter().map(|p| &p[k].diffs[d]));
+                moment_r1(&sums, ns[k].saturating_sub(d + 1), true)
+            }));
+        }
+    }
     r1
 }
 
 /// The raw sums of every wanted level over angle points `lo..hi` (see [`octave_r1`]); the AVX2
 /// copy of the same code is taken where the CPU has it (the sums vectorise four wide).
-fn octave_part(s: &[f64], wanted: &[Option<usize>], cs: &[f64], lo: usize, hi: usize, block: usize) -> Vec<RawSums> {
+fn octave_part(s: &[f64], raw: &[bool], diff: &[bool], cs: &[f64], lo: usize, hi: usize, block: usize) -> Vec<RawSums> {
     #[cfg(target_arch = "x86_64")]
     {
         if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
             // SAFETY: the CPU supports AVX2 and FMA (checked just above); the function is safe
             // code compiled for those features.
-            return unsafe { octave_part_avx2(s, wanted, cs, lo, hi, block) };
+            return unsafe { octave_part_avx2(s, raw, diff, cs, lo, hi, block) };
         }
     }
-    octave_part_body(s, wanted, cs, lo, hi, block)
+    octave_part_body(s, raw, diff, cs, lo, hi, block)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn octave_part_avx2(
     s: &[f64],
-    wanted: &[Option<usize>],
+    raw: &[bool],
+    diff: &[bool],
     cs: &[f64],
     lo: usize,
     hi: usize,
     block: usize,
 ) -> Vec<RawSums> {
-    octave_part_body(s, wanted, cs, lo, hi, block)
+    octave_part_body(s, raw, diff, cs, lo, hi, block)
 }
 
 #[inline(always)]
 fn octave_part_body(
     s: &[f64],
-    wanted: &[Option<usize>],
+    raw: &[bool],
+    diff: &[bool],
     cs: &[f64],
     lo: usize,
     hi: usize,
     block: usize,
 ) -> Vec<RawSums> {
-    let levels = wanted.len();
-    let mut acc = vec![RawSums::default(); levels];
+    // Levels up to the last one summed (the pair sums stop there).
+    let levels = raw.iter().zip(diff).rposition(|(&r, &d)| r || d).map_or(0, |k| k + 1);
+    let mut acc = vec![RawSums::default(); raw.len()];
     let mut cur = vec![0.0f64; block];
     let mut next = vec![0.0f64; block];
     // Per level: the two averages before the block (read straight from the angle at the start
@@ -261,9 +280,11 @@ fn octave_part_body(
             if count_k == 0 {
                 break;
             }
-            if wanted[k].is_some() {
-                let w = &cur[..count_k];
+            let w = &cur[..count_k];
+            if raw[k] {
                 raw_sums(w, (b0 >> k) as f64 - cs[k], &mut acc[k]);
+            }
+            if diff[k] {
                 difference_sums(w, &mut carry[k], &mut d1, &mut d2, &mut acc[k].diffs);
             }
             if k + 1 < levels {
@@ -710,20 +731,24 @@ mod tests {
     /// multiples of the block, and blocks smaller than the largest factor.
     #[test]
     fn octave_sweep_equals_the_factor_by_factor_identification() {
-        let mut checked = 0;
+        let (mut checked, mut differenced) = (0, 0);
         for (n, integrations, seed) in [(5000, 0, 1), (4999, 1, 2), (7777, 2, 3), (60_000, 0, 4), (60_001, 1, 5)] {
             let s = angle(n, integrations, seed);
             let ms: Vec<usize> = (0..12).map(|k| 1 << k).filter(|&m| (s.len() - 1) / m >= 30).collect();
             for block in [7, 64, 1000, BLOCK] {
-                let octave = octave_r1(&s, &ms, block);
+                let octave = octave_r1(&s, &ms, block, 2);
                 for (&m, r1) in ms.iter().zip(&octave) {
                     let (r1_0, plain) = (r1.order0.unwrap(), plain_r1(&s, m).unwrap());
                     assert!((r1_0 - plain).abs() <= 1e-9, "n={n} m={m} block={block}: {r1_0} vs {plain}");
-                    // The differences' r1 against the plain r1 of the differenced residual.
-                    let diffs = r1.diffs.unwrap();
-                    for d in 1..=2 {
-                        let (r1_d, plain) = (diffs[d - 1].unwrap().unwrap(), plain_diff_r1(&s, m, d).unwrap());
-                        assert!((r1_d - plain).abs() <= 1e-9, "n={n} m={m} d={d} block={block}: {r1_d} vs {plain}");
+                    // The differences are summed where delta >= 0.25, and only there; their r1
+                    // against the plain r1 of the differenced residual.
+                    assert_eq!(r1.diffs.is_some(), r1_0 / (1.0 + r1_0) >= 0.25, "n={n} m={m}");
+                    if let Some(diffs) = r1.diffs {
+                        for d in 1..=2 {
+                            let (r1_d, plain) = (diffs[d - 1].unwrap().unwrap(), plain_diff_r1(&s, m, d).unwrap());
+                            assert!((r1_d - plain).abs() <= 1e-9, "n={n} m={m} d={d} block={block}: {r1_d} vs {plain}");
+                        }
+                        differenced += 1;
                     }
                     checked += 1;
                 }
@@ -735,6 +760,7 @@ mod tests {
             }
         }
         assert!(checked > 100);
+        assert!(differenced > 40, "{differenced}");
     }
 
     /// A pure line w_t = a + b t has no residual: the one-sweep path must not invent one from
@@ -752,14 +778,20 @@ mod tests {
             raw_sums(&w, -c, &mut r);
             assert!(raw_r1(std::iter::once(&r), n, c).is_err(), "m={m}");
         }
-        let octave = octave_r1(&s, &ms, 64);
+        let octave = octave_r1(&s, &ms, 64, 2);
         let two = order0_r1(&s, &ms, 64);
         assert_eq!(octave.len(), 4);
         for (a, b) in octave.iter().zip(&two) {
             assert_eq!(a.order0.map(f64::to_bits), b.map(f64::to_bits));
-            // The first differences of a line are a constant (refused: left to the factor-by-
-            // factor rule); the second differences are rounding only.
-            assert!(a.diffs.unwrap()[0].is_err());
+        }
+        // The first differences of a line are a constant: refused (left to the factor-by-factor
+        // rule), not read from rounding.
+        let n_rate = s.len() - 1;
+        let cs: Vec<f64> = (0..4).map(|k| ((n_rate >> k) as f64 - 1.0) / 2.0).collect();
+        let part = octave_part(&s, &[false; 4], &[true; 4], &cs, 0, n_rate, 64);
+        for (k, sums) in part.iter().enumerate() {
+            let first = combine(std::iter::once(&sums.diffs[0]));
+            assert!(moment_r1(&first, (n_rate >> k) - 1, true).is_err(), "m={}", 1 << k);
         }
     }
 
