@@ -1139,11 +1139,7 @@ impl<R: Read> SeriesReader<R> {
         }
         if self.lines.is_empty() {
             if self.rows == 0 && !self.piece {
-                return Err(DataError::new(
-                    &self.header.file,
-                    "the file has a header but no data rows: expected at least one row of numbers",
-                )
-                .at_line(self.header.header_line));
+                return Err(no_data_rows(&self.header));
             }
             return Ok(None);
         }
@@ -1170,11 +1166,7 @@ impl<R: Read> SeriesReader<R> {
             if self.rows > limit {
                 let over = self.lines.len().saturating_sub((self.rows - limit) as usize);
                 let line = self.lines.get(over).copied().unwrap_or(self.line_no);
-                return Err(DataError::new(
-                    &self.header.file,
-                    format!("more than {limit} data rows: this record is larger than the reader accepts here (cut it into parts)"),
-                )
-                .at_line(line));
+                return Err(too_many_rows(&self.header, limit, line));
             }
         }
         let nch = self.header.channels.len();
@@ -1644,23 +1636,10 @@ fn collect_series_parallel<R: Read>(
         }
         r.line_no = line_no;
         r.pos = r.complete;
-        if let Some(limit) = r.max_rows {
-            if lines.len() as u64 > limit {
-                let line = lines.get(limit as usize).unwrap_or(0);
-                return Err(DataError::new(
-                    &header.file,
-                    format!("more than {limit} data rows: this record is larger than the reader accepts here (cut it into parts)"),
-                )
-                .at_line(line));
-            }
-        }
+        check_row_limit(&header, &lines, r.max_rows)?;
     }
     if lines.is_empty() {
-        return Err(DataError::new(
-            &header.file,
-            "the file has a header but no data rows: expected at least one row of numbers",
-        )
-        .at_line(header.header_line));
+        return Err(no_data_rows(&header));
     }
     let mut it = slots.into_iter();
     let channels: Vec<Vec<f64>> = it.by_ref().take(nch).collect();
@@ -1670,6 +1649,31 @@ fn collect_series_parallel<R: Read>(
     let mut channels = channels;
     channels.iter_mut().for_each(|c| c.shrink_to_fit());
     Ok(SeriesData { header, lines, time, time_compact: compact, temperature, table_rate, channels, quality })
+}
+
+/// The error of a file with a header and no data rows.
+fn no_data_rows(header: &SeriesHeader) -> DataError {
+    DataError::new(&header.file, "the file has a header but no data rows: expected at least one row of numbers")
+        .at_line(header.header_line)
+}
+
+/// The error of a record with more than `limit` data rows (`line`: the first row over it).
+fn too_many_rows(header: &SeriesHeader, limit: u64, line: u64) -> DataError {
+    DataError::new(
+        &header.file,
+        format!("more than {limit} data rows: this record is larger than the reader accepts here (cut it into parts)"),
+    )
+    .at_line(line)
+}
+
+/// A whole record's rows against the reader's limit (`max_rows`).
+fn check_row_limit(header: &SeriesHeader, lines: &LineMap, max_rows: Option<u64>) -> Result<(), DataError> {
+    match max_rows {
+        Some(limit) if lines.len() as u64 > limit => {
+            Err(too_many_rows(header, limit, lines.get(limit as usize).unwrap_or(0)))
+        }
+        _ => Ok(()),
+    }
 }
 
 /// Reads every block of an open reader into memory.

@@ -162,22 +162,9 @@ pub(super) fn collect_series_ranges(
         done.push(out);
     }
     if lines.is_empty() {
-        return Err(DataError::new(
-            &header.file,
-            "the file has a header but no data rows: expected at least one row of numbers",
-        )
-        .at_line(header.header_line));
+        return Err(no_data_rows(&header));
     }
-    if let Some(limit) = r.max_rows {
-        if lines.len() as u64 > limit {
-            let line = lines.get(limit as usize).unwrap_or(0);
-            return Err(DataError::new(
-                &header.file,
-                format!("more than {limit} data rows: this record is larger than the reader accepts here (cut it into parts)"),
-            )
-            .at_line(line));
-        }
-    }
+    check_row_limit(&header, &lines, r.max_rows)?;
     // Close up the regions (each range's rows move down to follow the ranges before).
     let offsets: Vec<usize> = caps.iter().scan(0usize, |at, c| Some(std::mem::replace(at, *at + c))).collect();
     let spilled = done.iter().any(|o| o.overflow.iter().any(|v| !v.is_empty()));
@@ -268,20 +255,16 @@ fn read_range(
         }
         // Complete lines from `pos` that start before the range's end.
         let limit = usize::try_from(range.end.saturating_sub(buf_at)).unwrap_or(usize::MAX);
-        let (cut, done) = if limit <= pos {
-            (pos, true)
-        } else if limit <= filled {
-            match memchr::memchr(b'\n', &buf[limit - 1..filled]) {
-                Some(i) => (limit + i, true),
-                None if eof => (filled, true),
-                None => (memchr::memrchr(b'\n', &buf[pos..filled]).map_or(pos, |i| pos + i + 1), false),
-            }
-        } else {
-            match memchr::memrchr(b'\n', &buf[pos..filled]) {
-                _ if eof => (filled, true),
-                Some(i) => (pos + i + 1, false),
-                None => (pos, false),
-            }
+        let whole_lines = |buf: &[u8]| memchr::memrchr(b'\n', &buf[pos..filled]).map_or(pos, |i| pos + i + 1);
+        // The range's last line ends at the first line end at or after its last byte.
+        let last_end = (pos < limit && limit <= filled)
+            .then(|| memchr::memchr(b'\n', &buf[limit - 1..filled]).map(|i| limit + i))
+            .flatten();
+        let (cut, done) = match last_end {
+            _ if limit <= pos => (pos, true),
+            Some(end) => (end, true),
+            None if eof => (filled, true),
+            None => (whole_lines(&buf), false),
         };
         // A last line without its line end gets one, as the sequential reader gives it.
         let cut = if done && cut == filled && cut > pos && buf[cut - 1] != b'\n' {
@@ -319,9 +302,6 @@ fn read_range(
                 return Err(RangeFailure::LongLine(out.lines_read + 1));
             }
             buf.resize((buf.len() * 2).min(MAX_LINE_BYTES + 1), 0);
-        }
-        if eof && pos >= filled {
-            break;
         }
     }
     out.quality = std::mem::take(&mut parser.quality);

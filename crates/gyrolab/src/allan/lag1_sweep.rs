@@ -368,21 +368,10 @@ fn difference_sums(
 
 /// The parts' sums of one series in part order: (sum, sum of squares, sum of neighbour
 /// products across the joins too, first, last).
-fn combine<'a>(parts: impl Iterator<Item = &'a ResidualSums>) -> (f64, f64, f64, f64, f64) {
+fn combine<'a>(parts: impl Iterator<Item = &'a ResidualSums> + Clone) -> (f64, f64, f64, f64, f64) {
+    let (first, last, joins) = joined_ends(parts.clone().filter(|r| r.started).map(|r| (r.first, r.last)));
     let (mut sum1, mut sum2, mut sum11) = ([0.0f64; LANES], [0.0f64; LANES], [0.0f64; LANES]);
-    let (mut first, mut last, mut started) = (0.0f64, 0.0f64, false);
-    let mut joins = 0.0f64;
-    for r in parts {
-        if !r.started {
-            continue;
-        }
-        if started {
-            joins += last * r.first;
-        } else {
-            first = r.first;
-            started = true;
-        }
-        last = r.last;
+    for r in parts.filter(|r| r.started) {
         for l in 0..LANES {
             sum1[l] += r.sum1[l];
             sum2[l] += r.sum2[l];
@@ -390,6 +379,25 @@ fn combine<'a>(parts: impl Iterator<Item = &'a ResidualSums>) -> (f64, f64, f64,
         }
     }
     (pairwise(&sum1), pairwise(&sum2), pairwise(&sum11) + joins, first, last)
+}
+
+/// The first value of the first part, the last of the last, and the sum of the neighbour
+/// products across the joins (each part's last value times the next part's first), from the
+/// (first, last) of the parts in order.
+fn joined_ends(parts: impl Iterator<Item = (f64, f64)>) -> (f64, f64, f64) {
+    let mut ends: Option<(f64, f64)> = None;
+    let mut joins = 0.0f64;
+    for (first, last) in parts {
+        ends = Some(match ends {
+            Some((f, l)) => {
+                joins += l * first;
+                (f, last)
+            }
+            None => (first, last),
+        });
+    }
+    let (first, last) = ends.unwrap_or((0.0, 0.0));
+    (first, last, joins)
 }
 
 /// r1 of a series of `len` values from its sums (as [`lag1_noise_id`]): `Ok(None)` for fewer
@@ -415,20 +423,10 @@ fn moment_r1(sums: &(f64, f64, f64, f64, f64), len: usize, guard: bool) -> Resul
 
 /// r1 of the residuals e_t = w_t - a0 - a1 u_t (u_t = t - c, n averages) from the parts' raw
 /// sums, combined in part order; `Err` when the expansion would cancel (see [`RAW_MIN_FRACTION`]).
-fn raw_r1<'a>(parts: impl Iterator<Item = &'a RawSums>, n: usize, c: f64) -> Result<Option<f64>, ()> {
+fn raw_r1<'a>(parts: impl Iterator<Item = &'a RawSums> + Clone, n: usize, c: f64) -> Result<Option<f64>, ()> {
+    let (wf, wl, joins) = joined_ends(parts.clone().filter(|r| r.started).map(|r| (r.first, r.last)));
     let (mut s0, mut s1, mut w2, mut w11) = ([0.0f64; LANES], [0.0f64; LANES], [0.0f64; LANES], [0.0f64; LANES]);
-    let (mut wf, mut wl, mut started, mut joins) = (0.0f64, 0.0f64, false, 0.0f64);
-    for r in parts {
-        if !r.started {
-            continue;
-        }
-        if started {
-            joins += wl * r.first;
-        } else {
-            wf = r.first;
-            started = true;
-        }
-        wl = r.last;
+    for r in parts.filter(|r| r.started) {
         for l in 0..LANES {
             s0[l] += r.s0[l];
             s1[l] += r.s1[l];
