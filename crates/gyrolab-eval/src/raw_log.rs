@@ -20,8 +20,9 @@ use std::path::{Path, PathBuf};
 ///
 /// ```
 /// use gyrolab_eval::{raw_log::SegmentationRequest, EvalError};
+/// # fn main() -> Result<(), EvalError> {
 /// let request = SegmentationRequest { settling_s: Some(2.0), min_plateau_s: Some(5.0), ..Default::default() };
-/// let o = request.options().unwrap();
+/// let o = request.options()?;
 /// assert_eq!((o.settling_s, o.min_duration_s), (2.0, 5.0));
 /// // Unset fields keep the defaults.
 /// let d = gyrolab::segment::SegmentOptions::default();
@@ -32,6 +33,8 @@ use std::path::{Path, PathBuf};
 ///     Err(EvalError::Invalid(e)) => assert_eq!(e.field, "steady_tolerance_dps"),
 ///     other => panic!("{other:?}"),
 /// }
+/// # Ok(())
+/// # }
 /// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SegmentationRequest {

@@ -79,8 +79,11 @@ pub struct SimOverrides {
 ///
 /// ```
 /// use gyrolab_eval::simulate::{sim_config, SimOverrides};
-/// let cfg = sim_config(&SimOverrides { seed: Some(7), duration_s: Some(60.0), ..Default::default() }).unwrap();
+/// # fn main() -> Result<(), gyrolab_eval::EvalError> {
+/// let cfg = sim_config(&SimOverrides { seed: Some(7), duration_s: Some(60.0), ..Default::default() })?;
 /// assert_eq!((cfg.seed, cfg.static_record.duration_s), (7, 60.0));
+/// # Ok(())
+/// # }
 /// ```
 pub fn sim_config(o: &SimOverrides) -> EvalResult<SimConfig> {
     let mut cfg = match &o.config {
@@ -224,9 +227,12 @@ pub fn record_samples(record: SimRecord, cfg: &SimConfig) -> f64 {
 ///
 /// ```
 /// use gyrolab_eval::simulate::{check_record_size, sim_config, SimOverrides, SimRecord};
-/// let cfg = sim_config(&SimOverrides { duration_s: Some(1e10), ..Default::default() }).unwrap();
+/// # fn main() -> Result<(), gyrolab_eval::EvalError> {
+/// let cfg = sim_config(&SimOverrides { duration_s: Some(1e10), ..Default::default() })?;
 /// let e = check_record_size(SimRecord::Static, &cfg, 1_000_000_000).unwrap_err();
 /// assert!(e.to_string().contains("1e12 samples"), "{e}");
+/// # Ok(())
+/// # }
 /// ```
 pub fn check_record_size(record: SimRecord, cfg: &SimConfig, max_samples: u64) -> EvalResult<f64> {
     let n = record_samples(record, cfg);

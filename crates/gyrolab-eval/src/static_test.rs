@@ -16,7 +16,8 @@ use std::path::{Path, PathBuf};
 ///
 /// ```
 /// use gyrolab_eval::static_test::{evaluate_static_tests, StaticTestRequest};
-/// let dir = tempfile::tempdir().unwrap();
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// let dir = tempfile::tempdir()?;
 /// let mut files = Vec::new();
 /// for (k, level) in [2.5001, 2.5003].into_iter().enumerate() {
 ///     let path = dir.path().join(format!("s{k}.csv"));
@@ -24,17 +25,20 @@ use std::path::{Path, PathBuf};
 ///     for i in 0..2000 {
 ///         text.push_str(&format!("{},{}\n", i as f64 * 0.1, level + if i % 2 == 0 { 1e-4 } else { -1e-4 }));
 ///     }
-///     std::fs::write(&path, text).unwrap();
+///     std::fs::write(&path, text)?;
 ///     files.push(path);
 /// }
 /// let mut request = StaticTestRequest::new(files);
 /// request.reference.scale_factor = Some(0.0075);
 /// request.reference.null = Some(2.5);
-/// let outcome = evaluate_static_tests(&request).unwrap();
+/// let outcome = evaluate_static_tests(&request)?;
 /// // B0 = (F - F0) / K: 0.0001 V / 0.0075 V/(deg/s) = 0.01333 deg/s = 48 deg/h.
-/// assert!((outcome.tests[0].result.bias_dph.unwrap() - 48.0).abs() < 1e-6);
-/// let r = outcome.repeatability[0].repeatability.bias_repeatability_dph.unwrap();
+/// let bias = outcome.tests[0].result.bias_dph.ok_or("no bias")?;
+/// assert!((bias - 48.0).abs() < 1e-6);
+/// let r = outcome.repeatability[0].repeatability.bias_repeatability_dph.ok_or("no repeatability")?;
 /// assert!((r - 96.0 / 2f64.sqrt()).abs() < 1e-6); // std (n-1) of 48 and 144 deg/h
+/// # Ok(())
+/// # }
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct StaticTestRequest {
