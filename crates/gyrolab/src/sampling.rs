@@ -399,7 +399,7 @@ pub fn estimate_interval_of<S: Stamps + Sync + ?Sized>(t: &S) -> Result<Interval
     // One pass, in parallel parts joined in order: stamps that do not increase, the first and
     // last finite stamps, and every BLOCK-th stamp for the block means.
     let pass = parallel_parts(n, |from, to| first_pass(t, from, to)).into_iter().reduce(FirstPass::join);
-    let FirstPass { first, last, non_increasing, first_non_increasing, marks } = pass.unwrap_or_default();
+    let FirstPass { first, last, non_increasing, first_non_increasing, marks, longest } = pass.unwrap_or_default();
     // First interval: the span over the count, or the median block mean when a long gap
     // stretches the span.
     let (Some((first, t_first)), Some((last, t_last))) = (first, last) else {
@@ -436,7 +436,8 @@ pub fn estimate_interval_of<S: Stamps + Sync + ?Sized>(t: &S) -> Result<Interval
         }
     };
     drop(marks);
-    let mut gaps = find_gaps(t, nominal);
+    // No interval over 1.5 times the nominal one: no gap, and no second pass to find one.
+    let mut gaps = if longest > GAP_FACTOR * nominal { find_gaps(t, nominal) } else { Vec::new() };
     let mut missing: usize = gaps.iter().map(|g| g.missing).sum();
     let mut interval_s = span / ((last - first) + missing) as f64;
     // Again with the interval that counts the missing samples, until the count holds.
@@ -501,6 +502,9 @@ struct FirstPass {
     first_non_increasing: Option<IrregularInterval>,
     /// The stamps at multiples of [`BLOCK`].
     marks: Vec<f64>,
+    /// The longest finite interval (ending in the run); -inf when there is none. No interval is
+    /// longer than a limit exactly when this is not: the gap search is skipped then.
+    longest: f64,
 }
 
 impl FirstPass {
@@ -511,6 +515,7 @@ impl FirstPass {
         self.non_increasing += next.non_increasing;
         self.first_non_increasing = self.first_non_increasing.or(next.first_non_increasing);
         self.marks.extend(next.marks);
+        self.longest = self.longest.max(next.longest);
         self
     }
 }
@@ -519,7 +524,11 @@ impl FirstPass {
 /// included when from > 0).
 fn first_pass<S: Stamps + ?Sized>(t: &S, from: usize, to: usize) -> FirstPass {
     let increasing = |d: f64| d.is_finite() && d > 0.0;
-    let mut out = FirstPass { marks: Vec::with_capacity((to - from) / BLOCK + 1), ..FirstPass::default() };
+    let mut out = FirstPass {
+        marks: Vec::with_capacity((to - from) / BLOCK + 1),
+        longest: f64::NEG_INFINITY,
+        ..FirstPass::default()
+    };
     let mut prev = f64::NAN;
     if from > 0 {
         let mut one = Vec::with_capacity(1);
@@ -536,7 +545,13 @@ fn first_pass<S: Stamps + ?Sized>(t: &S, from: usize, to: usize) -> FirstPass {
         // Intervals that do not increase: counted in one branch-free sweep, then found (rare)
         // one by one. The interval across the chunk bound comes first.
         let bound = usize::from(at > 0 && !increasing(chunk[0] - prev));
-        let inside = chunk.windows(2).map(|w| usize::from(!increasing(w[1] - w[0]))).sum::<usize>();
+        // The longest finite interval in the same sweep (the one across the bound included;
+        // `prev` is NaN before the record's first stamp, so that difference is not finite).
+        let (inside, longest) = chunk.windows(2).fold((0usize, finite_or(chunk[0] - prev)), |(bad, long), w| {
+            let d = w[1] - w[0];
+            (bad + usize::from(!increasing(d)), if finite_or(d) > long { d } else { long })
+        });
+        out.longest = out.longest.max(longest);
         if bound + inside > 0 {
             let mut p = prev;
             for (k, &v) in chunk.iter().enumerate() {
@@ -553,6 +568,16 @@ fn first_pass<S: Stamps + ?Sized>(t: &S, from: usize, to: usize) -> FirstPass {
         true
     });
     out
+}
+
+/// `d` when finite, else -inf (so that it is never the longest interval).
+#[inline(always)]
+fn finite_or(d: f64) -> f64 {
+    if d.is_finite() {
+        d
+    } else {
+        f64::NEG_INFINITY
+    }
 }
 
 /// Calls `f(first index, stamps)` on the stamps `from..to` in order, a chunk at a time (one
@@ -625,6 +650,9 @@ fn long_interval_in<S: Stamps + ?Sized>(t: &S, from: usize, to: usize, limit: f6
     found
 }
 
+/// An interval longer than this many sampling intervals is examined as a possible gap.
+const GAP_FACTOR: f64 = 1.5;
+
 /// The gaps of `t` at interval `dt` (see the module's rule).
 fn find_gaps<S: Stamps + Sync + ?Sized>(t: &S, dt: f64) -> Vec<Gap> {
     let n = t.len();
@@ -638,10 +666,10 @@ fn find_gaps<S: Stamps + Sync + ?Sized>(t: &S, dt: f64) -> Vec<Gap> {
     };
     while i < n {
         // The next interval longer than 1.5 dt (read chunk by chunk).
-        let Some(next) = next_long_interval(t, i, 1.5 * dt) else { break };
+        let Some(next) = next_long_interval(t, i, GAP_FACTOR * dt) else { break };
         i = next;
         let d = c.get(i) - c.get(i - 1);
-        if d.is_finite() && d > 1.5 * dt {
+        if d.is_finite() && d > GAP_FACTOR * dt {
             let before = floor(&mut c, previous.max(i.saturating_sub(WINDOW)), i);
             let after = floor(&mut c, i, (i + WINDOW).min(n));
             let shift = (after - before) / dt;
@@ -776,6 +804,23 @@ mod tests {
     }
 
     #[test]
+    fn one_missing_sample_is_a_gap() {
+        // One sample dropped (an interval of 2 dt, the shortest gap), once in a short record and
+        // once in a record long enough for the parallel passes; the stamps as compact ones too.
+        for n in [5_000usize, 3_000_000] {
+            let t: Vec<f64> = (0..n).filter(|&i| i != n / 2).map(|i| i as f64 * 0.01).collect();
+            let mut c = CompactStamps::default();
+            c.extend_from_slice(&t);
+            for e in [estimate_interval(&t).unwrap(), estimate_interval_of(&c).unwrap()] {
+                let found: Vec<(usize, usize)> = e.gaps.iter().map(|g| (g.index, g.missing)).collect();
+                assert_eq!(found, vec![(n / 2, 1)], "n = {n}");
+                assert_eq!(e.missing, 1);
+                assert!((e.interval_s - 0.01).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
     fn too_short_and_not_increasing_are_errors() {
         assert_eq!(estimate_interval(&[1.0]), Err(SamplingError::TooShort));
         assert_eq!(estimate_interval(&[1.0, 1.0, 0.5]), Err(SamplingError::NotIncreasing));
@@ -874,6 +919,13 @@ mod tests {
                 prop_assert_eq!(got.first_non_increasing.map(|g| g.index), bad.first().copied());
                 let marks: Vec<u64> = t.iter().step_by(BLOCK).map(|v| v.to_bits()).collect();
                 prop_assert_eq!(got.marks.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), marks);
+                let longest = (1..n).map(|i| t[i] - t[i - 1]).filter(|d| d.is_finite()).fold(f64::NEG_INFINITY, f64::max);
+                prop_assert_eq!(got.longest.to_bits(), longest.to_bits());
+                // The gap search is skipped exactly when it would find no interval to examine:
+                // at the nominal interval and at limits either side of the longest interval.
+                for limit in [GAP_FACTOR * dt, longest, longest * (1.0 - 1e-12), longest / GAP_FACTOR] {
+                    prop_assert_eq!(next_long_interval(&c, 1, limit).is_some(), got.longest > limit, "limit {}", limit);
+                }
             }
 
             /// Parts encoded apart and appended read back bit for bit, at any row (the access
