@@ -45,9 +45,10 @@ impl DataError {
         DataError { file: file.as_ref().to_path_buf(), line: None, column: None, message }
     }
 
-    /// Locates the problem on a line.
+    /// Locates the problem on a line (1-based). Line 0, which names no line (the header of a
+    /// file without a header row), leaves the error unlocated rather than printed as `file:0:`.
     pub fn at_line(mut self, line: u64) -> Self {
-        self.line = Some(line);
+        self.line = (line > 0).then_some(line);
         self
     }
 

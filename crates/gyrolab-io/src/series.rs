@@ -988,6 +988,18 @@ impl<R: Read> SeriesReader<R> {
                 .at_line(line));
             }
         }
+        if let Some((missing, _)) = options.column_units.iter().find(|(c, _)| !(0..names.len()).any(|i| matches(c, i)))
+        {
+            return Err(DataError::new(
+                &file,
+                format!(
+                    "a unit is given for column '{}', which is not in the header: found {}",
+                    crate::text::excerpt(missing),
+                    crate::text::excerpt(&names.join(", "))
+                ),
+            )
+            .at_line(line));
+        }
         if channels.is_empty() {
             let notes: Vec<String> = self.header.skipped.iter().map(|s| s.to_string()).collect();
             let why = if notes.is_empty() {
@@ -1004,9 +1016,19 @@ impl<R: Read> SeriesReader<R> {
             .at_line(line));
         }
         if self.header.time_column.is_none() && self.header.sample_rate_hz.is_none() {
+            let headerless = if self.header.headerless {
+                format!(
+                    " (the file has no header row: its columns are {}; name the time column, such as c1, or give column names that include a time)",
+                    crate::text::excerpt(&names.join(", "))
+                )
+            } else {
+                String::new()
+            };
             return Err(DataError::new(
                 &file,
-                "no time column (such as 'time_s' or 'timestamp [ns]') and no sample rate given: expected one of them",
+                format!(
+                    "no time column (such as 'time_s' or 'timestamp [ns]') and no sample rate given: expected one of them{headerless}"
+                ),
             )
             .at_line(line));
         }

@@ -133,6 +133,27 @@ fn headerless_files_get_numbered_or_given_names() {
     )
     .unwrap_err();
     assert!(e.message.contains("1 names given"), "{e}");
+    // Without a time: the message names the numbered columns and no line (a headerless file's
+    // header is no line of the file).
+    let e = read("0.00 1.5 2.5\n0.01 1.6 2.6\n", &SeriesOptions::default()).unwrap_err();
+    assert!(e.message.contains("no header row: its columns are c1, c2, c3"), "{e}");
+    assert_eq!(e.line, None, "{e}");
+    assert!(!e.to_string().contains(":0:"), "{e}");
+}
+
+#[test]
+fn a_unit_for_a_column_not_in_the_header_is_an_error() {
+    // A mistyped name is refused as a mistyped --column is, not silently ignored.
+    let text = "time,gx,gy\n0.000,0.01,0.02\n0.005,0.01,0.02\n";
+    let o = SeriesOptions { column_units: vec![("gq".into(), OutputUnit::RadPerSec)], ..Default::default() };
+    let e = read(text, &o).unwrap_err();
+    assert!(
+        e.message.contains("a unit is given for column 'gq', which is not in the header: found time, gx, gy"),
+        "{e}"
+    );
+    assert_eq!(e.line, Some(1));
+    let o = SeriesOptions { column_units: vec![("GX".into(), OutputUnit::RadPerSec)], ..Default::default() };
+    assert_eq!(read(text, &o).unwrap().header.channels[0].unit, OutputUnit::RadPerSec, "names match without case");
 }
 
 #[test]
