@@ -629,10 +629,20 @@ pub fn slope_line_terms(curve: &AllanCurve) -> Result<SlopeLineResult, NoiseErro
             bound_at(&pts, at, Unresolved::NoSupportedRegion, |hi, tau| hi * tau.sqrt())
         });
 
-    // Q: the first -1 run (shortest taus), read at its first point.
+    // Q: the first -1 run (shortest taus), read at its first point; only left of the first
+    // segment that supports a shallower slope (-1/2, 0, +1/2, +1) and not -1. The log-log slope
+    // of a sum of the model's terms never decreases with tau, so a -1 run right of such a
+    // segment is a chance dip of a noisy long-tau estimate, not quantization noise.
+    let shallower = (0..seg.len())
+        .find(|&j| {
+            let (s, w) = seg[j];
+            !supports(s, w, -1.0) && [-0.5, 0.0, 0.5, 1.0].iter().any(|&t| supports(s, w, t))
+        })
+        .unwrap_or(seg.len());
     let quantization = runs(&seg, -1.0, 1)
-        .first()
-        .map(|&run| Reading::Value { value: pts[run.0].dev * pts[run.0].tau / sqrt3, site: site(&pts, run, run.0) })
+        .into_iter()
+        .find(|r| r.1 < shallower)
+        .map(|run| Reading::Value { value: pts[run.0].dev * pts[run.0].tau / sqrt3, site: site(&pts, run, run.0) })
         .unwrap_or_else(|| bound_at(&pts, 0, Unresolved::NoSupportedRegion, |hi, tau| hi * tau / sqrt3));
 
     // R: the last +1 run right of the minimum, read at its last point.

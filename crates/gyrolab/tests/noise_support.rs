@@ -75,6 +75,9 @@ fn white_noise_gives_n_at_one_second_and_no_bias_instability() {
         assert!(s.bias_instability.value().is_none() && s.allan_minimum.value().is_none(), "seed {seed}");
         assert!(s.coefficients.bias_instability_dph.is_none());
         assert_ne!(s.bias_instability.basis(), Basis::Value);
+        // No quantization either: white noise has none, and a chance -1 dip of the noisy
+        // long-tau points lies right of the -1/2 region.
+        assert!(s.quantization.value().is_none(), "seed {seed}: Q {:?}", s.quantization);
     }
 }
 
@@ -171,6 +174,34 @@ fn equal_first_two_deviations_are_not_quantization() {
     let s = slope_line_terms(&hand_curve(&devs)).unwrap();
     let got = s.quantization.value().expect("Q resolved");
     assert!(rel(got, q) < 0.01, "Q {got}");
+}
+
+/// A -1 segment right of the -1/2 region (the last octave of a white curve halving: a chance
+/// dip of a long-tau estimate) is not quantization noise: the model's log-log slope never
+/// decreases with tau. Q is then the bound from the first point, sigma_hi(tau_1) tau_1 / sqrt(3),
+/// hand-computed below.
+#[test]
+fn a_minus_one_dip_at_long_tau_is_not_quantization() {
+    let mut devs: Vec<f64> = (0..12).map(|k| 1e-3 / (0.01 * f64::from(1u32 << k)).sqrt()).collect();
+    devs[11] = devs[10] / 2.0;
+    let s = slope_line_terms(&hand_curve(&devs)).unwrap();
+    assert!(s.quantization.value().is_none(), "{:?}", s.quantization);
+    // The bound at the first point: sigma exp(h) tau / sqrt(3), h = 1 / sqrt(2 edf), edf = 1000.
+    let hand = devs[0] * (1.0 / 2000f64.sqrt()).exp() * 0.01 / 3f64.sqrt();
+    assert!(rel(s.quantization.bound().expect("Q bound"), hand) < 1e-12, "{:?}", s.quantization);
+    assert!(rel(s.arw.value().unwrap(), 1e-3) < 1e-12, "{:?}", s.arw);
+    // The same dip with a true -1 region at the short taus: Q is read there, not at the dip.
+    let q = 1e-5;
+    let mut devs: Vec<f64> = (0..12)
+        .map(|k| {
+            let tau = 0.01 * f64::from(1u32 << k);
+            (3.0 * q * q / (tau * tau) + 1e-10 / tau).sqrt()
+        })
+        .collect();
+    devs[11] = devs[10] / 2.0;
+    let s = slope_line_terms(&hand_curve(&devs)).unwrap();
+    assert!(rel(s.quantization.value().expect("Q resolved"), q) < 0.01, "{:?}", s.quantization);
+    assert_eq!(s.quantization.tau_s(), Some(0.01));
 }
 
 /// The five-term fit is flagged poor when its weighted RMS residual exceeds FIT_RMS_LIMIT: a
