@@ -15,7 +15,7 @@ use gyrolab::units::{OutputUnit, Quantity, TimeUnit};
 use gyrolab::validate::{self, InvalidOption};
 use gyrolab_io::recording::{read_records, TopicMeta};
 use gyrolab_io::series::{ChannelInfo, SeriesData, SeriesOptions};
-use gyrolab_io::series::{LineMap, RowKind, SkippedColumn, UnitSource};
+use gyrolab_io::series::{LineMap, RowKind, SkipReason, SkippedColumn, UnitSource};
 use gyrolab_io::DataError;
 use gyrolab_report::allan::ChannelAnalysis;
 use rayon::prelude::*;
@@ -170,6 +170,14 @@ pub enum ReadNote {
         /// What the rows count.
         rows: RowKind,
     },
+    /// Dropout rows could not be looked for: fewer than two channels were read, and the file's
+    /// other channel columns were selected out.
+    DropoutsUnchecked {
+        /// The channels read.
+        read: Vec<String>,
+        /// The columns not read because they were not selected.
+        not_read: Vec<String>,
+    },
     /// A sample rate was given beside a time column: which one was used.
     SampleRateGiven {
         /// The given rate, Hz.
@@ -221,6 +229,12 @@ impl std::fmt::Display for ReadNote {
                 rows.word(),
                 first_lines.iter().map(u64::to_string).collect::<Vec<_>>().join(", ")
             ),
+            ReadNote::DropoutsUnchecked { read, not_read } => write!(
+                f,
+                "dropout rows (every channel zero, or repeating the row before) are looked for over two or more channels: with only {} read, such rows count as data; read {} too (name them with {{columns}}, or leave {{columns}} out) to find them",
+                gyrolab_io::text::excerpt(&read.join(", ")),
+                gyrolab_io::text::excerpt(&not_read.join(", "))
+            ),
             ReadNote::SampleRateGiven { given_hz, stamps_hz } => write!(
                 f,
                 "sample rate {given_hz} Hz as given ({{sample_rate_hz}}); the time stamps say {stamps_hz:.6} Hz"
@@ -262,7 +276,7 @@ impl ReadNote {
     /// The note with its option placeholders (`{units}`) spelled by the front end.
     pub fn render(&self, spell: &dyn Fn(&str) -> String) -> String {
         let mut t = self.to_string();
-        for f in ["units", "gaps", "sample_rate_hz"] {
+        for f in ["units", "gaps", "sample_rate_hz", "columns"] {
             t = t.replace(&format!("{{{f}}}"), &spell(f));
         }
         t
@@ -272,7 +286,9 @@ impl ReadNote {
 /// The notes of a file's header: skipped columns, a time unit not written in the header,
 /// channels without a unit.
 pub fn read_notes(header: &gyrolab_io::series::SeriesHeader) -> Vec<ReadNote> {
-    let mut notes: Vec<ReadNote> = header.skipped.iter().cloned().map(ReadNote::Skipped).collect();
+    // Columns left out by the user's own selection are no news.
+    let mut notes: Vec<ReadNote> =
+        header.skipped.iter().filter(|s| s.reason != SkipReason::NotSelected).cloned().map(ReadNote::Skipped).collect();
     if let (Some(c), Some(unit), Some(source)) = (header.time_column, header.time_unit, header.time_unit_source) {
         if !matches!(source, UnitSource::Header | UnitSource::Column) {
             let column = header.columns.get(c - 1).map_or(String::new(), |x| x.name.clone());
@@ -771,6 +787,12 @@ pub fn analyse_data(
             first_lines: dropped.iter().take(5).map(|&r| data.lines.get(r).unwrap_or(0)).collect(),
             rows,
         });
+    }
+    let not_read: Vec<String> =
+        data.header.skipped.iter().filter(|s| s.reason == SkipReason::NotSelected).map(|s| s.name.clone()).collect();
+    if data.channels.len() < 2 && !not_read.is_empty() {
+        let read = data.header.channels.iter().map(|c| c.name.clone()).collect();
+        notes.push(ReadNote::DropoutsUnchecked { read, not_read });
     }
     data.time = None;
     data.time_compact = None;

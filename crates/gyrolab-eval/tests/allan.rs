@@ -147,3 +147,46 @@ fn borrowed_samples_give_the_curve_of_owned_ones() {
         assert!(e.contains("x[123] = NaN is not a finite number"), "{unit:?}: {e}");
     }
 }
+
+/// Dropout rows need two or more channels: selecting one channel of a three-channel file that
+/// has 40 all-zero rows leaves them as data, and a note says so and names the columns to read;
+/// with two channels selected, they are found and treated as missing (the m = 1 term count
+/// drops by the 41 intervals that touch them: 40 rows in one run). A one-channel file gets no note.
+#[test]
+fn a_one_channel_selection_says_dropouts_were_not_looked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("three.csv");
+    let (x, y, z) = (white(4000, 0.1, 7), white(4000, 0.1, 8), white(4000, 0.1, 9));
+    let mut s = String::from("time_s,gx_dps,gy_dps,gz_dps\n");
+    for i in 0..4000 {
+        let zero = (2000..2040).contains(&i);
+        let v = |c: &[f64]| if zero { 0.0 } else { c[i] };
+        writeln!(s, "{:?},{:?},{:?},{:?}", i as f64 * 0.01, v(&x), v(&y), v(&z)).unwrap();
+    }
+    std::fs::write(&path, s).unwrap();
+    let unchecked = |o: &gyrolab_eval::allan::AllanOutcome| {
+        o.notes.iter().find_map(|n| match n {
+            gyrolab_eval::allan::ReadNote::DropoutsUnchecked { read, not_read } => {
+                Some((read.clone(), not_read.clone()))
+            }
+            _ => None,
+        })
+    };
+    let dropouts = |o: &gyrolab_eval::allan::AllanOutcome| {
+        o.notes.iter().any(|n| matches!(n, gyrolab_eval::allan::ReadNote::Dropouts { all_zero: 40, .. }))
+    };
+    let one = analyse_file(&AllanRequest { columns: vec!["gy_dps".into()], ..AllanRequest::new(&path) }).unwrap();
+    assert_eq!(unchecked(&one), Some((vec!["gy_dps".to_string()], vec!["gx_dps".to_string(), "gz_dps".to_string()])));
+    assert!(!dropouts(&one));
+    assert_eq!(one.analyses[0].curve.points[0].terms, 3999, "the zeros are data");
+    let two =
+        analyse_file(&AllanRequest { columns: vec!["gy_dps".into(), "gz_dps".into()], ..AllanRequest::new(&path) })
+            .unwrap();
+    assert_eq!(unchecked(&two), None);
+    assert!(dropouts(&two));
+    assert_eq!(two.analyses[0].curve.points[0].terms, 3999 - 41, "the zero rows are missing samples");
+    // A file with one channel column: nothing was selected out, no note.
+    let single = dir.path().join("one.csv");
+    write_rates(&single, &white(4000, 0.1, 3), None);
+    assert_eq!(unchecked(&analyse_file(&AllanRequest::new(&single)).unwrap()), None);
+}

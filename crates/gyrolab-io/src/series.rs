@@ -912,7 +912,13 @@ impl<R: Read> SeriesReader<R> {
                     ColumnRole::Temperature
                 }
             } else if !selected(i) {
-                ColumnRole::Ignored
+                // Listed (for the dropout note of a one-channel selection) when it could have been a
+                // channel; counters, ROS fields and text are simply left.
+                if is_counter_name(&cn.base) || is_ros_field_to_skip(&cn.base) || text_at(i) {
+                    ColumnRole::Ignored
+                } else {
+                    skip(SkipReason::NotSelected)
+                }
             } else if !explicitly_selected && is_counter_name(&cn.base) {
                 skip(SkipReason::Counter)
             } else if !explicitly_selected && is_ros_field_to_skip(&cn.base) {
