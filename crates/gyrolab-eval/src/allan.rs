@@ -134,6 +134,14 @@ pub enum ReadNote {
         /// Where it came from.
         source: UnitSource,
     },
+    /// The time unit was assumed to be seconds, but the stamps step by a whole number of
+    /// "seconds" (1 Hz or slower): perhaps a count of milliseconds. Shown as a warning.
+    TimeUnitDoubt {
+        /// The column's name.
+        column: String,
+        /// The sampling interval in the assumed unit (s).
+        step: f64,
+    },
     /// Channels without a unit: analysed in their own units, no noise terms.
     Unitless {
         /// Their names.
@@ -208,6 +216,12 @@ impl std::fmt::Display for ReadNote {
                 };
                 write!(f, "time column '{column}' read in {} ({why}); give {{units}} {column}=UNIT if that is wrong", unit.symbol())
             }
+            ReadNote::TimeUnitDoubt { column, step } => write!(
+                f,
+                "time column '{column}' read in s (assumed: the header names no unit), but its stamps step by whole seconds ({step} s, {:.4} Hz): if they count milliseconds (a microcontroller's millis(), say), give {{units}} {column}=ms (then {} Hz)",
+                1.0 / step,
+                1000.0 / step
+            ),
             ReadNote::Gaps { count, missing, first, rows } => {
                 let shown: Vec<String> =
                     first.iter().map(|(l, m)| format!("{} {l} ({m} missing)", rows.word())).collect();
@@ -273,6 +287,11 @@ impl std::fmt::Display for ReadNote {
 }
 
 impl ReadNote {
+    /// Whether the note is a warning (the figures may be wrong as read) rather than information.
+    pub fn is_warning(&self) -> bool {
+        matches!(self, ReadNote::Truncated(_) | ReadNote::TimeUnitDoubt { .. })
+    }
+
     /// The note with its option placeholders (`{units}`) spelled by the front end.
     pub fn render(&self, spell: &dyn Fn(&str) -> String) -> String {
         let mut t = self.to_string();
@@ -746,6 +765,19 @@ pub fn analyse_data(
     let mut notes = read_notes(&data.header);
     let timing = record_timing(&data, path, request.sample_rate_hz, request.gaps)?;
     let tau0 = timing.tau0_s;
+    // Seconds assumed, and a whole number of them between samples (1 Hz or slower): more likely
+    // a millisecond counter than an IMU logged at 1 Hz; the warning replaces the plain note.
+    if data.header.time_unit_source == Some(UnitSource::Assumed)
+        && request.sample_rate_hz.is_none()
+        && tau0 >= 1.0
+        && (tau0 - tau0.round()).abs() <= 1e-9 * tau0
+    {
+        if let Some(k) = notes.iter().position(|n| matches!(n, ReadNote::TimeUnit { .. })) {
+            if let ReadNote::TimeUnit { column, .. } = notes.remove(k) {
+                notes.insert(k, ReadNote::TimeUnitDoubt { column, step: tau0.round() });
+            }
+        }
+    }
     notes.extend(timing.note.clone());
     if timing.missing > 0 {
         let first = timing.gaps.iter().take(5).map(|g| (data.lines.get(g.index).unwrap_or(0), g.missing)).collect();

@@ -190,3 +190,38 @@ fn a_one_channel_selection_says_dropouts_were_not_looked_for() {
     write_rates(&single, &white(4000, 0.1, 3), None);
     assert_eq!(unchecked(&analyse_file(&AllanRequest::new(&single)).unwrap()), None);
 }
+
+/// Stamps in a column without a unit, read in seconds by assumption, that step by a whole
+/// number of "seconds" (here 5: an Arduino's millis() at 200 Hz) give a warning naming the
+/// column and the millisecond reading (200 Hz), in place of the plain "assumed" note; with the
+/// unit given, or with stamps 0.01 s apart, there is none.
+#[test]
+fn whole_number_stamps_read_as_seconds_are_doubted() {
+    use gyrolab_eval::allan::ReadNote;
+    use gyrolab_eval::layout::LogLayout;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("millis.csv");
+    let mut s = String::from("t,gx_dps\n");
+    for (i, v) in white(3000, 0.1, 5).iter().enumerate() {
+        writeln!(s, "{},{v:?}", 5 * i).unwrap();
+    }
+    std::fs::write(&path, s).unwrap();
+    let doubt = |o: &gyrolab_eval::allan::AllanOutcome| {
+        o.notes.iter().find_map(|n| match n {
+            ReadNote::TimeUnitDoubt { column, step } => Some((column.clone(), *step, n.is_warning())),
+            _ => None,
+        })
+    };
+    let o = analyse_file(&AllanRequest::new(&path)).unwrap();
+    assert_eq!(doubt(&o), Some(("t".to_string(), 5.0, true)));
+    assert!(!o.notes.iter().any(|n| matches!(n, ReadNote::TimeUnit { .. })), "the warning replaces the note");
+    assert!(o.notes.iter().any(|n| n.to_string().contains("then 200 Hz")));
+    let layout = LogLayout { units: vec!["t=ms".into()], ..Default::default() };
+    let o = analyse_file(&AllanRequest { layout, ..AllanRequest::new(&path) }).unwrap();
+    assert_eq!(doubt(&o), None);
+    assert!((o.sample_interval_s - 0.005).abs() < 1e-15);
+    let plain = dir.path().join("plain.csv");
+    write_rates(&plain, &white(3000, 0.1, 6), None);
+    std::fs::write(&plain, std::fs::read_to_string(&plain).unwrap().replacen("time_s", "time", 1)).unwrap();
+    assert_eq!(doubt(&analyse_file(&AllanRequest::new(&plain)).unwrap()), None);
+}

@@ -99,7 +99,7 @@ pub fn run(args: &AllanArgs) -> CliResult {
     let several = outcomes.len() > 1;
     for outcome in &outcomes {
         for n in &outcome.notes {
-            let level = if matches!(n, gyrolab_eval::allan::ReadNote::Truncated(_)) { "warning" } else { "note" };
+            let level = if n.is_warning() { "warning" } else { "note" };
             eprintln!("{level}: {}", n.render(&crate::error::flag));
         }
     }
