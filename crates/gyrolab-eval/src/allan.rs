@@ -134,6 +134,16 @@ pub enum ReadNote {
         /// Where it came from.
         source: UnitSource,
     },
+    /// More than three orientation and covariance fields of a ROS export, skipped (one note for
+    /// all of them).
+    RosFieldsSkipped {
+        /// How many.
+        count: usize,
+        /// The first one's name.
+        first: String,
+        /// The last one's name.
+        last: String,
+    },
     /// The time unit was assumed to be seconds, but the stamps step by a whole number of
     /// "seconds" (1 Hz or slower): perhaps a count of milliseconds. Shown as a warning.
     TimeUnitDoubt {
@@ -216,6 +226,12 @@ impl std::fmt::Display for ReadNote {
                 };
                 write!(f, "time column '{column}' read in {} ({why}); give {{units}} {column}=UNIT if that is wrong", unit.symbol())
             }
+            ReadNote::RosFieldsSkipped { count, first, last } => write!(
+                f,
+                "{count} orientation and covariance fields of a ROS message skipped ('{}' to '{}')",
+                gyrolab_io::text::excerpt(first),
+                gyrolab_io::text::excerpt(last)
+            ),
             ReadNote::TimeUnitDoubt { column, step } => write!(
                 f,
                 "time column '{column}' read in s (assumed: the header names no unit), but its stamps step by whole seconds ({step} s, {:.4} Hz): if they count milliseconds (a microcontroller's millis(), say), give {{units}} {column}=ms (then {} Hz)",
@@ -305,9 +321,20 @@ impl ReadNote {
 /// The notes of a file's header: skipped columns, a time unit not written in the header,
 /// channels without a unit.
 pub fn read_notes(header: &gyrolab_io::series::SeriesHeader) -> Vec<ReadNote> {
-    // Columns left out by the user's own selection are no news.
-    let mut notes: Vec<ReadNote> =
-        header.skipped.iter().filter(|s| s.reason != SkipReason::NotSelected).cloned().map(ReadNote::Skipped).collect();
+    // Columns left out by the user's own selection are no news; a ROS export's many orientation
+    // and covariance fields are one note.
+    let ros: Vec<&SkippedColumn> = header.skipped.iter().filter(|s| s.reason == SkipReason::RosField).collect();
+    let group_ros = ros.len() > 3;
+    let mut notes: Vec<ReadNote> = header
+        .skipped
+        .iter()
+        .filter(|s| s.reason != SkipReason::NotSelected && !(group_ros && s.reason == SkipReason::RosField))
+        .cloned()
+        .map(ReadNote::Skipped)
+        .collect();
+    if let (true, Some(first), Some(last)) = (group_ros, ros.first(), ros.last()) {
+        notes.push(ReadNote::RosFieldsSkipped { count: ros.len(), first: first.name.clone(), last: last.name.clone() });
+    }
     if let (Some(c), Some(unit), Some(source)) = (header.time_column, header.time_unit, header.time_unit_source) {
         if !matches!(source, UnitSource::Header | UnitSource::Column) {
             let column = header.columns.get(c - 1).map_or(String::new(), |x| x.name.clone());

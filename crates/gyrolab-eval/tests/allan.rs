@@ -225,3 +225,34 @@ fn whole_number_stamps_read_as_seconds_are_doubted() {
     std::fs::write(&plain, std::fs::read_to_string(&plain).unwrap().replacen("time_s", "time", 1)).unwrap();
     assert_eq!(doubt(&analyse_file(&AllanRequest::new(&plain)).unwrap()), None);
 }
+
+/// A `rostopic echo -p` export: the message stamp is the time (not `%time`), `frame_id` (a name)
+/// is skipped as text, and the orientation and covariance fields are one note, not one each.
+#[test]
+fn a_rostopic_export_reads_its_message_stamps_with_few_notes() {
+    use gyrolab_eval::allan::ReadNote;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("imu.csv");
+    let cov: Vec<String> = (0..9).map(|k| format!("field.angular_velocity_covariance{k}")).collect();
+    let mut s = format!(
+        "%time,field.header.seq,field.header.stamp,field.header.frame_id,field.orientation.x,field.orientation.w,{},field.angular_velocity.x\n",
+        cov.join(",")
+    );
+    for (i, v) in white(3000, 0.01, 11).iter().enumerate() {
+        let stamp = 1_700_000_000_000_000_000u64 + 5_000_000 * i as u64;
+        // the receive time: late by 0 to 3 ms
+        let recv = stamp + (i as u64 * 7919 % 3_000_000);
+        writeln!(s, "{recv},{i},{stamp},imu_link,0,1,{},{v:?}", ["0"; 9].join(",")).unwrap();
+    }
+    std::fs::write(&path, s).unwrap();
+    let o = analyse_file(&AllanRequest::new(&path)).unwrap();
+    // (the receive times would give 0.005 + 0.9e-6 s: their last one is 2.7 ms late)
+    assert!((o.sample_interval_s - 0.005).abs() < 1e-7, "{}", o.sample_interval_s);
+    let text: Vec<String> = o.notes.iter().map(|n| n.to_string()).collect();
+    assert!(text.iter().any(|t| t.contains("'%time' skipped: a second time column")), "{text:?}");
+    assert!(text.iter().any(|t| t.contains("'field.header.frame_id' skipped: text")), "{text:?}");
+    let grouped: Vec<&ReadNote> = o.notes.iter().filter(|n| matches!(n, ReadNote::RosFieldsSkipped { .. })).collect();
+    assert_eq!(grouped.len(), 1, "{text:?}");
+    assert!(matches!(grouped[0], ReadNote::RosFieldsSkipped { count: 11, .. }), "{text:?}");
+    assert!(!text.iter().any(|t| t.contains("covariance3")), "one note for all: {text:?}");
+}

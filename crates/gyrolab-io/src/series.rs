@@ -831,7 +831,15 @@ impl<R: Read> SeriesReader<R> {
                     .at_line(line))
                 }
             },
-            None => (0..names.len()).find(|&i| is_time_name(&parsed[i].base) && !text_at(i)),
+            // A ROS export's message stamp (`field.header.stamp`, the driver's time) before its
+            // receive time (`%time`, the host's, jittered by scheduling), then the first time name.
+            // A driver that leaves the stamp unset writes 0: then the receive time.
+            None => (0..names.len())
+                .find(|&i| {
+                    let unset = first_row.and_then(|r| r.get(i)).is_some_and(|f| f.trim().parse::<f64>() == Ok(0.0));
+                    parsed[i].base == "field.header.stamp" && !text_at(i) && !unset
+                })
+                .or_else(|| (0..names.len()).find(|&i| is_time_name(&parsed[i].base) && !text_at(i))),
         };
         let selected = |i: usize| options.channels.as_ref().is_none_or(|l| l.iter().any(|c| matches(c, i)));
         let mut columns = Vec::with_capacity(names.len());
@@ -919,12 +927,13 @@ impl<R: Read> SeriesReader<R> {
                 } else {
                     skip(SkipReason::NotSelected)
                 }
+            } else if !explicitly_selected && text_at(i) {
+                // Text first: a ROS `frame_id` holds a name, whatever its `_id` suggests.
+                skip(SkipReason::Text)
             } else if !explicitly_selected && is_counter_name(&cn.base) {
                 skip(SkipReason::Counter)
             } else if !explicitly_selected && is_ros_field_to_skip(&cn.base) {
                 skip(SkipReason::RosField)
-            } else if !explicitly_selected && text_at(i) {
-                skip(SkipReason::Text)
             } else {
                 let from_header = unit_text.map(|t| (t, OutputUnit::parse(t)));
                 let resolved = match (unit_override, from_header) {

@@ -162,7 +162,8 @@ fn unusable_columns_are_skipped_with_a_reason() {
                 1700000000000000000,1,1700000000000000000,0.1,0.01,9.8,OK,1013\n\
                 1700000005000000000,2,1700000005000000000,0.1,0.01,9.8,OK,1013\n";
     let d = read(text, &SeriesOptions::default()).unwrap();
-    assert_eq!(d.header.time_column, Some(1));
+    // The message stamp, not the receive time `%time` (which comes first).
+    assert_eq!(d.header.time_column, Some(3));
     assert_eq!(d.header.time_unit, Some(TimeUnit::Nanosecond));
     let u = units(&d);
     assert_eq!(u[0], ("field.angular_velocity.x".into(), OutputUnit::RadPerSec, UnitSource::RosConvention));
@@ -171,12 +172,15 @@ fn unusable_columns_are_skipped_with_a_reason() {
     assert_eq!(
         reasons,
         vec![
+            (1, SkipReason::SecondTime),
             (2, SkipReason::Counter),
-            (3, SkipReason::SecondTime),
             (4, SkipReason::RosField),
             (7, SkipReason::Text),
             (8, SkipReason::UnknownUnit("hpa".into())),
         ]
     );
     assert!(d.header.skipped[4].to_string().contains("column 8 'pressure [hPa]' skipped: unit 'hpa'"));
+    // A driver that leaves the message stamp unset (0): the receive time is the time.
+    let unset = text.replace(",1,1700000000000000000,", ",1,0,").replace(",2,1700000005000000000,", ",2,0,");
+    assert_eq!(read(&unset, &SeriesOptions::default()).unwrap().header.time_column, Some(1));
 }
