@@ -19,23 +19,24 @@ use std::path::{Path, PathBuf};
 /// // A calibration of the paper's axis x (K about 7.3 mV/(deg/s)), written as `rate --cal-out` does.
 /// let paper = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/paper/paper_rate_table_x.csv");
 /// let rate = RateRequest { files: vec![paper], axis_names: vec!["x".into()], ..Default::default() };
-/// let axes = evaluate_rates(&rate).unwrap().axes;
+/// let axes = evaluate_rates(&rate)?.axes;
 /// let (k, f0) = (axes[0].evaluation.scale_factor(), axes[0].evaluation.zero_offset());
-/// let dir = tempfile::tempdir().unwrap();
+/// let dir = tempfile::tempdir()?;
 /// let cal = dir.path().join("cal.toml");
-/// std::fs::write(&cal, calibration_file(&axes).to_toml().unwrap()).unwrap();
+/// std::fs::write(&cal, calibration_file(&axes).to_toml()?)?;
 /// // Outputs at 0 and 100 deg/s by that line.
 /// let input = dir.path().join("outputs.csv");
-/// std::fs::write(&input, format!("time_s,output_v\n0,{f0}\n0.01,{}\n", f0 + 100.0 * k)).unwrap();
+/// std::fs::write(&input, format!("time_s,output_v\n0,{f0}\n0.01,{}\n", f0 + 100.0 * k))?;
 /// let request = ApplyRequest { calibration: cal, input: input.clone(), calibration_axis: None, columns: vec![] };
-/// let plan = prepare_apply(&request).unwrap();
+/// let plan = prepare_apply(&request)?;
 /// assert_eq!(plan.columns, ["output_v"]);
 /// let mut out = Vec::new();
-/// let summary = apply_to(&input, &plan, &mut out, &mut |_| {}).unwrap();
+/// let summary = apply_to(&input, &plan, &mut out, &mut |_| {})?;
 /// assert_eq!(summary.rows, 2);
-/// let text = String::from_utf8(out).unwrap();
-/// let rates: Vec<f64> = text.lines().skip(1).map(|l| l.split(',').nth(1).unwrap().parse().unwrap()).collect();
+/// let text = String::from_utf8(out)?;
+/// let rates: Vec<f64> = text.lines().skip(1).map(|l| l.split(',').nth(1).map_or(Ok(f64::NAN), str::parse)).collect::<Result<_, _>>()?;
 /// assert!(rates[0].abs() < 1e-9 && (rates[1] - 100.0).abs() < 1e-9, "{text}");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct ApplyRequest {

@@ -54,9 +54,10 @@ impl RateSettings {
 /// use gyrolab_eval::rate::{RateRequest, evaluate_rates};
 /// let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/paper/paper_rate_table_x.csv");
 /// let request = RateRequest { files: vec![file], axis_names: vec!["x".into()], ..Default::default() };
-/// let outcome = evaluate_rates(&request).unwrap();
+/// let outcome = evaluate_rates(&request)?;
 /// let k = outcome.axes[0].evaluation.scale_factor();
 /// assert!((k * 1000.0 - 7.56).abs() < 0.01); // mV/(deg/s); the paper's Table 6 prints 7.6
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct RateRequest {
@@ -239,8 +240,9 @@ pub fn evaluate_rates(request: &RateRequest) -> EvalResult<RateOutcome> {
 ///         }
 ///     }
 /// }
-/// let axis = evaluate_observations("x", &obs, OutputUnit::Volt, &RateSettings::default()).unwrap();
+/// let axis = evaluate_observations("x", &obs, OutputUnit::Volt, &RateSettings::default())?;
 /// assert!((axis.evaluation.scale_factor() - 0.0075).abs() < 1e-15);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn evaluate_observations(
     name: &str,

@@ -62,11 +62,13 @@ pub struct ApplySummary {
 }
 
 /// Why a streamed application stopped.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum StreamError {
     /// Bad input data or a unit that does not match the calibration.
+    #[error("{0}")]
     Data(DataError),
     /// The output could not be written.
+    #[error("writing the output: {0}")]
     Write(std::io::Error),
 }
 

@@ -815,21 +815,16 @@ impl<R: Read> SeriesReader<R> {
                 .or_else(|| (0..names.len()).find(|&i| matches(given, i)))
         };
         let text_at = |i: usize| first_row.and_then(|r| r.get(i)).is_some_and(|f| !f.is_empty() && !is_number_text(f));
+        // A column an option names that the header does not have (`subject` says which).
+        let not_in_header = |subject: String| {
+            let found = crate::text::excerpt(&names.join(", "));
+            DataError::new(&file, format!("{subject} is not in the header: found {found}")).at_line(line)
+        };
         // The time column: the one named by the option, else the first whose name is a time.
         let time_index = match &options.time_column {
             Some(t) => match find(t) {
                 Some(i) => Some(i),
-                None => {
-                    return Err(DataError::new(
-                        &file,
-                        format!(
-                            "time column '{}' is not in the header: found {}",
-                            crate::text::excerpt(t),
-                            crate::text::excerpt(&names.join(", "))
-                        ),
-                    )
-                    .at_line(line))
-                }
+                None => return Err(not_in_header(format!("time column '{}'", crate::text::excerpt(t)))),
             },
             // A ROS export's message stamp (`field.header.stamp`, the driver's time) before its
             // receive time (`%time`, the host's, jittered by scheduling), then the first time name.
@@ -979,41 +974,20 @@ impl<R: Read> SeriesReader<R> {
         self.header.skipped = skipped;
         if let Some(rate) = &options.table_rate_column {
             if self.header.table_rate_column.is_none() {
-                return Err(DataError::new(
-                    &file,
-                    format!(
-                        "table-rate column '{}' is not in the header: found {}",
-                        crate::text::excerpt(rate),
-                        crate::text::excerpt(&names.join(", "))
-                    ),
-                )
-                .at_line(line));
+                return Err(not_in_header(format!("table-rate column '{}'", crate::text::excerpt(rate))));
             }
         }
         if let Some(list) = &options.channels {
             if let Some(missing) = list.iter().find(|c| !(0..names.len()).any(|i| matches(c, i))) {
-                return Err(DataError::new(
-                    &file,
-                    format!(
-                        "selected channel '{}' is not in the header: found {}",
-                        crate::text::excerpt(missing),
-                        crate::text::excerpt(&names.join(", "))
-                    ),
-                )
-                .at_line(line));
+                return Err(not_in_header(format!("selected channel '{}'", crate::text::excerpt(missing))));
             }
         }
         if let Some((missing, _)) = options.column_units.iter().find(|(c, _)| !(0..names.len()).any(|i| matches(c, i)))
         {
-            return Err(DataError::new(
-                &file,
-                format!(
-                    "a unit is given for column '{}', which is not in the header: found {}",
-                    crate::text::excerpt(missing),
-                    crate::text::excerpt(&names.join(", "))
-                ),
-            )
-            .at_line(line));
+            return Err(not_in_header(format!(
+                "a unit is given for column '{}', which",
+                crate::text::excerpt(missing)
+            )));
         }
         if channels.is_empty() {
             let notes: Vec<String> = self.header.skipped.iter().map(|s| s.to_string()).collect();

@@ -375,14 +375,15 @@ impl<'a, S: Stamps + ?Sized> Cursor<'a, S> {
 /// ```
 /// use gyrolab::sampling::estimate_interval;
 /// let t: Vec<f64> = (0..1000).map(|i| i as f64 * 0.01).collect();
-/// let e = estimate_interval(&t).unwrap();
+/// let e = estimate_interval(&t)?;
 /// assert!((e.interval_s - 0.01).abs() < 1e-15);
 /// assert!(e.first_irregular.is_none());
 /// // Samples 500 and 501 missing: one gap of two samples before index 500.
 /// let t: Vec<f64> = (0..1000).filter(|&i| i != 500 && i != 501).map(|i| i as f64 * 0.01).collect();
-/// let e = estimate_interval(&t).unwrap();
+/// let e = estimate_interval(&t)?;
 /// assert_eq!((e.gaps[0].index, e.gaps[0].missing, e.missing), (500, 2, 2));
 /// assert!((e.interval_s - 0.01).abs() < 1e-15);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn estimate_interval(t: &[f64]) -> Result<IntervalEstimate, SamplingError> {
     estimate_interval_of(t)

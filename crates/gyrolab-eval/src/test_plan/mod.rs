@@ -146,9 +146,10 @@ fn triad_section(t: &gyrolab_report::triad::TriadReport<'_>) -> ReportSection {
 /// ```
 /// use gyrolab_eval::{progress::Silent, test_plan::{read_test_plan, evaluate_test_plan}};
 /// let plan = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper_plan.toml");
-/// let folder = evaluate_test_plan(&read_test_plan(&plan).unwrap(), &plan.display().to_string(), &Silent).unwrap();
+/// let folder = evaluate_test_plan(&read_test_plan(&plan)?, &plan.display().to_string(), &Silent)?;
 /// assert!(folder.outputs.iter().any(|o| o.name == "results.json"));
 /// assert_eq!(folder.verdict, Some(gyrolab_report::limits::Verdict::Fail)); // the paper's own claims fail
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progress) -> EvalResult<ReportFolder> {
     progress.begin(progress_steps(plan));

@@ -53,9 +53,10 @@ pub fn deviation_from_rate_with_gaps_into(
 /// // (0,1), (1,2), (2,3), (5,6), (6,7): differences 1, -2, 1, 2, -1; sigma^2 = 11 / (2 * 5).
 /// let y = vec![0.0, 1.0, -1.0, 0.0, f64::NAN, 1.0, 3.0, 2.0];
 /// let o = AllanOptions::new(DeviationKind::Oadev).with_taus(TauList::Factors(vec![1])).with_confidence(None);
-/// let c = deviation_from_rate_with_gaps(y, 1.0, &o).unwrap();
+/// let c = deviation_from_rate_with_gaps(y, 1.0, &o)?;
 /// assert_eq!(c.points[0].terms, 5);
 /// assert!((c.points[0].deviation - (11.0f64 / 10.0).sqrt()).abs() < 1e-15);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn deviation_from_rate_with_gaps(
     mut rate: Vec<f64>,
