@@ -799,9 +799,9 @@ pub fn analyse_data(
         && tau0 >= 1.0
         && (tau0 - tau0.round()).abs() <= 1e-9 * tau0
     {
-        if let Some(k) = notes.iter().position(|n| matches!(n, ReadNote::TimeUnit { .. })) {
-            if let ReadNote::TimeUnit { column, .. } = notes.remove(k) {
-                notes.insert(k, ReadNote::TimeUnitDoubt { column, step: tau0.round() });
+        for n in &mut notes {
+            if let ReadNote::TimeUnit { column, .. } = n {
+                *n = ReadNote::TimeUnitDoubt { column: std::mem::take(column), step: tau0.round() };
             }
         }
     }

@@ -815,6 +815,7 @@ impl<R: Read> SeriesReader<R> {
                 .or_else(|| (0..names.len()).find(|&i| matches(given, i)))
         };
         let text_at = |i: usize| first_row.and_then(|r| r.get(i)).is_some_and(|f| !f.is_empty() && !is_number_text(f));
+        let in_header = |given: &str| (0..names.len()).any(|i| matches(given, i));
         // A column an option names that the header does not have (`subject` says which).
         let not_in_header = |subject: String| {
             let found = crate::text::excerpt(&names.join(", "));
@@ -978,12 +979,11 @@ impl<R: Read> SeriesReader<R> {
             }
         }
         if let Some(list) = &options.channels {
-            if let Some(missing) = list.iter().find(|c| !(0..names.len()).any(|i| matches(c, i))) {
+            if let Some(missing) = list.iter().find(|c| !in_header(c)) {
                 return Err(not_in_header(format!("selected channel '{}'", crate::text::excerpt(missing))));
             }
         }
-        if let Some((missing, _)) = options.column_units.iter().find(|(c, _)| !(0..names.len()).any(|i| matches(c, i)))
-        {
+        if let Some((missing, _)) = options.column_units.iter().find(|(c, _)| !in_header(c)) {
             return Err(not_in_header(format!(
                 "a unit is given for column '{}', which",
                 crate::text::excerpt(missing)
