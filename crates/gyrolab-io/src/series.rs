@@ -36,7 +36,7 @@ mod ranges;
 pub use ranges::{read_series_in_ranges, RANGE_CHUNK_BYTES};
 
 pub use crate::decimal::plain_decimal;
-use crate::decimal::{read_rows, FieldShape, RowLayout, SKIP_COLUMN};
+use crate::decimal::{read_rows, RowLayout, RowShapes, SKIP_COLUMN};
 pub use crate::text::Delimiter;
 
 /// Options of the time-series reader.
@@ -569,7 +569,10 @@ pub struct SeriesReader<R: Read> {
     tail_len: usize,
     rows: u64,
     targets: Vec<u32>,
-    shapes: Vec<Option<FieldShape>>,
+    shapes: RowShapes,
+    /// Whether a row of the current block was read by the general path (whose values may
+    /// exceed [`crate::text::MAX_MAGNITUDE`]; the fast path's stay below 10^42).
+    general_rows: bool,
     crlf: bool,
     time_slot: Option<usize>,
     temp_slot: Option<usize>,
@@ -644,7 +647,8 @@ impl<R: Read> SeriesReader<R> {
             tail_len: 0,
             rows: 0,
             targets: Vec::new(),
-            shapes: Vec::new(),
+            shapes: RowShapes::default(),
+            general_rows: false,
             crlf: false,
             time_slot: None,
             temp_slot: None,
@@ -1142,6 +1146,7 @@ impl<R: Read> SeriesReader<R> {
             c.clear();
         }
         self.lines.clear();
+        self.general_rows = false;
         while self.lines.len() < self.block_rows {
             if self.pos >= self.complete && !self.fill()? {
                 break;
@@ -1154,8 +1159,9 @@ impl<R: Read> SeriesReader<R> {
             }
             return Ok(None);
         }
-        // Values that would overflow the figures: a corrupt cell, reported where it is.
-        for (slot, col) in self.cols.iter().enumerate() {
+        // Values that would overflow the figures: a corrupt cell, reported where it is (only the
+        // general path reads such numbers).
+        for (slot, col) in self.cols.iter().enumerate().filter(|_| self.general_rows) {
             if let Some(k) = col.iter().position(|v| v.abs() > crate::text::MAX_MAGNITUDE) {
                 let ci = self.targets.iter().position(|&t| t as usize == slot).unwrap_or(0);
                 let msg = crate::text::check_magnitude(col[k]).err().unwrap_or_default();
@@ -1217,7 +1223,7 @@ impl<R: Read> SeriesReader<R> {
         let (mut refusals, mut general_only) = (0u32, 0u32);
         let layout = RowLayout { delim, crlf: self.crlf };
         if self.shapes.len() != ncols {
-            self.shapes = vec![None; ncols];
+            self.shapes = RowShapes::new(ncols);
         }
         let mut p = self.pos;
         let mut line_no = self.line_no;
@@ -1351,6 +1357,7 @@ impl<R: Read> SeriesReader<R> {
             }
             self.lines.push(line_no);
             self.rows += 1;
+            self.general_rows = true;
         };
         self.pos = p;
         self.line_no = line_no;
@@ -1521,7 +1528,8 @@ impl<R: Read> SeriesReader<R> {
             tail_len: 0,
             rows: 0,
             targets: self.targets.clone(),
-            shapes: Vec::new(),
+            shapes: RowShapes::default(),
+            general_rows: false,
             crlf: self.crlf,
             time_slot: self.time_slot,
             temp_slot: self.temp_slot,
