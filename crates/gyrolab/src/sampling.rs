@@ -207,41 +207,49 @@ impl CompactStamps {
         self.prev_d1 = d1;
     }
 
-    /// Appends stamps (the same codes as [`CompactStamps::push`] one by one, in a tighter loop:
-    /// the state in locals, an access point at the start of each run up to the next 64th row).
+    /// Appends stamps: the same codes as [`CompactStamps::push`] one by one. A stamp's code
+    /// depends only on it and the two stamps before (push's state is their differences), so
+    /// after the first two stamps the codes are made in one sweep that does not wait from stamp
+    /// to stamp; the escaped stamps and the access points are then taken in order.
     pub fn extend_from_slice(&mut self, t: &[f64]) {
-        self.codes.reserve(t.len());
-        let mut rest = t;
-        if self.codes.is_empty() {
-            let Some((&v, after)) = rest.split_first() else { return };
+        let head = t.len().min(2);
+        for &v in &t[..head] {
             self.push(v);
-            rest = after;
         }
-        let (mut prev_bits, mut prev_d1) = (self.prev_bits, self.prev_d1);
-        while !rest.is_empty() {
-            let n = self.codes.len();
-            let run = (CHECK - n % CHECK).min(rest.len());
-            let (now, after) = rest.split_at(run);
-            for (k, &v) in now.iter().enumerate() {
-                let bits = v.to_bits();
-                let d1 = bits.wrapping_sub(prev_bits);
-                let d2 = d1.wrapping_sub(prev_d1) as i64;
-                if (-127..=127).contains(&d2) {
-                    self.codes.push(d2 as i8);
-                } else {
-                    self.codes.push(ESCAPE);
-                    self.escaped.push(bits);
-                }
-                if k == 0 && n.is_multiple_of(CHECK) {
-                    self.checks.push((n, bits, d1, self.escaped.len()));
-                }
-                prev_bits = bits;
-                prev_d1 = d1;
+        let Some(&last) = t.get(2..).and_then(<[f64]>::last) else { return };
+        let base = self.codes.len();
+        self.codes.extend(t.windows(3).map(|w| {
+            let (a, b, c) = (w[0].to_bits(), w[1].to_bits(), w[2].to_bits());
+            let d2 = c.wrapping_sub(b).wrapping_sub(b.wrapping_sub(a)) as i64;
+            if (-127..=127).contains(&d2) {
+                d2 as i8
+            } else {
+                ESCAPE
             }
-            rest = after;
+        }));
+        let end = self.codes.len();
+        // Row r (base <= r < end) is stamp t[r + 2 - base]; row base - 1 is t[1].
+        let bits = |r: usize| t[r + 2 - base].to_bits();
+        let mut scanned = base;
+        let mut check = base.next_multiple_of(CHECK);
+        loop {
+            // The escaped stamps up to the next access point (included), then the point.
+            let upto = if check < end { check + 1 } else { end };
+            for (k, &c) in self.codes[scanned..upto].iter().enumerate() {
+                if c == ESCAPE {
+                    self.escaped.push(bits(scanned + k));
+                }
+            }
+            scanned = upto;
+            if check >= end {
+                break;
+            }
+            let d1 = bits(check).wrapping_sub(t[check + 1 - base].to_bits());
+            self.checks.push((check, bits(check), d1, self.escaped.len()));
+            check += CHECK;
         }
-        self.prev_bits = prev_bits;
-        self.prev_d1 = prev_d1;
+        self.prev_bits = last.to_bits();
+        self.prev_d1 = self.prev_bits.wrapping_sub(t[t.len() - 2].to_bits());
     }
 
     /// Appends the stamps of `other` (encoded on its own, as a piece of a file read in
@@ -419,16 +427,17 @@ pub fn estimate_interval_of<S: Stamps + Sync + ?Sized>(t: &S) -> Result<Interval
         if d.is_empty() {
             return Err(SamplingError::NotIncreasing);
         }
-        d.sort_by(f64::total_cmp);
-        d[d.len() / 2]
+        let mid = d.len() / 2;
+        *d.select_nth_unstable_by(mid, f64::total_cmp).1
     } else {
         let mut blocks: Vec<f64> =
             marks.windows(2).map(|w| (w[1] - w[0]) / BLOCK as f64).filter(|d| increasing(*d)).collect();
         if blocks.is_empty() {
             span_dt
         } else {
-            blocks.sort_by(f64::total_cmp);
-            let median = blocks[blocks.len() / 2];
+            // The median (the element a sort would put in the middle; no sort needed).
+            let mid = blocks.len() / 2;
+            let median = *blocks.select_nth_unstable_by(mid, f64::total_cmp).1;
             if (span_dt / median - 1.0).abs() <= 0.05 {
                 span_dt
             } else {
@@ -548,11 +557,8 @@ fn first_pass<S: Stamps + ?Sized>(t: &S, from: usize, to: usize) -> FirstPass {
         let bound = usize::from(at > 0 && !increasing(chunk[0] - prev));
         // The longest finite interval in the same sweep (the one across the bound included;
         // `prev` is NaN before the record's first stamp, so that difference is not finite).
-        let (inside, longest) = chunk.windows(2).fold((0usize, finite_or(chunk[0] - prev)), |(bad, long), w| {
-            let d = w[1] - w[0];
-            (bad + usize::from(!increasing(d)), if finite_or(d) > long { d } else { long })
-        });
-        out.longest = out.longest.max(longest);
+        let (inside, longest) = interval_sweep(chunk);
+        out.longest = out.longest.max(longest).max(finite_or(chunk[0] - prev));
         if bound + inside > 0 {
             let mut p = prev;
             for (k, &v) in chunk.iter().enumerate() {
@@ -569,6 +575,38 @@ fn first_pass<S: Stamps + ?Sized>(t: &S, from: usize, to: usize) -> FirstPass {
         true
     });
     out
+}
+
+/// Over the intervals between consecutive stamps of `t`: how many do not increase (not finite,
+/// or not above zero), and the longest finite one (-inf when there is none). Eight lanes of
+/// running counts and maxima, so that the sweep is vectorised (the order of a maximum does not
+/// change it).
+fn interval_sweep(t: &[f64]) -> (usize, f64) {
+    const LANES: usize = 8;
+    if t.len() < 2 {
+        return (0, f64::NEG_INFINITY);
+    }
+    let (a, b) = (&t[..t.len() - 1], &t[1..]);
+    let mut bad = [0u64; LANES];
+    let mut long = [f64::NEG_INFINITY; LANES];
+    #[inline(always)]
+    fn lane(d: f64, bad: &mut u64, long: &mut f64) {
+        *bad += u64::from(!(d > 0.0 && d < f64::INFINITY));
+        let finite = if d < f64::INFINITY { d } else { f64::NEG_INFINITY };
+        *long = if finite > *long { finite } else { *long };
+    }
+    let full = a.len() / LANES * LANES;
+    for (xa, xb) in a[..full].chunks_exact(LANES).zip(b[..full].chunks_exact(LANES)) {
+        let (Ok(xa), Ok(xb)) = (<&[f64; LANES]>::try_from(xa), <&[f64; LANES]>::try_from(xb)) else { continue };
+        for l in 0..LANES {
+            lane(xb[l] - xa[l], &mut bad[l], &mut long[l]);
+        }
+    }
+    for (k, (&x, &y)) in a[full..].iter().zip(&b[full..]).enumerate() {
+        lane(y - x, &mut bad[k], &mut long[k]);
+    }
+    let longest = long.iter().fold(f64::NEG_INFINITY, |m, &v| if v > m { v } else { m });
+    (bad.iter().sum::<u64>() as usize, longest)
 }
 
 /// `d` when finite, else -inf (so that it is never the longest interval).
