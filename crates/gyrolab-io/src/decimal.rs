@@ -881,21 +881,33 @@ mod tests {
     /// general reader would read them) and checks every row: taken rows hold exactly the full
     /// parser's values, and a row is refused only if one of its fields is not a plain decimal.
     fn check_rows(text: &str, ncols: usize, targets: &[u32]) -> Result<(), TestCaseError> {
-        check_rows_by(text, ncols, targets, 3)
+        check_rows_by(text, ncols, targets, 3, RowLayout { delim: b',', crlf: false })
     }
 
-    /// [`check_rows`] reading up to `room` rows a call.
-    fn check_rows_by(text: &str, ncols: usize, targets: &[u32], room: usize) -> Result<(), TestCaseError> {
+    /// [`check_rows`] reading up to `room` rows a call, of any layout.
+    fn check_rows_by(
+        text: &str,
+        ncols: usize,
+        targets: &[u32],
+        room: usize,
+        layout: RowLayout,
+    ) -> Result<(), TestCaseError> {
+        let d = layout.delim as char;
         let b = text.as_bytes();
         let mut shapes = RowShapes::new(ncols);
         let mut cols = vec![Vec::new(); ncols];
         let mut want: Vec<Vec<f64>> = vec![Vec::new(); ncols];
         let mut p = 0;
         while p < b.len() {
-            let (np, rows) =
-                read_rows(b, p, RowLayout { delim: b',', crlf: false }, targets, &mut shapes, &mut cols, room);
+            let (np, rows) = read_rows(b, p, layout, targets, &mut shapes, &mut cols, room);
             for line in std::str::from_utf8(&b[p..np]).unwrap().split_terminator('\n') {
-                let f: Vec<&str> = line.split(',').collect();
+                let line = if layout.crlf {
+                    prop_assert!(line.ends_with('\r'), "took {:?}", line);
+                    &line[..line.len() - 1]
+                } else {
+                    line
+                };
+                let f: Vec<&str> = line.split(d).collect();
                 prop_assert_eq!(f.len(), ncols, "{:?}", line);
                 for c in 0..ncols {
                     prop_assert!(is_plain(f[c]), "took {:?}", line);
@@ -907,10 +919,19 @@ mod tests {
             if rows == 0 {
                 let end = b[p..].iter().position(|&c| c == b'\n').map_or(b.len(), |i| p + i);
                 let line = std::str::from_utf8(&b[p..end]).unwrap();
-                let f: Vec<&str> = line.split(',').collect();
+                // With CRLF layouts a line must end in `\r` to be taken.
+                let (line, ends_right) = match line.strip_suffix('\r') {
+                    Some(l) if layout.crlf => (l, true),
+                    _ => (line, !layout.crlf),
+                };
+                let f: Vec<&str> = line.split(d).collect();
                 // A last line without its line end may be refused too (the reader adds one).
                 let unterminated = end == b.len();
-                prop_assert!(unterminated || f.len() != ncols || !f.iter().all(|x| is_plain(x)), "refused {:?}", line);
+                prop_assert!(
+                    unterminated || !ends_right || f.len() != ncols || !f.iter().all(|x| is_plain(x)),
+                    "refused {:?}",
+                    line
+                );
                 p = end + 1;
             } else {
                 p = np;
@@ -968,16 +989,18 @@ mod tests {
         }
 
         /// Long runs of rows of one layout (the digits random, the sign and the exponent's sign
-        /// now and then changed), as logs are, with corrupted bytes: the rows read a batch at a
-        /// time against every column's shape give exactly the full parser's values, and only
-        /// rows with a field that is not a plain decimal are refused.
+        /// now and then changed), as logs are, comma, semicolon or tab separated, with LF or
+        /// CRLF line ends, with corrupted bytes: the rows read a batch at a time against every
+        /// column's shape give exactly the full parser's values, and only rows with a field that
+        /// is not a plain decimal (or, with CRLF, a line not ending in it) are refused.
         #[test]
         fn runs_of_one_layout_equal_the_full_parser(
             layout in prop::collection::vec(number(), 1..8),
             rows in 40usize..300,
             seed in any::<u64>(),
             room in prop_oneof![Just(7usize), Just(1000usize)],
-            corrupt in prop::collection::vec((any::<prop::sample::Index>(), prop::sample::select(b"x.-+,e9 \r\n05E".to_vec())), 0..6),
+            (delim, crlf) in prop::sample::select(vec![(b',', false), (b';', true), (b'\t', false), (b',', true)]),
+            corrupt in prop::collection::vec((any::<prop::sample::Index>(), prop::sample::select(b"x.-+,;\te9 \r\n05E".to_vec())), 0..6),
         ) {
             let ncols = layout.len();
             let mut state = seed | 1;
@@ -998,7 +1021,11 @@ mod tests {
                         (if r % 8 == 1 { (s + 1) % 3 } else { s }, upper, 4 * (next() % 31) as u32 + e % 4)
                     });
                     text.push_str(&number_text((sign, int_digits, next(), width, next() % 1_000_000_000, exp)));
-                    text.push(if ci + 1 == ncols { '\n' } else { ',' });
+                    text.push_str(match (ci + 1 == ncols, crlf) {
+                        (false, _) => if delim == b',' { "," } else if delim == b';' { ";" } else { "\t" },
+                        (true, false) => "\n",
+                        (true, true) => "\r\n",
+                    });
                 }
             }
             let mut bytes = text.into_bytes();
@@ -1008,7 +1035,7 @@ mod tests {
             }
             let text = String::from_utf8(bytes).unwrap();
             let targets: Vec<u32> = (0..ncols as u32).collect();
-            check_rows_by(&text, ncols, &targets, room)?;
+            check_rows_by(&text, ncols, &targets, room, RowLayout { delim, crlf })?;
         }
 
         /// Any text made of number characters: the same checks.
