@@ -203,11 +203,13 @@ fn exponent_decimal(b: &[u8], d: &ScannedDecimal) -> Option<(f64, usize)> {
 }
 
 /// Bytes of the window a shape is checked in, from the first byte after the sign (three words
-/// for the masks, and room for an eight-byte load at any digit of them); a field is read
-/// against its shape only when this many bytes and one more (its sign) are in the buffer.
+/// for the masks, and room for an eight-byte load at any digit of them). A field is read
+/// against its shape only when 40 bytes from its first byte (its sign, if any) are in the
+/// buffer; fields closer to the end are scanned.
 const WINDOW: usize = 32;
 
-/// Most bytes a shape covers after the sign, its end character included (three words).
+/// Most bytes a shape covers after the sign, its end bytes included (the delimiter, or the line
+/// end: `\n`, or `\r\n`), in three words.
 const SHAPE_BYTES: usize = 24;
 
 /// Most digits of an integer without a point or exponent: w < 10^19 < 2^64, and `w as f64` is
@@ -397,8 +399,8 @@ fn scaled(w: u64, p: i32, negative: bool) -> Option<f64> {
 }
 
 /// Reads the field at `p` against `shape`: the value and the index of the next field, or `None`
-/// when the field (its end bytes included) does not have that shape, 32 bytes from its first
-/// digit are not available, or its exponent leaves a power outside the exact range.
+/// when the field (its end bytes included) does not have that shape, 40 bytes from its first
+/// byte are not available, or its exponent leaves a power outside the exact range.
 ///
 /// The check is one masked comparison per word of the window (see [`FieldShape::fold`]): the
 /// bytes that must be digits are, and the point, the `e` and the end bytes are those

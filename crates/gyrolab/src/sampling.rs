@@ -579,8 +579,9 @@ fn first_pass<S: Stamps + ?Sized>(t: &S, from: usize, to: usize) -> FirstPass {
 
 /// Over the intervals between consecutive stamps of `t`: how many do not increase (not finite,
 /// or not above zero), and the longest finite one (-inf when there is none). Eight lanes of
-/// running counts and maxima, so that the sweep is vectorised (the order of a maximum does not
-/// change it).
+/// running counts and maxima, so that the sweep is vectorised (the maximum does not depend on
+/// the order, but for the sign of a zero, which the comparison with a positive limit that reads
+/// it cannot see).
 fn interval_sweep(t: &[f64]) -> (usize, f64) {
     const LANES: usize = 8;
     if t.len() < 2 {
