@@ -71,14 +71,10 @@ fn leading_digits(v: u64) -> usize {
 /// halves are combined with three multiplications.
 #[inline(always)]
 fn digits_value(v: u64, n: usize) -> u64 {
-    let Some(d) = v.wrapping_sub(0x30 * ONES).checked_shl(64 - 8 * n as u32) else { return 0 };
-    // Bytes hold digits d0..d7 (d0 lowest = most significant). Pairs: 10 d0 + d1 in every
-    // even byte.
-    let pairs = d.wrapping_mul(10).wrapping_add(d >> 8);
-    // Quads in bits 0..32 and 32..64: 100 p0 + p1, then the halves 10^4 q0 + q1.
-    let lo = pairs & 0x0000_00ff_0000_00ff;
-    let hi = (pairs >> 16) & 0x0000_00ff_0000_00ff;
-    (lo.wrapping_mul(100 + (1_000_000 << 32)).wrapping_add(hi.wrapping_mul(1 + (10_000 << 32)))) >> 32
+    if n == 0 {
+        return 0;
+    }
+    eight_digits(v, (64 - 8 * n.min(8)) as u8)
 }
 
 /// Reads a run of digits from `i`, eight at a time, appending them to `w` (the value of the
@@ -225,8 +221,6 @@ pub struct FieldShape {
     int_digits: u8,
     /// Digits after the point.
     frac_digits: u8,
-    /// Whether the number has a point.
-    has_point: bool,
     /// Digits of the exponent (0: no exponent).
     exp_digits: u8,
     /// Whether the exponent has a sign (`e-05`, `e+05`; else `e05`).
@@ -337,7 +331,6 @@ impl FieldShape {
             before_point,
             int_digits: int_digits as u8,
             frac_digits: frac_digits as u8,
-            has_point,
             exp_digits: exp_digits as u8,
             exp_signed,
             step: step as u8,
@@ -392,10 +385,15 @@ fn digits_at(w: &[u8; WINDOW], k: usize, n: usize) -> u64 {
 /// correctly rounded multiplication or division (Clinger's fast path); `None` for other powers.
 #[inline(always)]
 fn scaled(w: u64, p: i32, negative: bool) -> Option<f64> {
-    let k = p.unsigned_abs() as usize;
-    let m = *POW10.get(k)?;
-    let v = if p >= 0 { w as f64 * m } else { w as f64 / m };
-    Some(with_sign(v, negative))
+    power_scaled(w as f64, p, negative)
+}
+
+/// x x 10^p with its sign, for an exact `x` (below 2^53) and |p| <= 22: as [`scaled`], for a
+/// significand already converted.
+#[inline(always)]
+fn power_scaled(x: f64, p: i32, negative: bool) -> Option<f64> {
+    let m = *POW10.get(p.unsigned_abs() as usize)?;
+    Some(with_sign(if p >= 0 { x * m } else { x / m }, negative))
 }
 
 /// Reads the field at `p` against `shape`: the value and the index of the next field, or `None`
@@ -462,8 +460,7 @@ fn shaped_field(b: &[u8], p: usize, shape: &FieldShape) -> Option<(f64, usize)> 
         }
         let e = (((run >> 8) & 0xf) * 10 + ((run >> 16) & 0xf)) as i32;
         let p = if negative_exp { -e } else { e } - i32::from(shape.frac_digits);
-        let m = *POW10.get(p.unsigned_abs() as usize)?;
-        return Some((with_sign(if p >= 0 { x * m } else { x / m }, negative), next));
+        return Some((power_scaled(x, p, negative)?, next));
     }
     let e = eight_digits(word_at(w, usize::from(shape.exp_at)), shape.exp_shift) as i32;
     let negative_exp = if shape.exp_signed {
@@ -476,15 +473,17 @@ fn shaped_field(b: &[u8], p: usize, shape: &FieldShape) -> Option<(f64, usize)> 
         false
     };
     let p = if negative_exp { -e } else { e } - i32::from(shape.frac_digits);
-    let m = *POW10.get(p.unsigned_abs() as usize)?;
-    Some((with_sign(if p >= 0 { x * m } else { x / m }, negative), next))
+    Some((power_scaled(x, p, negative)?, next))
 }
 
 /// The value of the ASCII digits of `v` that `shift` (bits) moves to the top bytes (those
-/// shifted out are ignored): as [`digits_value`] with a shift made beforehand.
+/// shifted out are ignored; zeros below act as leading zeros): [`digits_value`] with the shift
+/// made beforehand.
 #[inline(always)]
 fn eight_digits(v: u64, shift: u8) -> u64 {
     let d = v.wrapping_sub(0x30 * ONES) << (shift & 63);
+    // Bytes hold digits d0..d7 (d0 lowest = most significant). Pairs: 10 d0 + d1 in every
+    // even byte; quads in bits 0..32 and 32..64: 100 p0 + p1, then the halves 10^4 q0 + q1.
     let pairs = d.wrapping_mul(10).wrapping_add(d >> 8);
     let lo = pairs & 0x0000_00ff_0000_00ff;
     let hi = (pairs >> 16) & 0x0000_00ff_0000_00ff;

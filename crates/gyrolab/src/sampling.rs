@@ -187,18 +187,28 @@ impl PartialEq for CompactStamps {
 
 impl Eq for CompactStamps {}
 
+/// The code of a second difference of bit patterns: itself when it fits in -127..=127, else
+/// [`ESCAPE`] (the stamp is then stored whole).
+#[inline(always)]
+fn code_of(d2: u64) -> i8 {
+    let d2 = d2 as i64;
+    if (-127..=127).contains(&d2) {
+        d2 as i8
+    } else {
+        ESCAPE
+    }
+}
+
 impl CompactStamps {
     /// Appends a stamp.
     pub fn push(&mut self, t: f64) {
         let n = self.codes.len();
         let bits = t.to_bits();
         let d1 = if n == 0 { 0 } else { bits.wrapping_sub(self.prev_bits) };
-        let d2 = d1.wrapping_sub(self.prev_d1) as i64;
-        if n == 0 || !(-127..=127).contains(&d2) {
-            self.codes.push(ESCAPE);
+        let code = if n == 0 { ESCAPE } else { code_of(d1.wrapping_sub(self.prev_d1)) };
+        self.codes.push(code);
+        if code == ESCAPE {
             self.escaped.push(bits);
-        } else {
-            self.codes.push(d2 as i8);
         }
         if n.is_multiple_of(CHECK) {
             self.checks.push((n, bits, d1, self.escaped.len()));
@@ -220,12 +230,7 @@ impl CompactStamps {
         let base = self.codes.len();
         self.codes.extend(t.windows(3).map(|w| {
             let (a, b, c) = (w[0].to_bits(), w[1].to_bits(), w[2].to_bits());
-            let d2 = c.wrapping_sub(b).wrapping_sub(b.wrapping_sub(a)) as i64;
-            if (-127..=127).contains(&d2) {
-                d2 as i8
-            } else {
-                ESCAPE
-            }
+            code_of(c.wrapping_sub(b).wrapping_sub(b.wrapping_sub(a)))
         }));
         let end = self.codes.len();
         // Row r (base <= r < end) is stamp t[r + 2 - base]; row base - 1 is t[1].
@@ -272,11 +277,8 @@ impl CompactStamps {
         let mut inserted = false;
         if other.codes.len() > 1 && other.codes[1] != ESCAPE {
             let d1_1 = other.codes[1] as i64 as u64;
-            let d2 = d1_1.wrapping_sub(d1_0) as i64;
-            if (-127..=127).contains(&d2) {
-                other.codes[1] = d2 as i8;
-            } else {
-                other.codes[1] = ESCAPE;
+            other.codes[1] = code_of(d1_1.wrapping_sub(d1_0));
+            if other.codes[1] == ESCAPE {
                 other.escaped.insert(1, bits0.wrapping_add(d1_1));
                 inserted = true;
             }
