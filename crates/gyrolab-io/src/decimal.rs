@@ -18,6 +18,9 @@
 //! row that does not fit that either is left to the general reader ([`crate::series`]), which
 //! reads or reports it.
 
+#[cfg(target_arch = "x86_64")]
+mod avx512;
+
 /// Exact powers of ten representable in f64 (10^0 to 10^22).
 const POW10: [f64; 23] = [
     1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20,
@@ -632,7 +635,7 @@ pub fn read_rows(
             let Ok(buf) = <&mut [f64; PLANNED_VALUES]>::try_from(&mut buf[..PLANNED_VALUES]) else { break };
             loop {
                 let batch = (PLANNED_VALUES / nf).min(room - rows);
-                let (next, n) = planned_rows(b, p, &plan[..nf], buf, batch);
+                let (next, n) = planned_rows(b, p, &plan[..nf], layout.delim, buf, batch);
                 for (ci, &slot) in targets.iter().enumerate() {
                     if slot != SKIP_COLUMN {
                         cols[slot as usize].extend_from_slice(&buf[ci * batch..ci * batch + n]);
@@ -704,17 +707,39 @@ const PLANNED_VALUES: usize = 2048;
 /// Most fields of a row read a batch at a time (rows of more are read field by field).
 const MAX_PLANNED_FIELDS: usize = 16;
 
-/// Reads up to `batch` rows from `p` that fit `plan` (every field's shape) into `buf`, field `ci`
-/// of row `r` at `ci * batch + r`: returns where it stopped and the rows read.
+/// Reads up to `batch` rows from `p` that fit `plan` (every field's shape; fields separated by
+/// `delim`) into `buf`, field `ci` of row `r` at `ci * batch + r`: returns where it stopped and
+/// the rows read. Where the CPU has AVX-512, groups of eight rows are read at once first
+/// ([`avx512::planned_groups`], the same values bit for bit), and the rest row by row.
 #[inline(never)]
 fn planned_rows(
     b: &[u8],
     mut p: usize,
     plan: &[FieldShape],
+    delim: u8,
     buf: &mut [f64; PLANNED_VALUES],
     batch: usize,
 ) -> (usize, usize) {
     let mut r = 0;
+    #[cfg(target_arch = "x86_64")]
+    if avx512::available() && avx512::supports(plan) {
+        // SAFETY: the CPU has AVX-512 F, DQ and BW (checked just above); see the function's doc.
+        (p, r) = unsafe { avx512::planned_groups(b, p, plan, delim, buf, batch) };
+    }
+    let _ = delim;
+    scalar_rows(b, p, r, plan, buf, batch)
+}
+
+/// The row-by-row loop of [`planned_rows`], from row `r` at `p`.
+#[inline(always)]
+fn scalar_rows(
+    b: &[u8],
+    mut p: usize,
+    mut r: usize,
+    plan: &[FieldShape],
+    buf: &mut [f64; PLANNED_VALUES],
+    batch: usize,
+) -> (usize, usize) {
     'rows: while r < batch {
         let mut at = p;
         for (ci, shape) in plan.iter().enumerate() {
@@ -948,6 +973,139 @@ mod tests {
         Ok(())
     }
 
+    /// `rows` rows of the column layouts `layout` (random digits; now and then a sign changed,
+    /// and an exponent's sign), separated by `delim`, ending in `\n` or `\r\n`, with the bytes
+    /// of `corrupt` written over them.
+    fn layout_text(
+        layout: &[NumberParts],
+        rows: usize,
+        seed: u64,
+        delim: u8,
+        crlf: bool,
+        corrupt: &[(prop::sample::Index, u8)],
+    ) -> String {
+        let ncols = layout.len();
+        let mut state = seed | 1;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut text = String::new();
+        for _ in 0..rows {
+            for (ci, &(sign, int_digits, _, width, _, exp)) in layout.iter().enumerate() {
+                let r = next();
+                let sign = if r % 16 == 0 { (sign + 1) % 3 } else { sign };
+                // The exponent's width kept, its value (0 to 30, as logs have them) and now
+                // and then its sign changed from row to row.
+                let exp = exp.map(|(s, upper, e)| {
+                    (if r % 8 == 1 { (s + 1) % 3 } else { s }, upper, 4 * (next() % 31) as u32 + e % 4)
+                });
+                text.push_str(&number_text((sign, int_digits, next(), width, next() % 1_000_000_000, exp)));
+                text.push_str(match (ci + 1 == ncols, crlf) {
+                    (false, _) => {
+                        if delim == b',' {
+                            ","
+                        } else if delim == b';' {
+                            ";"
+                        } else {
+                            "\t"
+                        }
+                    }
+                    (true, false) => "\n",
+                    (true, true) => "\r\n",
+                });
+            }
+        }
+        let mut bytes = text.into_bytes();
+        for &(at, c) in corrupt {
+            let i = at.index(bytes.len());
+            bytes[i] = c;
+        }
+        String::from_utf8(bytes).unwrap()
+    }
+
+    /// Reads `text` from its second row on, a batch of `batch` rows at a time, against the
+    /// shapes of its first row, by the vector loop then the scalar one, and by the scalar loop
+    /// alone: both must stop at the same place with the same values, bit for bit. Returns the
+    /// rows the vector loop read.
+    #[cfg(target_arch = "x86_64")]
+    fn check_vector_rows(text: &str, ncols: usize, layout: RowLayout, batch: usize) -> Result<usize, TestCaseError> {
+        let b = text.as_bytes();
+        let targets: Vec<u32> = (0..ncols as u32).collect();
+        let mut shapes = vec![None; ncols];
+        let mut cols = vec![Vec::new(); ncols];
+        let Some(mut p) = read_row(b, 0, layout, &targets, &mut shapes, &mut cols) else { return Ok(0) };
+        let Some(plan) = shapes.into_iter().collect::<Option<Vec<FieldShape>>>() else { return Ok(0) };
+        if !avx512::supports(&plan) {
+            return Ok(0);
+        }
+        let batch = batch.min(PLANNED_VALUES / ncols);
+        let mut by_vector = 0;
+        while p < b.len() {
+            let (mut vb, mut sb) = ([f64::NAN; PLANNED_VALUES], [f64::NAN; PLANNED_VALUES]);
+            // SAFETY: the caller checked that the CPU has AVX-512 F, DQ and BW.
+            let (vp, vr) = unsafe { avx512::planned_groups(b, p, &plan, layout.delim, &mut vb, batch) };
+            by_vector += vr;
+            let (vp, vr) = scalar_rows(b, vp, vr, &plan, &mut vb, batch);
+            let (sp, sr) = scalar_rows(b, p, 0, &plan, &mut sb, batch);
+            prop_assert_eq!((vp, vr), (sp, sr), "from byte {}", p);
+            for ci in 0..ncols {
+                let got: Vec<u64> = vb[ci * batch..ci * batch + vr].iter().map(|v| v.to_bits()).collect();
+                let want: Vec<u64> = sb[ci * batch..ci * batch + sr].iter().map(|v| v.to_bits()).collect();
+                prop_assert_eq!(got, want, "column {} from byte {}", ci, p);
+            }
+            p = if sr == 0 { b[p..].iter().position(|&c| c == b'\n').map_or(b.len(), |i| p + i + 1) } else { sp };
+        }
+        Ok(by_vector)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn vector_rows_read_runs() {
+        if !avx512::available() {
+            eprintln!("SKIPPED: vector_rows_read_runs and vector_rows_equal_the_scalar_rows need AVX-512 F, DQ and BW, which this CPU lacks (the scalar loop is tested as ever)");
+            return;
+        }
+        // `%.7e` as C writes it (two exponent digits; Rust's `{:e}` writes one).
+        let c_exp = |x: f64| {
+            let s = format!("{x:.7e}");
+            let (m, e) = s.split_once('e').unwrap();
+            let e: i32 = e.parse().unwrap();
+            format!("{m}e{}{:02}", if e < 0 { '-' } else { '+' }, e.abs())
+        };
+        let mut text = String::from("time_s,rate_dps\n");
+        for i in 0..5000u32 {
+            let t = f64::from(i) * 0.01 + 12345.0;
+            let x = 0.5 + f64::from(i % 97) * 1e-4 - if i % 3 == 0 { 1.0 } else { 0.0 };
+            text.push_str(&format!("{t:.2},{}\n", c_exp(x)));
+        }
+        let text = &text[text.find('\n').unwrap() + 1..];
+        let layout = RowLayout { delim: b',', crlf: false };
+        let by_vector = check_vector_rows(text, 2, layout, 1000).unwrap();
+        // All but the first row and those within 64 bytes of the end.
+        assert!(by_vector > 4900, "{by_vector}");
+        // The exponent's sign is checked apart from the shape's masks: a row where it is not
+        // one stops both loops at that row.
+        for c in ["0", "x", " ", "e"] {
+            let at = text.match_indices("e-").nth(100).unwrap().0 + 1;
+            let bad = format!("{}{c}{}", &text[..at], &text[at + 1..]);
+            check_vector_rows(&bad, 2, layout, 1000).unwrap();
+        }
+        let mut kalibr = String::new();
+        for i in 0..3000u64 {
+            kalibr.push_str(&format!("{}", 1_700_000_000_000_000_000 + i * 2_500_000));
+            for c in 0..6u64 {
+                let v = (i * 7 + c * 13) as f64 * 1.234e-3 - 4.0;
+                kalibr.push_str(&format!(",{}", c_exp(v)));
+            }
+            kalibr.push('\n');
+        }
+        let by_vector = check_vector_rows(&kalibr, 7, layout, 292).unwrap();
+        assert!(by_vector > 1000, "{by_vector}");
+    }
+
     fn number() -> impl Strategy<Value = NumberParts> {
         (
             0u8..3,
@@ -995,6 +1153,22 @@ mod tests {
         /// column's shape give exactly the full parser's values, and only rows with a field that
         /// is not a plain decimal (or, with CRLF, a line not ending in it) are refused.
         #[test]
+        #[cfg(target_arch = "x86_64")]
+        #[test]
+        fn vector_rows_equal_the_scalar_rows(
+            layout in prop::collection::vec(number(), 1..8),
+            rows in 20usize..200,
+            seed in any::<u64>(),
+            batch in prop_oneof![Just(8usize), 9usize..70, Just(2048usize)],
+            (delim, crlf) in prop::sample::select(vec![(b',', false), (b';', true), (b'\t', false), (b',', true)]),
+            corrupt in prop::collection::vec((any::<prop::sample::Index>(), prop::sample::select(b"x.-+,;\te9 \r\n05E".to_vec())), 0..6),
+        ) {
+            if avx512::available() {
+                let text = layout_text(&layout, rows, seed, delim, crlf, &corrupt);
+                check_vector_rows(&text, layout.len(), RowLayout { delim, crlf }, batch)?;
+            }
+        }
+
         fn runs_of_one_layout_equal_the_full_parser(
             layout in prop::collection::vec(number(), 1..8),
             rows in 40usize..300,
@@ -1004,37 +1178,7 @@ mod tests {
             corrupt in prop::collection::vec((any::<prop::sample::Index>(), prop::sample::select(b"x.-+,;\te9 \r\n05E".to_vec())), 0..6),
         ) {
             let ncols = layout.len();
-            let mut state = seed | 1;
-            let mut next = move || {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                state
-            };
-            let mut text = String::new();
-            for _ in 0..rows {
-                for (ci, &(sign, int_digits, _, width, _, exp)) in layout.iter().enumerate() {
-                    let r = next();
-                    let sign = if r % 16 == 0 { (sign + 1) % 3 } else { sign };
-                    // The exponent's width kept, its value (0 to 30, as logs have them) and now
-                    // and then its sign changed from row to row.
-                    let exp = exp.map(|(s, upper, e)| {
-                        (if r % 8 == 1 { (s + 1) % 3 } else { s }, upper, 4 * (next() % 31) as u32 + e % 4)
-                    });
-                    text.push_str(&number_text((sign, int_digits, next(), width, next() % 1_000_000_000, exp)));
-                    text.push_str(match (ci + 1 == ncols, crlf) {
-                        (false, _) => if delim == b',' { "," } else if delim == b';' { ";" } else { "\t" },
-                        (true, false) => "\n",
-                        (true, true) => "\r\n",
-                    });
-                }
-            }
-            let mut bytes = text.into_bytes();
-            for (at, c) in corrupt {
-                let i = at.index(bytes.len());
-                bytes[i] = c;
-            }
-            let text = String::from_utf8(bytes).unwrap();
+            let text = layout_text(&layout, rows, seed, delim, crlf, &corrupt);
             let targets: Vec<u32> = (0..ncols as u32).collect();
             check_rows_by(&text, ncols, &targets, room, RowLayout { delim, crlf })?;
         }
