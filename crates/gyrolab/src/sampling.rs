@@ -199,6 +199,41 @@ fn code_of(d2: u64) -> i8 {
     }
 }
 
+/// `out[i]` = the code of stamp `t[i + 2]` ([`code_of`] its bit patterns' second difference),
+/// for `out.len() == t.len() - 2`: independent per stamp, so vectorised (AVX-512 or AVX2 where
+/// the CPU has them, chosen at run time; the same integer operations everywhere).
+fn second_difference_codes(t: &[f64], out: &mut [i8]) {
+    #[inline(always)]
+    fn body(t: &[f64], out: &mut [i8]) {
+        let n = out.len();
+        let (a, b, c) = (&t[..n], &t[1..n + 1], &t[2..n + 2]);
+        for (o, ((a, b), c)) in out.iter_mut().zip(a.iter().zip(b).zip(c)) {
+            let (a, b, c) = (a.to_bits(), b.to_bits(), c.to_bits());
+            *o = code_of(c.wrapping_sub(b).wrapping_sub(b.wrapping_sub(a)));
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx512f,avx512bw")]
+        unsafe fn body_avx512(t: &[f64], out: &mut [i8]) {
+            body(t, out)
+        }
+        #[target_feature(enable = "avx2")]
+        unsafe fn body_avx2(t: &[f64], out: &mut [i8]) {
+            body(t, out)
+        }
+        if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512bw") {
+            // SAFETY: the CPU has AVX-512 F and BW (checked just above).
+            return unsafe { body_avx512(t, out) };
+        }
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above).
+            return unsafe { body_avx2(t, out) };
+        }
+    }
+    body(t, out)
+}
+
 impl CompactStamps {
     /// Appends a stamp.
     pub fn push(&mut self, t: f64) {
@@ -228,10 +263,8 @@ impl CompactStamps {
         }
         let Some(&last) = t.get(2..).and_then(<[f64]>::last) else { return };
         let base = self.codes.len();
-        self.codes.extend(t.windows(3).map(|w| {
-            let (a, b, c) = (w[0].to_bits(), w[1].to_bits(), w[2].to_bits());
-            code_of(c.wrapping_sub(b).wrapping_sub(b.wrapping_sub(a)))
-        }));
+        self.codes.resize(base + t.len() - 2, 0);
+        second_difference_codes(t, &mut self.codes[base..]);
         let end = self.codes.len();
         // Row r (base <= r < end) is stamp t[r + 2 - base]; row base - 1 is t[1].
         let bits = |r: usize| t[r + 2 - base].to_bits();
@@ -240,9 +273,13 @@ impl CompactStamps {
         loop {
             // The escaped stamps up to the next access point (included), then the point.
             let upto = if check < end { check + 1 } else { end };
-            for (k, &c) in self.codes[scanned..upto].iter().enumerate() {
-                if c == ESCAPE {
-                    self.escaped.push(bits(scanned + k));
+            let codes = &self.codes[scanned..upto];
+            // (Escapes are rare: a branch-free test of the run first, which vectorises.)
+            if codes.iter().fold(false, |any, &c| any | (c == ESCAPE)) {
+                for (k, &c) in codes.iter().enumerate() {
+                    if c == ESCAPE {
+                        self.escaped.push(bits(scanned + k));
+                    }
                 }
             }
             scanned = upto;
@@ -583,8 +620,33 @@ fn first_pass<S: Stamps + ?Sized>(t: &S, from: usize, to: usize) -> FirstPass {
 /// or not above zero), and the longest finite one (-inf when there is none). Eight lanes of
 /// running counts and maxima, so that the sweep is vectorised (the maximum does not depend on
 /// the order, but for the sign of a zero, which the comparison with a positive limit that reads
-/// it cannot see).
+/// it cannot see). Compiled for AVX-512 and AVX2 too, chosen at run time (the same operations).
 fn interval_sweep(t: &[f64]) -> (usize, f64) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx512f")]
+        unsafe fn sweep_avx512(t: &[f64]) -> (usize, f64) {
+            interval_sweep_body(t)
+        }
+        #[target_feature(enable = "avx2")]
+        unsafe fn sweep_avx2(t: &[f64]) -> (usize, f64) {
+            interval_sweep_body(t)
+        }
+        if std::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU has AVX-512 F (checked just above).
+            return unsafe { sweep_avx512(t) };
+        }
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above).
+            return unsafe { sweep_avx2(t) };
+        }
+    }
+    interval_sweep_body(t)
+}
+
+/// The loop of [`interval_sweep`].
+#[inline(always)]
+fn interval_sweep_body(t: &[f64]) -> (usize, f64) {
     const LANES: usize = 8;
     if t.len() < 2 {
         return (0, f64::NEG_INFINITY);
