@@ -11,8 +11,8 @@
 //! - [`pages`]: how large in-memory records are backed (huge pages);
 //! - [`series`]: streaming reader of time-series files, and the static test of a file;
 //! - [`sim_csv`]: fast CSV writer for simulated static records and rate-table tests;
-//! - [`test_plan`]: test plans (TOML) for `gyrolab eval`;
-//! - [`plan_temperature`]: the plan's temperature tests at soaked points (`[temperature.<axis>]`).
+//! - [`test_plan`]: test plans (TOML) for `gyrolab eval`, one child module per plan section
+//!   (`test_plan::temperature`, `test_plan::uncertainty`, power-ups, threshold, g-sensitivity);
 //! - [`threshold_record`]: threshold and resolution records (rate, output per sample);
 //! - [`test_plan`]: test plans (TOML) for `gyrolab eval`.
 
@@ -23,8 +23,6 @@ pub mod decimal;
 pub mod error;
 pub mod pages;
 pub mod parquet_table;
-pub mod plan_temperature;
-pub mod plan_uncertainty;
 pub mod rate_table;
 pub mod raw_log;
 pub mod recording;

@@ -12,7 +12,7 @@ use gyrolab::uncertainty::{
     std_of_sample_std, Budget, Component, EvaluationType, LineUncertainty,
 };
 use gyrolab::units;
-use gyrolab_io::plan_uncertainty::UncertaintyPlan;
+use gyrolab_io::test_plan::uncertainty::UncertaintyPlan;
 use gyrolab_report::figures::AxisFigures;
 use gyrolab_report::format::sig;
 use gyrolab_report::html::{DataTable, ReportSection};

@@ -1,8 +1,8 @@
 //! The temperature tests of a test plan (`[temperature.<axis>]`, docs/PLAN.md): records at
 //! soaked temperature points, each a rate-table record, a static record, or both.
 
+use super::Ctx;
 use crate::rate_table::RateColumns;
-use crate::test_plan::Ctx;
 use crate::DataError;
 use gyrolab::thermal::Phase;
 use gyrolab::units::OutputUnit;

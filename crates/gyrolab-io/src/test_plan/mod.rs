@@ -16,15 +16,14 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
-#[path = "plan_threshold.rs"]
-mod plan_threshold;
-pub use plan_threshold::{NominalScaleFactor, StepTestPlan};
-#[path = "plan_power_ups.rs"]
-mod plan_power_ups;
-pub use plan_power_ups::{PowerUpsPlan, WarmupPlan, DEFAULT_WARMUP_WINDOW_S};
-#[path = "plan_g_sensitivity.rs"]
-mod plan_g_sensitivity;
-pub use plan_g_sensitivity::{GRecordPlan, GSensitivityAxisPlan};
+mod g_sensitivity;
+mod power_ups;
+pub mod temperature;
+mod threshold;
+pub mod uncertainty;
+pub use g_sensitivity::{GRecordPlan, GSensitivityAxisPlan};
+pub use power_ups::{PowerUpsPlan, WarmupPlan, DEFAULT_WARMUP_WINDOW_S};
+pub use threshold::{NominalScaleFactor, StepTestPlan};
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -45,18 +44,18 @@ struct RawPlan {
     #[serde(default)]
     equipment: Vec<Spanned<RawEquipment>>,
     #[serde(default)]
-    temperature: BTreeMap<String, Spanned<crate::plan_temperature::RawTemperature>>,
-    uncertainty: Option<crate::plan_uncertainty::RawUncertainty>,
+    temperature: BTreeMap<String, Spanned<temperature::RawTemperature>>,
+    uncertainty: Option<uncertainty::RawUncertainty>,
     #[serde(default)]
-    threshold: BTreeMap<String, Spanned<plan_threshold::RawThreshold>>,
+    threshold: BTreeMap<String, Spanned<threshold::RawThreshold>>,
     #[serde(default)]
-    resolution: BTreeMap<String, Spanned<plan_threshold::RawResolution>>,
+    resolution: BTreeMap<String, Spanned<threshold::RawResolution>>,
     #[serde(default)]
-    power_ups: BTreeMap<String, Spanned<plan_power_ups::RawPowerUps>>,
+    power_ups: BTreeMap<String, Spanned<power_ups::RawPowerUps>>,
     #[serde(default)]
-    warmup: BTreeMap<String, Spanned<plan_power_ups::RawWarmup>>,
+    warmup: BTreeMap<String, Spanned<power_ups::RawWarmup>>,
     #[serde(default)]
-    g_sensitivity: BTreeMap<String, Spanned<plan_g_sensitivity::RawGSensitivity>>,
+    g_sensitivity: BTreeMap<String, Spanned<g_sensitivity::RawGSensitivity>>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -366,9 +365,9 @@ pub struct TestPlan {
     /// The equipment used (`[[equipment]]`), in plan order.
     pub equipment: Vec<Equipment>,
     /// Temperature tests at soaked points (`[temperature.<axis>]`), in device axis order.
-    pub temperature: Vec<crate::plan_temperature::TemperaturePlan>,
+    pub temperature: Vec<temperature::TemperaturePlan>,
     /// Measurement-uncertainty inputs (`[uncertainty]`); `None`: no uncertainty budgets.
-    pub uncertainty: Option<crate::plan_uncertainty::UncertaintyPlan>,
+    pub uncertainty: Option<uncertainty::UncertaintyPlan>,
     /// Threshold tests (`[threshold.<axis>]`) in device axis order.
     pub threshold: Vec<StepTestPlan>,
     /// Resolution tests (`[resolution.<axis>]`) in device axis order.
@@ -723,7 +722,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
     let mut temperature = Vec::new();
     for axis in &axes {
         if let Some(t) = raw.temperature.get(axis) {
-            temperature.push(crate::plan_temperature::parse(&cx, axis, t)?);
+            temperature.push(temperature::parse(&cx, axis, t)?);
         }
     }
 
@@ -761,19 +760,19 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
     let uncertainty = raw
         .uncertainty
         .as_ref()
-        .map(|u| crate::plan_uncertainty::parse_uncertainty(u, &|span, key, msg| cx.err(span, key, msg)))
+        .map(|u| uncertainty::parse_uncertainty(u, &|span, key, msg| cx.err(span, key, msg)))
         .transpose()?;
-    let (threshold, resolution) = plan_threshold::parse_step_tests(
+    let (threshold, resolution) = threshold::parse_step_tests(
         &cx,
         &axes,
-        &plan_threshold::RawStepTables { threshold: &raw.threshold, resolution: &raw.resolution },
+        &threshold::RawStepTables { threshold: &raw.threshold, resolution: &raw.resolution },
         &|a| raw.rate.contains_key(a),
         options.calibration.as_ref(),
     )?;
 
-    let power_ups = plan_power_ups::power_ups(&cx, &raw.power_ups, &axes)?;
-    let warmup = plan_power_ups::warmups(&cx, &raw.warmup, &axes)?;
-    let g_sensitivity = plan_g_sensitivity::parse_g_sensitivity(&cx, &raw.g_sensitivity, &axes)?;
+    let power_ups = power_ups::power_ups(&cx, &raw.power_ups, &axes)?;
+    let warmup = power_ups::warmups(&cx, &raw.warmup, &axes)?;
+    let g_sensitivity = g_sensitivity::parse_g_sensitivity(&cx, &raw.g_sensitivity, &axes)?;
     Ok(TestPlan {
         file: path.to_path_buf(),
         device: DevicePlan {
