@@ -1,19 +1,48 @@
 #!/usr/bin/env bash
 # The project's test command (README): every test, including checks against references and the
-# browser test of the HTML report and the equality check with Python allantools. Installs what
-# the checks need (allantools into .venv, Chromium) on a fresh machine.
+# browser test of the HTML report and the equality check with Python allantools, and every
+# example of the README. Installs what the checks need (allantools into .venv, Chromium) where
+# it is missing, saying so first (scripts/install-test-deps.sh: opt-outs GYROLAB_SKIP_PYTHON=1,
+# GYROLAB_SKIP_BROWSER=1, each check then printing SKIPPED:).
+#
+# One build: `cargo test --workspace --all-targets` builds the gyrolab binary and the examples
+# with the workspace's features; the checks below use those files (a `cargo build -p ...` here
+# would resolve other features and build the crates again; docs/PERFORMANCE.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-test-deps.sh
+if [ "${GYROLAB_SKIP_BROWSER:-}" != "1" ] && ! bash scripts/install-test-deps.sh --browser; then
+    export GYROLAB_SKIP_BROWSER=1
+fi
+skip_python=0
+if [ "${GYROLAB_SKIP_PYTHON:-}" = "1" ]; then
+    skip_python=1
+fi
 cargo test --workspace --all-targets
-# Allan deviations equal to Python allantools (rate data = data_type 'freq') at relative 1e-9.
-cargo build --quiet -p gyrolab-cli
-.venv/bin/python scripts/check_allantools.py target/debug/gyrolab
-# Chi-squared quantiles (the confidence bounds) equal to scipy's chi2.ppf from 1 to 1e9 degrees
-# of freedom at relative 1e-9.
-cargo build --quiet -p gyrolab --example chi2_quantiles
-.venv/bin/python scripts/check_chi2_scipy.py target/debug/examples/chi2_quantiles
-# The Python package: built with maturin and installed into .venv, then its pytest suite
-# (equality with allantools and with the command line, simulated truth, malformed inputs).
-PATH="$PWD/.venv/bin:$PATH" .venv/bin/pip install --quiet --disable-pip-version-check --no-build-isolation ./python
-GYROLAB_BIN=target/debug/gyrolab .venv/bin/python -m pytest -q -rs python/tests
+bin=target/debug/gyrolab
+# Both are built by the line above; should a cargo version not leave them there, build them (once).
+if [ ! -x "$bin" ]; then
+    echo "test.sh: $bin not left by cargo test: building it" >&2
+    cargo build --quiet -p gyrolab-cli
+fi
+if [ ! -x target/debug/examples/chi2_quantiles ]; then
+    echo "test.sh: target/debug/examples/chi2_quantiles not left by cargo test: building it" >&2
+    cargo build --quiet -p gyrolab --example chi2_quantiles
+fi
+# Hostile recordings (written by the hostile test above) under a 2 GiB address-space limit.
+bash scripts/test_hostile_ulimit.sh "$bin"
+if [ "$skip_python" = "1" ]; then
+    echo "SKIPPED: GYROLAB_SKIP_PYTHON=1: allantools and scipy equality checks, the Python package's tests" >&2
+else
+    # Allan deviations equal to Python allantools (rate data = data_type 'freq') at relative 1e-9.
+    .venv/bin/python scripts/check_allantools.py "$bin"
+    # Chi-squared quantiles (the confidence bounds) equal to scipy's chi2.ppf from 1 to 1e9 degrees
+    # of freedom at relative 1e-9.
+    .venv/bin/python scripts/check_chi2_scipy.py target/debug/examples/chi2_quantiles
+    # The Python package: built with maturin and installed into .venv, then its pytest suite
+    # (equality with allantools and with the command line, simulated truth, malformed inputs).
+    PATH="$PWD/.venv/bin:$PATH" .venv/bin/pip install --quiet --disable-pip-version-check --no-build-isolation ./python
+    GYROLAB_BIN="$bin" .venv/bin/python -m pytest -q -rs python/tests
+fi
+# Every example of the README, as written (python blocks SKIPPED without the package).
+GYROLAB_PYTHON="$PWD/.venv/bin/python" bash scripts/readme_examples.sh "$bin"
