@@ -13,18 +13,13 @@
 # GYROLAB_SKIP_BROWSER=1 (no Chromium; the browser and PDF tests print SKIPPED:).
 #
 # usage: bash scripts/install-test-deps.sh            install what is missing
-#        bash scripts/install-test-deps.sh --browser  exit 0 when a browser is there, else 1
+#        bash scripts/install-test-deps.sh --browser  exit 0 when /usr/bin/chromium is there, else 1
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# A browser the tests can use: the one of GYROLAB_CHROMIUM, or one on PATH (as `--pdf` looks).
+# The browser the tests use (crates/gyrolab-cli/tests/browser.rs and pdf.rs): /usr/bin/chromium.
 have_browser() {
-    if [ -n "${GYROLAB_CHROMIUM:-}" ] && [ -x "${GYROLAB_CHROMIUM}" ]; then
-        return 0
-    fi
-    [ -x /usr/bin/chromium ] && return 0
-    command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 ||
-        command -v google-chrome >/dev/null 2>&1
+    [ -x /usr/bin/chromium ]
 }
 if [ "${1:-}" = "--browser" ]; then
     have_browser
@@ -57,8 +52,7 @@ if [ "$(id -u)" != "0" ]; then
         cat >&2 <<'EOF'
 install-test-deps: the browser and PDF tests need Chromium, which is not installed, and installing
 it needs root (this user cannot sudo without a password). Either
-    sudo apt-get install chromium          (Debian, Ubuntu: about 124 MB), then run the tests again,
-    GYROLAB_CHROMIUM=/path/to/chrome       (a Chromium or Chrome already there), or
+    sudo apt-get install chromium          (Debian, Ubuntu: about 124 MB), then run the tests again, or
     GYROLAB_SKIP_BROWSER=1                 (skip those two tests; they print SKIPPED:).
 This run goes on without them (scripts/test.sh sets GYROLAB_SKIP_BROWSER=1 for it).
 EOF
@@ -66,7 +60,7 @@ EOF
     fi
 fi
 echo "install-test-deps: installing chromium (Debian package, about 124 MB) for the browser and PDF tests" >&2
-echo "install-test-deps: (GYROLAB_SKIP_BROWSER=1 skips those tests instead; GYROLAB_CHROMIUM=PATH uses another browser)" >&2
+echo "install-test-deps: (GYROLAB_SKIP_BROWSER=1 skips those tests instead)" >&2
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update
 $SUDO apt-get install -y --no-install-recommends chromium
