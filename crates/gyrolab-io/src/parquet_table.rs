@@ -23,7 +23,19 @@ fn perr(path: &Path, e: impl std::fmt::Display) -> DataError {
 /// Reads the numeric columns (INT32, INT64, FLOAT, DOUBLE; nulls as missing cells) of a
 /// Parquet file as a time series; other columns are skipped with a note.
 pub fn read_parquet(path: &Path, options: &SeriesOptions) -> Result<SeriesData, DataError> {
-    let file = std::fs::File::open(path).map_err(|e| DataError::io(path, &e))?;
+    let (file, _, _) = crate::recording::open_sniffed(path)?;
+    read_parquet_file(path, file, options)
+}
+
+/// [`read_parquet`] of a file already opened (once, by [`crate::recording::open_sniffed`]).
+/// The footer's schema is checked first ([`check_footer`]): the `parquet` crate reserves room
+/// for a group's declared children before reading them.
+pub fn read_parquet_file(
+    path: &Path,
+    mut file: std::fs::File,
+    options: &SeriesOptions,
+) -> Result<SeriesData, DataError> {
+    check_footer(path, &mut file)?;
     let reader = SerializedFileReader::new(file).map_err(|e| perr(path, e))?;
     let meta = reader.metadata();
     let schema = meta.file_metadata().schema_descr();
@@ -60,6 +72,221 @@ pub fn read_parquet(path: &Path, options: &SeriesOptions) -> Result<SeriesData, 
     let mut data = series_from_columns(path, &names, columns, RowKind::Row, options)?;
     data.header.skipped.extend(skipped);
     Ok(data)
+}
+
+/// Longest footer (file metadata) read, bytes: 64 MiB.
+pub const MAX_FOOTER_BYTES: u64 = 64 << 20;
+
+/// Checks a Parquet footer before the `parquet` crate reads it: its length against the file
+/// and [`MAX_FOOTER_BYTES`], and in its schema (Thrift compact protocol, parquet-format's
+/// `FileMetaData` field 2, a list of `SchemaElement`, field 5 `num_children`) every group's
+/// count of children against the elements that follow it. The crate reserves a vector of the
+/// declared count first (2^30 children: 8 GiB) — refused here.
+fn check_footer(path: &Path, file: &mut std::fs::File) -> Result<(), DataError> {
+    use std::io::{Read, Seek, SeekFrom};
+    let size = file.metadata().map_err(|e| crate::recording::io_error(path, &e))?.len();
+    let bad = |what: String| DataError::new(path, format!("not a readable Parquet file: {what}"));
+    if size < 12 {
+        return Err(bad(format!("{size} bytes, too short for a Parquet file")));
+    }
+    let mut tail = [0u8; 8];
+    file.seek(SeekFrom::End(-8)).map_err(|e| crate::recording::io_error(path, &e))?;
+    file.read_exact(&mut tail).map_err(|e| crate::recording::io_error(path, &e))?;
+    if &tail[4..] != b"PAR1" {
+        return Err(bad("the file does not end with the PAR1 magic (cut off?)".into()));
+    }
+    let len = u64::from(u32::from_le_bytes([tail[0], tail[1], tail[2], tail[3]]));
+    if len + 12 > size || len > MAX_FOOTER_BYTES {
+        return Err(bad(format!(
+            "the footer declares {len} bytes, more than the file's {size} bytes or the {MAX_FOOTER_BYTES} accepted"
+        )));
+    }
+    let mut footer = Vec::new();
+    file.seek(SeekFrom::Start(size - 8 - len)).map_err(|e| crate::recording::io_error(path, &e))?;
+    file.by_ref().take(len).read_to_end(&mut footer).map_err(|e| crate::recording::io_error(path, &e))?;
+    file.seek(SeekFrom::Start(0)).map_err(|e| crate::recording::io_error(path, &e))?;
+    let at = size - 8 - len;
+    let counts =
+        thrift::schema_children(&footer).map_err(|why| bad(format!("the footer at byte {at} is damaged: {why}")))?;
+    // The elements are the schema tree in pre-order: each takes one open slot and opens as
+    // many as its declared children, which must fit in the elements that follow.
+    let mut open: u64 = 1;
+    for (i, c) in counts.iter().enumerate() {
+        if open == 0 {
+            return Err(bad(format!("the footer at byte {at}: schema element {} belongs to no group", i + 1)));
+        }
+        open -= 1;
+        let n = match c {
+            Some(n) if *n < 0 => {
+                return Err(bad(format!("the footer at byte {at}: schema element {} declares {n} children", i + 1)))
+            }
+            Some(n) => *n as u64,
+            None => 0,
+        };
+        let left = (counts.len() - i - 1) as u64;
+        if open + n > left {
+            return Err(bad(format!(
+                "the footer at byte {at}: schema element {} declares {n} children, but only {left} elements follow",
+                i + 1
+            )));
+        }
+        open += n;
+    }
+    Ok(())
+}
+
+/// Just enough of the Thrift compact protocol to read the schema's children counts.
+mod thrift {
+    /// Deepest nesting of structs and lists walked.
+    const MAX_DEPTH: u32 = 64;
+
+    struct Cursor<'a> {
+        b: &'a [u8],
+    }
+
+    impl Cursor<'_> {
+        fn byte(&mut self) -> Result<u8, String> {
+            let (&x, rest) = self.b.split_first().ok_or("it ends early")?;
+            self.b = rest;
+            Ok(x)
+        }
+        fn varint(&mut self) -> Result<u64, String> {
+            let mut v = 0u64;
+            for shift in (0..70).step_by(7) {
+                let x = self.byte()?;
+                if shift == 63 && x > 1 {
+                    return Err("a number longer than 64 bits".into());
+                }
+                v |= u64::from(x & 0x7f) << shift;
+                if x & 0x80 == 0 {
+                    return Ok(v);
+                }
+            }
+            Err("a number longer than 64 bits".into())
+        }
+        fn zigzag(&mut self) -> Result<i64, String> {
+            let v = self.varint()?;
+            Ok((v >> 1) as i64 ^ -((v & 1) as i64))
+        }
+        fn skip(&mut self, n: u64) -> Result<(), String> {
+            if n > self.b.len() as u64 {
+                return Err(format!("a field of {n} bytes where {} are left", self.b.len()));
+            }
+            self.b = &self.b[n as usize..];
+            Ok(())
+        }
+        /// A list header: (element type, count), the count checked against the bytes left
+        /// (every element takes at least one byte, except booleans packed in the header).
+        fn list(&mut self) -> Result<(u8, u64), String> {
+            let h = self.byte()?;
+            let n = if h >> 4 == 15 { self.varint()? } else { u64::from(h >> 4) };
+            if n > self.b.len() as u64 {
+                return Err(format!("a list of {n} elements in {} bytes", self.b.len()));
+            }
+            Ok((h & 0x0f, n))
+        }
+        /// Skips a value of compact type `t`.
+        fn skip_value(&mut self, t: u8, depth: u32) -> Result<(), String> {
+            if depth > MAX_DEPTH {
+                return Err("nested deeper than 64 levels".into());
+            }
+            match t {
+                1 | 2 => Ok(()),
+                3 => self.skip(1),
+                4..=6 => self.varint().map(drop),
+                7 => self.skip(8),
+                8 => {
+                    let n = self.varint()?;
+                    self.skip(n)
+                }
+                9 | 10 => {
+                    let (et, n) = self.list()?;
+                    for _ in 0..n {
+                        self.skip_value(et, depth + 1)?;
+                    }
+                    Ok(())
+                }
+                11 => {
+                    let n = self.varint()?;
+                    if n == 0 {
+                        return Ok(());
+                    }
+                    let kv = self.byte()?;
+                    if n > self.b.len() as u64 {
+                        return Err(format!("a map of {n} entries in {} bytes", self.b.len()));
+                    }
+                    for _ in 0..n {
+                        self.skip_value(kv >> 4, depth + 1)?;
+                        self.skip_value(kv & 0x0f, depth + 1)?;
+                    }
+                    Ok(())
+                }
+                12 => self.walk_struct(depth + 1, &mut |_, _, _| Ok(false)),
+                _ => Err(format!("an unknown Thrift type {t}")),
+            }
+        }
+        /// Walks a struct's fields; `on(cursor, id, type)` reads a field itself (returns true)
+        /// or leaves it to be skipped (false).
+        fn walk_struct(
+            &mut self,
+            depth: u32,
+            on: &mut dyn FnMut(&mut Self, i16, u8) -> Result<bool, String>,
+        ) -> Result<(), String> {
+            if depth > MAX_DEPTH {
+                return Err("nested deeper than 64 levels".into());
+            }
+            let mut id: i16 = 0;
+            loop {
+                let h = self.byte()?;
+                if h == 0 {
+                    return Ok(());
+                }
+                let t = h & 0x0f;
+                let delta = h >> 4;
+                id = if delta == 0 {
+                    i16::try_from(self.zigzag()?).map_err(|_| "a field id out of range".to_string())?
+                } else {
+                    id.wrapping_add(i16::from(delta))
+                };
+                if !on(self, id, t)? {
+                    self.skip_value(t, depth)?;
+                }
+            }
+        }
+    }
+
+    /// The `num_children` of every element of the schema (field 2 of FileMetaData), in order.
+    pub fn schema_children(footer: &[u8]) -> Result<Vec<Option<i64>>, String> {
+        let mut c = Cursor { b: footer };
+        let mut counts = Vec::new();
+        let mut found = false;
+        c.walk_struct(0, &mut |c, id, t| {
+            if id != 2 || t != 9 {
+                return Ok(false);
+            }
+            let (et, n) = c.list()?;
+            if et != 12 {
+                return Err("the schema is not a list of elements".into());
+            }
+            found = true;
+            for _ in 0..n {
+                let mut children = None;
+                c.walk_struct(1, &mut |c, id, t| {
+                    if id == 5 && t == 5 {
+                        children = Some(c.zigzag()?);
+                        return Ok(true);
+                    }
+                    Ok(false)
+                })?;
+                counts.push(children);
+            }
+            Ok(true)
+        })?;
+        if !found || counts.is_empty() {
+            return Err("no schema".into());
+        }
+        Ok(counts)
+    }
 }
 
 /// Appends a column's values as f64, nulls as NaN.

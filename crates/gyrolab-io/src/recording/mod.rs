@@ -59,23 +59,88 @@ impl FileFormat {
     }
 }
 
-/// The format of a file by its first bytes (`-`, standard input, is text).
+/// The format of a file by its first bytes (`-`, standard input, is text). A FIFO, socket or
+/// device is refused before it is opened ([`check_regular`]).
 pub fn sniff_format(path: &Path) -> Result<FileFormat, DataError> {
     if path.as_os_str() == "-" {
         return Ok(FileFormat::Text);
     }
+    Ok(open_sniffed(path)?.1)
+}
+
+/// Refuses a path that is not a regular file (a FIFO, socket, character or block device, or a
+/// directory), from its metadata: nothing is opened, so a FIFO without a writer cannot block.
+pub fn check_regular(path: &Path) -> Result<u64, DataError> {
+    let meta = std::fs::metadata(path).map_err(|e| io_error(path, &e))?;
+    let kind = meta.file_type();
+    if kind.is_file() {
+        return Ok(meta.len());
+    }
+    #[cfg(unix)]
+    let what = {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            "a FIFO (named pipe)"
+        } else if kind.is_socket() {
+            "a socket"
+        } else if kind.is_char_device() {
+            "a character device"
+        } else if kind.is_block_device() {
+            "a block device"
+        } else if kind.is_dir() {
+            "a directory"
+        } else {
+            "not a regular file"
+        }
+    };
+    #[cfg(not(unix))]
+    let what = if kind.is_dir() { "a directory" } else { "not a regular file" };
+    Err(DataError::new(
+        path,
+        format!("{what}, not a regular file: give a file (standard input is read as `-`, for delimited text)"),
+    ))
+}
+
+/// Opens a regular file once ([`check_regular`] first), reads its first bytes for the format
+/// and rewinds it: (the file, its format, its size in bytes).
+pub fn open_sniffed(path: &Path) -> Result<(std::fs::File, FileFormat, u64), DataError> {
+    use std::io::{Seek, SeekFrom};
+    check_regular(path)?;
+    let mut f = std::fs::File::open(path).map_err(|e| io_error(path, &e))?;
+    // The file opened may differ from the one checked (replaced in between): checked again.
+    let meta = f.metadata().map_err(|e| io_error(path, &e))?;
+    if !meta.is_file() {
+        return Err(DataError::new(path, "not a regular file (it changed while being opened)"));
+    }
     let mut head = [0u8; 16];
-    let mut f = std::fs::File::open(path).map_err(|e| DataError::io(path, &e))?;
     let mut n = 0;
     while n < head.len() {
         match f.read(&mut head[n..]) {
             Ok(0) => break,
             Ok(k) => n += k,
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-            Err(e) => return Err(DataError::io(path, &e)),
+            Err(e) => return Err(io_error(path, &e)),
         }
     }
-    Ok(format_of(&head[..n]))
+    f.seek(SeekFrom::Start(0)).map_err(|e| io_error(path, &e))?;
+    Ok((f, format_of(&head[..n]), meta.len()))
+}
+
+/// An I/O error in words: what failed, without the operating system's error number.
+pub(crate) fn io_error(path: &Path, e: &std::io::Error) -> DataError {
+    use std::io::ErrorKind as K;
+    let what = match e.kind() {
+        K::NotFound => "no such file".to_string(),
+        K::PermissionDenied => "permission denied".to_string(),
+        K::IsADirectory => "a directory, not a file".to_string(),
+        K::InvalidInput => "the file cannot be read this way (invalid argument)".to_string(),
+        K::UnexpectedEof => "the file ends early".to_string(),
+        _ => {
+            let t = e.to_string();
+            t.split(" (os error").next().unwrap_or(&t).to_string()
+        }
+    };
+    DataError::new(path, format!("cannot read the file: {what}"))
 }
 
 /// The format of a file that starts with `head`.
@@ -94,6 +159,11 @@ pub fn format_of(head: &[u8]) -> FileFormat {
         FileFormat::Text
     }
 }
+
+/// Largest magnitude of a value read from a recording: 1e100. Beyond it, squares and sums of
+/// squares of the Allan variance would leave the range of f64 (about 1.8e308); no sensor
+/// reports such a number, so it is damage and an error naming the message.
+pub const MAX_ABS_VALUE: f64 = 1e100;
 
 /// Where a topic's time stamps come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -171,8 +241,10 @@ impl ImuTopic {
             out_of_order: self.out_of_order,
             first_stamp_ns: first,
         };
-        // In place (same size and alignment: the allocation of the stamps is reused).
-        let time: Vec<f64> = self.stamps_ns.into_iter().map(|t| (t - first) as f64 * 1e-9).collect();
+        // In 128 bits: stamps far apart (a negative header stamp, a log time near 2^63) cannot
+        // overflow; in place (same size and alignment: the allocation of the stamps is reused).
+        let time: Vec<f64> =
+            self.stamps_ns.into_iter().map(|t| (i128::from(t) - i128::from(first)) as f64 * 1e-9).collect();
         let mut names = vec!["time_s".to_string()];
         names.extend(self.names);
         let mut columns = vec![time];
@@ -223,7 +295,11 @@ pub struct FileRecords {
 /// Reads any file gyrolab reads, by its content: delimited text and Parquet as one table,
 /// MCAP, ROS 1 bags and ULog as one record per IMU topic (`topics` selects; empty: all).
 pub fn read_records(path: &Path, options: &SeriesOptions, topics: &[String]) -> Result<FileRecords, DataError> {
-    let format = sniff_format(path)?;
+    let (file, format, _) = if path.as_os_str() == "-" {
+        return read_stdin_records(path, options, topics);
+    } else {
+        open_sniffed(path)?
+    };
     if !format.is_recording() && !topics.is_empty() {
         return Err(DataError::new(
             path,
@@ -238,9 +314,13 @@ pub fn read_records(path: &Path, options: &SeriesOptions, topics: &[String]) -> 
         return Err(sqlite_refused(path));
     }
     match format {
-        FileFormat::Text => Ok(table(crate::series::read_series_all(path, options)?)),
-        FileFormat::Parquet => Ok(table(crate::parquet_table::read_parquet(path, options)?)),
+        FileFormat::Text => {
+            drop(file);
+            Ok(table(crate::series::read_series_all(path, options)?))
+        }
+        FileFormat::Parquet => Ok(table(crate::parquet_table::read_parquet_file(path, file, options)?)),
         _ => {
+            drop(file);
             let rec = read_recording(path, &RecordingOptions { topics: topics.to_vec(), ..Default::default() })?;
             let mut records = Vec::with_capacity(rec.imu.len());
             for t in rec.imu {
@@ -254,6 +334,18 @@ pub fn read_records(path: &Path, options: &SeriesOptions, topics: &[String]) -> 
             Ok(FileRecords { format, records, truncated: rec.truncated })
         }
     }
+}
+
+/// Standard input (`-`): delimited text.
+fn read_stdin_records(path: &Path, options: &SeriesOptions, topics: &[String]) -> Result<FileRecords, DataError> {
+    if !topics.is_empty() {
+        return Err(DataError::new(
+            path,
+            "topics were given, but standard input is read as delimited text, not a recording (MCAP, ROS 1 bag, PX4 ULog)",
+        ));
+    }
+    let data = crate::series::read_series_all(path, options)?;
+    Ok(FileRecords { format: FileFormat::Text, records: vec![FileRecord { topic: None, data }], truncated: None })
 }
 
 /// What [`read_recording`] reads.
@@ -290,17 +382,17 @@ fn sqlite_refused(path: &Path) -> DataError {
     )
 }
 
-/// Reads a recording (MCAP, ROS 1 bag, ULog) in one pass.
+/// Reads a recording (MCAP, ROS 1 bag, ULog) in one pass, the file opened once.
 pub fn read_recording(path: &Path, options: &RecordingOptions) -> Result<Recording, DataError> {
-    let format = sniff_format(path)?;
+    let (file, format, size) = open_sniffed(path)?;
     if format == FileFormat::Sqlite {
         return Err(sqlite_refused(path));
     }
     let mut c = Collector::new(options);
     let end = match format {
-        FileFormat::Mcap => mcap_file::read(path, &mut c),
-        FileFormat::RosBag => bag::read(path, &mut c),
-        FileFormat::ULog => ulog::read(path, &mut c),
+        FileFormat::Mcap => mcap_file::read(path, file, size, &mut c),
+        FileFormat::RosBag => bag::read(path, file, size, &mut c),
+        FileFormat::ULog => ulog::read(path, file, &mut c),
         _ => {
             return Err(DataError::new(
                 path,
@@ -308,9 +400,10 @@ pub fn read_recording(path: &Path, options: &RecordingOptions) -> Result<Recordi
             ))
         }
     };
-    let truncated = match end {
-        Ok(()) => None,
-        Err(Stop::Damaged { at, what }) if c.decoded_messages() > 0 => Some(format!(
+    let mut notes = Vec::new();
+    match end {
+        Ok(()) => {}
+        Err(Stop::Damaged { at, what }) if c.decoded_messages() > 0 => notes.push(format!(
             "the file ends early or is damaged at {at} ({}); the messages before it are analysed",
             crate::text::short_message(&what)
         )),
@@ -322,6 +415,18 @@ pub fn read_recording(path: &Path, options: &RecordingOptions) -> Result<Recordi
         }
         Err(Stop::Error(e)) => return Err(e),
     };
+    if let Some((at, why)) = c.damaged_chunks.first() {
+        let n = c.damaged_chunks.len();
+        notes.insert(
+            0,
+            format!(
+                "{n} damaged chunk{} skipped (the first at byte {at}: {}); the messages of the other chunks are analysed",
+                if n == 1 { "" } else { "s" },
+                crate::text::short_message(why)
+            ),
+        );
+    }
+    let truncated = (!notes.is_empty()).then(|| notes.join("; "));
     c.finish(path, format, truncated)
 }
 
@@ -383,6 +488,8 @@ pub(crate) struct Collector {
     stamps: bool,
     inventory_only: bool,
     topics: Vec<TopicState>,
+    /// Chunks skipped as damaged: (byte offset, why).
+    pub damaged_chunks: Vec<(u64, String)>,
 }
 
 impl Collector {
@@ -392,6 +499,7 @@ impl Collector {
             stamps: options.stamps,
             inventory_only: options.inventory_only,
             topics: Vec::new(),
+            damaged_chunks: Vec::new(),
         }
     }
 
@@ -421,6 +529,11 @@ impl Collector {
             source,
         });
         self.topics.len() - 1
+    }
+
+    /// Whether a topic of this name is among those to decode (all, when none were named).
+    pub fn selected(&self, name: &str) -> bool {
+        !self.inventory_only && (self.want.is_empty() || self.want.iter().any(|w| w == name))
     }
 
     /// Whether the messages of topic `id` are to be decoded.
@@ -463,6 +576,35 @@ impl Collector {
             None => (stamp, stamp),
             Some((a, b)) => (a.min(stamp), b.max(stamp)),
         });
+    }
+
+    /// [`Collector::push`] after checking the values: one beyond [`MAX_ABS_VALUE`] (or
+    /// infinite) is an error naming the message (its 1-based index in the topic), the channel
+    /// and `at` (where in the file); NaN is kept (a missing sample).
+    pub fn push_checked(
+        &mut self,
+        path: &Path,
+        id: usize,
+        stamp_ns: i64,
+        log_ns: i64,
+        values: &[f64],
+        at: &str,
+    ) -> Result<(), DataError> {
+        if let Some(k) = values.iter().position(|v| v.abs() > MAX_ABS_VALUE) {
+            let t = &self.topics[id];
+            let name = t.layout.as_ref().and_then(|l| l.names.get(k)).map_or("a value", String::as_str);
+            return Err(DataError::new(
+                path,
+                format!(
+                    "message {} of topic '{}' ({at}): {name} is {:e}, beyond the range gyrolab computes with (magnitude at most {MAX_ABS_VALUE:e}): a damaged value",
+                    t.info.messages + 1,
+                    crate::text::excerpt(&t.info.topic),
+                    values[k]
+                ),
+            ));
+        }
+        self.push(id, stamp_ns, log_ns, values);
+        Ok(())
     }
 
     fn decoded_messages(&self) -> u64 {

@@ -39,6 +39,147 @@ impl RosImuType {
     }
 }
 
+impl RosImuType {
+    /// The ROS 2 type name.
+    pub fn name(self) -> &'static str {
+        match self {
+            RosImuType::Imu => "sensor_msgs/msg/Imu",
+            RosImuType::Vector3Stamped => "geometry_msgs/msg/Vector3Stamped",
+        }
+    }
+
+    /// The channels of the type.
+    pub(crate) fn layout(self) -> super::ImuLayout {
+        match self {
+            RosImuType::Imu => super::ImuLayout::six(),
+            RosImuType::Vector3Stamped => super::ImuLayout::three(["x", "y", "z"]),
+        }
+    }
+
+    /// The MD5 sum ROS 1 gives the type's definition (the `md5sum` of a bag's connection):
+    /// `rosmsg md5 sensor_msgs/Imu`, `rosmsg md5 geometry_msgs/Vector3Stamped` (ROS Noetic).
+    pub fn ros1_md5(self) -> &'static str {
+        match self {
+            RosImuType::Imu => "6a62c6daae103f4ff57a132d6f95cec2",
+            RosImuType::Vector3Stamped => "7b324c7325e683bf02a9b14b01090ec7",
+        }
+    }
+
+    /// The fields of the type, in order: (type, name), types without their package's `msg/`.
+    fn fields(self) -> &'static [(&'static str, &'static str)] {
+        match self {
+            RosImuType::Imu => &[
+                ("std_msgs/Header", "header"),
+                ("geometry_msgs/Quaternion", "orientation"),
+                ("float64[9]", "orientation_covariance"),
+                ("geometry_msgs/Vector3", "angular_velocity"),
+                ("float64[9]", "angular_velocity_covariance"),
+                ("geometry_msgs/Vector3", "linear_acceleration"),
+                ("float64[9]", "linear_acceleration_covariance"),
+            ],
+            RosImuType::Vector3Stamped => &[("std_msgs/Header", "header"), ("geometry_msgs/Vector3", "vector")],
+        }
+    }
+}
+
+/// The fields of the types an IMU message holds, as the decoder reads them (ROS 2 and ROS 1
+/// differ in the header and the time).
+fn nested_fields(ty: &str, encoding: Encoding) -> Option<&'static [(&'static str, &'static str)]> {
+    Some(match (ty, encoding) {
+        ("geometry_msgs/Vector3", _) => &[("float64", "x"), ("float64", "y"), ("float64", "z")],
+        ("geometry_msgs/Quaternion", _) => &[("float64", "x"), ("float64", "y"), ("float64", "z"), ("float64", "w")],
+        ("std_msgs/Header", Encoding::Cdr) => &[("builtin_interfaces/Time", "stamp"), ("string", "frame_id")],
+        ("std_msgs/Header", Encoding::Ros1) => &[("uint32", "seq"), ("time", "stamp"), ("string", "frame_id")],
+        ("builtin_interfaces/Time", _) => &[("int32", "sec"), ("uint32", "nanosec")],
+        _ => return None,
+    })
+}
+
+/// A type name as written in a definition, in one spelling: `pkg/msg/T` and `pkg/T` alike,
+/// `Header` as `std_msgs/Header`, `time` of ROS 1 as itself.
+fn normal_type(t: &str) -> String {
+    let t = t.replace("/msg/", "/");
+    if t == "Header" {
+        "std_msgs/Header".to_string()
+    } else {
+        t
+    }
+}
+
+/// The fields (type, name) of each section of a message definition (ROS 2 `ros2msg` or ROS 1
+/// text: the type's own fields first, then `MSG: pkg/Type` sections after lines of `=`);
+/// comments, blank lines and constants are left out.
+fn definition_sections(text: &str) -> Vec<(String, Vec<(String, String)>)> {
+    let mut sections = vec![(String::new(), Vec::new())];
+    for line in text.lines() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        if line.len() >= 3 && line.bytes().all(|b| b == b'=') {
+            sections.push((String::new(), Vec::new()));
+            continue;
+        }
+        if let Some(name) = line.strip_prefix("MSG:") {
+            if let Some(last) = sections.last_mut() {
+                last.0 = normal_type(name.trim());
+            }
+            continue;
+        }
+        let mut parts = line.split_whitespace();
+        let (Some(ty), Some(name)) = (parts.next(), parts.next()) else { continue };
+        if name.contains('=') || parts.next().is_some_and(|p| p.starts_with('=')) {
+            continue; // a constant
+        }
+        if let Some(last) = sections.last_mut() {
+            last.1.push((normal_type(ty), name.to_string()));
+        }
+    }
+    sections
+}
+
+/// Checks a message definition against the layout the decoder reads for `kind` in `encoding`:
+/// the type's fields in order with their types, and those of the nested types the definition
+/// spells out (a nested type it leaves out is the standard one its name says). An empty
+/// definition is accepted (nothing to check). The error names the first field that differs.
+pub fn check_definition(kind: RosImuType, encoding: Encoding, text: &str) -> Result<(), String> {
+    let sections = definition_sections(text);
+    let Some((_, top)) = sections.first() else { return Ok(()) };
+    if top.is_empty() && sections.len() == 1 {
+        return Ok(());
+    }
+    let compare = |owner: &str, got: &[(String, String)], want: &[(&str, &str)]| -> Result<(), String> {
+        for (i, w) in want.iter().enumerate() {
+            match got.get(i) {
+                None => return Err(format!("{owner} has no field '{}' ({} expected)", w.1, w.0)),
+                Some((t, n)) if n != w.1 || t != w.0 => {
+                    return Err(format!(
+                        "field {} of {owner} is '{} {}', where '{} {}' is expected",
+                        i + 1,
+                        crate::text::excerpt(t),
+                        crate::text::excerpt(n),
+                        w.0,
+                        w.1
+                    ))
+                }
+                Some(_) => {}
+            }
+        }
+        if let Some((t, n)) = got.get(want.len()) {
+            return Err(format!("{owner} has a field more, '{} {}'", crate::text::excerpt(t), crate::text::excerpt(n)));
+        }
+        Ok(())
+    };
+    compare(kind.name(), top, kind.fields())?;
+    for (name, fields) in &sections[1..] {
+        let name = if encoding == Encoding::Ros1 && name == "builtin_interfaces/Time" { "" } else { name.as_str() };
+        if let Some(want) = nested_fields(name, encoding) {
+            compare(name, fields, want)?;
+        }
+    }
+    Ok(())
+}
+
 /// One decoded message: its header stamp (ns) and values (gyro x/y/z then accel x/y/z for an
 /// Imu; x/y/z for a Vector3Stamped).
 #[derive(Debug, Clone, Copy, PartialEq)]

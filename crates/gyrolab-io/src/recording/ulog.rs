@@ -14,8 +14,8 @@
 
 use super::{Collector, ImuLayout, StampSource, Stop};
 use crate::error::DataError;
-use px4_ulog::stream_parser::file_reader::{read_file_with_simple_callback, Message, SimpleCallbackResult};
-use px4_ulog::stream_parser::model::{Completeness, FlattenedField, FlattenedFieldType, FlattenedFormat};
+use px4_ulog::stream_parser::file_reader::LogParser;
+use px4_ulog::stream_parser::model::{FlattenedField, FlattenedFieldType, FlattenedFormat};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -105,21 +105,63 @@ fn plan_of(f: &FlattenedFormat) -> Option<(ImuLayout, StampSource, Option<Flatte
     }
 }
 
-/// The description inside the parser's debug text of an error, without the message format it
-/// quotes (`UlogParseError { .., description: "data message had wrong size 50, format: ..." }`).
-fn parse_error_text(why: &str) -> String {
-    let d = why.split_once("description: \"").map_or(why, |(_, d)| d);
-    let d = d.split(", format:").next().unwrap_or(d);
-    d.trim_end_matches(['"', ' ', '}']).to_string()
+/// The parser's error description in words: without the message format it may quote
+/// (`data message had wrong size 50, format: FlattenedFormat { .. }`) or any other debug text.
+fn parse_error_text(description: &str) -> String {
+    let mut d = description;
+    for cut in [", format", "FlattenedFormat", "Some(", " {", "Format {"] {
+        if let Some(i) = d.find(cut) {
+            d = &d[..i];
+        }
+    }
+    let d = d.trim_end_matches([':', ',', ' ', '"']).trim();
+    if d.is_empty() {
+        "a message the ULog parser cannot read".to_string()
+    } else {
+        crate::text::short_message(d)
+    }
 }
 
-/// Reads every data message of a ULog file into `c`.
-pub(super) fn read(path: &Path, c: &mut Collector) -> Result<(), Stop> {
-    let shown = path.to_string_lossy().to_string();
+/// A time stamp field (microseconds, an integer type) read exactly, as ns; `Err` when it is
+/// beyond the range of nanosecond stamps (about 292 years).
+fn stamp_value(data: &[u8], f: &FlattenedField) -> Option<Result<i64, u64>> {
+    let o = f.offset as usize;
+    let us: u64 = match f.field_type {
+        FlattenedFieldType::UInt64 | FlattenedFieldType::Int64 => {
+            let b: [u8; 8] = data.get(o..o + 8)?.try_into().ok()?;
+            let v = u64::from_le_bytes(b);
+            if f.field_type == FlattenedFieldType::Int64 && (v as i64) < 0 {
+                return Some(Err(v));
+            }
+            v
+        }
+        _ => {
+            let v = value(data, f)?;
+            if !(0.0..9.2e18).contains(&v) {
+                return Some(Err(u64::MAX));
+            }
+            v as u64
+        }
+    };
+    Some(i64::try_from(us).ok().and_then(|u| u.checked_mul(1000)).ok_or(us))
+}
+
+/// Bytes fed to the parser at once.
+const FEED: usize = 64 * 1024;
+
+/// Reads every data message of a ULog file (opened once) into `c`.
+pub(super) fn read(path: &Path, mut file: std::fs::File, c: &mut Collector) -> Result<(), Stop> {
+    use std::io::Read;
     let mut plans: HashMap<(u16, u8), (usize, Option<Plan>)> = HashMap::new();
     let mut failure: Option<DataError> = None;
-    let mut callback = |m: &Message| {
-        let Message::Data(d) = m else { return SimpleCallbackResult::KeepReading };
+    // Where the bytes being parsed start: a message found there is located by them.
+    let fed_from = std::cell::Cell::new(0u64);
+    let fed_to = std::cell::Cell::new(0u64);
+    let stopped = std::cell::Cell::new(false);
+    let mut callback = |d: &px4_ulog::stream_parser::model::DataMessage| {
+        if stopped.get() {
+            return;
+        }
         let fmt = d.flattened_format;
         let multi = d.multi_id.value();
         let (id, plan) = plans.entry((d.msg_id, multi)).or_insert_with(|| {
@@ -139,12 +181,23 @@ pub(super) fn read(path: &Path, c: &mut Collector) -> Result<(), Stop> {
         let log_ns = log_us.map_or(0, |u| (u.min(i64::MAX as u64 / 1000) * 1000) as i64);
         let Some(plan) = plan else {
             c.count(id, log_ns);
-            return SimpleCallbackResult::KeepReading;
+            return;
         };
         if !c.decodes(id) {
             c.count(id, log_ns);
-            return SimpleCallbackResult::KeepReading;
+            return;
         }
+        let at = format!("in bytes {} to {}", fed_from.get(), fed_to.get());
+        let located = |c: &Collector, what: String| {
+            DataError::new(
+                path,
+                format!(
+                    "message {} of topic '{}' ({at}): {what}",
+                    c.topics[id].info.messages + 1,
+                    crate::text::excerpt(&c.topics[id].info.topic)
+                ),
+            )
+        };
         let mut values = [0.0f64; 6];
         for (slot, v) in values.iter_mut().zip(&plan.values) {
             let x = match v {
@@ -158,36 +211,71 @@ pub(super) fn read(path: &Path, c: &mut Collector) -> Result<(), Stop> {
             match x {
                 Some(x) => *slot = x,
                 None => {
-                    failure = Some(DataError::new(
-                        &shown,
-                        format!(
-                            "message {} of topic '{}': shorter than its format",
-                            c.topics[id].info.messages + 1,
-                            crate::text::excerpt(&c.topics[id].info.topic)
-                        ),
-                    ));
-                    return SimpleCallbackResult::Stop;
+                    failure = Some(located(c, "shorter than its format".into()));
+                    stopped.set(true);
+                    return;
                 }
             }
         }
-        let stamp_ns =
-            plan.stamp.as_ref().and_then(|s| value(d.data, s)).map_or(log_ns, |us| (us as i64).saturating_mul(1000));
+        let stamp_ns = match plan.stamp.as_ref().and_then(|s| stamp_value(d.data, s)) {
+            None => log_ns,
+            Some(Ok(ns)) => ns,
+            Some(Err(us)) => {
+                failure = Some(located(
+                    c,
+                    format!(
+                        "its time stamp {us} us is beyond the range of nanosecond stamps (about 292 years since boot): a damaged stamp"
+                    ),
+                ));
+                stopped.set(true);
+                return;
+            }
+        };
         let width = plan.values.len();
-        c.push(id, stamp_ns, log_ns, &values[..width]);
-        SimpleCallbackResult::KeepReading
+        if let Err(e) = c.push_checked(path, id, stamp_ns, log_ns, &values[..width], &at) {
+            failure = Some(e);
+            stopped.set(true);
+        }
     };
-    let completeness = read_file_with_simple_callback(&shown, &mut callback);
+    let mut parser = LogParser::default();
+    parser.set_data_message_callback(&mut callback);
+    let mut buf = vec![0u8; FEED];
+    let mut offset = 0u64;
+    let mut parse_error = None;
+    loop {
+        let n = match file.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(super::io_error(path, &e).into()),
+        };
+        fed_from.set(offset);
+        fed_to.set(offset + n as u64);
+        if let Err(e) = parser.consume_bytes(&buf[..n]) {
+            parse_error = Some((offset, offset + n as u64, parse_error_text(&e.description), parser.in_data()));
+            break;
+        }
+        offset += n as u64;
+        if stopped.get() {
+            break;
+        }
+    }
+    let leftover = parser.has_leftover();
+    drop(parser);
     if let Some(e) = failure {
         return Err(Stop::Error(e));
     }
-    match completeness {
-        Ok(Completeness::Complete) => Ok(()),
-        Ok(Completeness::Truncated) => {
-            Err(Stop::Damaged { at: "the end".into(), what: "the last message is cut off".into() })
+    match parse_error {
+        Some((from, to, what, true)) => {
+            Err(Stop::Damaged { at: format!("a data message in bytes {from} to {to}"), what })
         }
-        Ok(Completeness::MalformedRecord(why)) => {
-            Err(Stop::Damaged { at: "a data message".into(), what: parse_error_text(&why) })
+        Some((from, to, what, false)) => {
+            Err(Stop::Damaged { at: format!("the header or definitions (bytes {from} to {to})"), what })
         }
-        Err(e) => Err(Stop::Damaged { at: "the header or definitions".into(), what: e.to_string() }),
+        None if leftover => Err(Stop::Damaged {
+            at: format!("byte {offset}"),
+            what: format!("the last message is cut off: the file ends at byte {offset} inside it"),
+        }),
+        None => Ok(()),
     }
 }
