@@ -471,6 +471,7 @@ pub fn record_timing(data: &SeriesData, path: &Path, given_hz: Option<f64>, poli
         }
     }
     let (gaps, missing) = estimate.as_ref().map_or((Vec::new(), 0), |e| (e.gaps.clone(), e.missing));
+    check_grid_size(data, path, &gaps, missing)?;
     match (given_hz, &estimate) {
         (Some(f), Some(e)) => {
             if let Some(msg) = disagreement(e, f, "{sample_rate_hz}", path) {
@@ -495,6 +496,33 @@ pub fn record_timing(data: &SeriesData, path: &Path, given_hz: Option<f64>, poli
             format!("{}: no time column (such as time_s): give {{sample_rate_hz}}", path.display()),
         )),
     }
+}
+
+/// Most samples the gaps of a record may add to its uniform grid, as a multiple of the samples
+/// it has: 1 (the grid at most twice the record). A stamp that leaps (far in the future, zero,
+/// negative, a clock that falls back to another epoch) would otherwise size the grid: one stamp
+/// 54 years away at 1 kHz asks for 1.7e12 slots (14 TB per channel). Such a record is refused,
+/// naming the line (message) of its longest gap, before anything is allocated.
+pub const MAX_GAP_FILL: usize = 1;
+
+/// Refuses a record whose gaps would make its uniform grid more than [`MAX_GAP_FILL`] times its
+/// samples longer (see there).
+fn check_grid_size(data: &SeriesData, path: &Path, gaps: &[gyrolab::sampling::Gap], missing: usize) -> EvalResult<()> {
+    let n = data.channels.first().map_or(0, Vec::len);
+    if missing <= n.saturating_mul(MAX_GAP_FILL) {
+        return Ok(());
+    }
+    let Some(g) = gaps.iter().max_by_key(|g| g.missing) else { return Ok(()) };
+    let line = data.lines.get(g.index).unwrap_or(0);
+    Err(DataError::new(
+        path,
+        format!(
+            "the time stamps leap: a gap of {} s before this sample would leave {} samples missing ({} in all gaps), more than the record's {n} samples; a stamp far from the others (damaged, zero, or on another clock) — split the record at the leap or remove the stamp",
+            g.interval_s, g.missing, missing
+        ),
+    )
+    .at_line(line)
+    .into())
 }
 
 /// Places a channel's samples on the uniform grid of the record: sample i goes to slot
