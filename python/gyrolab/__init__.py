@@ -16,17 +16,20 @@ from __future__ import annotations
 
 import json
 import os
-from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
+from ._errors import Error
 from . import _gyrolab
-from ._gyrolab import Error, __version__
+from ._gyrolab import __version__
+from ._results import AllanResult, AllanResults
 
 __all__ = [
     "Error",
     "AllanResult",
+    "AllanResults",
+    "UNITS",
     "allan",
     "bias",
     "rate_table",
@@ -68,125 +71,247 @@ def _float_array(x: Any, name: str, check_finite: bool = True) -> np.ndarray:
     return a
 
 
-def _taus_text(taus: Union[str, Sequence[float]]) -> str:
-    if isinstance(taus, str):
-        return taus
-    return ",".join(repr(float(t)) for t in taus)
+#: The units ``allan`` reads (``unit=`` / ``units=``), with their aliases.
+UNITS = (
+    "dps", "deg/s", "dph", "deg/h", "rad_s", "rad/s", "mrad_s", "mrad/s",  # angular rates
+    "m/s^2", "m/s2", "g", "mg", "ug",  # accelerations
+    "v", "mv", "lsb",  # sensor outputs (noise terms need scale_factor)
+    "1",  # no unit: deviations in the data's own unit, no noise terms
+)
+
+_TIME_NAMES = ("time_s", "time", "t")
 
 
-@dataclass
-class AllanResult:
-    """An Allan-family deviation with its bounds and noise terms.
-
-    Arrays (one value per averaging time): ``taus_s``, ``m`` (averaging factor), ``dev``,
-    ``ci_low``, ``ci_high`` (NaN where no bound exists), ``n_terms``, ``alpha`` (noise type,
-    NaN where not identified). ``noise`` holds the slope-line noise terms with their units
-    (``arw_deg_rt_h``, ``bias_instability_dph``, ``rrw_deg_h_rt_h``, ...; ``None`` when absent),
-    ``readings`` where each was read, ``fit`` the five-term fit, ``unit`` the unit of ``dev``.
-    """
-
-    taus_s: np.ndarray
-    m: np.ndarray
-    dev: np.ndarray
-    ci_low: np.ndarray
-    ci_high: np.ndarray
-    n_terms: np.ndarray
-    alpha: np.ndarray
-    kind: str
-    unit: str
-    noise: Dict[str, Any] = field(default_factory=dict)
-    readings: List[Dict[str, Any]] = field(default_factory=list)
-    fit: Optional[Dict[str, Any]] = None
-    _doc: Dict[str, Any] = field(default_factory=dict, repr=False)
-
-    def to_dict(self) -> Dict[str, Any]:
-        """The result with the keys of ``gyrolab allan --json``."""
-        return json.loads(json.dumps(self._doc))
-
-    def plot(self, ax: Any = None, label: Optional[str] = None) -> Any:
-        """Draws the log-log curve with its bounds and the N, B, K asymptotes on ``ax``
-        (a new figure when None); needs matplotlib. Returns the axes."""
+def _samples(x: Any, name: str, unit: Optional[str]) -> np.ndarray:
+    """A 1-D float64 array of samples (the array itself when it is one: never copied); integer
+    samples need their unit named, booleans are refused."""
+    a = np.asarray(x)
+    if a.dtype == np.bool_:
+        raise Error(f"{name}: boolean samples are not measurements: give numbers", keyword=None)
+    if a.dtype.kind in "iu" and unit is None:
+        raise Error(
+            f"{name}: integer samples (counts?): give their unit, e.g. unit='lsb' with scale_factor, "
+            "or unit='dps' if they are rates in deg/s",
+            keyword="unit",
+        )
+    if a.dtype != np.float64:
         try:
-            import matplotlib.pyplot as plt
-        except ImportError as e:  # pragma: no cover - depends on the environment
-            raise ImportError("plot() needs matplotlib: pip install matplotlib") from e
-        if ax is None:
-            _, ax = plt.subplots(figsize=(7, 5))
-        t, d = self.taus_s, self.dev
-        lo = np.where(np.isfinite(self.ci_low), d - self.ci_low, 0.0)
-        hi = np.where(np.isfinite(self.ci_high), self.ci_high - d, 0.0)
-        ax.errorbar(t, d, yerr=[lo, hi], fmt="o-", ms=3, capsize=2, label=label or self.kind.upper())
-        n = self.noise.get("arw_deg_rt_s")
-        b = self.noise.get("bias_instability_dph")
-        b_min = self.noise.get("allan_minimum_dph")
-        k = self.noise.get("rrw_deg_s_rt_s")
-        if self.unit == "deg/s":
-            tt = np.geomspace(t[0], t[-1], 50)
-            if n:
-                ax.plot(tt, n / np.sqrt(tt), "--", lw=1, label=f"N = {self.noise['arw_deg_rt_h']:.3g} deg/√h")
-            if b and b_min:
-                # The flat level is the Allan minimum (0.6643 B, IEEE 952), given by gyrolab.
-                ax.plot(tt, np.full_like(tt, b_min / 3600.0), ":", lw=1, label=f"B = {b:.3g} deg/h (minimum {b_min:.3g})")
-            if k:
-                ax.plot(tt, k * np.sqrt(tt / 3.0), "-.", lw=1, label=f"K = {self.noise['rrw_deg_h_rt_h']:.3g} deg/h/√h")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("averaging time τ (s)")
-        ax.set_ylabel(f"{self.kind.upper()} σ(τ) ({self.unit})")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(loc="best", fontsize="small")
-        return ax
+            a = a.astype(np.float64)
+        except (TypeError, ValueError) as e:
+            raise Error(f"{name}: expected an array of numbers ({e})") from None
+    if a.ndim != 1:
+        raise Error(f"{name}: expected a 1-D array, got {a.ndim} dimensions with shape {a.shape}")
+    if a.size == 0:
+        raise Error(f"{name}: the array is empty")
+    return a
+
+
+def _channels(
+    x: Any, names: Optional[Sequence[str]], time: Any, unit: Optional[str], units: Any
+) -> Tuple[List[str], List[np.ndarray], List[str], Optional[np.ndarray], bool]:
+    """(names, arrays, units, time stamps, single): the channels of a 1-D array, a 2-D array
+    (samples x channels), a dict of arrays or a pandas DataFrame."""
+    given_units: Dict[str, str] = {}
+    if isinstance(units, Mapping):
+        given_units = {str(k): str(v) for k, v in units.items()}
+    elif isinstance(units, str):
+        unit = units if unit is None else unit
+    elif units is not None:
+        # read()'s spelling: ["gx=rad/s", "m/s^2"] (a bare unit applies to every channel)
+        for u in units:
+            k, eq, v = str(u).partition("=")
+            if eq:
+                given_units[k.strip()] = v.strip()
+            else:
+                unit = k.strip()
+    time_name = time if isinstance(time, str) else None
+    stamps = None if time is None or time_name is not None else _samples(time, "time", "s")
+    single = False
+    attrs_units: Dict[str, str] = {}
+    if hasattr(x, "columns") and hasattr(x, "to_numpy"):  # a pandas DataFrame
+        attrs_units = dict(getattr(x, "attrs", {}).get("units", {}) or {})
+        cols = [str(c) for c in x.columns]
+        if time_name is None and time is None:
+            found = [c for c in cols if attrs_units.get(c) == "s"] or [c for c in cols if c in _TIME_NAMES]
+            time_name = found[0] if found else None
+        table = {str(c): x[c].to_numpy() for c in x.columns}
+    elif isinstance(x, Mapping):
+        table = {str(k): v for k, v in x.items()}
+        cols = list(table)
+        if time_name is None and time is None:
+            found = [c for c in cols if c in _TIME_NAMES]
+            time_name = found[0] if found else None
+    else:
+        a = np.asarray(x) if not isinstance(x, np.ndarray) else x
+        if a.ndim == 2:
+            cols = list(names) if names is not None else [f"ch{i}" for i in range(a.shape[1])]
+            if len(cols) != a.shape[1]:
+                raise Error(f"names: {len(cols)} names for {a.shape[1]} columns (channels are columns)", keyword="names")
+            table = {c: a[:, i] for i, c in enumerate(cols)}
+        else:
+            single = True
+            cols = [names[0] if names else "x"]
+            table = {cols[0]: x}
+    if time_name is not None:
+        if time_name not in table:
+            raise Error(f"time='{time_name}': no such column (columns: {', '.join(cols)})", keyword="time")
+        stamps = _samples(table.pop(time_name), f"time ('{time_name}')", "s")
+        cols = [c for c in cols if c != time_name]
+    # Temperature columns read() marks are not channels.
+    cols = [c for c in cols if attrs_units.get(c) != "degC"]
+    if names is not None and not single and not (hasattr(x, "ndim") and getattr(x, "ndim") == 2):
+        wanted = [str(n) for n in names]
+        missing = [n for n in wanted if n not in table]
+        if missing:
+            raise Error(f"names: no such channel {missing} (channels: {', '.join(cols)})", keyword="names")
+        cols = wanted
+    unknown = [k for k in given_units if k not in cols]
+    if unknown:
+        raise Error(f"units: no channel named {unknown} (channels: {', '.join(cols)})", keyword="units")
+    out_units = []
+    for c in cols:
+        u = given_units.get(c) or unit or attrs_units.get(c)
+        out_units.append(u)
+    arrays = [_samples(table[c], c if not single else "x", u) for c, u in zip(cols, out_units)]
+    return cols, arrays, [u or "dps" for u in out_units], stamps, single
+
+
+def _factors(taus: Sequence[float], rate_hz: Optional[float], stamps: Optional[np.ndarray]) -> Tuple[List[int], Dict[float, float]]:
+    """Averaging factors of taus in seconds, each rounded to the nearest whole multiple of the
+    sample interval as allantools does (m = round(tau * rate)); the taus it changed."""
+    t = np.asarray([float(v) for v in taus], dtype=np.float64)
+    if t.size == 0 or not np.all(np.isfinite(t)) or np.any(t <= 0):
+        raise Error("taus: expected positive numbers of seconds", keyword="taus")
+    if rate_hz is None:
+        if stamps is None or stamps.size < 2:
+            raise Error("give rate_hz (the sample rate, Hz) or time= (time stamps in seconds)", keyword="rate_hz")
+        rate = (stamps.size - 1) / (stamps[-1] - stamps[0])
+    else:
+        rate = float(rate_hz)
+    m = np.round(t * rate).astype(np.int64)
+    if np.any(m < 1):
+        raise Error(f"taus: {t[m < 1][0]} s is shorter than the sample interval {1.0 / rate} s", keyword="taus")
+    rounded = {float(a): float(k / rate) for a, k in zip(t, m) if abs(a * rate - k) > 1e-9 * k}
+    return sorted(set(int(v) for v in m)), rounded
 
 
 def allan(
     x: Any,
-    rate_hz: float,
+    rate_hz: Optional[float] = None,
     kind: str = "oadev",
     taus: Union[str, Sequence[float]] = "octave",
     confidence: Optional[float] = 0.683,
-    unit: str = "dps",
+    unit: Optional[str] = None,
     scale_factor: Optional[float] = None,
     null: Optional[float] = None,
-    fit_range_s: Optional[Tuple[float, float]] = None,
-) -> AllanResult:
-    """Allan-family deviation of rate samples ``x`` taken at ``rate_hz``.
+    fit_range_s: Optional[Sequence[float]] = None,
+    *,
+    units: Any = None,
+    time: Any = None,
+    gaps: str = "error",
+    names: Optional[Sequence[str]] = None,
+    record: Optional[str] = None,
+) -> Union[AllanResult, AllanResults]:
+    """Allan-family deviation, confidence bounds and noise terms of rate samples.
+
+    ``x``: a 1-D array (one channel: returns an :class:`AllanResult`); or a pandas DataFrame,
+    a dict of arrays or a 2-D array (samples x channels, named by ``names``): every channel
+    in one native call, returns an :class:`AllanResults` mapping channel -> result, with
+    ``to_dataframe()`` and ``noise_table()``; or a file path (read as :func:`read` does).
+
+    Sampling: ``rate_hz`` (Hz), or ``time`` (a column name, or an array of stamps in seconds;
+    a DataFrame's ``time_s``/``time`` column, or the column ``read()`` marks in seconds, is
+    used by default); with both, they must agree.
 
     ``kind``: oadev (default), adev, mdev, tdev, hdev, ohdev, totdev. ``taus``: "octave",
-    "decade", "all", "N/decade" or a list of seconds. ``confidence``: level of the bounds, or None.
-    ``unit``: of ``x``: "dps", "dph", "rad_s" (rates), or "v", "mv", "lsb" with ``scale_factor``
-    (output units per deg/s) and ``null`` for noise terms in deg units. The computation runs
-    with the interpreter released.
+    "decade", "all", "N/decade", or seconds (each rounded to the nearest whole multiple of
+    the sample interval as allantools does; ``result.taus_rounded`` lists the changes).
+    ``confidence``: level of the bounds, or None. ``fit_range_s``: (low, high) taus of the
+    five-term fit, any two-number sequence.
+
+    Units: ``unit`` for every channel, ``units`` per channel (a dict, or read()'s
+    ``["gx=rad/s", "m/s^2"]``), else a DataFrame's ``attrs["units"]`` (as read() sets them),
+    else deg/s. Accepted: angular rates ``dps`` (``deg/s``), ``dph`` (``deg/h``), ``rad_s``
+    (``rad/s``), ``mrad_s``; accelerations ``m/s^2`` (``m/s2``), ``g``, ``mg``, ``ug``;
+    sensor outputs ``v``, ``mv``, ``lsb`` (noise terms in deg units need ``scale_factor``,
+    output units per deg/s, and ``null``; refused with any other unit); ``1`` (no unit).
+    Integer samples need their unit named.
+
+    ``gaps``: "error" (default: a NaN sample or a gap in the time stamps is refused, naming
+    the first) or "analyse" (computed over, as ``gyrolab allan --gaps analyse``).
+    ``record``: the name results and errors carry (default the path, or ``<array>``).
+
+    Every channel is computed with the interpreter released, on gyrolab's own thread pool
+    (safe in fork-based multiprocessing pools).
     """
-    a = _float_array(x, "x", check_finite=False)
-    doc_json, arrays = _gyrolab.allan(
-        a,
-        float(rate_hz),
+    if isinstance(x, (str, os.PathLike)):
+        path = os.fspath(x)
+        arrays, file_units = _gyrolab.read(path, None, None, None, None)
+        frame = dict(arrays)
+        if time is None:
+            tcols = [k for k, u in file_units.items() if u == "s"]
+            time = tcols[0] if tcols else None
+        for k, u in file_units.items():
+            if u == "degC":
+                frame.pop(k, None)
+        merged = {k: u for k, u in file_units.items() if u not in ("s", "degC") and k in frame}
+        if isinstance(units, Mapping):
+            merged.update({str(k): str(v) for k, v in units.items()})
+        elif units is not None or unit is not None:
+            merged = {}
+        x = frame
+        units = merged if merged else units
+        record = record or path
+    if gaps not in ("error", "analyse", "analyze"):
+        raise Error(f"gaps='{gaps}': expected 'error' or 'analyse'", keyword="gaps")
+    cols, arrays, chan_units, stamps, single = _channels(x, names, time, unit, units)
+    if fit_range_s is not None:
+        try:
+            pair = [float(v) for v in fit_range_s]
+        except (TypeError, ValueError):
+            raise Error(f"fit_range_s={fit_range_s!r}: expected two numbers of seconds (low, high)", keyword="fit_range_s") from None
+        if len(pair) != 2 or not (0 < pair[0] < pair[1]):
+            raise Error(
+                f"fit_range_s={tuple(pair)}: expected two increasing positive taus in seconds (low, high)",
+                keyword="fit_range_s",
+            )
+        fit_range_s = pair
+    rounded: Dict[float, float] = {}
+    factors = None
+    taus_text = "octave"
+    if isinstance(taus, str):
+        taus_text = taus
+    else:
+        factors, rounded = _factors(taus, rate_hz, stamps)
+    if rate_hz is not None:
+        try:
+            rate_hz = float(rate_hz)
+        except (TypeError, ValueError):
+            raise Error(f"rate_hz={rate_hz!r}: expected a number of hertz", keyword="rate_hz") from None
+    doc_json, per_channel = _gyrolab.allan_channels(
+        arrays,
+        cols,
+        chan_units,
+        rate_hz,
+        stamps,
         kind,
-        _taus_text(taus),
+        taus_text,
+        factors,
         confidence,
-        unit,
         scale_factor,
         null,
         fit_range_s,
+        "analyse" if gaps in ("analyse", "analyze") else "error",
+        record or "<array>",
     )
     doc = json.loads(doc_json)
-    ch = doc["channels"][0]
-    noise = ch.get("noise") or {}
-    return AllanResult(
-        taus_s=arrays[0],
-        m=arrays[1].astype(np.int64),
-        dev=arrays[2],
-        ci_low=arrays[3],
-        ci_high=arrays[4],
-        n_terms=arrays[5].astype(np.int64),
-        alpha=arrays[6],
-        kind=doc.get("kind", kind),
-        unit=ch.get("dev_unit", unit),
-        noise={k: v for k, v in noise.items() if k not in ("readings", "fit", "kalibr")},
-        readings=noise.get("readings", []),
-        fit=noise.get("fit"),
-        _doc=doc,
-    )
+    results = {
+        ch["channel"]: AllanResult._from_json(ch, arrays_of, rounded)
+        for ch, arrays_of in zip(doc["channels"], per_channel)
+    }
+    if single:
+        return next(iter(results.values()))
+    return AllanResults(results, record or "<array>")
 
 
 def bias(
@@ -231,7 +356,7 @@ def rate_table(
     runs: Optional[Sequence[int]] = None,
     strokes: Optional[Sequence[str]] = None,
     *,
-    unit: str = "v",
+    unit: Optional[str] = None,
     files: Optional[Sequence[PathLike]] = None,
     data: Any = None,
     axis_names: Optional[Sequence[str]] = None,
@@ -244,19 +369,36 @@ def rate_table(
     ... as ``gyrolab rate --json`` (a dict with ``axes``).
 
     From arrays (one entry per sample or plateau mean: ``rates_dps``, ``outputs`` in ``unit``,
-    ``runs`` numbers, ``strokes`` "fwd"/"rev"), from a pandas DataFrame ``data`` with columns
-    ``rate_dps``, ``run``, ``stroke`` and the output (``output_<unit>``), or from ``files``
-    (long, wide or raw logs, as the command line reads them).
+    default "v"; ``runs`` numbers, ``strokes`` "fwd"/"rev" or "up"/"down"), from a pandas
+    DataFrame ``data`` with columns ``rate_dps``, ``run``, ``stroke`` and the output
+    (``output_<unit>``), or from ``files`` (long, wide or raw logs, as the command line reads
+    them; ``unit`` overrides the unit they declare). ``half_hysteresis``,
+    ``nonlinearity_limit_pct``, ``coverage`` and ``order`` apply to every source. Units of
+    outputs: v, mv, lsb, dps, dph, rad_s, mrad_s.
     """
+    sources = [n for n, v in (("rates_dps/outputs", rates_dps if rates_dps is not None else outputs), ("files", files), ("data", data)) if v is not None]
+    if len(sources) > 1:
+        raise Error(f"give one source of observations, not {' and '.join(sources)}", keyword=sources[1])
     if files is not None:
         return json.loads(
-            _gyrolab.rate_table_files([str(f) for f in files], list(axis_names) if axis_names else None, coverage, order)
+            _gyrolab.rate_table_files(
+                [os.fspath(f) for f in files],
+                list(axis_names) if axis_names else None,
+                float(coverage),
+                int(order),
+                unit,
+                bool(half_hysteresis),
+                nonlinearity_limit_pct,
+            )
         )
     if data is not None:
         out_cols = [c for c in data.columns if str(c).startswith("output_")]
         if len(out_cols) != 1:
-            raise Error(f"data: expected one output_<unit> column, found {out_cols}")
-        unit = str(out_cols[0])[len("output_"):]
+            raise Error(f"data: expected one output_<unit> column, found {out_cols}", keyword="data")
+        col_unit = str(out_cols[0])[len("output_"):]
+        if unit is not None and unit.lower() != col_unit.lower():
+            raise Error(f"unit='{unit}' but data's output column is {out_cols[0]}: leave unit out", keyword="unit")
+        unit = col_unit
         rates_dps, outputs = data["rate_dps"].to_numpy(), data[out_cols[0]].to_numpy()
         runs, strokes = data["run"].to_numpy(), data["stroke"].astype(str).to_numpy()
     if rates_dps is None or outputs is None or runs is None or strokes is None:
@@ -266,7 +408,7 @@ def rate_table(
         _float_array(outputs, "outputs"),
         [int(r) for r in runs],
         [str(s) for s in strokes],
-        unit,
+        unit or "v",
         float(coverage),
         int(order),
         bool(half_hysteresis),

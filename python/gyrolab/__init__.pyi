@@ -1,7 +1,7 @@
 """Type stubs of the gyrolab package (see the docstrings in __init__.py)."""
 
 import os
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -11,11 +11,30 @@ __version__: str
 PathLike = Union[str, os.PathLike[str]]
 ArrayLike = npt.ArrayLike
 
+UNITS: Tuple[str, ...]
+
 class Error(ValueError):
-    """A gyrolab evaluation failed: bad data or options (the message names file, line, field)."""
+    """A gyrolab evaluation failed: bad data or options (the message names file, line, field);
+    pickles with its message and location attributes."""
+
+    message: str
+    file: Optional[str]
+    line: Optional[int]
+    column: Optional[str]
+    keyword: Optional[str]
+    def __init__(
+        self,
+        message: str = ...,
+        *,
+        file: Optional[str] = ...,
+        line: Optional[int] = ...,
+        column: Optional[str] = ...,
+        keyword: Optional[str] = ...,
+    ) -> None: ...
 
 class AllanResult:
-    """An Allan-family deviation with bounds and noise terms; arrays per averaging time."""
+    """An Allan-family deviation of one channel with bounds and noise terms; arrays per
+    averaging time; the noise terms also as attributes (``arw_deg_rt_h``, ``vrw_m_s_rt_h``)."""
 
     taus_s: np.ndarray
     m: np.ndarray
@@ -26,28 +45,58 @@ class AllanResult:
     alpha: np.ndarray
     kind: str
     unit: str
+    channel: str
+    record: str
+    quantity: str
+    confidence: Optional[float]
+    tau0_s: float
+    samples: int
     noise: Dict[str, Any]
     readings: List[Dict[str, Any]]
     fit: Optional[Dict[str, Any]]
+    noise_note: Optional[str]
+    taus_rounded: Dict[float, float]
+    def __getattr__(self, name: str) -> Any: ...
     def to_dict(self) -> Dict[str, Any]:
         """The result with the keys of `gyrolab allan --json`."""
-    def plot(self, ax: Any = ..., label: Optional[str] = ...) -> Any:
-        """Log-log curve with bounds and N/B/K asymptotes (needs matplotlib); returns the axes."""
+    def to_dataframe(self) -> Any:
+        """The curve as a tidy DataFrame."""
+    def noise_table(self) -> Any:
+        """The noise terms as a DataFrame (channel, term, value, unit, basis, support)."""
+    def plot(self, ax: Any = ..., label: Optional[str] = ..., asymptotes: bool = ...) -> Any:
+        """Log-log curve with bounds and noise-term asymptotes (needs matplotlib); returns the axes."""
+
+class AllanResults(Mapping[str, AllanResult]):
+    """The channels of one record: channel -> AllanResult."""
+
+    record: str
+    def __getitem__(self, key: str) -> AllanResult: ...
+    def __iter__(self) -> Iterator[str]: ...
+    def __len__(self) -> int: ...
+    def to_dataframe(self) -> Any: ...
+    def noise_table(self) -> Any: ...
+    def to_dict(self) -> Dict[str, Any]: ...
+    def plot(self, ax: Any = ..., asymptotes: bool = ...) -> Any: ...
 
 def allan(
-    x: ArrayLike,
-    rate_hz: float,
+    x: Any,
+    rate_hz: Optional[float] = ...,
     kind: str = ...,
     taus: Union[str, Sequence[float]] = ...,
     confidence: Optional[float] = ...,
-    unit: str = ...,
+    unit: Optional[str] = ...,
     scale_factor: Optional[float] = ...,
     null: Optional[float] = ...,
-    fit_range_s: Optional[Tuple[float, float]] = ...,
-) -> AllanResult:
-    """Allan-family deviation of rate samples `x` at `rate_hz` (kind oadev, adev, mdev, tdev,
-    hdev, ohdev, totdev; taus octave, decade, all, N/decade or seconds; unit dps, dph, rad_s, or
-    v, mv, lsb with scale_factor and null)."""
+    fit_range_s: Optional[Sequence[float]] = ...,
+    *,
+    units: Any = ...,
+    time: Any = ...,
+    gaps: str = ...,
+    names: Optional[Sequence[str]] = ...,
+    record: Optional[str] = ...,
+) -> Any:
+    """Allan-family deviation of rate samples: a 1-D array gives an AllanResult; a DataFrame,
+    dict of arrays, 2-D array or file path gives AllanResults (see the docstring)."""
 
 def bias(
     x: ArrayLike,
@@ -68,7 +117,7 @@ def rate_table(
     runs: Optional[Sequence[int]] = ...,
     strokes: Optional[Sequence[str]] = ...,
     *,
-    unit: str = ...,
+    unit: Optional[str] = ...,
     files: Optional[Sequence[PathLike]] = ...,
     data: Any = ...,
     axis_names: Optional[Sequence[str]] = ...,

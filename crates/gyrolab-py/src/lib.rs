@@ -3,129 +3,385 @@
 //! results go out as numpy arrays and JSON documents with the keys of the command line's
 //! `--json` output; the Python package (`python/gyrolab`) wraps them in result objects.
 //!
-//! Long computations run with the interpreter released (`Python::detach`). Every failure is a
-//! `gyrolab.Error` (a `ValueError`) carrying the evaluation's located message, with request
-//! fields spelled as the Python keywords.
+//! Long computations run with the interpreter released (`Python::detach`) on the package's own
+//! thread pool, which a process made by `fork` builds again (see [`POOL`]): gyrolab works in
+//! the workers of a fork-based `multiprocessing.Pool` after a call in the parent. Every failure
+//! is a `gyrolab.Error` (a `ValueError` defined in `gyrolab/_errors.py`, so that it pickles)
+//! carrying the evaluation's located message, with request fields spelled as the Python
+//! keywords, and its file, line, column or keyword as attributes.
 
-use gyrolab::allan::{AllanOptions, DeviationKind};
+use gyrolab::allan::{AllanOptions, DeviationKind, TauList};
 use gyrolab::rate_test::{RateObservation, Stroke};
 use gyrolab::static_test::{SampleBlock, StaticTestConfig};
 use gyrolab::units::OutputUnit;
-use gyrolab_eval::allan::{analyse_channel_borrowed, parse_taus, ChannelSetup, GapPolicy};
+use gyrolab_eval::allan::{analyse_channel_borrowed, on_grid, parse_taus, ChannelSetup, GapPolicy};
 use gyrolab_eval::reference::ReferenceRequest;
 use gyrolab_eval::EvalError;
 use gyrolab_io::series::{ChannelInfo, SeriesOptions};
-use numpy::{PyArray1, PyReadonlyArray1};
-use pyo3::create_exception;
-use pyo3::exceptions::PyValueError;
+use numpy::{PyArray1, PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyType};
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 
-create_exception!(_gyrolab, Error, PyValueError, "A gyrolab evaluation failed: bad data or options.");
+/// The Python class of every failure, `gyrolab.Error` (defined in `gyrolab/_errors.py` so that
+/// it pickles: its module imports).
+static ERROR_TYPE: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
+/// Where a failure is, as the attributes of `gyrolab.Error`.
+#[derive(Default)]
+struct Location {
+    file: Option<String>,
+    line: Option<u64>,
+    column: Option<String>,
+    keyword: Option<String>,
+}
+
+/// A `gyrolab.Error` with `message` and its location.
+fn raise(message: String, at: Location) -> PyErr {
+    Python::attach(|py| {
+        let made = (|| -> PyResult<PyErr> {
+            let class = ERROR_TYPE.import(py, "gyrolab._errors", "Error")?;
+            let kwargs = PyDict::new(py);
+            kwargs.set_item("file", at.file)?;
+            kwargs.set_item("line", at.line)?;
+            kwargs.set_item("column", at.column)?;
+            kwargs.set_item("keyword", at.keyword)?;
+            Ok(PyErr::from_value(class.call((message.as_str(),), Some(&kwargs))?))
+        })();
+        made.unwrap_or_else(|e| e)
+    })
+}
+
+/// A `gyrolab.Error` with a message and no location.
+fn error(message: impl Into<String>) -> PyErr {
+    raise(message.into(), Location::default())
+}
+
+/// A `gyrolab.Error` about the keyword argument `keyword`.
+fn keyword_error(keyword: &str, message: impl Into<String>) -> PyErr {
+    raise(message.into(), Location { keyword: Some(keyword.into()), ..Location::default() })
+}
 
 /// The Python spelling of a request field: its keyword.
 fn keyword(field: &str) -> String {
     match field {
         "sample_rate_hz" => "rate_hz".into(),
-        "latitude_deg" => "latitude_deg".into(),
+        "topics" => "topic".into(),
         other => other.into(),
     }
 }
 
+/// The `gyrolab.Error` of an evaluation's failure: the message with request fields spelled as
+/// keywords, and the file, line, column or keyword it names.
 fn err(e: EvalError) -> PyErr {
-    Error::new_err(e.render(&keyword))
+    let message = e.render(&keyword);
+    let at = match &e {
+        EvalError::Data(d) => Location {
+            file: Some(d.file.display().to_string()),
+            line: d.line,
+            column: d.column.as_ref().map(|c| c.name.clone().unwrap_or_else(|| c.index.to_string())),
+            keyword: None,
+        },
+        EvalError::Invalid(i) => Location { keyword: Some(keyword(i.field)), ..Location::default() },
+        EvalError::Conflict { fields, .. } => {
+            Location { keyword: fields.first().map(|f| keyword(f)), ..Location::default() }
+        }
+        EvalError::Output(_) => Location::default(),
+    };
+    raise(message, at)
 }
 
 fn json_err(e: serde_json::Error) -> PyErr {
-    Error::new_err(format!("cannot serialise the result: {e}"))
+    error(format!("cannot serialise the result: {e}"))
 }
 
-/// The output unit of a keyword (`dps`, `rad_s`, `v`, `mv`, `lsb`); `dph` is handled by the
-/// caller (converted to deg/s).
+/// The process that built [`POOL`]'s threads, and the pool.
+type OwnedPool = (u32, Arc<rayon::ThreadPool>);
+
+/// The package's own thread pool (rayon's global pool is never used): built on first use, and
+/// built again in a child process made by `fork`, where the parent's threads do not exist (a
+/// pool whose threads are gone would wait for them forever). The old pool is leaked there on
+/// purpose: dropping it would signal threads that are not in this process.
+static POOL: Mutex<Option<OwnedPool>> = Mutex::new(None);
+
+/// The thread pool of this process (see [`POOL`]); `RAYON_NUM_THREADS` sets its size.
+fn pool() -> PyResult<Arc<rayon::ThreadPool>> {
+    let pid = std::process::id();
+    let mut slot = POOL.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    if let Some((owner, pool)) = slot.as_ref() {
+        if *owner == pid {
+            return Ok(pool.clone());
+        }
+    }
+    if let Some(inherited) = slot.take() {
+        std::mem::forget(inherited);
+    }
+    let pool = Arc::new(
+        rayon::ThreadPoolBuilder::new()
+            .thread_name(|i| format!("gyrolab-{i}"))
+            .build()
+            .map_err(|e| error(format!("cannot start the worker threads: {e}")))?,
+    );
+    *slot = Some((pid, pool.clone()));
+    Ok(pool)
+}
+
+/// Runs `work` on the package's thread pool with the interpreter released.
+fn run<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
+    let pool = pool()?;
+    Ok(py.detach(|| pool.install(work)))
+}
+
+/// The units `allan` reads, as listed in its docstring and errors.
+const ALLAN_UNITS: &str = "dps (deg/s), dph (deg/h), rad_s (rad/s), mrad_s (mrad/s), m/s^2 (m/s2), g, mg, ug, \
+     v, mv, lsb, or 1 (no unit)";
+
+/// How samples in a unit reach the engine: its unit there, and a factor applied first (deg/h
+/// to deg/s; micro-g to milli-g).
+fn input_unit(text: &str) -> PyResult<(OutputUnit, Option<f64>)> {
+    let t: String = text.trim().to_ascii_lowercase().chars().filter(|c| !c.is_whitespace()).collect();
+    let parsed = match t.as_str() {
+        "dph" | "deg/h" | "deg_h" => Some((OutputUnit::DegPerSec, Some(gyrolab::units::dph_to_dps(1.0)))),
+        "m/s2" | "m/s**2" | "m·s^-2" | "m/s²" => Some((OutputUnit::MeterPerSec2, None)),
+        "ug" | "µg" | "μg" | "micro-g" => Some((OutputUnit::MilliG, Some(1e-3))),
+        "1" | "" | "none" | "unitless" => Some((OutputUnit::Unitless, None)),
+        _ => OutputUnit::parse(&t).map(|u| (u, None)),
+    };
+    parsed.ok_or_else(|| keyword_error("units", format!("unit '{text}' is not known: expected {ALLAN_UNITS}")))
+}
+
+/// The output unit of a keyword (`dps`, `rad_s`, `v`, `mv`, `lsb`, ...).
 fn output_unit(unit: &str) -> PyResult<OutputUnit> {
-    OutputUnit::parse(unit)
-        .ok_or_else(|| Error::new_err(format!("unit='{unit}': expected dps, dph, rad_s, v, mv or lsb")))
+    OutputUnit::parse(unit).ok_or_else(|| {
+        keyword_error(
+            "unit",
+            format!("unit='{unit}': expected v, mv, lsb, dps (deg/s), dph (deg/h), rad_s (rad/s) or mrad_s"),
+        )
+    })
 }
 
 fn reference(scale_factor: Option<f64>, null: Option<f64>) -> PyResult<gyrolab_eval::reference::Reference> {
     ReferenceRequest { scale_factor, null, ..Default::default() }.resolve().map_err(err)
 }
 
-/// Allan analysis of one array: returns (JSON document as `gyrolab allan --json`, taus_s, m,
-/// dev, ci_low, ci_high, n_terms, alpha); bounds are NaN where none exists.
+/// One channel's samples as the engine reads them: borrowed where they can be, else a copy.
+enum Samples<'a> {
+    Borrowed(&'a [f64]),
+    Owned(Vec<f64>),
+}
+
+/// Allan analysis of channels of one record in one native call, the channels in parallel on
+/// the package's pool: returns (JSON document as `gyrolab allan --json`, per channel the arrays
+/// taus_s, m, dev, ci_low, ci_high, n_terms, alpha; bounds NaN where none exists). `rate_hz`
+/// or `time_s` (seconds, one per sample) gives the sampling; gaps in `time_s` and NaN samples
+/// follow `gaps` (`error` or `analyse`). `factors` replaces `taus` by averaging factors.
 #[pyfunction]
-#[pyo3(signature = (x, rate_hz, kind, taus, confidence, unit, scale_factor=None, null=None, fit_range_s=None, name="x"))]
+#[pyo3(signature = (columns, names, units, rate_hz, time_s, kind, taus, factors, confidence, scale_factor=None, null=None, fit_range_s=None, gaps="error", record="<array>"))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
-fn allan<'py>(
+fn allan_channels<'py>(
     py: Python<'py>,
-    x: PyReadonlyArray1<'py, f64>,
-    rate_hz: f64,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    names: Vec<String>,
+    units: Vec<String>,
+    rate_hz: Option<f64>,
+    time_s: Option<PyReadonlyArray1<'py, f64>>,
     kind: &str,
     taus: &str,
+    factors: Option<Vec<usize>>,
     confidence: Option<f64>,
-    unit: &str,
     scale_factor: Option<f64>,
     null: Option<f64>,
-    fit_range_s: Option<(f64, f64)>,
-    name: &str,
-) -> PyResult<(String, Vec<Bound<'py, PyArray1<f64>>>)> {
-    gyrolab::validate::positive("sample_rate_hz", rate_hz).map_err(|e| err(e.into()))?;
+    fit_range_s: Option<Vec<f64>>,
+    gaps: &str,
+    record: &str,
+) -> PyResult<(String, Vec<Vec<Bound<'py, PyArray1<f64>>>>)> {
+    let policy = GapPolicy::parse(gaps).map_err(|e| err(e.into()))?;
+    if let Some(f) = rate_hz {
+        gyrolab::validate::positive("sample_rate_hz", f).map_err(|e| err(e.into()))?;
+    }
     if let Some(c) = confidence {
         gyrolab::validate::confidence("confidence", c).map_err(|e| err(e.into()))?;
     }
-    let kind = DeviationKind::parse(kind).map_err(|e| Error::new_err(e.to_string()))?;
-    let taus = parse_taus(taus).map_err(err)?;
-    let reference = reference(scale_factor, null)?;
-    let (unit, per_hour) = if unit == "dph" { (OutputUnit::DegPerSec, true) } else { (output_unit(unit)?, false) };
-    // The working buffer the angle series is built in (room for its extra point), on huge
-    // pages; a contiguous array is read where it is, never copied (the angle conversion reads
-    // it twice and writes the buffer once). Samples in deg/h and strided arrays are copied once.
-    let view = x.as_array();
-    let mut buffer = Vec::with_capacity(view.len() + 1);
-    gyrolab_io::pages::advise_huge_pages(&mut buffer);
-    let slice = x.as_slice().ok();
-    let copied: Option<Vec<f64>> = match (slice, per_hour) {
-        (Some(_), false) => None,
-        (Some(s), true) => Some(s.iter().map(|&v| gyrolab::units::dph_to_dps(v)).collect()),
-        (None, true) => Some(view.iter().map(|&v| gyrolab::units::dph_to_dps(v)).collect()),
-        (None, false) => Some(view.iter().copied().collect()),
+    let fit_range_s = match fit_range_s {
+        None => None,
+        Some(v) => gyrolab::validate::increasing_pair("fit_range_s", &v).map_err(|e| err(e.into()))?,
     };
-    let values: &[f64] = copied.as_deref().or(slice).unwrap_or(&[]);
-    let info =
-        ChannelInfo { name: name.to_string(), column: 1, unit, unit_source: gyrolab_io::series::UnitSource::Column };
-    let options = AllanOptions { kind, taus, confidence, max_factor: None };
-    let analysis = py
-        .detach(|| {
-            let setup = ChannelSetup {
-                path: Path::new("<array>"),
-                shown: "<array>".into(),
-                topic: None,
-                lines: &gyrolab_io::series::LineMap::default(),
-                tau0_s: 1.0 / rate_hz,
-                options: &options,
-                reference: &reference,
-                fit_range_s,
-                uncalibrated_hint: "give scale_factor (and null), or unit='dps', for noise terms in deg units",
-            };
-            // NaN is refused like inf: an array is a complete record
-            analyse_channel_borrowed(&setup, &info, values, buffer, GapPolicy::Error)
+    let kind = DeviationKind::parse(kind).map_err(|e| keyword_error("kind", e.to_string()))?;
+    let taus = match factors {
+        Some(m) => TauList::Factors(m),
+        None => parse_taus(taus).map_err(err)?,
+    };
+    if columns.len() != names.len() || columns.len() != units.len() || columns.is_empty() {
+        return Err(error(format!(
+            "give one name and one unit per channel: {} channels, {} names, {} units",
+            columns.len(),
+            names.len(),
+            units.len()
+        )));
+    }
+    let parsed: Vec<(OutputUnit, Option<f64>)> = units.iter().map(|u| input_unit(u)).collect::<PyResult<_>>()?;
+    if scale_factor.is_some() || null.is_some() {
+        let calibrated = |u: &OutputUnit| u.quantity() != gyrolab::units::Quantity::SensorOutput;
+        if let Some((i, (u, _))) = parsed.iter().enumerate().find(|(_, (u, _))| calibrated(u)) {
+            let given = if scale_factor.is_some() { "scale_factor" } else { "null" };
+            return Err(keyword_error(
+                given,
+                format!(
+                    "{given} applies to outputs in v, mv or lsb, but channel '{}' is in {}: leave {given} out",
+                    names[i],
+                    u.symbol()
+                ),
+            ));
+        }
+    }
+    let reference = reference(scale_factor, null)?;
+    let path = Path::new(record);
+    let n = columns[0].len();
+    if let Some((i, c)) = columns.iter().enumerate().find(|(_, c)| c.len() != n) {
+        return Err(error(format!(
+            "channel '{}' has {} samples where '{}' has {n}: the channels of a record have one length",
+            names[i],
+            c.len(),
+            names[0]
+        )));
+    }
+    // The sampling: the given rate, else the time stamps' (gaps found there are missing samples).
+    let mut grid_gaps: Vec<gyrolab::sampling::Gap> = Vec::new();
+    let mut missing = 0usize;
+    let tau0_s = match (&time_s, rate_hz) {
+        (None, None) => {
+            return Err(keyword_error(
+                "rate_hz",
+                "give rate_hz (the sample rate, Hz) or time= (time stamps in seconds, a column or an array)",
+            ))
+        }
+        (None, Some(f)) => 1.0 / f,
+        (Some(t), given) => {
+            let t = t.as_slice().map_err(|_| error("time: expected a contiguous float64 array"))?;
+            if t.len() != n {
+                return Err(keyword_error("time", format!("time has {} stamps for {n} samples", t.len())));
+            }
+            let e = gyrolab::sampling::estimate_interval(t)
+                .map_err(|_| keyword_error("time", "time: fewer than two stamps, or stamps that do not increase"))?;
+            if let Some(g) = e.first_non_increasing {
+                return Err(keyword_error(
+                    "time",
+                    format!(
+                        "time[{}] does not increase (interval {} s): expected increasing time stamps",
+                        g.index, g.interval_s
+                    ),
+                ));
+            }
+            if policy == GapPolicy::Error {
+                if let Some(g) = e.gaps.first() {
+                    return Err(keyword_error(
+                        "gaps",
+                        format!(
+                            "a gap in the time stamps before time[{}]: {} sample(s) missing (interval {} s where the record's is {} s); gaps='analyse' computes over them",
+                            g.index, g.missing, g.interval_s, e.interval_s
+                        ),
+                    ));
+                }
+            }
+            if let Some(f) = given {
+                if let Some(msg) = gyrolab_eval::allan::rate_disagreement(t, f, "rate_hz", path) {
+                    return Err(keyword_error("rate_hz", msg));
+                }
+            }
+            missing = e.missing;
+            grid_gaps = e.gaps;
+            given.map_or(e.interval_s, |f| 1.0 / f)
+        }
+    };
+    let infos: Vec<ChannelInfo> = names
+        .iter()
+        .zip(&parsed)
+        .enumerate()
+        .map(|(i, (name, (unit, _)))| ChannelInfo {
+            name: name.clone(),
+            column: i + 1,
+            unit: *unit,
+            unit_source: gyrolab_io::series::UnitSource::Column,
         })
-        .map_err(err)?;
-    let doc = gyrolab_report::allan::allan_document(std::slice::from_ref(&analysis))
-        .ok_or_else(|| Error::new_err("no curve"))?;
+        .collect();
+    // A contiguous array in its unit is read where it is, never copied (the angle conversion
+    // reads it twice and writes the working buffer once); a strided array, a unit converted
+    // first and a record with gaps are copied once.
+    let samples: Vec<Samples<'_>> = columns
+        .iter()
+        .zip(&parsed)
+        .map(|(c, (_, factor))| {
+            let owned = |v: Vec<f64>| -> Vec<f64> {
+                let v = match factor {
+                    Some(f) => v.into_iter().map(|x| x * f).collect(),
+                    None => v,
+                };
+                if missing > 0 {
+                    on_grid(v, &grid_gaps, missing)
+                } else {
+                    v
+                }
+            };
+            match c.as_slice() {
+                Ok(s) if factor.is_none() && missing == 0 => Samples::Borrowed(s),
+                Ok(s) => Samples::Owned(owned(s.to_vec())),
+                Err(_) => Samples::Owned(owned(c.as_array().iter().copied().collect())),
+            }
+        })
+        .collect();
+    let options = AllanOptions { kind, taus, confidence, max_factor: None };
+    let lines = gyrolab_io::series::LineMap::default();
+    let setup = ChannelSetup {
+        path,
+        shown: record.to_string(),
+        topic: None,
+        lines: &lines,
+        tau0_s,
+        options: &options,
+        reference: &reference,
+        fit_range_s,
+        uncalibrated_hint: "give scale_factor (and null), or a rate unit such as 'dps', for noise terms",
+    };
+    // Missing samples in the record (NaN or gaps) are computed over only when asked for.
+    let missing_policy = if policy == GapPolicy::Analyse { GapPolicy::Analyse } else { GapPolicy::Error };
+    let analyses = run(py, || {
+        samples
+            .par_iter()
+            .zip(infos.par_iter())
+            .map(|(s, info)| {
+                let values: &[f64] = match s {
+                    Samples::Borrowed(s) => s,
+                    Samples::Owned(v) => v,
+                };
+                let mut buffer = Vec::with_capacity(values.len() + 1);
+                gyrolab_io::pages::advise_huge_pages(&mut buffer);
+                analyse_channel_borrowed(&setup, info, values, buffer, missing_policy)
+            })
+            .collect::<Result<Vec<_>, _>>()
+    })?
+    .map_err(err)?;
+    let doc = gyrolab_report::allan::allan_document(&analyses).ok_or_else(|| error("no channel"))?;
     let json = serde_json::to_string(&doc).map_err(json_err)?;
-    let p = &analysis.curve.points;
-    let col = |f: &dyn Fn(&gyrolab::allan::AllanPoint) -> f64| PyArray1::from_vec(py, p.iter().map(f).collect());
-    let arrays = vec![
-        col(&|q| q.tau_s),
-        col(&|q| q.m as f64),
-        col(&|q| q.deviation),
-        col(&|q| q.lower.unwrap_or(f64::NAN)),
-        col(&|q| q.upper.unwrap_or(f64::NAN)),
-        col(&|q| q.terms as f64),
-        col(&|q| q.alpha.map_or(f64::NAN, f64::from)),
-    ];
+    let arrays = analyses
+        .iter()
+        .map(|a| {
+            let p = &a.curve.points;
+            let col =
+                |f: &dyn Fn(&gyrolab::allan::AllanPoint) -> f64| PyArray1::from_vec(py, p.iter().map(f).collect());
+            vec![
+                col(&|q| q.tau_s),
+                col(&|q| q.m as f64),
+                col(&|q| q.deviation),
+                col(&|q| q.lower.unwrap_or(f64::NAN)),
+                col(&|q| q.upper.unwrap_or(f64::NAN)),
+                col(&|q| q.terms as f64),
+                col(&|q| q.alpha.map_or(f64::NAN, f64::from)),
+            ]
+        })
+        .collect();
     Ok((json, arrays))
 }
 
@@ -168,16 +424,15 @@ fn bias(
     let temp = temp_c.map(|t| t.as_array().to_vec());
     for (what, v) in [("time_s", &time), ("temp_c", &temp)] {
         if v.as_ref().is_some_and(|v| v.len() != output.len()) {
-            return Err(Error::new_err(format!("{what} has a different length from x ({})", output.len())));
+            return Err(error(format!("{what} has a different length from x ({})", output.len())));
         }
     }
-    let result = py
-        .detach(|| {
-            let block =
-                SampleBlock { output: &output, time_s: time.as_deref(), temperature_c: temp.as_deref(), lines: None };
-            gyrolab_eval::static_test::evaluate_samples(&block, &config, &reference)
-        })
-        .map_err(err)?;
+    let result = run(py, || {
+        let block =
+            SampleBlock { output: &output, time_s: time.as_deref(), temperature_c: temp.as_deref(), lines: None };
+        gyrolab_eval::static_test::evaluate_samples(&block, &config, &reference)
+    })?
+    .map_err(err)?;
     serde_json::to_string(&gyrolab_report::bias::TestReport { file: "<array>".into(), result }).map_err(json_err)
 }
 
@@ -187,6 +442,7 @@ fn bias(
 #[pyo3(signature = (rates_dps, outputs, runs, strokes, unit, coverage=3.0, order=1, half_hysteresis=false, nonlinearity_limit_pct=None, name="x"))]
 #[allow(clippy::too_many_arguments)]
 fn rate_table(
+    py: Python<'_>,
     rates_dps: PyReadonlyArray1<'_, f64>,
     outputs: PyReadonlyArray1<'_, f64>,
     runs: Vec<u32>,
@@ -202,7 +458,7 @@ fn rate_table(
     let out = outputs.as_array();
     let n = rates.len();
     if out.len() != n || runs.len() != n || strokes.len() != n {
-        return Err(Error::new_err(format!(
+        return Err(error(format!(
             "rates_dps, outputs, runs and strokes need the same length, got {}, {}, {}, {}",
             n,
             out.len(),
@@ -213,30 +469,42 @@ fn rate_table(
     let mut obs = Vec::with_capacity(n);
     for i in 0..n {
         let stroke = Stroke::from_label(&strokes[i])
-            .ok_or_else(|| Error::new_err(format!("strokes[{i}] = '{}': expected fwd or rev", strokes[i])))?;
+            .ok_or_else(|| error(format!("strokes[{i}] = '{}': expected fwd or rev", strokes[i])))?;
         obs.push(RateObservation { rate_dps: rates[i], run: runs[i], stroke, output: out[i] });
     }
     let settings = gyrolab_eval::rate::RateSettings { coverage, half_hysteresis, order, nonlinearity_limit_pct };
-    let axis = gyrolab_eval::rate::evaluate_observations(name, &obs, output_unit(unit)?, &settings).map_err(err)?;
+    let unit = output_unit(unit)?;
+    let axis = run(py, || gyrolab_eval::rate::evaluate_observations(name, &obs, unit, &settings))?.map_err(err)?;
     serde_json::to_string(&gyrolab_report::rate::rate_json(&[axis.report()])).map_err(json_err)
 }
 
 /// Rate-table evaluation of files (long, wide or raw logs): the JSON of `gyrolab rate --json`.
+/// `unit` overrides the output unit the files declare.
 #[pyfunction]
-#[pyo3(signature = (files, axis_names=None, coverage=3.0, order=1))]
+#[pyo3(signature = (files, axis_names=None, coverage=3.0, order=1, unit=None, half_hysteresis=false, nonlinearity_limit_pct=None))]
+#[allow(clippy::too_many_arguments)]
 fn rate_table_files(
+    py: Python<'_>,
     files: Vec<PathBuf>,
     axis_names: Option<Vec<String>>,
     coverage: f64,
     order: i64,
+    unit: Option<&str>,
+    half_hysteresis: bool,
+    nonlinearity_limit_pct: Option<f64>,
 ) -> PyResult<String> {
+    let mut columns = gyrolab_io::rate_table::RateColumns::default();
+    if let Some(u) = unit {
+        columns.output_unit = Some(output_unit(u)?);
+    }
     let request = gyrolab_eval::rate::RateRequest {
         files,
+        columns,
         axis_names: axis_names.unwrap_or_default(),
-        settings: gyrolab_eval::rate::RateSettings { coverage, order, ..Default::default() },
+        settings: gyrolab_eval::rate::RateSettings { coverage, order, half_hysteresis, nonlinearity_limit_pct },
         ..Default::default()
     };
-    let outcome = gyrolab_eval::rate::evaluate_rates(&request).map_err(err)?;
+    let outcome = run(py, || gyrolab_eval::rate::evaluate_rates(&request))?.map_err(err)?;
     let reports: Vec<_> = outcome.axes.iter().map(|a| a.report()).collect();
     let mut doc = gyrolab_report::rate::rate_json(&reports);
     let segs: Vec<_> = outcome.logs.iter().map(|l| l.report()).collect();
@@ -263,7 +531,12 @@ fn simulate_static<'py>(
     record_temperature: bool,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
     let preset = preset
-        .map(|p| gyrolab::sim::Preset::parse(p).ok_or_else(|| Error::new_err(format!("unknown preset '{p}'"))))
+        .map(|p| {
+            gyrolab::sim::Preset::parse(p).ok_or_else(|| {
+                let known: Vec<&str> = gyrolab::sim::Preset::ALL.iter().map(|p| p.name()).collect();
+                keyword_error("preset", format!("unknown preset '{p}': expected one of {}", known.join(", ")))
+            })
+        })
         .transpose()?;
     let o = gyrolab_eval::simulate::SimOverrides {
         seed: Some(seed),
@@ -280,7 +553,7 @@ fn simulate_static<'py>(
         ..Default::default()
     };
     let cfg = gyrolab_eval::simulate::sim_config(&o).map_err(err)?;
-    let s = py.detach(|| gyrolab_eval::simulate::simulate_static_samples(&cfg)).map_err(err)?;
+    let s = run(py, || gyrolab_eval::simulate::simulate_static_samples(&cfg))?.map_err(err)?;
     Ok((PyArray1::from_vec(py, s.time_s), PyArray1::from_vec(py, s.output), PyArray1::from_vec(py, s.temp_c)))
 }
 
@@ -308,7 +581,7 @@ fn read<'py>(
     let options = layout.apply(SeriesOptions::default()).map_err(err)?;
     let topics: Vec<String> = topic.into_iter().collect();
     let mut records =
-        py.detach(|| gyrolab_io::recording::read_records(&path, &options, &topics)).map_err(|e| err(e.into()))?.records;
+        run(py, || gyrolab_io::recording::read_records(&path, &options, &topics))?.map_err(|e| err(e.into()))?.records;
     if records.len() > 1 {
         let names: Vec<String> = records.iter().filter_map(|r| r.topic.as_ref().map(|t| t.topic.clone())).collect();
         return Err(err(gyrolab_eval::EvalError::conflict(format!(
@@ -341,12 +614,11 @@ fn read<'py>(
 /// Evaluates a test plan and writes its report folder: (verdict or None, files written, failures).
 #[pyfunction]
 fn evaluate_plan(py: Python<'_>, plan: PathBuf, out: PathBuf) -> PyResult<(Option<String>, Vec<PathBuf>, Vec<String>)> {
-    let folder = py
-        .detach(|| {
-            let p = gyrolab_eval::test_plan::read_test_plan(&plan)?;
-            gyrolab_eval::test_plan::evaluate_test_plan(&p, &plan.display().to_string(), &gyrolab_eval::Silent)
-        })
-        .map_err(err)?;
+    let folder = run(py, || {
+        let p = gyrolab_eval::test_plan::read_test_plan(&plan)?;
+        gyrolab_eval::test_plan::evaluate_test_plan(&p, &plan.display().to_string(), &gyrolab_eval::Silent)
+    })?
+    .map_err(err)?;
     let files: Vec<(&str, &[u8])> = folder.outputs.iter().map(|o| (o.name.as_str(), &o.bytes[..])).collect();
     let written = gyrolab_io::atomic::write_folder(&out, &files).map_err(|(p, e)| {
         pyo3::exceptions::PyOSError::new_err(format!("{}: cannot write the file: {e}", p.display()))
@@ -367,7 +639,7 @@ fn apply<'py>(
 ) -> PyResult<(Vec<Bound<'py, PyArray1<f64>>>, Vec<&'static str>)> {
     let owned: Vec<Vec<f64>> = outputs.iter().map(|o| o.as_array().to_vec()).collect();
     let slices: Vec<&[f64]> = owned.iter().map(Vec::as_slice).collect();
-    let (rates, status) = py.detach(|| gyrolab_eval::apply::apply_arrays(&calibration, axis, &slices)).map_err(err)?;
+    let (rates, status) = run(py, || gyrolab_eval::apply::apply_arrays(&calibration, axis, &slices))?.map_err(err)?;
     let status = status
         .into_iter()
         .map(|s| match s {
@@ -383,9 +655,8 @@ fn apply<'py>(
 /// The native module.
 #[pymodule]
 fn _gyrolab(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add("Error", m.py().get_type::<Error>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
-    m.add_function(wrap_pyfunction!(allan, m)?)?;
+    m.add_function(wrap_pyfunction!(allan_channels, m)?)?;
     m.add_function(wrap_pyfunction!(bias, m)?)?;
     m.add_function(wrap_pyfunction!(rate_table, m)?)?;
     m.add_function(wrap_pyfunction!(rate_table_files, m)?)?;

@@ -1,0 +1,383 @@
+"""Result objects of :func:`gyrolab.allan`: one channel (:class:`AllanResult`) and the channels
+of one record (:class:`AllanResults`, a mapping by channel), with tidy tables and plots."""
+
+from __future__ import annotations
+
+import html
+import json
+from dataclasses import dataclass, field
+from typing import Any, Dict, Iterator, List, Mapping, Optional, Tuple
+
+import numpy as np
+
+# Standard gravity (CGPM 1901), m/s^2 per g: accelerometer bias readings are in micro-g.
+_G_N = 9.80665
+
+# The slope-line terms of a gyro (deg/s curve) and of an accelerometer (m/s^2 curve): the
+# reading's term, its short symbol in plots, and the key of its value in the curve's unit
+# (per-second density) and in the unit shown.
+_GYRO_TERMS = {
+    "arw": ("N", "arw_deg_rt_s", "arw_deg_rt_h", "deg/√h"),
+    "bias_instability": ("B", "bias_instability_dph", "bias_instability_dph", "deg/h"),
+    "allan_minimum": ("min", "allan_minimum_dph", "allan_minimum_dph", "deg/h"),
+    "rrw": ("K", "rrw_deg_s_rt_s", "rrw_deg_h_rt_h", "deg/h/√h"),
+}
+_ACCEL_TERMS = {
+    "vrw": ("VRW", "vrw_m_s2_rt_hz", "vrw_m_s_rt_h", "m/s/√h"),
+    "bias_instability": ("B", "bias_instability_ug", "bias_instability_ug", "µg"),
+    "allan_minimum": ("min", "allan_minimum_ug", "allan_minimum_ug", "µg"),
+    "accel_random_walk": ("AcRW", "accel_random_walk_m_s3_rt_hz", "accel_random_walk_m_s2_rt_h", "m/s²/√h"),
+}
+
+# Above this many taus, error bars are drawn on a log-spaced subset (the curve keeps every
+# point): matplotlib draws 180 k error bars in seconds, a line of 180 k points in milliseconds.
+_MAX_ERROR_BARS = 60
+
+
+def _same(a: Any, b: Any) -> bool:
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        a, b = np.asarray(a), np.asarray(b)
+        return a.shape == b.shape and bool(np.array_equal(a, b, equal_nan=a.dtype.kind == "f"))
+    return bool(a == b)
+
+
+@dataclass(eq=False, repr=False)
+class AllanResult:
+    """An Allan-family deviation of one channel with its bounds and noise terms.
+
+    Arrays (one value per averaging time): ``taus_s``, ``m`` (averaging factor), ``dev``,
+    ``ci_low``, ``ci_high`` (NaN where no bound exists), ``n_terms``, ``alpha`` (noise type,
+    NaN where not identified). ``unit`` is the unit of ``dev`` (``deg/s`` for a gyro,
+    ``m/s^2`` for an accelerometer, the output's unit when uncalibrated).
+
+    ``noise`` holds the slope-line noise terms, each key naming its unit (gyro:
+    ``arw_deg_rt_h``, ``bias_instability_dph``, ``allan_minimum_dph``, ``rrw_deg_h_rt_h``, ...;
+    accelerometer: ``vrw_m_s_rt_h``, ``bias_instability_ug``, ``allan_minimum_ug``,
+    ``accel_random_walk_m_s2_rt_h``, ...; ``None`` when absent); each is also an attribute
+    (``r.arw_deg_rt_h``, ``r.vrw_m_s_rt_h``). ``readings`` says where each term was read (its
+    basis and supported tau range), ``fit`` is the five-term fit (gyro), ``noise_note`` why
+    there are no terms. ``taus_rounded`` maps each requested tau (s) that was not a whole
+    multiple of the sample interval to the tau used.
+    """
+
+    taus_s: np.ndarray
+    m: np.ndarray
+    dev: np.ndarray
+    ci_low: np.ndarray
+    ci_high: np.ndarray
+    n_terms: np.ndarray
+    alpha: np.ndarray
+    kind: str
+    unit: str
+    channel: str = "x"
+    record: str = "<array>"
+    quantity: str = "angular_rate"
+    confidence: Optional[float] = None
+    tau0_s: float = float("nan")
+    samples: int = 0
+    noise: Dict[str, Any] = field(default_factory=dict)
+    readings: List[Dict[str, Any]] = field(default_factory=list)
+    fit: Optional[Dict[str, Any]] = None
+    noise_note: Optional[str] = None
+    taus_rounded: Dict[float, float] = field(default_factory=dict)
+    _doc: Dict[str, Any] = field(default_factory=dict)
+
+    @classmethod
+    def _from_json(cls, ch: Dict[str, Any], arrays: List[np.ndarray], rounded: Dict[float, float]) -> "AllanResult":
+        accel = ch.get("quantity") == "acceleration"
+        terms = (ch.get("accel_noise") if accel else ch.get("noise")) or {}
+        return cls(
+            taus_s=arrays[0],
+            m=arrays[1].astype(np.int64),
+            dev=arrays[2],
+            ci_low=arrays[3],
+            ci_high=arrays[4],
+            n_terms=arrays[5].astype(np.int64),
+            alpha=arrays[6],
+            kind=ch["kind"],
+            unit=ch["dev_unit"],
+            channel=ch["channel"],
+            record=ch["file"],
+            quantity=ch["quantity"],
+            confidence=ch.get("confidence"),
+            tau0_s=ch["tau0_s"],
+            samples=ch["samples"],
+            noise={k: v for k, v in terms.items() if k not in ("readings", "fit", "kalibr")},
+            readings=terms.get("readings", []),
+            fit=terms.get("fit"),
+            noise_note=ch.get("noise_note"),
+            taus_rounded=dict(rounded),
+            _doc=ch,
+        )
+
+    def __getattr__(self, name: str) -> Any:
+        # The noise terms as attributes (r.arw_deg_rt_h); private names and the fields
+        # themselves are never looked up here (unpickling asks before the fields exist).
+        if name.startswith("_"):
+            raise AttributeError(name)
+        noise = self.__dict__.get("noise")
+        if noise is not None and name in noise:
+            return noise[name]
+        known = _ACCEL_TERMS if self.__dict__.get("quantity") == "acceleration" else _GYRO_TERMS
+        if any(name in (v[1], v[2]) for v in known.values()):
+            return None
+        raise AttributeError(f"'AllanResult' has no attribute '{name}'")
+
+    def __dir__(self) -> List[str]:
+        return sorted(set(super().__dir__()) | set(self.__dict__.get("noise") or {}))
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, AllanResult):
+            return NotImplemented
+        names = [f for f in self.__dataclass_fields__ if f != "_doc"]
+        return all(_same(getattr(self, f), getattr(other, f)) for f in names)
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def _terms_text(self) -> List[str]:
+        known = _ACCEL_TERMS if self.quantity == "acceleration" else _GYRO_TERMS
+        out = []
+        basis = {r["term"]: r["basis"] for r in self.readings}
+        for term, (sym, _, key, unit) in known.items():
+            if term == "allan_minimum":
+                continue
+            b = basis.get(term)
+            v = self.noise.get(key)
+            if b == "value" and v is not None:
+                out.append(f"{sym}={v:.4g} {unit}")
+            elif b == "upper_bound":
+                r = next(r for r in self.readings if r["term"] == term)
+                out.append(f"{sym}<{r['value']:.3g} {r['unit']}")
+            elif b is not None:
+                out.append(f"{sym} absent")
+        return out
+
+    def __repr__(self) -> str:
+        span = f"{len(self.taus_s)} taus {self.taus_s[0]:.3g}..{self.taus_s[-1]:.3g} s" if len(self.taus_s) else "no taus"
+        terms = self._terms_text()
+        tail = ", ".join(terms) if terms else (self.noise_note or "no noise terms")
+        rate = 1.0 / self.tau0_s if self.tau0_s > 0 else float("nan")
+        return (
+            f"<AllanResult {self.record}:{self.channel} {self.kind} in {self.unit}, {self.samples} samples "
+            f"at {rate:.6g} Hz, {span}; {tail}>"
+        )
+
+    def _repr_html_(self) -> str:
+        e = html.escape
+        rows = "".join(
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>".format(
+                e(r["term"]),
+                "" if r["value"] is None else format(r["value"], ".4g"),
+                e(r["unit"]),
+                e(r["basis"]),
+                e(_support(r)),
+            )
+            for r in self.readings
+        )
+        rate = 1.0 / self.tau0_s if self.tau0_s > 0 else float("nan")
+        head = (
+            f"<b>{e(self.record)}</b> · {e(self.channel)} · {e(self.kind.upper())} in {e(self.unit)} · "
+            f"{self.samples} samples at {rate:.6g} Hz · {len(self.taus_s)} taus"
+        )
+        if not rows:
+            return f"<div>{head}<br><i>{e(self.noise_note or 'no noise terms')}</i></div>"
+        return (
+            f"<div>{head}<table><tr><th>term</th><th>value</th><th>unit</th><th>basis</th>"
+            f"<th>support</th></tr>{rows}</table></div>"
+        )
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The channel's result with the keys of ``gyrolab allan --json``."""
+        return json.loads(json.dumps(self._doc))
+
+    def to_dataframe(self) -> Any:
+        """The curve as a tidy pandas DataFrame: ``channel``, ``tau_s``, ``m``, ``dev``,
+        ``ci_low``, ``ci_high``, ``dev_unit``, ``n_terms``, ``alpha``, ``kind``."""
+        import pandas as pd
+
+        return pd.DataFrame(
+            {
+                "channel": self.channel,
+                "tau_s": self.taus_s,
+                "m": self.m,
+                "dev": self.dev,
+                "ci_low": self.ci_low,
+                "ci_high": self.ci_high,
+                "dev_unit": self.unit,
+                "n_terms": self.n_terms,
+                "alpha": self.alpha,
+                "kind": self.kind,
+            }
+        )
+
+    def noise_table(self) -> Any:
+        """The noise terms as a pandas DataFrame, one row per term: ``channel``, ``term``,
+        ``value`` (the value, or the upper bound), ``unit``, ``basis`` (``value``,
+        ``upper_bound``, ``absent``), ``support`` (where it was read), ``tau_low_s``,
+        ``tau_high_s`` (the supported tau range of a value)."""
+        import pandas as pd
+
+        return pd.DataFrame(_noise_rows(self), columns=_NOISE_COLUMNS)
+
+    def plot(self, ax: Any = None, label: Optional[str] = None, asymptotes: bool = True) -> Any:
+        """Draws the log-log curve with its bounds (confidence level in the legend) and the
+        noise-term asymptotes over the tau ranges that support them (gyro: N, B with the
+        Allan minimum marked, K; accelerometer: VRW, B, acceleration random walk), in one
+        colour per result; on ``ax`` (a new figure when None). Needs matplotlib. Returns ax."""
+        return _plot([self], ax, [label], asymptotes)
+
+
+_NOISE_COLUMNS = ["channel", "term", "value", "unit", "basis", "support", "tau_low_s", "tau_high_s"]
+
+
+def _support(r: Dict[str, Any]) -> str:
+    if r.get("tau_range_s"):
+        lo, hi = r["tau_range_s"]
+        slope = r.get("local_slope")
+        s = f"tau {lo:.3g}..{hi:.3g} s"
+        return s + (f", slope {slope:.2f}" if slope is not None else "")
+    if r.get("reason"):
+        s = str(r["reason"])
+        if r.get("needed_record_s"):
+            s += f" (needs a record of {r['needed_record_s']:.3g} s)"
+        return s
+    if r.get("tau_s") is not None:
+        return f"at tau {r['tau_s']:.3g} s"
+    return ""
+
+
+def _noise_rows(r: AllanResult) -> List[Tuple[Any, ...]]:
+    rows = []
+    for g in r.readings:
+        lo, hi = g["tau_range_s"] if g.get("tau_range_s") else (np.nan, np.nan)
+        value = np.nan if g["value"] is None else g["value"]
+        rows.append((r.channel, g["term"], value, g["unit"], g["basis"], _support(g), lo, hi))
+    return rows
+
+
+class AllanResults(Mapping[str, AllanResult]):
+    """The channels of one record analysed in one call: a mapping channel name ->
+    :class:`AllanResult` (in the record's order), with tidy tables of all of them."""
+
+    def __init__(self, results: Dict[str, AllanResult], record: str = "<array>") -> None:
+        self._results = dict(results)
+        self.record = record
+
+    def __getitem__(self, key: str) -> AllanResult:
+        return self._results[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._results)
+
+    def __len__(self) -> int:
+        return len(self._results)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, AllanResults):
+            return NotImplemented
+        return self.record == other.record and list(self) == list(other) and all(self[k] == other[k] for k in self)
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        lines = [f"<AllanResults {self.record}: {len(self)} channels"]
+        for r in self._results.values():
+            terms = r._terms_text()
+            lines.append(f"  {r.channel} ({r.unit}): " + (", ".join(terms) if terms else (r.noise_note or "no noise terms")))
+        return "\n".join(lines) + ">"
+
+    def _repr_html_(self) -> str:
+        return "".join(r._repr_html_() for r in self._results.values())
+
+    def to_dataframe(self) -> Any:
+        """Every channel's curve in one tidy DataFrame (see :meth:`AllanResult.to_dataframe`)."""
+        import pandas as pd
+
+        return pd.concat([r.to_dataframe() for r in self._results.values()], ignore_index=True)
+
+    def noise_table(self) -> Any:
+        """Every channel's noise terms in one DataFrame (see :meth:`AllanResult.noise_table`)."""
+        import pandas as pd
+
+        return pd.DataFrame([row for r in self._results.values() for row in _noise_rows(r)], columns=_NOISE_COLUMNS)
+
+    def to_dict(self) -> Dict[str, Any]:
+        """``{channel: to_dict()}``."""
+        return {k: r.to_dict() for k, r in self._results.items()}
+
+    def plot(self, ax: Any = None, asymptotes: bool = False) -> Any:
+        """Every channel's curve on one axes (one colour each; a gyro and an accelerometer have
+        different units: plot them separately, ``results['gx'].plot()``)."""
+        return _plot(list(self._results.values()), ax, [None] * len(self), asymptotes)
+
+
+def _asymptotes(r: AllanResult) -> List[Tuple[str, np.ndarray, np.ndarray, str]]:
+    """The slope lines of the terms read as values, each over its supported tau range:
+    (label, taus, level, line style)."""
+    if r.kind not in ("oadev", "adev") or r.quantity not in ("angular_rate", "acceleration"):
+        return []
+    accel = r.quantity == "acceleration"
+    terms = _ACCEL_TERMS if accel else _GYRO_TERMS
+    found = {g["term"]: g for g in r.readings if g["basis"] == "value" and g.get("tau_range_s")}
+    out = []
+    for term, (sym, density_key, key, unit) in terms.items():
+        g = found.get(term)
+        v, shown = r.noise.get(density_key), r.noise.get(key)
+        if g is None or v is None or shown is None:
+            continue
+        lo, hi = g["tau_range_s"]
+        tt = np.geomspace(lo, hi, 24) if hi > lo else np.array([lo, hi])
+        if term in ("arw", "vrw"):
+            out.append((f"{sym} = {shown:.3g} {unit}", tt, v / np.sqrt(tt), "--"))
+        elif term in ("rrw", "accel_random_walk"):
+            out.append((f"{sym} = {shown:.3g} {unit}", tt, v * np.sqrt(tt / 3.0), "-."))
+        elif term == "allan_minimum":
+            level = v * _G_N * 1e-6 if accel else v / 3600.0
+            ieee = r.noise.get("bias_instability_ug" if accel else "bias_instability_dph")
+            text = f"Allan minimum = {shown:.3g} {unit} at τ = {g.get('tau_s') or lo:.3g} s"
+            if ieee is not None:
+                text += f"; B (IEEE) = {ieee:.3g} {unit}"
+            out.append((text, tt, np.full_like(tt, level), ":"))
+    return out
+
+
+def _plot(results: List[AllanResult], ax: Any, labels: List[Optional[str]], asymptotes: bool) -> Any:
+    try:
+        import matplotlib.pyplot as plt
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise ImportError("plot() needs matplotlib: pip install matplotlib") from e
+    if ax is None:
+        _, ax = plt.subplots(figsize=(7, 5))
+    for r, label in zip(results, labels):
+        t, d = r.taus_s, r.dev
+        name = label or (r.channel if len(results) > 1 or r.channel != "x" else r.kind.upper())
+        if r.confidence is not None:
+            name += f" ({r.confidence * 100:.3g} % bounds)"
+        (line,) = ax.plot(t, d, "o-" if len(t) <= _MAX_ERROR_BARS else "-", ms=3, label=name)
+        colour = line.get_color()
+        idx = np.arange(len(t))
+        if len(t) > _MAX_ERROR_BARS:
+            idx = np.unique(np.round(np.geomspace(1, len(t), _MAX_ERROR_BARS)).astype(int) - 1)
+        lo = np.where(np.isfinite(r.ci_low[idx]), d[idx] - r.ci_low[idx], 0.0)
+        hi = np.where(np.isfinite(r.ci_high[idx]), r.ci_high[idx] - d[idx], 0.0)
+        if np.any(lo) or np.any(hi):
+            ax.errorbar(t[idx], d[idx], yerr=[lo, hi], fmt="none", ecolor=colour, capsize=2, lw=0.8)
+        if asymptotes:
+            for text, tt, yy, style in _asymptotes(r):
+                ax.plot(tt, yy, style, color=colour, lw=1, alpha=0.8, label=text)
+            m = next((g for g in r.readings if g["term"] == "allan_minimum" and g["basis"] == "value"), None)
+            if m is not None and m.get("tau_s"):
+                j = int(np.argmin(np.abs(t - m["tau_s"])))
+                ax.plot([t[j]], [d[j]], "v", color=colour, ms=8, mfc="none")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("averaging time τ (s)")
+    units = sorted({r.unit for r in results})
+    kinds = sorted({r.kind.upper() for r in results})
+    ax.set_ylabel(f"{'/'.join(kinds)} σ(τ) ({', '.join(units)})")
+    ax.grid(True, which="both", alpha=0.3)
+    # One legend entry per label, even when several results are drawn on one axes.
+    handles, texts = ax.get_legend_handles_labels()
+    unique = dict(zip(texts, handles))
+    ax.legend(unique.values(), unique.keys(), loc="best", fontsize="small")
+    return ax
