@@ -15,6 +15,7 @@
 //! - [`segment`]: plateaus, strokes and runs found in raw rate-table logs;
 //! - [`triad`]: three-axis scale-factor, misalignment and bias calibration (12 parameters);
 //! - [`apply`]: calibrations applied to output samples (output to rate);
+//! - [`conformity`]: decision rules, guard bands, verdicts and rounding that never contradicts them;
 //! - [`sampling`]: the sampling interval of a record from its time stamps (one estimator);
 //! - [`validate`]: validators of option values (errors name the request field);
 //! - [`thermal`]: temperature tests at soaked points: K(T), bias(T), sensitivities, compensation;
@@ -25,6 +26,7 @@
 
 pub mod allan;
 pub mod apply;
+pub mod conformity;
 pub mod dropout;
 pub mod fit;
 pub mod g_sensitivity;
