@@ -29,6 +29,7 @@
 mod chi2;
 mod confidence;
 mod fast;
+pub mod gap_fill;
 mod gaps;
 mod kernels;
 mod lag1_sweep;
