@@ -29,8 +29,6 @@ if [ ! -x target/debug/examples/chi2_quantiles ]; then
     echo "test.sh: target/debug/examples/chi2_quantiles not left by cargo test: building it" >&2
     cargo build --quiet -p gyrolab --example chi2_quantiles
 fi
-# Hostile recordings (written by the hostile test above) under a 2 GiB address-space limit.
-bash scripts/test_hostile_ulimit.sh "$bin"
 if [ "$skip_python" = "1" ]; then
     echo "SKIPPED: GYROLAB_SKIP_PYTHON=1: allantools and scipy equality checks, the Python package's tests" >&2
 else
