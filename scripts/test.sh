@@ -5,6 +5,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-test-deps.sh
+# A throw-away PostgreSQL server for the records store tests (exports GYROLAB_TEST_PG_URL; stopped
+# and removed at exit; installs the Debian package postgresql when missing): docs/STORE.md.
+source scripts/pg-test-server.sh start
 cargo test --workspace --all-targets
 # Allan deviations equal to Python allantools (rate data = data_type 'freq') at relative 1e-9.
 cargo build --quiet -p gyrolab-cli
