@@ -6,6 +6,7 @@
 //! - [`allan`]: the Allan-variance family with noise identification and confidence intervals;
 //! - [`fit`]: least-squares lines and polynomials;
 //! - [`g_sensitivity`]: g-sensitivity (acceleration-sensitive bias) from records in several orientations;
+//! - [`gmwm`]: GMWM (wavelet-variance) estimation of composite noise models, and overbounding;
 //! - [`noise`]: IEEE 952 noise terms (ARW, bias instability, RRW, ...) from an Allan curve;
 //! - [`rate_test`]: rate-table (scale-factor) test figures;
 //! - [`static_test`]: static (bias) test figures, accumulated block by block;
@@ -29,6 +30,7 @@ pub mod dropout;
 pub mod control_chart;
 pub mod fit;
 pub mod g_sensitivity;
+pub mod gmwm;
 pub mod noise;
 pub mod power_ups;
 pub mod published;
