@@ -11,7 +11,7 @@ pub enum Val {
     /// 64-bit integer (INTEGER / BIGINT).
     I(i64),
     /// Optional 64-bit integer (a null reference).
-    IN(Option<i64>),
+    IOpt(Option<i64>),
     /// Optional double (REAL / DOUBLE PRECISION).
     F(Option<f64>),
     /// Optional text (TEXT).
@@ -30,7 +30,7 @@ impl Val {
     pub fn int(&self) -> i64 {
         match self {
             Val::I(i) => *i,
-            Val::IN(i) => i.unwrap_or(0),
+            Val::IOpt(i) => i.unwrap_or(0),
             _ => 0,
         }
     }
@@ -39,7 +39,7 @@ impl Val {
         match self {
             Val::F(f) => *f,
             Val::I(i) => Some(*i as f64),
-            Val::IN(i) => i.map(|i| i as f64),
+            Val::IOpt(i) => i.map(|i| i as f64),
             _ => None,
         }
     }
@@ -74,7 +74,7 @@ impl SqliteToSql for Val {
     fn to_sql(&self) -> rusqlite::Result<ToSqlOutput<'_>> {
         match self {
             Val::I(i) => i.to_sql(),
-            Val::IN(i) => i.to_sql(),
+            Val::IOpt(i) => i.to_sql(),
             Val::F(f) => f.to_sql(),
             Val::T(t) => t.to_sql(),
         }
@@ -121,7 +121,7 @@ fn pg_params(params: &[Val]) -> Vec<Box<dyn postgres::types::ToSql + Sync>> {
         .map(|p| -> Box<dyn postgres::types::ToSql + Sync> {
             match p {
                 Val::I(i) => Box::new(*i),
-                Val::IN(i) => Box::new(*i),
+                Val::IOpt(i) => Box::new(*i),
                 Val::F(f) => Box::new(*f),
                 Val::T(t) => Box::new(t.clone()),
             }

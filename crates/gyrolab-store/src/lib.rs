@@ -377,7 +377,7 @@ impl Store {
             let o = |s: &Option<String>| Val::T(s.clone());
             let (supersedes, kind, by, why) = match revision {
                 Some(r) => (Val::I(r.supersedes), t(r.kind.as_str()), Val::T(Some(r.by.clone())), Val::T(Some(r.reason.clone()))),
-                None => (Val::IN(None), t("original"), Val::T(None), Val::T(None)),
+                None => (Val::IOpt(None), t("original"), Val::T(None), Val::T(None)),
             };
             if let Some(r) = revision {
                 let taken = x

@@ -255,6 +255,9 @@ pub struct FigureSeries {
     pub simulated: bool,
 }
 
+/// Values (serial, id, test order key, value), limits and id of the latest evaluation, simulated.
+type Group = (Vec<(String, i64, String, f64)>, Option<f64>, Option<f64>, i64, bool);
+
 /// One series per (axis, figure, unit) of the current evaluations in `lot` (all lots: `None`),
 /// each device once (its latest current evaluation).
 pub fn lot_series(store: &mut Store, lot: Option<&str>) -> StoreResult<Vec<FigureSeries>> {
@@ -275,10 +278,7 @@ pub fn lot_series(store: &mut Store, lot: Option<&str>) -> StoreResult<Vec<Figur
         let e = latest.entry(r[1].text().unwrap_or_default()).or_insert(i64::MIN);
         *e = (*e).max(r[0].int());
     }
-    let mut groups: BTreeMap<
-        (String, String, String),
-        (Vec<(String, i64, String, f64)>, Option<f64>, Option<f64>, i64, bool),
-    > = BTreeMap::new();
+    let mut groups: BTreeMap<(String, String, String), Group> = BTreeMap::new();
     for r in &rows {
         let serial = r[1].text().unwrap_or_default();
         let id = r[0].int();
