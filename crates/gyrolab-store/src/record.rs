@@ -184,20 +184,20 @@ pub fn plan_inputs(plan: &gyrolab_io_plan::TestPlan) -> Vec<PathBuf> {
         }
     }
     if let Some(t) = &plan.triad {
-        t.files.iter().for_each(|f| add(f));
+        t.files.iter().for_each(&mut add);
         if let Some(s) = &t.segmentation.segments {
             add(s);
         }
     }
     for s in &plan.static_tests {
-        s.files.iter().for_each(|f| add(f));
+        s.files.iter().for_each(&mut add);
         if let Some(a) = &s.allan_file {
             add(a);
         }
     }
     for t in &plan.temperature {
         for p in &t.points {
-            p.rate_file.iter().chain(&p.static_file).for_each(|f| add(f));
+            p.rate_file.iter().chain(&p.static_file).for_each(&mut add);
         }
     }
     plan.threshold.iter().chain(&plan.resolution).for_each(|s| add(&s.file));
@@ -245,7 +245,7 @@ fn csv_records(text: &str) -> Vec<String> {
     for line in text.split_inclusive('\n') {
         cur.push_str(line);
         quotes += line.matches('"').count();
-        if quotes % 2 == 0 {
+        if quotes.is_multiple_of(2) {
             let rec = cur.trim_end_matches(['\n', '\r']).to_string();
             if !rec.is_empty() {
                 out.push(rec);
