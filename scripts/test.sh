@@ -18,6 +18,9 @@ skip_python=0
 if [ "${GYROLAB_SKIP_PYTHON:-}" = "1" ]; then
     skip_python=1
 fi
+# A throw-away PostgreSQL server for the records store tests (exports GYROLAB_TEST_PG_URL; stopped
+# and removed at exit; installs the Debian package postgresql when missing): docs/STORE.md.
+source scripts/pg-test-server.sh start
 cargo test --workspace --all-targets
 bin=target/debug/gyrolab
 # Both are built by the line above; should a cargo version not leave them there, build them (once).

@@ -1,6 +1,7 @@
 //! Errors of the command-line program and their exit codes (documented in README):
 //! 0 success; 1 an internal or output failure; 2 bad usage or bad data (a plan error included);
-//! 3 a spec limit failed (`gyrolab eval`: every output was written, the report shows FAIL).
+//! 3 a spec limit failed (`gyrolab eval`: every output was written, the report shows FAIL);
+//! 4 some inputs of a batch failed (`gyrolab batch`: the others were evaluated and written).
 
 use gyrolab_eval::EvalError;
 use std::process::ExitCode;
@@ -18,6 +19,9 @@ pub enum CliError {
     /// The evaluation succeeded and its outputs were written, but a spec limit failed (exit 3).
     #[error("{0}")]
     LimitFailed(String),
+    /// Some inputs of a batch failed; the others were evaluated and written (exit 4).
+    #[error("{0}")]
+    SomeFailed(String),
 }
 
 impl CliError {
@@ -27,6 +31,7 @@ impl CliError {
             CliError::Eval(EvalError::Output(_)) | CliError::Output(_) => ExitCode::from(1),
             CliError::Eval(_) => ExitCode::from(2),
             CliError::LimitFailed(_) => ExitCode::from(3),
+            CliError::SomeFailed(_) => ExitCode::from(4),
         }
     }
 }

@@ -47,6 +47,8 @@ enum Command {
     Simulate(cmd::simulate::SimulateCommand),
     /// Evaluate a test plan and write the report folder (report.html, results.json, calibration, CSV).
     Eval(cmd::eval::EvalArgs),
+    /// Allan analysis of many records on every core, resumable, one results table (CSV, Parquet).
+    Batch(Box<cmd::batch::BatchArgs>),
     /// Run the paper's worked example on its data (built in) and compare with its printed tables.
     Demo(cmd::demo::DemoArgs),
 }
@@ -64,6 +66,7 @@ fn main() -> ExitCode {
         Command::Rate(a) => cmd::rate::run(a),
         Command::Eval(a) => cmd::eval::run(a),
         Command::Demo(a) => cmd::demo::run(a),
+        Command::Batch(a) => cmd::batch::run(a),
         Command::Bias(a) => cmd::bias::run(a),
         Command::Allan(a) => cmd::allan::run(a),
         Command::Apply(a) => cmd::apply::run(a),

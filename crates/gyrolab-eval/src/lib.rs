@@ -9,6 +9,7 @@
 //! - [`static_test`]: static tests (bias, bias stability, repeatability, drift, temperature);
 //! - [`allan`]: Allan-variance analyses of time series, with noise terms;
 //! - [`apply`]: a calibration applied to a time series, streaming;
+//! - [`batch`]: many records on every core, resumable by input hash, one result row per channel;
 //! - [`simulate`]: simulator configurations from a file and overrides;
 //! - [`record_length`]: the record length a noise term's precision needs;
 //! - [`recording`]: recordings (MCAP, ROS 1 bags, ULog): inventories and conversion to CSV/Parquet;
@@ -26,6 +27,7 @@
 
 pub mod allan;
 pub mod apply;
+pub mod batch;
 pub mod demo;
 pub mod error;
 pub mod layout;

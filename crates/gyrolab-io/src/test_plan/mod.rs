@@ -126,6 +126,8 @@ struct RawDevice {
     description: Option<String>,
     #[serde(default)]
     simulated: Option<String>,
+    #[serde(default)]
+    lot: Option<String>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -190,6 +192,8 @@ pub struct DevicePlan {
     /// The plan's records are SIMULATED: how they were made (every section, table and summary row
     /// of the report is then labelled SIMULATED with it).
     pub simulated: Option<String>,
+    /// Production lot (`lot`), the key of the records store's lot statistics.
+    pub lot: Option<String>,
 }
 
 /// Who tested, where, under which conditions and to which procedure (`[test]`), for the
@@ -781,6 +785,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
             axes,
             description: raw.device.description,
             simulated: raw.device.simulated,
+            lot: raw.device.lot,
         },
         options,
         rate,

@@ -1,0 +1,362 @@
+//! `gyrolab batch INPUT... --out DIR`: the Allan analysis of many records (folders, globs, lists)
+//! on every core, with a progress bar (throughput, time left), one stderr line per failure, a
+//! summary table, and the combined results (`results.csv`, `results.parquet`: one row per record
+//! and channel). Resumable: `DIR/batch-journal.jsonl` holds each record done, by the SHA-256 of
+//! its bytes, and a batch started again passes over those.
+//!
+//! Exit code: 0 every input evaluated (now or by an earlier run); 4 some inputs failed (the
+//! others evaluated and written; the failures listed on stderr and in `DIR/failures.csv`);
+//! 2 bad usage (no input found, a journal of other options); 1 an output could not be written.
+
+use crate::args::{LayoutArgs, ReferenceArgs};
+use crate::error::{flag, CliError, CliResult};
+use crate::output::print;
+use clap::Args;
+use gyrolab::allan::DeviationKind;
+use gyrolab::validate;
+use gyrolab_eval::allan::{parse_confidence, parse_taus, AllanRequest, GapPolicy};
+use gyrolab_eval::batch::{
+    collect_inputs, journal_header, journal_line, journal_rows, options_fingerprint, results_csv, results_parquet,
+    run_batch, BatchRequest, BatchSink, Cell, DoneInput, FailedInput, Journal, ResultRow, Skipped,
+};
+use gyrolab_eval::{EvalError, Progress};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::collections::BTreeMap;
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// The journal's file name in the output folder.
+const JOURNAL: &str = "batch-journal.jsonl";
+
+/// Options of `gyrolab batch`.
+#[derive(Debug, Args)]
+pub struct BatchArgs {
+    /// Records: files, folders (their .csv, .tsv, .txt, .dat, .parquet, .mcap, .bag, .ulg and
+    /// .log files at any depth) or glob patterns (quote them: 'fleet/**/*.mcap').
+    #[arg(value_name = "INPUT")]
+    pub inputs: Vec<String>,
+    /// A file listing inputs, one a line (blank lines and # comments passed over); repeatable.
+    #[arg(long = "list", value_name = "FILE")]
+    pub lists: Vec<PathBuf>,
+    /// Folder of the results (created if missing): results.csv, results.parquet, failures.csv
+    /// and the journal batch-journal.jsonl that lets a batch started again resume.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_name = "N")]
+    pub jobs: Option<usize>,
+    /// No progress bar and no summary on standard output (failures still go to stderr).
+    #[arg(long, short)]
+    pub quiet: bool,
+    /// Topic of the recordings to analyse (default: every IMU topic), repeatable.
+    #[arg(long = "topic", value_name = "NAME")]
+    pub topics: Vec<String>,
+    #[command(flatten)]
+    pub layout: LayoutArgs,
+    /// Output columns to analyse (default: every output column), repeatable.
+    #[arg(long = "column", value_name = "NAME")]
+    pub columns: Vec<String>,
+    /// Sample rate in Hz (for files without a time column).
+    #[arg(long, value_name = "HZ")]
+    pub sample_rate_hz: Option<f64>,
+    #[command(flatten)]
+    pub reference: ReferenceArgs,
+    /// Deviation: oadev (default), adev, mdev, tdev, hdev, ohdev, totdev.
+    #[arg(long, default_value = "oadev", value_name = "KIND")]
+    pub kind: String,
+    /// Taus: octave (default), decade, N/decade, all, or seconds (0.1,1,10).
+    #[arg(long, default_value = "octave", value_name = "LIST")]
+    pub taus: String,
+    /// Confidence level of the bounds (default 0.683), or `none`.
+    #[arg(long, default_value = "0.683", value_name = "C")]
+    pub confidence: String,
+    /// Fit the five-term noise model over this tau range only, seconds: LOW,HIGH.
+    #[arg(long, value_name = "LOW,HIGH", value_delimiter = ',', num_args = 1..=2)]
+    pub fit_range: Vec<f64>,
+    /// Missing samples: `analyse` (default) or `error` (as `gyrolab allan --gaps`).
+    #[arg(long, default_value = "analyse", value_name = "POLICY")]
+    pub gaps: String,
+}
+
+impl BatchArgs {
+    fn allan(&self) -> CliResult<AllanRequest> {
+        let kind = DeviationKind::parse(&self.kind).map_err(|e| EvalError::conflict(e.to_string()))?;
+        Ok(AllanRequest {
+            file: PathBuf::new(),
+            columns: self.columns.clone(),
+            sample_rate_hz: self.sample_rate_hz,
+            reference: self.reference.request(),
+            kind,
+            taus: parse_taus(&self.taus)?,
+            confidence: parse_confidence(&self.confidence)?,
+            fit_range_s: validate::increasing_pair("fit_range_s", &self.fit_range)?,
+            layout: self.layout.layout(),
+            gaps: GapPolicy::parse(&self.gaps)?,
+            topics: self.topics.clone(),
+        })
+    }
+}
+
+/// The progress bar of a batch: position, throughput and time left; hidden when stderr is not a
+/// terminal (or `--quiet`), when failure lines go to stderr directly.
+struct BatchBar(ProgressBar);
+
+impl BatchBar {
+    fn new(quiet: bool) -> BatchBar {
+        if quiet || !std::io::stderr().is_terminal() {
+            return BatchBar(ProgressBar::hidden());
+        }
+        let bar = ProgressBar::new(0);
+        let template = "{spinner} [{elapsed_precise}] [{bar:30}] {pos}/{len} records, {per_sec}, {eta} left {msg}";
+        if let Ok(style) = ProgressStyle::with_template(template) {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        BatchBar(bar)
+    }
+
+    fn line(&self, text: &str) {
+        if self.0.is_hidden() {
+            eprintln!("{text}");
+        } else {
+            self.0.println(text);
+        }
+    }
+}
+
+impl Progress for BatchBar {
+    fn begin(&self, steps: u64) {
+        self.0.set_length(steps);
+    }
+    fn advance(&self, steps: u64) {
+        self.0.inc(steps);
+    }
+}
+
+/// Appends each input done to the journal (one line, one write, under a lock) and shows each
+/// failure.
+struct JournalSink<'a> {
+    file: Mutex<std::fs::File>,
+    bar: &'a BatchBar,
+}
+
+impl BatchSink for JournalSink<'_> {
+    fn done(&self, input: &DoneInput) -> Result<(), String> {
+        let line = journal_line(input);
+        let mut f = self.file.lock().unwrap_or_else(|p| p.into_inner());
+        f.write_all(line.as_bytes()).map_err(|e| format!("cannot append to the journal: {e}"))
+    }
+    fn failed(&self, input: &FailedInput) {
+        self.bar.line(&format!("failed: {}", failure_text(input)));
+    }
+}
+
+/// `FILE: reason`, the file named once.
+fn failure_text(input: &FailedInput) -> String {
+    let reason = input.error.render(&flag);
+    let file = input.file.display().to_string();
+    if reason.starts_with(&file) {
+        reason
+    } else {
+        format!("{file}: {reason}")
+    }
+}
+
+/// Opens (or starts) the journal of `out`: the entries of earlier runs and the file to append to.
+fn open_journal(out: &Path, options: &str) -> CliResult<(Journal, std::fs::File)> {
+    let path = out.join(JOURNAL);
+    let io = |e: std::io::Error| CliError::Output(format!("{}: {e}", path.display()));
+    std::fs::create_dir_all(out)
+        .map_err(|e| CliError::Output(format!("{}: cannot create the folder: {e}", out.display())))?;
+    let journal = match std::fs::read(&path) {
+        Ok(bytes) => {
+            let text = String::from_utf8_lossy(&bytes);
+            let journal = Journal::parse(&text, &path)?;
+            if journal.options.as_deref() != Some(options) {
+                return Err(EvalError::conflict(format!(
+                    "{}: this folder holds a batch run with other options or by another gyrolab version; give another --out, or delete {} to start the batch over",
+                    out.display(),
+                    path.display()
+                ))
+                .into());
+            }
+            let mut f = std::fs::OpenOptions::new().append(true).open(&path).map_err(io)?;
+            if !text.ends_with('\n') {
+                // The last line was cut short by a killed run: end it, so the next entry starts
+                // on a line of its own (the cut line is passed over when read).
+                f.write_all(b"\n").map_err(io)?;
+            }
+            journal
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            gyrolab_io::atomic::write_atomic(&path, journal_header(options).as_bytes()).map_err(io)?;
+            Journal { options: Some(options.to_string()), ..Journal::default() }
+        }
+        Err(e) => return Err(io(e)),
+    };
+    let file = std::fs::OpenOptions::new().append(true).open(&path).map_err(io)?;
+    Ok((journal, file))
+}
+
+/// Runs `gyrolab batch`.
+pub fn run(args: &BatchArgs) -> CliResult {
+    let allan = args.allan()?;
+    if let Some(n) = args.jobs {
+        validate::positive("jobs", n as f64)?;
+    }
+    let inputs = collect_inputs(&args.inputs, &args.lists, Some(&args.out))?;
+    if inputs.is_empty() {
+        return Err(
+            EvalError::conflict("no record to evaluate: give files, folders, glob patterns or --list FILE").into()
+        );
+    }
+    let options = options_fingerprint(&allan);
+    let (mut journal, file) = open_journal(&args.out, &options)?;
+    if journal.unreadable_lines > 0 {
+        eprintln!(
+            "note: {} line(s) of {} were cut short by an interrupted run; their records are evaluated again",
+            journal.unreadable_lines,
+            args.out.join(JOURNAL).display()
+        );
+    }
+    let bar = BatchBar::new(args.quiet);
+    let sink = JournalSink { file: Mutex::new(file), bar: &bar };
+    let request = BatchRequest { inputs, allan, jobs: args.jobs };
+    let outcome = run_batch(&request, &journal, &sink, &bar);
+    bar.0.finish_and_clear();
+    let outcome = outcome?;
+    let file = sink.file.into_inner().unwrap_or_else(|p| p.into_inner());
+    file.sync_data().map_err(|e| CliError::Output(format!("{}: {e}", args.out.join(JOURNAL).display())))?;
+    let now = outcome.evaluated.len();
+    for d in outcome.evaluated {
+        journal.entries.insert(d.sha256.clone(), d);
+    }
+    // The union of this run and the earlier ones, in file order: complete or untouched.
+    let rows = journal_rows(&journal);
+    let csv = results_csv(&rows);
+    let parquet = results_parquet(&rows)?;
+    let failures_csv = (!outcome.failures.is_empty()).then(|| {
+        let mut s = String::from("file,reason\n");
+        for f in &outcome.failures {
+            let reason = f.error.render(&flag).replace('"', "\"\"");
+            s.push_str(&format!("\"{}\",\"{reason}\"\n", f.file.display().to_string().replace('"', "\"\"")));
+        }
+        s
+    });
+    let mut files: Vec<(&str, &[u8])> = vec![("results.csv", csv.as_bytes()), ("results.parquet", &parquet)];
+    if let Some(f) = &failures_csv {
+        files.push(("failures.csv", f.as_bytes()));
+    }
+    gyrolab_io::atomic::write_folder(&args.out, &files)
+        .map_err(|(path, e)| CliError::Output(format!("{}: cannot write the file: {e}", path.display())))?;
+    if failures_csv.is_none() {
+        // A list of failures from an earlier run would no longer be true.
+        let _ = std::fs::remove_file(args.out.join("failures.csv"));
+    }
+    let done_before = outcome.skipped.iter().filter(|s| matches!(s, Skipped::AlreadyDone { .. })).count();
+    let duplicates = outcome.skipped.len() - done_before;
+    if !args.quiet {
+        let mut s = format!(
+            "{} inputs: {now} evaluated now, {done_before} already done (journal), {duplicates} same bytes as another input, {} failed\n",
+            request.inputs.len(),
+            outcome.failures.len()
+        );
+        s.push_str(&summary_table(&rows));
+        s.push_str(&format!(
+            "Wrote {} ({} rows), {}{}\n",
+            args.out.join("results.csv").display(),
+            rows.len(),
+            args.out.join("results.parquet").display(),
+            if failures_csv.is_some() {
+                format!(", {}", args.out.join("failures.csv").display())
+            } else {
+                String::new()
+            }
+        ));
+        print(&s)?;
+    }
+    if !outcome.failures.is_empty() {
+        return Err(CliError::SomeFailed(format!(
+            "{} of {} inputs failed (listed above and in {}); the others are in {}",
+            outcome.failures.len(),
+            request.inputs.len(),
+            args.out.join("failures.csv").display(),
+            args.out.join("results.csv").display()
+        )));
+    }
+    Ok(())
+}
+
+/// The fleet at a glance: per channel name and noise term, how many records resolved it and
+/// the median, smallest and largest value.
+fn summary_table(rows: &[ResultRow]) -> String {
+    const TERMS: [&str; 6] = [
+        "arw_deg_rt_h",
+        "bias_instability_dph",
+        "rrw_deg_h_rt_h",
+        "vrw_m_s_rt_h",
+        "bias_instability_ug",
+        "accel_random_walk_m_s2_rt_h",
+    ];
+    let simulated = rows.iter().filter(|r| matches!(r.get("simulated"), Some(Cell::Text(_)))).count();
+    let mut groups: BTreeMap<(String, &str), (usize, Vec<f64>)> = BTreeMap::new();
+    for r in rows {
+        let channel = match (r.get("topic"), r.get("channel")) {
+            (Some(Cell::Text(t)), Some(Cell::Text(c))) => format!("{t}/{c}"),
+            (_, Some(Cell::Text(c))) => c.clone(),
+            _ => String::new(),
+        };
+        for term in TERMS {
+            let applies = match term {
+                "vrw_m_s_rt_h" | "bias_instability_ug" | "accel_random_walk_m_s2_rt_h" => {
+                    matches!(r.get("vrw_basis"), Some(Cell::Text(_)))
+                }
+                _ => matches!(r.get("arw_basis"), Some(Cell::Text(_))),
+            };
+            if !applies {
+                continue;
+            }
+            let g = groups.entry((channel.clone(), term)).or_default();
+            g.0 += 1;
+            if let Some(x) = r.get(term).and_then(Cell::number) {
+                g.1.push(x);
+            }
+        }
+    }
+    if groups.is_empty() {
+        return "No noise terms (no channel in deg/s or m/s^2; give --unit or a calibration).\n".into();
+    }
+    let mut lines =
+        vec![["channel".to_string(), "term".into(), "resolved".into(), "median".into(), "min".into(), "max".into()]];
+    let g4 = |x: f64| format!("{x:.4e}");
+    for ((channel, term), (n, mut v)) in groups {
+        v.sort_by(f64::total_cmp);
+        let median = match v.len() {
+            0 => None,
+            k if k % 2 == 1 => Some(v[k / 2]),
+            k => Some(0.5 * (v[k / 2 - 1] + v[k / 2])),
+        };
+        lines.push([
+            channel,
+            term.to_string(),
+            format!("{}/{n}", v.len()),
+            median.map_or("-".into(), g4),
+            v.first().map_or("-".into(), |x| g4(*x)),
+            v.last().map_or("-".into(), |x| g4(*x)),
+        ]);
+    }
+    let widths: Vec<usize> = (0..6).map(|i| lines.iter().map(|l| l[i].chars().count()).max().unwrap_or(0)).collect();
+    let mut s = String::new();
+    for l in &lines {
+        let cells: Vec<String> = l.iter().zip(&widths).map(|(c, w)| format!("{c:<w$}")).collect();
+        s.push_str(cells.join("  ").trim_end());
+        s.push('\n');
+    }
+    if simulated > 0 {
+        s.push_str(&format!(
+            "SIMULATED: {simulated} of {} rows come from simulated records (column `simulated`)\n",
+            rows.len()
+        ));
+    }
+    s
+}

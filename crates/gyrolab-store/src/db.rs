@@ -1,0 +1,171 @@
+//! The two back ends behind one small interface: SQLite (rusqlite, bundled) and PostgreSQL (the
+//! synchronous `postgres` client). Every statement is a constant string with `$1, $2, ...`
+//! parameters, numbered in order of first appearance (SQLite reads `$N` as a named parameter
+//! whose index is its first appearance, so the same text binds the same way on both).
+
+use rusqlite::types::{ToSql as SqliteToSql, ToSqlOutput};
+
+/// A parameter or a column value.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Val {
+    /// 64-bit integer (INTEGER / BIGINT).
+    I(i64),
+    /// Optional 64-bit integer (a null reference).
+    IOpt(Option<i64>),
+    /// Optional double (REAL / DOUBLE PRECISION).
+    F(Option<f64>),
+    /// Optional text (TEXT).
+    T(Option<String>),
+}
+
+impl Val {
+    /// Text of a value (`None` for null or a number).
+    pub fn text(&self) -> Option<&str> {
+        match self {
+            Val::T(t) => t.as_deref(),
+            _ => None,
+        }
+    }
+    /// Integer of a value (0 for anything else).
+    pub fn int(&self) -> i64 {
+        match self {
+            Val::I(i) => *i,
+            Val::IOpt(i) => i.unwrap_or(0),
+            _ => 0,
+        }
+    }
+    /// Double of a value.
+    pub fn float(&self) -> Option<f64> {
+        match self {
+            Val::F(f) => *f,
+            Val::I(i) => Some(*i as f64),
+            Val::IOpt(i) => i.map(|i| i as f64),
+            _ => None,
+        }
+    }
+    /// Owned text (empty for null).
+    pub fn string(&self) -> String {
+        self.text().unwrap_or_default().to_string()
+    }
+}
+
+/// The kind of a result column, to read it on either back end.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// 64-bit integer.
+    I,
+    /// Optional double.
+    F,
+    /// Optional text.
+    T,
+}
+
+/// Something that runs statements: a connection or a transaction of either back end.
+pub trait Exec {
+    /// Runs a statement; the number of rows changed.
+    fn exec(&mut self, sql: &str, params: &[Val]) -> Result<u64, String>;
+    /// Runs a query; every row read as `kinds`.
+    fn query(&mut self, sql: &str, params: &[Val], kinds: &[Kind]) -> Result<Vec<Vec<Val>>, String>;
+    /// Runs several statements without parameters (schema changes).
+    fn batch(&mut self, sql: &str) -> Result<(), String>;
+}
+
+impl SqliteToSql for Val {
+    fn to_sql(&self) -> rusqlite::Result<ToSqlOutput<'_>> {
+        match self {
+            Val::I(i) => i.to_sql(),
+            Val::IOpt(i) => i.to_sql(),
+            Val::F(f) => f.to_sql(),
+            Val::T(t) => t.to_sql(),
+        }
+    }
+}
+
+fn sqlite_row(row: &rusqlite::Row<'_>, kinds: &[Kind]) -> rusqlite::Result<Vec<Val>> {
+    kinds
+        .iter()
+        .enumerate()
+        .map(|(i, k)| {
+            Ok(match k {
+                Kind::I => Val::I(row.get::<_, Option<i64>>(i)?.unwrap_or(0)),
+                Kind::F => Val::F(row.get(i)?),
+                Kind::T => Val::T(row.get(i)?),
+            })
+        })
+        .collect()
+}
+
+/// SQLite statements on a connection or a transaction (which derefs to one).
+pub struct SqliteExec<'a>(pub &'a rusqlite::Connection);
+
+impl Exec for SqliteExec<'_> {
+    fn exec(&mut self, sql: &str, params: &[Val]) -> Result<u64, String> {
+        let mut st = self.0.prepare_cached(sql).map_err(|e| e.to_string())?;
+        st.execute(rusqlite::params_from_iter(params.iter())).map(|n| n as u64).map_err(|e| e.to_string())
+    }
+    fn query(&mut self, sql: &str, params: &[Val], kinds: &[Kind]) -> Result<Vec<Vec<Val>>, String> {
+        let mut st = self.0.prepare_cached(sql).map_err(|e| e.to_string())?;
+        let rows = st
+            .query_map(rusqlite::params_from_iter(params.iter()), |r| sqlite_row(r, kinds))
+            .map_err(|e| e.to_string())?;
+        rows.collect::<rusqlite::Result<Vec<_>>>().map_err(|e| e.to_string())
+    }
+    fn batch(&mut self, sql: &str) -> Result<(), String> {
+        self.0.execute_batch(sql).map_err(|e| e.to_string())
+    }
+}
+
+fn pg_params(params: &[Val]) -> Vec<Box<dyn postgres::types::ToSql + Sync>> {
+    params
+        .iter()
+        .map(|p| -> Box<dyn postgres::types::ToSql + Sync> {
+            match p {
+                Val::I(i) => Box::new(*i),
+                Val::IOpt(i) => Box::new(*i),
+                Val::F(f) => Box::new(*f),
+                Val::T(t) => Box::new(t.clone()),
+            }
+        })
+        .collect()
+}
+
+fn pg_error(e: postgres::Error) -> String {
+    match e.as_db_error() {
+        Some(db) => db.message().to_string(),
+        None => e.to_string(),
+    }
+}
+
+/// PostgreSQL statements on a client or a transaction.
+pub struct PgExec<'a, C: postgres::GenericClient>(pub &'a mut C);
+
+impl<C: postgres::GenericClient> Exec for PgExec<'_, C> {
+    fn exec(&mut self, sql: &str, params: &[Val]) -> Result<u64, String> {
+        let p = pg_params(params);
+        let refs: Vec<&(dyn postgres::types::ToSql + Sync)> = p.iter().map(|b| b.as_ref()).collect();
+        self.0.execute(sql, &refs).map_err(pg_error)
+    }
+    fn query(&mut self, sql: &str, params: &[Val], kinds: &[Kind]) -> Result<Vec<Vec<Val>>, String> {
+        let p = pg_params(params);
+        let refs: Vec<&(dyn postgres::types::ToSql + Sync)> = p.iter().map(|b| b.as_ref()).collect();
+        let rows = self.0.query(sql, &refs).map_err(pg_error)?;
+        rows.iter()
+            .map(|r| {
+                kinds
+                    .iter()
+                    .enumerate()
+                    .map(|(i, k)| {
+                        Ok(match k {
+                            Kind::I => Val::I(r.try_get::<_, Option<i64>>(i).map_err(pg_error)?.unwrap_or(0)),
+                            Kind::F => Val::F(r.try_get(i).map_err(pg_error)?),
+                            Kind::T => Val::T(r.try_get(i).map_err(pg_error)?),
+                        })
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+    fn batch(&mut self, sql: &str) -> Result<(), String> {
+        self.0.batch_execute(sql).map_err(pg_error)
+    }
+}

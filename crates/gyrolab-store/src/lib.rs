@@ -1,0 +1,593 @@
+//! The records store of gyrolab: every evaluation kept per device, lot and software version, in
+//! an embedded SQLite file by default or on a shared PostgreSQL server; revisions instead of
+//! changes; history of a serial, lot statistics, lot comparison, control charts. The only crate
+//! with SQL; every statement is a constant with parameters (docs/STORE.md).
+//!
+//! Layout: [`db`] the two back ends behind one interface; [`schema`] tables and migrations;
+//! [`record`] what is kept of one evaluation, read from a finished report folder; [`query`] the
+//! queries and their statistics (computed by the core crate: `gyrolab::process_capability`,
+//! `gyrolab::control_chart`, `gyrolab::two_sample`).
+
+pub mod db;
+pub mod query;
+pub mod record;
+pub mod reevaluate;
+pub mod schema;
+
+use db::{Exec, Kind, PgExec, SqliteExec, Val};
+use record::EvaluationRecord;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+use thiserror::Error;
+
+/// Errors of the store; each names the store (password masked).
+#[derive(Debug, Error)]
+pub enum StoreError {
+    /// The store cannot be opened or is not a gyrolab store (exit code 2).
+    #[error("store {store}: {message}")]
+    Open {
+        /// The store, password masked.
+        store: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The store was written by a newer gyrolab (exit code 2).
+    #[error(
+        "store {store}: schema version {found} is newer than this gyrolab {software} knows (up to {known}); use a newer gyrolab"
+    )]
+    NewerSchema {
+        /// The store, password masked.
+        store: String,
+        /// Version in the store.
+        found: i64,
+        /// Newest version this build knows.
+        known: i64,
+        /// This build's version.
+        software: String,
+    },
+    /// A value was refused before anything was written (exit code 2).
+    #[error("store {store}: refused: {message}")]
+    Refused {
+        /// The store, password masked.
+        store: String,
+        /// What was refused and why.
+        message: String,
+    },
+    /// A report folder or an input could not be read (exit code 2).
+    #[error("{path}: {message}")]
+    Input {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// Nothing found for a query (exit code 2).
+    #[error("store {store}: {message}")]
+    NotFound {
+        /// The store, password masked.
+        store: String,
+        /// What was not found.
+        message: String,
+    },
+    /// The database failed during an operation (exit code 1; the transaction was rolled back).
+    #[error("store {store}: {message}")]
+    Database {
+        /// The store, password masked.
+        store: String,
+        /// The database's message.
+        message: String,
+    },
+}
+
+impl StoreError {
+    /// True for errors of the user's data or store (exit code 2), false for failures (exit code 1).
+    pub fn is_bad_input(&self) -> bool {
+        !matches!(self, StoreError::Database { .. })
+    }
+}
+
+/// Result of store operations.
+pub type StoreResult<T> = Result<T, StoreError>;
+
+/// The version of this build (written into every record).
+pub const SOFTWARE_VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// The environment variable naming the default store.
+pub const STORE_ENV: &str = "GYROLAB_STORE";
+
+/// The default store's file name, beside the plan.
+pub const DEFAULT_FILE: &str = "gyrolab.db";
+
+/// Where the store is: `explicit` (a path or a `postgres://` URL), else `GYROLAB_STORE`, else
+/// `gyrolab.db` in `plan_dir` (the current folder without one).
+pub fn resolve_location(explicit: Option<&str>, plan_dir: Option<&Path>) -> String {
+    if let Some(e) = explicit.filter(|e| !e.is_empty()) {
+        return e.to_string();
+    }
+    if let Ok(env) = std::env::var(STORE_ENV) {
+        if !env.is_empty() {
+            return env;
+        }
+    }
+    let dir = plan_dir.map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from("."));
+    dir.join(DEFAULT_FILE).display().to_string()
+}
+
+/// True when `location` names a PostgreSQL server.
+pub fn is_postgres(location: &str) -> bool {
+    location.starts_with("postgres://") || location.starts_with("postgresql://")
+}
+
+/// The location with any password replaced by `***` (URL user info and `password=` parameters).
+pub fn mask_location(location: &str) -> String {
+    let mut out = location.to_string();
+    if let Some(scheme_end) = out.find("://") {
+        let rest_start = scheme_end + 3;
+        let authority_end = out[rest_start..].find(['/', '?']).map_or(out.len(), |i| rest_start + i);
+        if let Some(at) = out[rest_start..authority_end].rfind('@') {
+            let userinfo = &out[rest_start..rest_start + at];
+            if let Some(colon) = userinfo.find(':') {
+                out.replace_range(rest_start + colon + 1..rest_start + at, "***");
+            }
+        }
+    }
+    let lower = out.to_ascii_lowercase();
+    if let Some(p) = lower.find("password=") {
+        let start = p + "password=".len();
+        let end = out[start..].find(['&', ' ']).map_or(out.len(), |i| start + i);
+        out.replace_range(start..end, "***");
+    }
+    out
+}
+
+fn password_of(location: &str) -> Option<String> {
+    let config: postgres::Config = location.parse().ok()?;
+    config.get_password().map(|p| String::from_utf8_lossy(p).into_owned()).filter(|p| !p.is_empty())
+}
+
+enum Conn {
+    Sqlite(rusqlite::Connection),
+    Postgres(Box<postgres::Client>),
+}
+
+/// An open store with its schema up to date.
+pub struct Store {
+    conn: Conn,
+    name: String,
+    password: Option<String>,
+}
+
+const SQLITE_HEADER: &[u8; 16] = b"SQLite format 3\0";
+
+impl Store {
+    /// Opens the store at `location` (a file path or a `postgres://` URL). `create`: a missing
+    /// SQLite file is created (else it is an error). The schema is created or migrated on first
+    /// use; a store of a newer schema, a file that is not SQLite, or an SQLite file with tables
+    /// but no gyrolab schema is refused with nothing written.
+    pub fn open(location: &str, create: bool) -> StoreResult<Store> {
+        let name = mask_location(location);
+        let mut store = if is_postgres(location) {
+            let password = password_of(location);
+            let mask = |m: String| match &password {
+                Some(p) => m.replace(p.as_str(), "***"),
+                None => m,
+            };
+            let mut config: postgres::Config = location
+                .parse()
+                .map_err(|e: postgres::Error| StoreError::Open { store: name.clone(), message: mask(e.to_string()) })?;
+            config.connect_timeout(Duration::from_secs(10));
+            let client = config.connect(postgres::NoTls).map_err(|e| StoreError::Open {
+                store: name.clone(),
+                message: mask(format!(
+                    "cannot connect: {}",
+                    e.as_db_error().map_or_else(|| e.to_string(), |d| d.message().to_string())
+                )),
+            })?;
+            Store { conn: Conn::Postgres(Box::new(client)), name, password }
+        } else {
+            let path = Path::new(location);
+            let open_err = |m: String| StoreError::Open { store: name.clone(), message: m };
+            match std::fs::File::open(path) {
+                Ok(mut f) => {
+                    use std::io::Read;
+                    let mut head = [0u8; 16];
+                    let mut got = 0;
+                    while got < 16 {
+                        match f.read(&mut head[got..]) {
+                            Ok(0) => break,
+                            Ok(n) => got += n,
+                            Err(e) => return Err(open_err(format!("cannot read: {e}"))),
+                        }
+                    }
+                    if got > 0 && (got < 16 || head != *SQLITE_HEADER) {
+                        return Err(open_err("not an SQLite database (wrong header): not a gyrolab store".into()));
+                    }
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                    if !create {
+                        return Err(StoreError::NotFound {
+                            store: name.clone(),
+                            message: "no store here (it is created by `gyrolab store add` or `gyrolab eval --store`)"
+                                .into(),
+                        });
+                    }
+                }
+                Err(e) => return Err(open_err(format!("cannot open: {e}"))),
+            }
+            let conn = rusqlite::Connection::open(path).map_err(|e| open_err(e.to_string()))?;
+            conn.busy_timeout(Duration::from_secs(30)).map_err(|e| open_err(e.to_string()))?;
+            let mut store = Store { conn: Conn::Sqlite(conn), name, password: None };
+            store.check_foreign_sqlite()?;
+            if let Conn::Sqlite(c) = &store.conn {
+                c.pragma_update(None, "journal_mode", "WAL").map_err(|e| store.open_error(e.to_string()))?;
+                c.pragma_update(None, "foreign_keys", "ON").map_err(|e| store.open_error(e.to_string()))?;
+            }
+            store
+        };
+        store.migrate()?;
+        Ok(store)
+    }
+
+    /// The store's name for messages (password masked).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// True on PostgreSQL.
+    pub fn is_postgres(&self) -> bool {
+        matches!(self.conn, Conn::Postgres(_))
+    }
+
+    fn mask(&self, m: String) -> String {
+        match &self.password {
+            Some(p) => m.replace(p.as_str(), "***"),
+            None => m,
+        }
+    }
+
+    fn open_error(&self, m: String) -> StoreError {
+        StoreError::Open { store: self.name.clone(), message: self.mask(m) }
+    }
+
+    pub(crate) fn db_error(&self, m: String) -> StoreError {
+        StoreError::Database { store: self.name.clone(), message: self.mask(m) }
+    }
+
+    /// An SQLite file with tables but no `gyrolab_schema` is someone else's database.
+    fn check_foreign_sqlite(&mut self) -> StoreResult<()> {
+        let Conn::Sqlite(c) = &self.conn else { return Ok(()) };
+        let rows = SqliteExec(c)
+            .query("SELECT name FROM sqlite_master WHERE type = 'table'", &[], &[Kind::T])
+            .map_err(|e| self.open_error(format!("not a usable SQLite database: {e}")))?;
+        let names: Vec<String> = rows.iter().map(|r| r[0].string()).collect();
+        if !names.is_empty() && !names.iter().any(|n| n == "gyrolab_schema") {
+            return Err(self.open_error(format!(
+                "an SQLite database without a gyrolab schema (tables: {}): not a gyrolab store",
+                names.join(", ")
+            )));
+        }
+        Ok(())
+    }
+
+    /// Runs `f` in one transaction (SQLite: BEGIN IMMEDIATE, so concurrent writers queue on the
+    /// busy timeout); rolled back on any error.
+    pub(crate) fn transaction<T>(&mut self, f: impl FnOnce(&mut dyn Exec) -> Result<T, StoreError>) -> StoreResult<T> {
+        let name = self.name.clone();
+        let password = self.password.clone();
+        let dberr = move |m: String| StoreError::Database {
+            store: name.clone(),
+            message: match &password {
+                Some(p) => m.replace(p.as_str(), "***"),
+                None => m,
+            },
+        };
+        match &mut self.conn {
+            Conn::Sqlite(c) => {
+                let tx = c
+                    .transaction_with_behavior(rusqlite::TransactionBehavior::Immediate)
+                    .map_err(|e| dberr(e.to_string()))?;
+                let out = f(&mut SqliteExec(&tx))?;
+                tx.commit().map_err(|e| dberr(e.to_string()))?;
+                Ok(out)
+            }
+            Conn::Postgres(c) => {
+                let mut tx = c.transaction().map_err(|e| dberr(e.to_string()))?;
+                let out = f(&mut PgExec(&mut tx))?;
+                tx.commit().map_err(|e| dberr(e.to_string()))?;
+                Ok(out)
+            }
+        }
+    }
+
+    /// Runs a read-only query.
+    pub(crate) fn query(&mut self, sql: &str, params: &[Val], kinds: &[Kind]) -> StoreResult<Vec<Vec<Val>>> {
+        let r = match &mut self.conn {
+            Conn::Sqlite(c) => SqliteExec(c).query(sql, params, kinds),
+            Conn::Postgres(c) => PgExec(c.as_mut()).query(sql, params, kinds),
+        };
+        r.map_err(|e| self.db_error(e))
+    }
+
+    /// The schema version in the store (0 for a new store).
+    pub fn schema_version(&mut self) -> StoreResult<i64> {
+        let rows = self.query("SELECT COALESCE(MAX(version), 0) FROM gyrolab_schema", &[], &[Kind::I])?;
+        Ok(rows.first().map_or(0, |r| r[0].int()))
+    }
+
+    fn migrate(&mut self) -> StoreResult<()> {
+        let postgres = self.is_postgres();
+        let migrations = if postgres { schema::POSTGRES_MIGRATIONS } else { schema::SQLITE_MIGRATIONS };
+        let store = self.name.clone();
+        let now = now_rfc3339();
+        let dberr = |m: String| StoreError::Open { store: store.clone(), message: m };
+        self.transaction(|x| {
+            if postgres {
+                // One migrating client at a time; others wait here and then find it done.
+                x.exec("SELECT pg_advisory_xact_lock(7291835)", &[]).map_err(&dberr)?;
+            }
+            x.batch(schema::VERSION_TABLE).map_err(&dberr)?;
+            let found = x
+                .query("SELECT COALESCE(MAX(version), 0) FROM gyrolab_schema", &[], &[Kind::I])
+                .map_err(&dberr)?
+                .first()
+                .map_or(0, |r| r[0].int());
+            if found > schema::SCHEMA_VERSION {
+                return Err(StoreError::NewerSchema {
+                    store: store.clone(),
+                    found,
+                    known: schema::SCHEMA_VERSION,
+                    software: SOFTWARE_VERSION.to_string(),
+                });
+            }
+            for (i, sql) in migrations.iter().enumerate().skip(found as usize) {
+                x.batch(sql).map_err(&dberr)?;
+                x.exec(
+                    "INSERT INTO gyrolab_schema (version, applied_at, software_version) VALUES ($1, $2, $3)",
+                    &[Val::I(i as i64 + 1), Val::T(Some(now.clone())), Val::T(Some(SOFTWARE_VERSION.to_string()))],
+                )
+                .map_err(&dberr)?;
+            }
+            Ok(())
+        })
+        .map_err(|e| match e {
+            StoreError::Database { store, message } => StoreError::Open { store, message },
+            other => other,
+        })
+    }
+
+    /// Stores one evaluation (a new original record) in one transaction; its id.
+    pub fn add(&mut self, record: &EvaluationRecord) -> StoreResult<i64> {
+        self.insert(record, None)
+    }
+
+    pub(crate) fn insert(&mut self, record: &EvaluationRecord, revision: Option<&Revision>) -> StoreResult<i64> {
+        if let Err(m) = record.check() {
+            return Err(StoreError::Refused { store: self.name.clone(), message: m });
+        }
+        if let Some(r) = revision {
+            if let Err(m) = r.check() {
+                return Err(StoreError::Refused { store: self.name.clone(), message: m });
+            }
+        }
+        let store = self.name.clone();
+        let now = now_rfc3339();
+        let dberr = |m: String| StoreError::Database { store: store.clone(), message: m };
+        let id = self.transaction(|x| {
+            let t = |s: &str| Val::T(Some(s.to_string()));
+            let o = |s: &Option<String>| Val::T(s.clone());
+            let (supersedes, kind, by, why) = match revision {
+                Some(r) => (Val::I(r.supersedes), t(r.kind.as_str()), Val::T(Some(r.by.clone())), Val::T(Some(r.reason.clone()))),
+                None => (Val::IOpt(None), t("original"), Val::T(None), Val::T(None)),
+            };
+            if let Some(r) = revision {
+                let taken = x
+                    .query("SELECT id FROM evaluation WHERE supersedes = $1", &[Val::I(r.supersedes)], &[Kind::I])
+                    .map_err(&dberr)?;
+                if let Some(row) = taken.first() {
+                    return Err(StoreError::Refused {
+                        store: store.clone(),
+                        message: format!(
+                            "evaluation {} is already superseded by {}: revise the current revision",
+                            r.supersedes,
+                            row[0].int()
+                        ),
+                    });
+                }
+            }
+            let rows = x
+                .query(
+                    "INSERT INTO evaluation (supersedes, revision_kind, revision_by, revision_reason, stored_at, serial, model, lot, \
+                     operator, approver, test_date, evaluated_at, software_version, plan_path, plan_text, plan_sha256, results_json, \
+                     verdict, simulated) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14, $15, $16, $17, $18, $19) \
+                     RETURNING id",
+                    &[
+                        supersedes,
+                        kind,
+                        by,
+                        why,
+                        t(&now),
+                        t(&record.serial),
+                        t(&record.model),
+                        o(&record.lot),
+                        o(&record.operator),
+                        o(&record.approver),
+                        o(&record.test_date),
+                        t(&record.evaluated_at),
+                        t(&record.software_version),
+                        t(&record.plan_path),
+                        t(&record.plan_text),
+                        t(&record.plan_sha256),
+                        t(&record.results_json),
+                        o(&record.verdict),
+                        Val::I(record.simulated as i64),
+                    ],
+                    &[Kind::I],
+                )
+                .map_err(&dberr)?;
+            let id = rows.first().map(|r| r[0].int()).ok_or_else(|| dberr("no id returned".into()))?;
+            for f in &record.inputs {
+                x.exec(
+                    "INSERT INTO input_file (evaluation_id, path, sha256, size_bytes) VALUES ($1, $2, $3, $4)",
+                    &[Val::I(id), t(&f.path), t(&f.sha256), Val::I(f.size_bytes as i64)],
+                )
+                .map_err(&dberr)?;
+            }
+            for f in &record.report_files {
+                x.exec(
+                    "INSERT INTO report_file (evaluation_id, name, sha256, size_bytes) VALUES ($1, $2, $3, $4)",
+                    &[Val::I(id), t(&f.path), t(&f.sha256), Val::I(f.size_bytes as i64)],
+                )
+                .map_err(&dberr)?;
+            }
+            for f in &record.figures {
+                x.exec(
+                    "INSERT INTO figure (evaluation_id, axis, figure, value, unit, basis, expanded_uncertainty, coverage_factor, \
+                     limit_min, limit_max, verdict, simulated) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12)",
+                    &[
+                        Val::I(id),
+                        t(&f.axis),
+                        t(&f.figure),
+                        Val::F(f.value),
+                        t(&f.unit),
+                        t(&f.basis),
+                        Val::F(f.expanded_uncertainty),
+                        Val::F(f.coverage_factor),
+                        Val::F(f.limit_min),
+                        Val::F(f.limit_max),
+                        o(&f.verdict),
+                        Val::I(f.simulated as i64),
+                    ],
+                )
+                .map_err(&dberr)?;
+            }
+            Ok(id)
+        });
+        id.map_err(|e| match e {
+            StoreError::Database { store, message } => StoreError::Database { store, message: self.mask(message) },
+            other => other,
+        })
+    }
+
+    /// Stores a revision of evaluation `revision.supersedes`: a copy of it with `changes`
+    /// applied (a correction or an approval), or `record` (a re-evaluation). The superseded
+    /// record stays as it was. Its id.
+    pub fn revise(
+        &mut self,
+        revision: &Revision,
+        changes: &Changes,
+        record: Option<&EvaluationRecord>,
+    ) -> StoreResult<i64> {
+        let mut rec = match record {
+            Some(r) => r.clone(),
+            None => self.evaluation(revision.supersedes)?.record,
+        };
+        if let Some(v) = &changes.serial {
+            rec.serial = v.clone();
+        }
+        if let Some(v) = &changes.model {
+            rec.model = v.clone();
+        }
+        if let Some(v) = &changes.lot {
+            rec.lot = Some(v.clone());
+        }
+        if let Some(v) = &changes.operator {
+            rec.operator = Some(v.clone());
+        }
+        if let Some(v) = &changes.test_date {
+            rec.test_date = Some(v.clone());
+        }
+        if revision.kind == RevisionKind::Approval {
+            rec.approver = Some(revision.by.clone());
+        } else if let Some(v) = &changes.approver {
+            rec.approver = Some(v.clone());
+        }
+        self.insert(&rec, Some(revision))
+    }
+
+    /// One stored evaluation with its files and figures.
+    pub fn evaluation(&mut self, id: i64) -> StoreResult<query::StoredEvaluation> {
+        query::evaluation(self, id)
+    }
+}
+
+/// Stores one finished report folder in the store at `location` (see [`resolve_location`]; the
+/// default is `gyrolab.db` beside the plan), created when missing: the evaluation's id and the
+/// store's name (password masked). Shared by `gyrolab store add` and `gyrolab eval --store`.
+pub fn add_report_folder(dir: &Path, plan: Option<&Path>, location: Option<&str>) -> StoreResult<(i64, String)> {
+    let rec = record::from_report_folder(dir, plan)?;
+    let plan_dir = Path::new(&rec.plan_path).parent().filter(|p| !p.as_os_str().is_empty()).map(Path::to_path_buf);
+    let mut store = Store::open(&resolve_location(location, plan_dir.as_deref()), true)?;
+    let id = store.add(&rec)?;
+    Ok((id, store.name().to_string()))
+}
+
+/// Kinds of revision.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RevisionKind {
+    /// The stored plan and inputs evaluated again (another software version).
+    Reevaluation,
+    /// Recorded facts corrected (serial, lot, operator, date...).
+    Correction,
+    /// Approved by someone (who = the approver).
+    Approval,
+}
+
+impl RevisionKind {
+    /// The stored text.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            RevisionKind::Reevaluation => "reevaluation",
+            RevisionKind::Correction => "correction",
+            RevisionKind::Approval => "approval",
+        }
+    }
+}
+
+/// Who revises which evaluation, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Revision {
+    /// The evaluation superseded (must be a current revision).
+    pub supersedes: i64,
+    /// Kind of revision.
+    pub kind: RevisionKind,
+    /// Who.
+    pub by: String,
+    /// Why.
+    pub reason: String,
+}
+
+impl Revision {
+    fn check(&self) -> Result<(), String> {
+        if self.by.trim().is_empty() {
+            return Err("a revision needs who made it (--by)".into());
+        }
+        if self.reason.trim().is_empty() {
+            return Err("a revision needs a reason (--reason)".into());
+        }
+        record::check_text("--by", &self.by)?;
+        record::check_text("--reason", &self.reason)
+    }
+}
+
+/// Fields a correction changes (unset: kept).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Changes {
+    /// New serial.
+    pub serial: Option<String>,
+    /// New model.
+    pub model: Option<String>,
+    /// New lot.
+    pub lot: Option<String>,
+    /// New operator.
+    pub operator: Option<String>,
+    /// New approver.
+    pub approver: Option<String>,
+    /// New test date.
+    pub test_date: Option<String>,
+}
+
+/// Now, RFC 3339 UTC to the microsecond (sortable as text).
+pub fn now_rfc3339() -> String {
+    humantime::format_rfc3339_micros(std::time::SystemTime::now()).to_string()
+}

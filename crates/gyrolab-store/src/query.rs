@@ -1,0 +1,552 @@
+//! The queries of the store: one evaluation, the history of a serial, lot statistics, the
+//! comparison of two lots, control charts. The statistics are the core crate's
+//! (`gyrolab::process_capability`, `gyrolab::two_sample`, `gyrolab::control_chart`); here they
+//! are only fed with the right values in the right order.
+//!
+//! Which values count: the *current* revision of an evaluation is the one no other revision
+//! supersedes; for lot statistics and charts each device (serial) counts once, with its latest
+//! current evaluation (highest id), in test order (test date, else evaluation time, then id).
+
+use crate::db::{Kind, Val};
+use crate::record::{EvaluationRecord, FigureRecord, FileRecord};
+use crate::{Store, StoreError, StoreResult};
+use gyrolab::control_chart::{individuals_moving_range, xbar_s, Chart};
+use gyrolab::process_capability::{lot_statistics, LotStatistics};
+use gyrolab::two_sample::{compare_samples, TwoSampleComparison};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// One stored evaluation and its place among the revisions.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StoredEvaluation {
+    /// Id.
+    pub id: i64,
+    /// The evaluation this one supersedes.
+    pub supersedes: Option<i64>,
+    /// The revision that supersedes this one (`None`: this is current).
+    pub superseded_by: Option<i64>,
+    /// original, reevaluation, correction, approval.
+    pub revision_kind: String,
+    /// Who made the revision.
+    pub revision_by: Option<String>,
+    /// Why.
+    pub revision_reason: Option<String>,
+    /// When it was stored (RFC 3339 UTC).
+    pub stored_at: String,
+    /// The record.
+    pub record: EvaluationRecord,
+}
+
+const EVALUATION_COLUMNS: &[Kind] = &[
+    Kind::I, // id
+    Kind::T, // supersedes as text (null-able integer)
+    Kind::T, // revision_kind
+    Kind::T,
+    Kind::T,
+    Kind::T, // stored_at
+    Kind::T, // serial
+    Kind::T,
+    Kind::T,
+    Kind::T,
+    Kind::T,
+    Kind::T,
+    Kind::T, // evaluated_at
+    Kind::T,
+    Kind::T,
+    Kind::T,
+    Kind::T,
+    Kind::T, // results_json
+    Kind::T, // verdict
+    Kind::I, // simulated
+];
+
+/// One evaluation by id.
+pub fn evaluation(store: &mut Store, id: i64) -> StoreResult<StoredEvaluation> {
+    let rows = store.query(
+        "SELECT id, CAST(supersedes AS TEXT), revision_kind, revision_by, revision_reason, stored_at, serial, model, lot, operator, \
+         approver, test_date, evaluated_at, software_version, plan_path, plan_text, plan_sha256, results_json, verdict, simulated \
+         FROM evaluation WHERE id = $1",
+        &[Val::I(id)],
+        EVALUATION_COLUMNS,
+    )?;
+    let Some(r) = rows.into_iter().next() else {
+        return Err(StoreError::NotFound { store: store.name().to_string(), message: format!("no evaluation {id}") });
+    };
+    let later = store.query("SELECT id FROM evaluation WHERE supersedes = $1", &[Val::I(id)], &[Kind::I])?;
+    let files = |store: &mut Store, sql: &str| -> StoreResult<Vec<FileRecord>> {
+        Ok(store
+            .query(sql, &[Val::I(id)], &[Kind::T, Kind::T, Kind::I])?
+            .into_iter()
+            .map(|f| FileRecord { path: f[0].string(), sha256: f[1].string(), size_bytes: f[2].int() as u64 })
+            .collect())
+    };
+    let inputs =
+        files(store, "SELECT path, sha256, size_bytes FROM input_file WHERE evaluation_id = $1 ORDER BY path")?;
+    let report_files =
+        files(store, "SELECT name, sha256, size_bytes FROM report_file WHERE evaluation_id = $1 ORDER BY name")?;
+    let figures = store
+        .query(
+            "SELECT axis, figure, value, unit, basis, expanded_uncertainty, coverage_factor, limit_min, limit_max, verdict, simulated \
+             FROM figure WHERE evaluation_id = $1",
+            &[Val::I(id)],
+            &[Kind::T, Kind::T, Kind::F, Kind::T, Kind::T, Kind::F, Kind::F, Kind::F, Kind::F, Kind::T, Kind::I],
+        )?
+        .into_iter()
+        .map(|f| FigureRecord {
+            axis: f[0].string(),
+            figure: f[1].string(),
+            value: f[2].float(),
+            unit: f[3].string(),
+            basis: f[4].string(),
+            expanded_uncertainty: f[5].float(),
+            coverage_factor: f[6].float(),
+            limit_min: f[7].float(),
+            limit_max: f[8].float(),
+            verdict: f[9].text().map(str::to_string),
+            simulated: f[10].int() != 0,
+        })
+        .collect();
+    let t = |i: usize| r[i].text().map(str::to_string);
+    Ok(StoredEvaluation {
+        id: r[0].int(),
+        supersedes: r[1].text().and_then(|s| s.parse().ok()),
+        superseded_by: later.first().map(|l| l[0].int()),
+        revision_kind: r[2].string(),
+        revision_by: t(3),
+        revision_reason: t(4),
+        stored_at: r[5].string(),
+        record: EvaluationRecord {
+            serial: r[6].string(),
+            model: r[7].string(),
+            lot: t(8),
+            operator: t(9),
+            approver: t(10),
+            test_date: t(11),
+            evaluated_at: r[12].string(),
+            software_version: r[13].string(),
+            plan_path: r[14].string(),
+            plan_text: r[15].string(),
+            plan_sha256: r[16].string(),
+            results_json: r[17].string(),
+            verdict: t(18),
+            simulated: r[19].int() != 0,
+            inputs,
+            report_files,
+            figures,
+        },
+    })
+}
+
+/// One figure of one evaluation, as history lists it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HistoryRow {
+    /// Evaluation id.
+    pub evaluation: i64,
+    /// The evaluation it supersedes.
+    pub supersedes: Option<i64>,
+    /// True when no revision supersedes it.
+    pub current: bool,
+    /// original, reevaluation, correction, approval.
+    pub revision_kind: String,
+    /// Test date, else the evaluation time.
+    pub tested: String,
+    /// gyrolab version of the evaluation.
+    pub software_version: String,
+    /// Lot.
+    pub lot: Option<String>,
+    /// Overall verdict.
+    pub overall_verdict: Option<String>,
+    /// SIMULATED inputs.
+    pub simulated: bool,
+    /// The figure.
+    #[serde(flatten)]
+    pub figure: FigureRecord,
+}
+
+/// Every figure of every evaluation (all revisions) of a serial, oldest first.
+pub fn history(store: &mut Store, serial: &str) -> StoreResult<Vec<HistoryRow>> {
+    let rows = store.query(
+        "SELECT e.id, CAST(e.supersedes AS TEXT), CAST(CASE WHEN EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id) THEN 0 ELSE 1 END AS BIGINT), \
+         e.revision_kind, COALESCE(e.test_date, e.evaluated_at), e.software_version, e.lot, e.verdict, e.simulated, \
+         f.axis, f.figure, f.value, f.unit, f.basis, f.expanded_uncertainty, f.coverage_factor, f.limit_min, f.limit_max, f.verdict, f.simulated \
+         FROM evaluation e JOIN figure f ON f.evaluation_id = e.id WHERE e.serial = $1 ORDER BY e.id, f.axis, f.figure",
+        &[Val::T(Some(serial.to_string()))],
+        &[
+            Kind::I,
+            Kind::T,
+            Kind::I,
+            Kind::T,
+            Kind::T,
+            Kind::T,
+            Kind::T,
+            Kind::T,
+            Kind::I,
+            Kind::T,
+            Kind::T,
+            Kind::F,
+            Kind::T,
+            Kind::T,
+            Kind::F,
+            Kind::F,
+            Kind::F,
+            Kind::F,
+            Kind::T,
+            Kind::I,
+        ],
+    )?;
+    if rows.is_empty() {
+        let any = store.query(
+            "SELECT COUNT(*) FROM evaluation WHERE serial = $1",
+            &[Val::T(Some(serial.to_string()))],
+            &[Kind::I],
+        )?;
+        if any.first().is_none_or(|r| r[0].int() == 0) {
+            return Err(StoreError::NotFound {
+                store: store.name().to_string(),
+                message: format!("no evaluation of serial {serial:?}"),
+            });
+        }
+    }
+    Ok(rows
+        .into_iter()
+        .map(|r| HistoryRow {
+            evaluation: r[0].int(),
+            supersedes: r[1].text().and_then(|s| s.parse().ok()),
+            current: r[2].int() == 1,
+            revision_kind: r[3].string(),
+            tested: r[4].string(),
+            software_version: r[5].string(),
+            lot: r[6].text().map(str::to_string),
+            overall_verdict: r[7].text().map(str::to_string),
+            simulated: r[8].int() != 0,
+            figure: FigureRecord {
+                axis: r[9].string(),
+                figure: r[10].string(),
+                value: r[11].float(),
+                unit: r[12].string(),
+                basis: r[13].string(),
+                expanded_uncertainty: r[14].float(),
+                coverage_factor: r[15].float(),
+                limit_min: r[16].float(),
+                limit_max: r[17].float(),
+                verdict: r[18].text().map(str::to_string),
+                simulated: r[19].int() != 0,
+            },
+        })
+        .collect())
+}
+
+/// The values of one figure of one axis over a lot's devices, in test order.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FigureSeries {
+    /// Axis.
+    pub axis: String,
+    /// Figure key.
+    pub figure: String,
+    /// Unit.
+    pub unit: String,
+    /// Lower limit (of the latest evaluation).
+    pub limit_min: Option<f64>,
+    /// Upper limit (of the latest evaluation).
+    pub limit_max: Option<f64>,
+    /// (serial, evaluation id, value) in test order.
+    pub values: Vec<(String, i64, f64)>,
+    /// Any value from SIMULATED records.
+    pub simulated: bool,
+}
+
+/// Values (serial, id, test order key, value), limits and id of the latest evaluation, simulated.
+type Group = (Vec<(String, i64, String, f64)>, Option<f64>, Option<f64>, i64, bool);
+
+/// One series per (axis, figure, unit) of the current evaluations in `lot` (all lots: `None`),
+/// each device once (its latest current evaluation).
+pub fn lot_series(store: &mut Store, lot: Option<&str>) -> StoreResult<Vec<FigureSeries>> {
+    const SQL_LOT: &str = "SELECT e.id, e.serial, COALESCE(e.test_date, e.evaluated_at), f.axis, f.figure, f.unit, f.value, f.limit_min, \
+         f.limit_max, f.simulated FROM evaluation e JOIN figure f ON f.evaluation_id = e.id \
+         WHERE e.lot = $1 AND NOT EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id) AND f.value IS NOT NULL";
+    const SQL_ALL: &str = "SELECT e.id, e.serial, COALESCE(e.test_date, e.evaluated_at), f.axis, f.figure, f.unit, f.value, f.limit_min, \
+         f.limit_max, f.simulated FROM evaluation e JOIN figure f ON f.evaluation_id = e.id \
+         WHERE NOT EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id) AND f.value IS NOT NULL";
+    let kinds = [Kind::I, Kind::T, Kind::T, Kind::T, Kind::T, Kind::T, Kind::F, Kind::F, Kind::F, Kind::I];
+    let rows = match lot {
+        Some(l) => store.query(SQL_LOT, &[Val::T(Some(l.to_string()))], &kinds)?,
+        None => store.query(SQL_ALL, &[], &kinds)?,
+    };
+    // The latest current evaluation per serial.
+    let mut latest: BTreeMap<&str, i64> = BTreeMap::new();
+    for r in &rows {
+        let e = latest.entry(r[1].text().unwrap_or_default()).or_insert(i64::MIN);
+        *e = (*e).max(r[0].int());
+    }
+    let mut groups: BTreeMap<(String, String, String), Group> = BTreeMap::new();
+    for r in &rows {
+        let serial = r[1].text().unwrap_or_default();
+        let id = r[0].int();
+        if latest.get(serial) != Some(&id) {
+            continue;
+        }
+        let Some(v) = r[6].float() else { continue };
+        let g = groups.entry((r[3].string(), r[4].string(), r[5].string())).or_insert((
+            Vec::new(),
+            None,
+            None,
+            i64::MIN,
+            false,
+        ));
+        g.0.push((serial.to_string(), id, r[2].string(), v));
+        if id > g.3 {
+            g.1 = r[7].float();
+            g.2 = r[8].float();
+            g.3 = id;
+        }
+        g.4 |= r[9].int() != 0;
+    }
+    Ok(groups
+        .into_iter()
+        .map(|((axis, figure, unit), (mut v, lo, hi, _, sim))| {
+            v.sort_by(|a, b| a.2.cmp(&b.2).then(a.1.cmp(&b.1)));
+            FigureSeries {
+                axis,
+                figure,
+                unit,
+                limit_min: lo,
+                limit_max: hi,
+                values: v.into_iter().map(|(s, id, _, x)| (s, id, x)).collect(),
+                simulated: sim,
+            }
+        })
+        .collect())
+}
+
+/// The statistics of one figure over a lot.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LotFigure {
+    /// Axis.
+    pub axis: String,
+    /// Figure key.
+    pub figure: String,
+    /// Unit.
+    pub unit: String,
+    /// Lower limit.
+    pub limit_min: Option<f64>,
+    /// Upper limit.
+    pub limit_max: Option<f64>,
+    /// Statistics (capability intervals: chi-squared for Cp/Pp, Bissell for Cpk/Ppk).
+    pub statistics: LotStatistics,
+    /// Serial numbers of the outliers (Tukey's fences).
+    pub outlier_serials: Vec<String>,
+    /// Any value from SIMULATED records.
+    pub simulated: bool,
+}
+
+/// Lot statistics of every figure of `lot` at `confidence` (e.g. 0.95).
+pub fn lot(store: &mut Store, lot: &str, confidence: f64) -> StoreResult<Vec<LotFigure>> {
+    let series = lot_series(store, Some(lot))?;
+    if series.is_empty() {
+        return Err(StoreError::NotFound {
+            store: store.name().to_string(),
+            message: format!("no figures stored for lot {lot:?}"),
+        });
+    }
+    Ok(series
+        .into_iter()
+        .filter_map(|s| {
+            let values: Vec<f64> = s.values.iter().map(|v| v.2).collect();
+            let statistics = lot_statistics(&values, s.limit_min, s.limit_max, confidence)?;
+            let outlier_serials = statistics.outliers.iter().map(|i| s.values[*i].0.clone()).collect();
+            Some(LotFigure {
+                axis: s.axis,
+                figure: s.figure,
+                unit: s.unit,
+                limit_min: s.limit_min,
+                limit_max: s.limit_max,
+                statistics,
+                outlier_serials,
+                simulated: s.simulated,
+            })
+        })
+        .collect())
+}
+
+/// The comparison of one figure between two lots.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LotComparison {
+    /// Axis.
+    pub axis: String,
+    /// Figure key.
+    pub figure: String,
+    /// Unit.
+    pub unit: String,
+    /// Devices in the first lot.
+    pub n1: usize,
+    /// Devices in the second lot.
+    pub n2: usize,
+    /// Mean of the first lot.
+    pub mean1: f64,
+    /// Mean of the second lot.
+    pub mean2: f64,
+    /// Welch's t-test and the F-test (`None`: a lot has fewer than two values or no spread).
+    pub test: Option<TwoSampleComparison>,
+}
+
+/// Every figure present in both lots, compared.
+pub fn compare(store: &mut Store, lot1: &str, lot2: &str) -> StoreResult<Vec<LotComparison>> {
+    let a = lot_series(store, Some(lot1))?;
+    let b = lot_series(store, Some(lot2))?;
+    for (l, s) in [(lot1, &a), (lot2, &b)] {
+        if s.is_empty() {
+            return Err(StoreError::NotFound {
+                store: store.name().to_string(),
+                message: format!("no figures stored for lot {l:?}"),
+            });
+        }
+    }
+    Ok(a.iter()
+        .filter_map(|x| {
+            let y = b.iter().find(|y| y.axis == x.axis && y.figure == x.figure && y.unit == x.unit)?;
+            let xv: Vec<f64> = x.values.iter().map(|v| v.2).collect();
+            let yv: Vec<f64> = y.values.iter().map(|v| v.2).collect();
+            Some(LotComparison {
+                axis: x.axis.clone(),
+                figure: x.figure.clone(),
+                unit: x.unit.clone(),
+                n1: xv.len(),
+                n2: yv.len(),
+                mean1: xv.iter().sum::<f64>() / xv.len() as f64,
+                mean2: yv.iter().sum::<f64>() / yv.len() as f64,
+                test: compare_samples(&xv, &yv),
+            })
+        })
+        .collect())
+}
+
+/// Control charts of one figure of one axis.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ControlCharts {
+    /// Axis.
+    pub axis: String,
+    /// Figure key.
+    pub figure: String,
+    /// Unit.
+    pub unit: String,
+    /// Serial of each individual point, in test order.
+    pub serials: Vec<String>,
+    /// Individuals chart (`None`: fewer than two devices or no variation).
+    pub individuals: Option<Chart>,
+    /// Moving-range chart.
+    pub moving_range: Option<Chart>,
+    /// Lot of each X-bar/S point.
+    pub lots: Vec<String>,
+    /// X-bar chart over lots (lots of at least two devices; `None` without such lots).
+    pub xbar: Option<Chart>,
+    /// S chart over lots.
+    pub s: Option<Chart>,
+}
+
+/// I-MR charts over the devices of `lot` (all lots: `None`) and X-bar/S over every lot.
+pub fn control_charts(store: &mut Store, lot: Option<&str>, axis: &str, figure: &str) -> StoreResult<ControlCharts> {
+    let series = lot_series(store, lot)?;
+    let Some(s) = series.into_iter().find(|s| s.axis == axis && s.figure == figure) else {
+        return Err(StoreError::NotFound {
+            store: store.name().to_string(),
+            message: format!(
+                "no values of figure {figure:?} on axis {axis:?}{}",
+                lot.map_or(String::new(), |l| format!(" in lot {l:?}"))
+            ),
+        });
+    };
+    let values: Vec<f64> = s.values.iter().map(|v| v.2).collect();
+    let im = individuals_moving_range(&values);
+    // X-bar/S: every lot, devices grouped by their lot.
+    let rows = store.query(
+        "SELECT e.id, e.serial, e.lot, f.value FROM evaluation e JOIN figure f ON f.evaluation_id = e.id \
+         WHERE e.lot IS NOT NULL AND f.axis = $1 AND f.figure = $2 AND f.value IS NOT NULL \
+         AND NOT EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id) ORDER BY e.id",
+        &[Val::T(Some(axis.to_string())), Val::T(Some(figure.to_string()))],
+        &[Kind::I, Kind::T, Kind::T, Kind::F],
+    )?;
+    let mut per_serial: BTreeMap<String, (String, f64, i64)> = BTreeMap::new();
+    for r in rows {
+        if let Some(v) = r[3].float() {
+            per_serial.insert(r[1].string(), (r[2].string(), v, r[0].int()));
+        }
+    }
+    let mut lots: BTreeMap<String, (i64, Vec<f64>)> = BTreeMap::new();
+    for (lot, v, id) in per_serial.into_values() {
+        let e = lots.entry(lot).or_insert((i64::MAX, Vec::new()));
+        e.0 = e.0.min(id);
+        e.1.push(v);
+    }
+    let mut ordered: Vec<(String, (i64, Vec<f64>))> = lots.into_iter().filter(|(_, g)| g.1.len() >= 2).collect();
+    ordered.sort_by_key(|(_, g)| g.0);
+    let groups: Vec<Vec<f64>> = ordered.iter().map(|(_, g)| g.1.clone()).collect();
+    let xs = xbar_s(&groups);
+    Ok(ControlCharts {
+        axis: s.axis,
+        figure: s.figure,
+        unit: s.unit,
+        serials: s.values.iter().map(|v| v.0.clone()).collect(),
+        individuals: im.as_ref().map(|c| c.0.clone()),
+        moving_range: im.map(|c| c.1),
+        lots: ordered.into_iter().map(|(l, _)| l).collect(),
+        xbar: xs.as_ref().map(|c| c.0.clone()),
+        s: xs.map(|c| c.1),
+    })
+}
+
+/// The changes between two evaluations: every figure whose value or verdict differs.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FigureChange {
+    /// Axis.
+    pub axis: String,
+    /// Figure key.
+    pub figure: String,
+    /// Unit.
+    pub unit: String,
+    /// Value before.
+    pub before: Option<f64>,
+    /// Value after.
+    pub after: Option<f64>,
+    /// after - before.
+    pub difference: Option<f64>,
+    /// Verdict before.
+    pub verdict_before: Option<String>,
+    /// Verdict after.
+    pub verdict_after: Option<String>,
+}
+
+/// Every figure whose value (bit for bit) or verdict changed from `before` to `after`, and
+/// figures present in only one of them.
+pub fn diff_figures(before: &[FigureRecord], after: &[FigureRecord]) -> Vec<FigureChange> {
+    let key = |f: &FigureRecord| (f.axis.clone(), f.figure.clone());
+    let mut out = Vec::new();
+    for b in before {
+        let a = after.iter().find(|a| key(a) == key(b));
+        let (av, aver) = (a.and_then(|a| a.value), a.and_then(|a| a.verdict.clone()));
+        if a.is_none() || av.map(f64::to_bits) != b.value.map(f64::to_bits) || aver != b.verdict {
+            out.push(FigureChange {
+                axis: b.axis.clone(),
+                figure: b.figure.clone(),
+                unit: b.unit.clone(),
+                before: b.value,
+                after: av,
+                difference: av.zip(b.value).map(|(a, b)| a - b),
+                verdict_before: b.verdict.clone(),
+                verdict_after: aver,
+            });
+        }
+    }
+    for a in after.iter().filter(|a| !before.iter().any(|b| key(b) == key(a))) {
+        out.push(FigureChange {
+            axis: a.axis.clone(),
+            figure: a.figure.clone(),
+            unit: a.unit.clone(),
+            before: None,
+            after: a.value,
+            difference: None,
+            verdict_before: None,
+            verdict_after: a.verdict.clone(),
+        });
+    }
+    out
+}

@@ -1,0 +1,473 @@
+//! What the store keeps of one evaluation, read from a finished report folder (results.json,
+//! summary.csv, the other report files) and the plan it names (its text and every input file
+//! it names, hashed), so that `gyrolab store add DIR` and `gyrolab eval --store` take one path.
+
+use crate::{StoreError, StoreResult};
+use gyrolab_eval::test_plan::read_test_plan;
+use serde::Serialize;
+use sha2::{Digest, Sha256};
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+/// Longest text accepted in one field (a plan, a serial...): 16 MiB.
+pub const MAX_TEXT_BYTES: usize = 16 << 20;
+
+/// A file of an evaluation: an input record or a report file.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FileRecord {
+    /// Path (inputs: as resolved from the plan) or name (report files).
+    pub path: String,
+    /// SHA-256, lower-case hex.
+    pub sha256: String,
+    /// Size, bytes.
+    pub size_bytes: u64,
+}
+
+/// One figure of one axis.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FigureRecord {
+    /// Axis name.
+    pub axis: String,
+    /// Figure key (docs/JSON.md).
+    pub figure: String,
+    /// Value (`None`: not computed).
+    pub value: Option<f64>,
+    /// Unit.
+    pub unit: String,
+    /// `value`, or `upper_bound` when the figure is a bound (an Allan term read off a curve
+    /// too short to show its minimum).
+    pub basis: String,
+    /// Expanded uncertainty U of the figure, in its unit, when the evaluation gives one.
+    pub expanded_uncertainty: Option<f64>,
+    /// Coverage factor k of U.
+    pub coverage_factor: Option<f64>,
+    /// Lower limit.
+    pub limit_min: Option<f64>,
+    /// Upper limit.
+    pub limit_max: Option<f64>,
+    /// PASS, FAIL, NOT_EVALUATED (`None`: no limit).
+    pub verdict: Option<String>,
+    /// The figure comes from SIMULATED records.
+    pub simulated: bool,
+}
+
+/// Everything kept of one evaluation.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EvaluationRecord {
+    /// Serial number.
+    pub serial: String,
+    /// Model.
+    pub model: String,
+    /// Lot (the plan's `[device] lot`).
+    pub lot: Option<String>,
+    /// Operator (the plan's `[test] operator`).
+    pub operator: Option<String>,
+    /// Approver.
+    pub approver: Option<String>,
+    /// Test date (the plan's `[test] date`).
+    pub test_date: Option<String>,
+    /// When the evaluation ran (results.json `created`).
+    pub evaluated_at: String,
+    /// gyrolab version of the evaluation.
+    pub software_version: String,
+    /// The plan's path.
+    pub plan_path: String,
+    /// The plan's text.
+    pub plan_text: String,
+    /// SHA-256 of the plan's bytes.
+    pub plan_sha256: String,
+    /// results.json as written.
+    pub results_json: String,
+    /// Overall verdict (`None`: no limits).
+    pub verdict: Option<String>,
+    /// Any input SIMULATED.
+    pub simulated: bool,
+    /// Input files named by the plan.
+    pub inputs: Vec<FileRecord>,
+    /// The report folder's files.
+    pub report_files: Vec<FileRecord>,
+    /// Every figure of every axis.
+    pub figures: Vec<FigureRecord>,
+}
+
+/// Checks a text field: no NUL character (PostgreSQL text cannot hold one, so neither back end
+/// takes it) and at most [`MAX_TEXT_BYTES`].
+pub fn check_text(field: &str, text: &str) -> Result<(), String> {
+    if let Some(i) = text.find('\0') {
+        return Err(format!("{field} holds a NUL character (byte {i}); texts with NUL are not stored"));
+    }
+    if text.len() > MAX_TEXT_BYTES {
+        return Err(format!("{field} is {} bytes, more than the {} accepted", text.len(), MAX_TEXT_BYTES));
+    }
+    Ok(())
+}
+
+impl EvaluationRecord {
+    /// Checks every text before anything is written.
+    pub fn check(&self) -> Result<(), String> {
+        let fields = [
+            ("serial", Some(&self.serial)),
+            ("model", Some(&self.model)),
+            ("lot", self.lot.as_ref()),
+            ("operator", self.operator.as_ref()),
+            ("approver", self.approver.as_ref()),
+            ("test date", self.test_date.as_ref()),
+            ("plan path", Some(&self.plan_path)),
+            ("plan text", Some(&self.plan_text)),
+            ("results.json", Some(&self.results_json)),
+        ];
+        for (name, v) in fields {
+            if let Some(v) = v {
+                check_text(name, v)?;
+            }
+        }
+        if self.serial.trim().is_empty() {
+            return Err("the serial number is empty".into());
+        }
+        for f in self.inputs.iter().chain(&self.report_files) {
+            check_text("file path", &f.path)?;
+        }
+        for f in &self.figures {
+            check_text("figure axis", &f.axis)?;
+            check_text("figure key", &f.figure)?;
+            check_text("figure unit", &f.unit)?;
+        }
+        Ok(())
+    }
+}
+
+/// SHA-256 (hex) and size of a file, read in blocks.
+pub fn hash_file(path: &Path) -> StoreResult<(String, u64)> {
+    let err = |e: std::io::Error| StoreError::Input {
+        path: path.display().to_string(),
+        message: format!("cannot read: {e}"),
+    };
+    let mut f = std::fs::File::open(path).map_err(err)?;
+    let mut h = Sha256::new();
+    let mut buf = vec![0u8; 1 << 16];
+    let mut size = 0u64;
+    loop {
+        let n = f.read(&mut buf).map_err(err)?;
+        if n == 0 {
+            break;
+        }
+        size += n as u64;
+        h.update(&buf[..n]);
+    }
+    Ok((hex(&h.finalize()), size))
+}
+
+/// SHA-256 (hex) of bytes.
+pub fn hash_bytes(bytes: &[u8]) -> String {
+    hex(&Sha256::digest(bytes))
+}
+
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Every input file a plan names, resolved against its folder, in plan order, without repeats.
+pub fn plan_inputs(plan: &gyrolab_io_plan::TestPlan) -> Vec<PathBuf> {
+    let mut out: Vec<PathBuf> = Vec::new();
+    let mut add = |p: &PathBuf| {
+        if !out.iter().any(|q| q == p) {
+            out.push(p.clone());
+        }
+    };
+    if let Some(c) = &plan.options.calibration {
+        add(c);
+    }
+    for r in &plan.rate {
+        add(&r.file);
+        if let Some(s) = &r.segmentation.segments {
+            add(s);
+        }
+    }
+    if let Some(t) = &plan.triad {
+        t.files.iter().for_each(&mut add);
+        if let Some(s) = &t.segmentation.segments {
+            add(s);
+        }
+    }
+    for s in &plan.static_tests {
+        s.files.iter().for_each(&mut add);
+        if let Some(a) = &s.allan_file {
+            add(a);
+        }
+    }
+    for t in &plan.temperature {
+        for p in &t.points {
+            p.rate_file.iter().chain(&p.static_file).for_each(&mut add);
+        }
+    }
+    plan.threshold.iter().chain(&plan.resolution).for_each(|s| add(&s.file));
+    for p in &plan.power_ups {
+        p.rate_files.iter().chain(&p.static_files).for_each(|(f, _)| add(f));
+    }
+    plan.warmup.iter().for_each(|w| add(&w.file));
+    for g in &plan.g_sensitivity {
+        g.records.iter().for_each(|r| add(&r.file));
+    }
+    out
+}
+
+/// The plan types (re-exported by gyrolab-eval's plan reader).
+pub mod gyrolab_io_plan {
+    pub use gyrolab_io::test_plan::TestPlan;
+}
+
+/// Splits one CSV line (RFC 4180 quoting, as summary.csv writes it).
+fn csv_fields(line: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut cur = String::new();
+    let mut quoted = false;
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                cur.push('"');
+                chars.next();
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => out.push(std::mem::take(&mut cur)),
+            _ => cur.push(c),
+        }
+    }
+    out.push(cur);
+    out
+}
+
+/// Splits CSV text into records (a quoted field may hold a line break).
+fn csv_records(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut cur = String::new();
+    let mut quotes = 0usize;
+    for line in text.split_inclusive('\n') {
+        cur.push_str(line);
+        quotes += line.matches('"').count();
+        if quotes.is_multiple_of(2) {
+            let rec = cur.trim_end_matches(['\n', '\r']).to_string();
+            if !rec.is_empty() {
+                out.push(rec);
+            }
+            cur.clear();
+            quotes = 0;
+        }
+    }
+    out
+}
+
+fn number(text: &str, path: &Path, line: usize, column: &str) -> StoreResult<Option<f64>> {
+    if text.is_empty() {
+        return Ok(None);
+    }
+    text.parse::<f64>().map(Some).map_err(|_| StoreError::Input {
+        path: path.display().to_string(),
+        message: format!("line {line}, column {column}: {text:?} is not a number"),
+    })
+}
+
+/// The figures of summary.csv (axis, figure, unit, value, limit_min, limit_max, verdict), with
+/// each `*_expanded_uncertainty*` figure's value attached as U to the figure of the same name
+/// without `_expanded_uncertainty` and the same unit, k = `coverage`.
+pub fn figures_from_summary(text: &str, path: &Path, coverage: f64, simulated: bool) -> StoreResult<Vec<FigureRecord>> {
+    let records = csv_records(text);
+    let bad = |line: usize, m: String| StoreError::Input {
+        path: path.display().to_string(),
+        message: format!("line {line}: {m}"),
+    };
+    let Some(header) = records.first() else {
+        return Err(bad(1, "empty file".into()));
+    };
+    let cols = csv_fields(header);
+    let want = ["axis", "figure", "unit", "value", "limit_min", "limit_max", "verdict"];
+    if cols != want {
+        return Err(bad(1, format!("header {cols:?}, expected {want:?}")));
+    }
+    let mut out = Vec::new();
+    for (i, rec) in records.iter().enumerate().skip(1) {
+        let line = i + 1;
+        let f = csv_fields(rec);
+        if f.len() != 7 {
+            return Err(bad(line, format!("{} fields, expected 7", f.len())));
+        }
+        out.push(FigureRecord {
+            axis: f[0].clone(),
+            figure: f[1].clone(),
+            unit: f[2].clone(),
+            value: number(&f[3], path, line, "value")?,
+            basis: "value".into(),
+            expanded_uncertainty: None,
+            coverage_factor: None,
+            limit_min: number(&f[4], path, line, "limit_min")?,
+            limit_max: number(&f[5], path, line, "limit_max")?,
+            verdict: Some(f[6].clone()).filter(|v| !v.is_empty()),
+            simulated,
+        });
+    }
+    let uncertainties: Vec<(String, String, String, Option<f64>)> = out
+        .iter()
+        .filter(|f| f.figure.contains("_expanded_uncertainty"))
+        .map(|f| (f.axis.clone(), f.figure.replacen("_expanded_uncertainty", "", 1), f.unit.clone(), f.value))
+        .collect();
+    for f in &mut out {
+        if f.figure.contains("_expanded_uncertainty") {
+            f.coverage_factor = f.value.map(|_| coverage);
+            continue;
+        }
+        if let Some((_, _, _, u)) =
+            uncertainties.iter().find(|(a, n, unit, _)| *a == f.axis && *n == f.figure && *unit == f.unit)
+        {
+            f.expanded_uncertainty = *u;
+            f.coverage_factor = u.map(|_| coverage);
+        }
+    }
+    Ok(out)
+}
+
+/// Marks the figures that are upper bounds: results.json objects naming a figure key with a
+/// `basis` of `upper_bound` (the Allan noise terms), matched by key and axis where given.
+fn mark_bounds(results: &serde_json::Value, figures: &mut [FigureRecord]) {
+    fn walk(v: &serde_json::Value, axis: Option<&str>, out: &mut Vec<(Option<String>, String)>) {
+        match v {
+            serde_json::Value::Object(m) => {
+                let axis = m.get("axis").and_then(|a| a.as_str()).or(axis);
+                if m.get("basis").and_then(|b| b.as_str()) == Some("upper_bound") {
+                    if let Some(k) = m.get("figure").or_else(|| m.get("key")).and_then(|k| k.as_str()) {
+                        out.push((axis.map(str::to_string), k.to_string()));
+                    }
+                }
+                m.values().for_each(|x| walk(x, axis, out));
+            }
+            serde_json::Value::Array(a) => a.iter().for_each(|x| walk(x, axis, out)),
+            _ => {}
+        }
+    }
+    let mut bounds = Vec::new();
+    walk(results, None, &mut bounds);
+    for f in figures.iter_mut() {
+        if bounds.iter().any(|(a, k)| *k == f.figure && a.as_deref().is_none_or(|a| a == f.axis)) {
+            f.basis = "upper_bound".into();
+        }
+    }
+}
+
+fn read_text(path: &Path) -> StoreResult<String> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| StoreError::Input { path: path.display().to_string(), message: format!("cannot read: {e}") })?;
+    String::from_utf8(bytes).map_err(|e| StoreError::Input {
+        path: path.display().to_string(),
+        message: format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+    })
+}
+
+fn json_text(v: &serde_json::Value, keys: &[&str]) -> Option<String> {
+    let mut cur = v;
+    for k in keys {
+        cur = cur.get(k)?;
+    }
+    cur.as_str().map(str::to_string)
+}
+
+/// Reads the record of a finished report folder. `plan`: the plan file (default: the
+/// `plan_file` results.json names, as written, relative to the current folder).
+pub fn from_report_folder(dir: &Path, plan: Option<&Path>) -> StoreResult<EvaluationRecord> {
+    let results_path = dir.join("results.json");
+    let results_json = read_text(&results_path)?;
+    let bad = |m: String| StoreError::Input { path: results_path.display().to_string(), message: m };
+    let results: serde_json::Value = serde_json::from_str(&results_json)
+        .map_err(|e| bad(format!("line {}, column {}: {e}", e.line(), e.column())))?;
+    let need = |keys: &[&str]| {
+        json_text(&results, keys).ok_or_else(|| bad(format!("key {} missing or not text", keys.join("."))))
+    };
+    let serial = need(&["device", "serial"])?;
+    let model = need(&["device", "model"])?;
+    let software_version = need(&["gyrolab_version"])?;
+    let evaluated_at = need(&["created"])?;
+    let plan_file = need(&["plan_file"])?;
+    let plan_path = plan.map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from(&plan_file));
+    if !plan_path.is_file() {
+        return Err(bad(format!(
+            "the plan it names, {plan_file}, is not found from here ({}): give it with --plan",
+            plan_path.display()
+        )));
+    }
+    let plan_text = read_text(&plan_path)?;
+    let parsed = read_test_plan(&plan_path)
+        .map_err(|e| StoreError::Input { path: plan_path.display().to_string(), message: e.to_string() })?;
+    let mut inputs = Vec::new();
+    for p in plan_inputs(&parsed) {
+        let (sha256, size_bytes) = hash_file(&p)?;
+        inputs.push(FileRecord { path: p.display().to_string(), sha256, size_bytes });
+    }
+    let mut report_files = Vec::new();
+    let mut names: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| StoreError::Input { path: dir.display().to_string(), message: format!("cannot list: {e}") })?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file())
+        .collect();
+    names.sort();
+    for p in names {
+        let (sha256, size_bytes) = hash_file(&p)?;
+        let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        report_files.push(FileRecord { path: name, sha256, size_bytes });
+    }
+    let simulated = parsed.device.simulated.is_some();
+    let summary_path = dir.join("summary.csv");
+    let mut figures =
+        figures_from_summary(&read_text(&summary_path)?, &summary_path, parsed.options.coverage, simulated)?;
+    mark_bounds(&results, &mut figures);
+    let verdict = json_text(&results, &["verdict"]);
+    Ok(EvaluationRecord {
+        serial,
+        model,
+        lot: parsed.device.lot.clone(),
+        operator: json_text(&results, &["test", "operator"]).or(parsed.test.operator.clone()),
+        approver: json_text(&results, &["test", "approver"]).or(parsed.test.approver.clone()),
+        test_date: json_text(&results, &["test", "date"]).or(parsed.test.date.clone()),
+        evaluated_at,
+        software_version,
+        plan_path: plan_path.display().to_string(),
+        plan_sha256: hash_bytes(plan_text.as_bytes()),
+        plan_text,
+        results_json,
+        verdict,
+        simulated,
+        inputs,
+        report_files,
+        figures,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_quoting_as_summary_csv_writes_it() {
+        assert_eq!(csv_fields(r#"a,"b,c","d""e",,"#), vec!["a", "b,c", "d\"e", "", ""]);
+        assert_eq!(csv_records("h\n\"x\ny\",1\nz,2\n"), vec!["h", "\"x\ny\",1", "z,2"]);
+    }
+
+    #[test]
+    fn uncertainty_attached_to_its_figure() {
+        let text = "axis,figure,unit,value,limit_min,limit_max,verdict\n\
+                    x,bias_dph,deg/h,1.5,,2,PASS\n\
+                    x,bias_expanded_uncertainty_dph,deg/h,0.25,,,\n";
+        let f = figures_from_summary(text, Path::new("s.csv"), 2.0, false).unwrap();
+        assert_eq!(f[0].expanded_uncertainty, Some(0.25));
+        assert_eq!(f[0].coverage_factor, Some(2.0));
+        assert_eq!(f[0].limit_max, Some(2.0));
+        assert_eq!(f[0].verdict.as_deref(), Some("PASS"));
+        assert_eq!(f[1].coverage_factor, Some(2.0));
+        let e = figures_from_summary("axis,figure\n", Path::new("s.csv"), 2.0, false).unwrap_err();
+        assert!(e.to_string().contains("s.csv: line 1"), "{e}");
+    }
+
+    #[test]
+    fn nul_and_huge_texts_are_refused_by_name() {
+        assert!(check_text("serial", "a\0b").unwrap_err().contains("serial holds a NUL"));
+        assert!(check_text("plan text", &"x".repeat(MAX_TEXT_BYTES + 1)).is_err());
+        assert!(check_text("serial", "'; DROP TABLE evaluation; --").is_ok());
+    }
+}

@@ -1,0 +1,101 @@
+//! Shared by the store tests: the back ends to run every test on (SQLite always; PostgreSQL at
+//! GYROLAB_TEST_PG_URL, started by scripts/pg-test-server.sh; a missing URL fails under CI=true
+//! and prints SKIPPED: otherwise) and synthetic records.
+
+#![allow(dead_code)]
+
+use gyrolab_store::record::{EvaluationRecord, FigureRecord, FileRecord};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// A back end for one test: its location and, for SQLite, the folder that holds the file.
+pub struct Backend {
+    /// Location (a file path or a URL).
+    pub location: String,
+    /// Short name for messages.
+    pub name: &'static str,
+    _dir: Option<tempfile::TempDir>,
+}
+
+static COUNTER: AtomicUsize = AtomicUsize::new(0);
+
+/// The PostgreSQL URL of the test server, or `None` (with SKIPPED: printed) outside CI.
+pub fn pg_url(test: &str) -> Option<String> {
+    match std::env::var("GYROLAB_TEST_PG_URL") {
+        Ok(u) if !u.is_empty() => Some(u),
+        _ => {
+            if std::env::var("CI").is_ok_and(|v| v == "true") {
+                panic!("GYROLAB_TEST_PG_URL is not set under CI=true: the PostgreSQL store tests must run (scripts/pg-test-server.sh)");
+            }
+            eprintln!(
+                "SKIPPED: {test} on PostgreSQL: GYROLAB_TEST_PG_URL is not set (run under scripts/pg-test-server.sh)"
+            );
+            None
+        }
+    }
+}
+
+/// A fresh, empty store location on each back end: an SQLite file in a new folder, and a new
+/// schema of the test server (its URL with `search_path` set to it).
+pub fn backends(test: &str) -> Vec<Backend> {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut out = vec![Backend {
+        location: dir.path().join("gyrolab.db").display().to_string(),
+        name: "sqlite",
+        _dir: Some(dir),
+    }];
+    if let Some(url) = pg_url(test) {
+        let schema = format!(
+            "t_{}_{}_{}",
+            test.replace(|c: char| !c.is_ascii_alphanumeric(), "_"),
+            std::process::id(),
+            COUNTER.fetch_add(1, Ordering::SeqCst)
+        );
+        let mut c = postgres::Client::connect(&url, postgres::NoTls).expect("connect to the test server");
+        c.batch_execute(&format!("CREATE SCHEMA {schema}")).expect("create schema");
+        let sep = if url.contains('?') { '&' } else { '?' };
+        out.push(Backend {
+            location: format!("{url}{sep}options=-c%20search_path%3D{schema}"),
+            name: "postgres",
+            _dir: None,
+        });
+    }
+    out
+}
+
+/// A synthetic record of `serial` in `lot` with figures `(axis, key, value)`, limits 9 .. 11.
+pub fn record(serial: &str, lot: Option<&str>, figures: &[(&str, &str, f64)]) -> EvaluationRecord {
+    EvaluationRecord {
+        serial: serial.into(),
+        model: "ADXRS-test".into(),
+        lot: lot.map(str::to_string),
+        operator: Some("A. Operator".into()),
+        approver: None,
+        test_date: Some("2026-11-27".into()),
+        evaluated_at: "2026-11-27T10:00:00Z".into(),
+        software_version: "0.1.0".into(),
+        plan_path: "/lab/plan.toml".into(),
+        plan_text: "[device]\nmodel = \"ADXRS-test\"\n".into(),
+        plan_sha256: "00".repeat(32),
+        results_json: "{}".into(),
+        verdict: Some("PASS".into()),
+        simulated: true,
+        inputs: vec![FileRecord { path: "/lab/x.csv".into(), sha256: "ab".repeat(32), size_bytes: 1234 }],
+        report_files: vec![FileRecord { path: "results.json".into(), sha256: "cd".repeat(32), size_bytes: 2 }],
+        figures: figures
+            .iter()
+            .map(|(axis, key, v)| FigureRecord {
+                axis: axis.to_string(),
+                figure: key.to_string(),
+                value: Some(*v),
+                unit: "deg/h".into(),
+                basis: "value".into(),
+                expanded_uncertainty: Some(0.01),
+                coverage_factor: Some(2.0),
+                limit_min: Some(9.0),
+                limit_max: Some(11.0),
+                verdict: Some(if (9.0..=11.0).contains(v) { "PASS" } else { "FAIL" }.into()),
+                simulated: true,
+            })
+            .collect(),
+    }
+}
