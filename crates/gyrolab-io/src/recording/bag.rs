@@ -28,8 +28,11 @@ const OP_BAG_HEADER: u8 = 0x03;
 const OP_CHUNK: u8 = 0x05;
 const OP_CONNECTION: u8 = 0x07;
 
+/// One `name=value` field of a record header: the name's bytes and the value's bytes.
+type Field<'a> = (&'a [u8], &'a [u8]);
+
 /// The `name=value` fields of a record header (or a connection's data).
-fn fields(mut b: &[u8]) -> Result<Vec<(&[u8], &[u8])>, String> {
+fn fields(mut b: &[u8]) -> Result<Vec<Field<'_>>, String> {
     let mut out = Vec::new();
     while !b.is_empty() {
         let n = b.get(..4).ok_or("a header field length is cut off")?;
