@@ -71,3 +71,13 @@ impl ReferenceArgs {
         }
     }
 }
+
+/// The note saying that a simulated record's own header gave the scale factor and null.
+pub fn stated_reference_note(file: &str, r: &gyrolab_eval::simulate::StatedReference) -> String {
+    let unit = r.output_unit;
+    format!(
+        "{file}: scale factor {} {unit}/(deg/s) and null {} {unit} read from the header comments `gyrolab \
+         simulate` wrote (--scale-factor and --null, or --cal, use others)",
+        r.scale_factor_per_dps, r.null
+    )
+}

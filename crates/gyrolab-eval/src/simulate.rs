@@ -4,8 +4,10 @@
 use crate::error::{EvalError, EvalResult};
 use gyrolab::sim::{Preset, SimConfig, TemperatureProfile};
 use gyrolab::units::OutputUnit;
+pub use gyrolab_io::sim_csv::StatedReference;
 use gyrolab_io::sim_csv::{
-    read_sim_config, write_rate_table_csv, write_static_csv, NumberFormat, SimCsvError, SimCsvOptions,
+    read_sim_config, read_stated_reference, write_rate_table_csv, write_static_csv, NumberFormat, SimCsvError,
+    SimCsvOptions,
 };
 use std::io::Write;
 use std::path::PathBuf;
@@ -171,6 +173,142 @@ pub fn sim_config(o: &SimOverrides) -> EvalResult<SimConfig> {
         rt.rest_samples = v;
     }
     Ok(cfg)
+}
+
+/// The sensor `simulate static` simulates when neither a set-up file, a preset nor any error
+/// term is given: a typical MEMS gyro (consumer to industrial grade, such as the ADIS16470 or
+/// BMI088 classes) in deg/s, so that a record made with no options has noise to analyse.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TypicalMems {
+    /// Angle random walk N, deg/sqrt(h).
+    pub arw_deg_rt_h: f64,
+    /// Bias instability B (IEEE 952), deg/h.
+    pub bias_instability_dph: f64,
+    /// Constant (turn-on) bias, deg/h.
+    pub bias_dph: f64,
+}
+
+/// The typical MEMS gyro of [`TypicalMems`]: N = 0.3 deg/sqrt(h), B = 5 deg/h, bias 20 deg/h
+/// (the middle of the MEMS class: ADIS16470 0.34 deg/sqrt(h) and 8 deg/h, BMI088 about
+/// 0.8 deg/sqrt(h); methods notes section 5).
+pub const TYPICAL_MEMS: TypicalMems = TypicalMems { arw_deg_rt_h: 0.3, bias_instability_dph: 5.0, bias_dph: 20.0 };
+
+impl TypicalMems {
+    /// One line for stderr and the record's comments.
+    pub fn describe(&self) -> String {
+        format!(
+            "typical MEMS gyro: angle random walk {} deg/sqrt(h), bias instability {} deg/h, bias {} deg/h",
+            self.arw_deg_rt_h, self.bias_instability_dph, self.bias_dph
+        )
+    }
+}
+
+/// Whether the typical MEMS gyro applies to these overrides: no set-up file, no preset and no
+/// error term (bias, noise, ramp, warm-up, quantization, temperature coefficient) given.
+pub fn uses_typical_mems(o: &SimOverrides) -> bool {
+    o.config.is_none()
+        && o.preset.is_none()
+        && [
+            o.bias_dph,
+            o.arw_deg_rt_h,
+            o.bias_instability_dph,
+            o.rrw_deg_h_rt_h,
+            o.rate_ramp_dph_per_h,
+            o.warmup_amplitude_dph,
+            o.output_quantization_step,
+            o.bias_temp_coeff_dph_per_c,
+        ]
+        .iter()
+        .all(Option::is_none)
+}
+
+/// The set-up of a static record: [`sim_config`], with the [`TYPICAL_MEMS`] gyro's error terms
+/// when [`uses_typical_mems`] (returned, for the front end to say so), so that a static record
+/// is never all one value unless an error term was set to zero on purpose.
+///
+/// ```
+/// use gyrolab_eval::simulate::{static_sim_config, SimOverrides, TYPICAL_MEMS};
+/// # fn main() -> Result<(), gyrolab_eval::EvalError> {
+/// let (cfg, typical) = static_sim_config(&SimOverrides::default())?;
+/// assert_eq!(typical, Some(TYPICAL_MEMS));
+/// assert_eq!(cfg.sensor.arw_deg_rt_h, Some(0.3));
+/// let (cfg, typical) = static_sim_config(&SimOverrides { arw_deg_rt_h: Some(0.0), ..Default::default() })?;
+/// assert_eq!((typical, cfg.sensor.bias_instability_dph), (None, None));
+/// # Ok(())
+/// # }
+/// ```
+pub fn static_sim_config(o: &SimOverrides) -> EvalResult<(SimConfig, Option<TypicalMems>)> {
+    if !uses_typical_mems(o) {
+        return Ok((sim_config(o)?, None));
+    }
+    let t = TYPICAL_MEMS;
+    let o = SimOverrides {
+        arw_deg_rt_h: Some(t.arw_deg_rt_h),
+        bias_instability_dph: Some(t.bias_instability_dph),
+        bias_dph: Some(t.bias_dph),
+        ..o.clone()
+    };
+    Ok((sim_config(&o)?, Some(t)))
+}
+
+/// The scale factor and null that gyrolab's simulator states in the header comments of every
+/// file in `files` (all the same), when `request` gives no reference of its own and the output
+/// unit is not already a rate in deg/s: the request with them set, and what was read (for the
+/// front end's note). `None` otherwise (a file from elsewhere, files that disagree, standard
+/// input, or a reference given).
+///
+/// ```
+/// use gyrolab_eval::reference::ReferenceRequest;
+/// use gyrolab_eval::simulate::reference_from_headers;
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// let dir = tempfile::tempdir()?;
+/// let p = dir.path().join("s.csv");
+/// let lines = ["# gyrolab simulated static record", "# sensor.output_unit = V"];
+/// let more = ["# sensor.scale_factor_per_dps = 0.0075", "# sensor.null = 2.5", "time_s,output_v", "0,2.5"];
+/// std::fs::write(&p, [&lines[..], &more[..]].concat().join("\n"))?;
+/// let (r, _) = reference_from_headers(&[p], &ReferenceRequest::default()).ok_or("no reference")?;
+/// assert_eq!((r.scale_factor, r.null), (Some(0.0075), Some(2.5)));
+/// # Ok(())
+/// # }
+/// ```
+pub fn reference_from_headers(
+    files: &[PathBuf],
+    request: &crate::reference::ReferenceRequest,
+) -> Option<(crate::reference::ReferenceRequest, StatedReference)> {
+    if request.calibration.is_some() || request.scale_factor.is_some() || request.null.is_some() {
+        return None;
+    }
+    let mut stated = None;
+    for f in files {
+        let r = read_stated_reference(f)?;
+        if stated.is_some_and(|s| s != r) {
+            return None;
+        }
+        stated = Some(r);
+    }
+    let r = stated?;
+    if r.output_unit.native_scale_factor_per_dps() == Some(r.scale_factor_per_dps) && r.null == 0.0 {
+        return None;
+    }
+    let request = crate::reference::ReferenceRequest {
+        scale_factor: Some(r.scale_factor_per_dps),
+        null: Some(r.null),
+        ..request.clone()
+    };
+    Some((request, r))
+}
+
+/// The seed of the example test program's records (`gyrolab simulate test-program`), the one
+/// `examples/test_program/plan.toml` was written with.
+pub const TEST_PROGRAM_SEED: u64 = 2026;
+
+/// Writes the example test program (every test of a lab's program on one axis, SIMULATED
+/// records with known truth, [`crate::program_sim::write_test_program`]) into `dir`, created if
+/// missing: `plan.toml` and the CSV records it names.
+pub fn write_test_program_folder(dir: &std::path::Path, seed: u64) -> EvalResult<()> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| EvalError::Output(format!("{}: cannot create the folder: {e}", dir.display())))?;
+    crate::program_sim::write_test_program(dir, seed).map(|_| ())
 }
 
 /// CSV options of a simulated record: `decimals` fixed decimals (0 to 15) or the shortest form;

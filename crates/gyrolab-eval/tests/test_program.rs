@@ -1,5 +1,5 @@
 //! The example plan with every test of a lab's program (`examples/test_program/plan.toml`): its
-//! SIMULATED records are written here by the same generator as the example
+//! SIMULATED records are written here by the same generator as `gyrolab simulate test-program`
 //! (`program_sim::write_test_program`), the plan it writes must be the committed one, and the
 //! evaluation gives every section, labelled SIMULATED, with the spec limits met.
 
@@ -10,8 +10,8 @@ use gyrolab_report::limits::Verdict;
 use serde_json::Value;
 use std::path::Path;
 
-/// The seed of `crates/gyrolab-eval/examples/example_test_program.rs`.
-const SEED: u64 = 2026;
+/// The seed of `gyrolab simulate test-program`.
+const SEED: u64 = gyrolab_eval::simulate::TEST_PROGRAM_SEED;
 
 #[test]
 fn the_example_test_program_evaluates_every_section() {
@@ -21,8 +21,8 @@ fn the_example_test_program_evaluates_every_section() {
     assert_eq!(
         std::fs::read_to_string(&committed).unwrap(),
         plan_text,
-        "examples/test_program/plan.toml is out of date: run `cargo run -p gyrolab-eval --example \
-         example_test_program -- examples/test_program`"
+        "examples/test_program/plan.toml is out of date: run `gyrolab simulate test-program \
+         examples/test_program`"
     );
     let plan = read_test_plan(&dir.path().join("plan.toml")).unwrap();
     let folder = evaluate_test_plan(&plan, "plan.toml", &Silent).unwrap();

@@ -552,7 +552,14 @@ fn simulate_static<'py>(
         record_temperature,
         ..Default::default()
     };
-    let cfg = gyrolab_eval::simulate::sim_config(&o).map_err(err)?;
+    // The command line's defaults: no preset and no noise term simulate a typical MEMS gyro in
+    // deg/s (said in a UserWarning, as `gyrolab simulate static` says it on stderr).
+    let (cfg, typical) = gyrolab_eval::simulate::static_sim_config(&o).map_err(err)?;
+    if let Some(t) = typical {
+        let text = format!("no preset and no noise term given: simulating a {} (output in deg/s)", t.describe());
+        let text = std::ffi::CString::new(text).map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+        PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &text, 1)?;
+    }
     let s = run(py, || gyrolab_eval::simulate::simulate_static_samples(&cfg))?.map_err(err)?;
     Ok((PyArray1::from_vec(py, s.time_s), PyArray1::from_vec(py, s.output), PyArray1::from_vec(py, s.temp_c)))
 }

@@ -9,6 +9,7 @@ use clap::Args;
 use gyrolab::allan::DeviationKind;
 use gyrolab::validate;
 use gyrolab_eval::allan::{analyse_records, parse_confidence, parse_taus, AllanRequest};
+use gyrolab_eval::simulate::reference_from_headers;
 use gyrolab_eval::EvalError;
 use gyrolab_report::allan::{allan_csv, allan_document, allan_text, imu_utils_yaml, kalibr_yaml};
 use std::path::PathBuf;
@@ -91,7 +92,11 @@ impl AllanArgs {
 
 /// Runs `gyrolab allan`.
 pub fn run(args: &AllanArgs) -> CliResult {
-    let request = args.request()?;
+    let mut request = args.request()?;
+    if let Some((reference, stated)) = reference_from_headers(std::slice::from_ref(&args.file), &request.reference) {
+        eprintln!("note: {}", crate::args::stated_reference_note(&args.file.display().to_string(), &stated));
+        request.reference = reference;
+    }
     let spinner = Bar::spinner(format!("analysing {}", args.file.display()));
     let outcomes = analyse_records(&request);
     spinner.finish();
@@ -126,6 +131,22 @@ pub fn run(args: &AllanArgs) -> CliResult {
     }
     let analyses: Vec<_> = outcomes.into_iter().flat_map(|o| o.analyses).collect();
     let analyses = &analyses;
+    for a in analyses {
+        if is_flat(a) {
+            eprintln!(
+                "warning: {} ({}): every sample has the same value (the Allan deviation is 0 at every tau): no \
+                 noise term can be read from a record without noise; a stuck sensor, or a simulation without \
+                 noise terms?",
+                a.file, a.channel
+            );
+        } else if a.slope_lines.is_none() && a.quantity == gyrolab::units::Quantity::SensorOutput {
+            eprintln!(
+                "hint: {} ({}): the data are in {}: give --scale-factor K (output units per deg/s) and --null F, \
+                 or --cal FILE.toml (from `gyrolab rate --cal-out`), for noise terms in deg units",
+                a.file, a.channel, a.rate_unit
+            );
+        }
+    }
     if args.json {
         let doc = allan_document(analyses).ok_or_else(|| EvalError::conflict("no channel to analyse"))?;
         return print(&to_json(&doc)?);
@@ -135,4 +156,11 @@ pub fn run(args: &AllanArgs) -> CliResult {
     }
     let text: Vec<String> = analyses.iter().map(allan_text).collect();
     print(&(text.join("\n") + "\n"))
+}
+
+/// Whether a channel's curve is flat at zero: every deviation at or below 1e-9 (in the
+/// channel's unit: far below any sensor's noise, above the rounding of a constant record's
+/// angle sums), i.e. every sample has the same value.
+fn is_flat(a: &gyrolab_report::allan::ChannelAnalysis) -> bool {
+    !a.curve.points.is_empty() && a.curve.points.iter().all(|p| p.deviation.abs() <= 1e-9)
 }

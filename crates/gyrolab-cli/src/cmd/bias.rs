@@ -6,6 +6,7 @@ use crate::error::CliResult;
 use crate::output::{print, to_json};
 use clap::Args;
 use gyrolab::units::OutputUnit;
+use gyrolab_eval::simulate::reference_from_headers;
 use gyrolab_eval::static_test::{evaluate_static_tests, StaticTestRequest};
 use gyrolab_report::bias::{bias_json, bias_table, quality_lines};
 use std::path::PathBuf;
@@ -64,7 +65,7 @@ pub struct BiasArgs {
 
 /// Runs `gyrolab bias`.
 pub fn run(args: &BiasArgs) -> CliResult {
-    let request = StaticTestRequest {
+    let mut request = StaticTestRequest {
         files: args.files.clone(),
         columns: args.columns.clone(),
         output_unit: args.output_unit,
@@ -82,6 +83,11 @@ pub fn run(args: &BiasArgs) -> CliResult {
             ..gyrolab::warmup::WarmupConfig::new(b)
         }),
     };
+    if let Some((reference, stated)) = reference_from_headers(&args.files, &request.reference) {
+        let shown = if args.files.len() == 1 { args.files[0].display().to_string() } else { "every file".into() };
+        eprintln!("note: {}", crate::args::stated_reference_note(&shown, &stated));
+        request.reference = reference;
+    }
     let outcome = evaluate_static_tests(&request)?;
     for f in &outcome.files {
         if let Some(c) = f.quality.first_missing.first() {
@@ -111,6 +117,15 @@ pub fn run(args: &BiasArgs) -> CliResult {
         for note in &t.result.notes {
             eprintln!("note: {} ({}): {note}", t.file, t.result.channel);
         }
+        let r = &t.result;
+        if r.valid_samples > 1 && r.std_output <= 1e-12 * r.mean_output.abs() {
+            eprintln!(
+                "warning: {} ({}): every sample has the same value ({} {}): the bias is that value, but no \
+                 stability or noise figure can be read from a record without noise; a stuck sensor, or a \
+                 simulation without noise terms?",
+                t.file, r.channel, r.mean_output, r.output_unit
+            );
+        }
     }
     if args.json {
         return print(&to_json(&bias_json(tests, outcome.repeatability, &outcome.warmup))?);
@@ -126,7 +141,9 @@ pub fn run(args: &BiasArgs) -> CliResult {
         );
     }
     if outcome.reference.is_none() && tests.iter().any(|t| t.result.bias_dps.is_none()) {
-        text.push_str("No scale factor given (--cal or --scale-factor): figures are in output units only.\n");
+        text.push_str(
+            "No scale factor given (--cal FILE.toml, or --scale-factor K --null F): figures are in output units only.\n",
+        );
     }
     print(&text)
 }

@@ -1,12 +1,13 @@
-//! `gyrolab simulate static|rate-table`: records with known truth, in exactly the layouts that
-//! `gyrolab bias`, `gyrolab allan` and `gyrolab rate` read.
+//! `gyrolab simulate static|rate-table|test-program`: records with known truth, in exactly the
+//! layouts that `gyrolab bias`, `gyrolab allan`, `gyrolab rate` and `gyrolab eval` read.
 
 use crate::error::{CliError, CliResult};
 use clap::{Args, Subcommand};
 use gyrolab::sim::Preset;
 use gyrolab::units::OutputUnit;
 use gyrolab_eval::simulate::{
-    check_record_size, csv_options, sim_config, simulate_to, SimOverrides, SimRecord, DEFAULT_MAX_SAMPLES,
+    check_record_size, csv_options, sim_config, simulate_to, static_sim_config, write_test_program_folder,
+    SimOverrides, SimRecord, DEFAULT_MAX_SAMPLES, TEST_PROGRAM_SEED,
 };
 use gyrolab_io::sim_csv::SimCsvError;
 use std::io::Write;
@@ -15,10 +16,25 @@ use std::path::PathBuf;
 /// What to simulate.
 #[derive(Debug, Subcommand)]
 pub enum SimulateCommand {
-    /// A static (bias) record: time_s and the output (deg/s by default), optional temp_c.
+    /// A static (bias) record: time_s and the output (deg/s by default), optional temp_c. With
+    /// no --preset, --config or error-term flag, a typical MEMS gyro (said on stderr).
     Static(Box<StaticArgs>),
     /// A rate-table test: rate_dps, run, stroke, output per sample, with rest records.
     RateTable(Box<RateTableArgs>),
+    /// The example test program: plan.toml and its SIMULATED records (every test of a lab's
+    /// program on one axis, about 17 MB) written into DIR, for `gyrolab eval DIR/plan.toml`.
+    TestProgram(TestProgramArgs),
+}
+
+/// Options of `gyrolab simulate test-program`.
+#[derive(Debug, Args)]
+pub struct TestProgramArgs {
+    /// Folder to write plan.toml and the records into (created if missing).
+    #[arg(value_name = "DIR")]
+    pub dir: PathBuf,
+    /// Seed (default 2026: the records examples/test_program/plan.toml describes).
+    #[arg(long)]
+    pub seed: Option<u64>,
 }
 
 /// Options shared by both records.
@@ -192,6 +208,15 @@ fn overrides(c: &CommonArgs) -> SimOverrides {
 /// Runs `gyrolab simulate`.
 pub fn run(cmd: &SimulateCommand) -> CliResult {
     let (record, common, o) = match cmd {
+        SimulateCommand::TestProgram(a) => {
+            write_test_program_folder(&a.dir, a.seed.unwrap_or(TEST_PROGRAM_SEED))?;
+            eprintln!(
+                "wrote {} (plan.toml and its SIMULATED records): gyrolab eval {}/plan.toml --out report/",
+                a.dir.display(),
+                a.dir.display()
+            );
+            return Ok(());
+        }
         SimulateCommand::Static(a) => (
             SimRecord::Static,
             &a.common,
@@ -214,10 +239,23 @@ pub fn run(cmd: &SimulateCommand) -> CliResult {
             },
         ),
     };
-    let cfg = sim_config(&o)?;
+    let (cfg, typical) = match record {
+        SimRecord::Static => static_sim_config(&o)?,
+        SimRecord::RateTable => (sim_config(&o)?, None),
+    };
     check_record_size(record, &cfg, common.max_samples.unwrap_or(DEFAULT_MAX_SAMPLES))?;
-    let command = format!("command: {}", std::env::args().collect::<Vec<_>>().join(" "));
-    let opts = csv_options(common.decimals, vec![command])?;
+    let mut comments = vec![format!("command: {}", std::env::args().collect::<Vec<_>>().join(" "))];
+    if let Some(t) = typical {
+        let unit = cfg.sensor_model().output_unit;
+        eprintln!(
+            "note: no --preset and no noise flag given: simulating a {}, output in {unit} (--preset NAME, \
+             or --arw-deg-rt-h, --bias-instability-dph, --bias-dph ... for another sensor; --arw-deg-rt-h 0 for \
+             a noise-free record)",
+            t.describe()
+        );
+        comments.push(format!("defaults: {} (no preset and no noise flag given)", t.describe()));
+    }
+    let opts = csv_options(common.decimals, comments)?;
     emit(&common.out, |w| simulate_to(record, &cfg, &opts, w))
 }
 fn emit(out: &Option<PathBuf>, write: impl FnOnce(&mut (dyn Write + Send)) -> Result<(), SimCsvError>) -> CliResult {

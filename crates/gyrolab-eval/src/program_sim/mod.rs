@@ -29,9 +29,9 @@ pub fn write_test_program(dir: &Path, seed: u64) -> EvalResult<String> {
     let axis = "x";
     let mut plan = String::from(
         "# gyrolab test plan: the whole test program of a lab on one gyro axis, on SIMULATED records\n\
-         # (written by `cargo run -p gyrolab-eval --example example_test_program`, which also writes this file;\n\
+         # (written by `gyrolab simulate test-program examples/test_program`, which also writes this file;\n\
          # every key is described in docs/PLAN.md).\n#\n\
-         #   cargo run -p gyrolab-eval --example example_test_program -- examples/test_program\n\
+         #   gyrolab simulate test-program examples/test_program\n\
          #   gyrolab eval examples/test_program/plan.toml --out report/\n\n\
          [device]\nmodel = \"ADXRS646-class MEMS rate gyro (SIMULATED)\"\nserial = \"SIM-0001\"\naxes = [\"x\"]\n",
     );

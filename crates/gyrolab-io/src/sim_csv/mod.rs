@@ -215,7 +215,7 @@ fn write_static_csv_as<N: NumberText, W: Write + Send>(
     let mut preamble = TextBuf::new(4096);
     let mut truth = vec![format!("truth.earth_rate_dps = {:?}", generator.earth_rate_dps())];
     truth.extend(generator.flicker_design().map(flicker_comment));
-    let title = "gyrolab simulated static record";
+    let title = STATIC_RECORD_TITLE;
     write_preamble(&mut preamble, title, seed, options, model, spec.parameter_lines(), truth);
     preamble.text(static_header(model.output_unit, generator.records_temperature()).as_bytes());
     preamble.byte(b'\n');
@@ -363,6 +363,63 @@ fn write_rate_table_csv_as<N: NumberText, W: Write>(
     }
     let bytes = w.finish()?;
     Ok(WriteSummary { rows, bytes })
+}
+
+/// The title line of a static record written by [`write_static_csv`].
+pub const STATIC_RECORD_TITLE: &str = "gyrolab simulated static record";
+
+/// The output-to-rate reference a simulated static record states in its comment lines
+/// (`# sensor.output_unit = V`, `# sensor.scale_factor_per_dps = 0.0075`, `# sensor.null = 2.5`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StatedReference {
+    /// The output unit of the record.
+    pub output_unit: OutputUnit,
+    /// Nominal scale factor K, output units per deg/s.
+    pub scale_factor_per_dps: f64,
+    /// Null (zero-rate output), output units.
+    pub null: f64,
+}
+
+/// Reads the scale factor, null and output unit that gyrolab's simulator writes into the
+/// comment lines at the top of a static record; `None` for any other file (first line not
+/// [`STATIC_RECORD_TITLE`], a key missing or unreadable, or an I/O error: the file's reader
+/// reports those). Reads at most the first 64 KiB, comment lines only.
+///
+/// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// let dir = tempfile::tempdir()?;
+/// let p = dir.path().join("s.csv");
+/// let lines = ["# gyrolab simulated static record", "# sensor.output_unit = V"];
+/// let more = ["# sensor.scale_factor_per_dps = 0.0075", "# sensor.null = 2.5", "time_s,output_v", "0,2.5"];
+/// std::fs::write(&p, [&lines[..], &more[..]].concat().join("\n"))?;
+/// let r = gyrolab_io::sim_csv::read_stated_reference(&p).ok_or("no reference")?;
+/// assert_eq!((r.scale_factor_per_dps, r.null), (0.0075, 2.5));
+/// # Ok(())
+/// # }
+/// ```
+pub fn read_stated_reference(path: &std::path::Path) -> Option<StatedReference> {
+    use std::io::{BufRead, Read};
+    let file = std::fs::File::open(path).ok()?;
+    let reader = std::io::BufReader::new(file.take(64 * 1024));
+    let mut lines = reader.lines();
+    let first = lines.next()?.ok()?;
+    if first.trim_start_matches('\u{feff}').trim_start_matches('#').trim() != STATIC_RECORD_TITLE {
+        return None;
+    }
+    let (mut unit, mut k, mut null) = (None, None, None);
+    for line in lines {
+        let line = line.ok()?;
+        let Some(comment) = line.strip_prefix('#') else { break };
+        let Some((key, value)) = comment.split_once('=') else { continue };
+        let value = value.trim();
+        match key.trim() {
+            "sensor.output_unit" => unit = OutputUnit::parse(value),
+            "sensor.scale_factor_per_dps" => k = value.parse::<f64>().ok().filter(|k| k.is_finite() && *k != 0.0),
+            "sensor.null" => null = value.parse::<f64>().ok().filter(|n| n.is_finite()),
+            _ => {}
+        }
+    }
+    Some(StatedReference { output_unit: unit?, scale_factor_per_dps: k?, null: null? })
 }
 
 /// Reads a simulation set-up (TOML: `seed`, `preset`, `[sensor]`, `[static_record]`,

@@ -411,9 +411,16 @@ impl Ctx<'_> {
                 value.span(),
                 key,
                 format!(
-                    "file '{}' not found (looked for {}; relative paths start at the plan's folder)",
+                    "file '{}' not found (looked for {}; relative paths start at the plan's folder){}",
                     value.get_ref(),
-                    p.display()
+                    p.display(),
+                    // The example test program's plan names the command that writes its records.
+                    if self.text.contains("gyrolab simulate test-program") {
+                        let dir = if self.base.as_os_str().is_empty() { Path::new(".") } else { &self.base };
+                        format!("; write the records with `gyrolab simulate test-program {}`", dir.display())
+                    } else {
+                        String::new()
+                    }
                 ),
             ))
         }

@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# GMWM against simulated truth beside the slope readings and the five-term fit: three composite
+# models x SEEDS seeds (default 100) of HOURS hours at 10 Hz (default 10): bias and RMSE of each
+# parameter relative to the truth, and the coverage of the GMWM 68.3 % two-sided intervals. The
+# table goes into docs/METHODS.md section 3.1 ("GMWM study"). Not part of the normal test suite
+# (minutes of CPU); the suite's short version is crates/gyrolab/src/gmwm/tests.rs.
+# Usage: bash bench/gmwm_study.sh [SEEDS] [HOURS]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build --quiet --release -p gyrolab --example gmwm_study
+target/release/examples/gmwm_study "${1:-100}" "${2:-10}"

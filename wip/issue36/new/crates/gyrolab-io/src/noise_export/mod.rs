@@ -1,0 +1,529 @@
+//! Noise-parameter files for state estimators ("filter stacks"), each in the stack's own keys,
+//! units, file format and time convention (docs/EXPORTS.md; conversions in docs/METHODS.md,
+//! "Filter exports"). Sources of each convention:
+//! - Kalibr: wiki "IMU Noise Model" (continuous-time densities; sigma_d = sigma_c sqrt(rate) for
+//!   white noise, sigma_bd = sigma_b / sqrt(rate) for a random walk);
+//! - OpenVINS: `kalibr_imu_chain.yaml` of its configs (`%YAML:1.0`, `imu0:` with Kalibr's keys,
+//!   read with OpenCV FileStorage);
+//! - VINS-Fusion / VINS-Mono: `acc_n`, `gyr_n`, `acc_w`, `gyr_w` in the `%YAML:1.0` config
+//!   (continuous-time, the imu_utils convention);
+//! - ORB-SLAM3: `IMU.NoiseGyro`, `IMU.NoiseAcc`, `IMU.GyroWalk`, `IMU.AccWalk` (continuous,
+//!   Tracking.cc multiplies the noises by sqrt(IMU.Frequency) and divides the walks by it);
+//! - Basalt: calibration JSON `gyro_noise_std`, `accel_noise_std` (continuous; its
+//!   `dicrete_time_*_noise_std()` multiply by sqrt(imu_update_rate)), `gyro_bias_std`,
+//!   `accel_bias_std` (continuous random-walk densities);
+//! - PX4 EKF2: `EKF2_GYR_NOISE` rad/s, `EKF2_ACC_NOISE` m/s^2 (the delta-angle variance is
+//!   (dt x EKF2_GYR_NOISE)^2), `EKF2_GYR_B_NOISE` rad/s^2, `EKF2_ACC_B_NOISE` m/s^3 (the bias
+//!   increment per step is dt x the parameter): per step, so from the densities at the step rate f:
+//!   N sqrt(f) and K sqrt(f);
+//! - ROS `sensor_msgs/Imu`: row-major 3x3 covariances of one message (per-sample variances);
+//!   `orientation_covariance[0] = -1` when no orientation is given (the message's comment).
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// A filter stack gyrolab writes noise parameters for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stack {
+    /// Kalibr `imu.yaml`.
+    Kalibr,
+    /// OpenVINS `kalibr_imu_chain.yaml`.
+    Openvins,
+    /// VINS-Fusion / VINS-Mono config entries.
+    Vins,
+    /// ORB-SLAM3 settings entries (`%YAML:1.0`).
+    Orbslam3,
+    /// Basalt calibration JSON (IMU noise part).
+    Basalt,
+    /// PX4 parameter file for `param set` (NuttX shell script lines).
+    Px4,
+    /// QGroundControl `.params` file (tab-separated) of the same PX4 parameters.
+    Px4Qgc,
+    /// ROS `sensor_msgs/Imu` covariance matrices.
+    RosCovariance,
+}
+
+/// Every stack, in the order of the documentation.
+pub const STACKS: [Stack; 8] = [
+    Stack::Kalibr,
+    Stack::Openvins,
+    Stack::Vins,
+    Stack::Orbslam3,
+    Stack::Basalt,
+    Stack::Px4,
+    Stack::Px4Qgc,
+    Stack::RosCovariance,
+];
+
+impl Stack {
+    /// The stack's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stack::Kalibr => "kalibr",
+            Stack::Openvins => "openvins",
+            Stack::Vins => "vins",
+            Stack::Orbslam3 => "orbslam3",
+            Stack::Basalt => "basalt",
+            Stack::Px4 => "px4",
+            Stack::Px4Qgc => "px4-qgc",
+            Stack::RosCovariance => "ros-covariance",
+        }
+    }
+
+    /// Parses a stack name (case-insensitive).
+    pub fn parse(text: &str) -> Option<Stack> {
+        let t = text.trim().to_ascii_lowercase();
+        STACKS.iter().copied().find(|s| s.name() == t)
+    }
+
+    /// Whether the stack's values are per sample (discrete time) rather than densities.
+    pub fn per_sample(self) -> bool {
+        matches!(self, Stack::Px4 | Stack::Px4Qgc | Stack::RosCovariance)
+    }
+}
+
+/// How an exported term was obtained.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TermSource {
+    /// `value`, `upper_bound`, `fit_value` or `gmwm`.
+    pub basis: &'static str,
+    /// What the basis means for this term, for the file's header (confidence and sidedness of a
+    /// bound or interval, the channel it comes from).
+    pub detail: String,
+}
+
+/// One continuous-time noise term as exported.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExportTerm {
+    /// The value written, after every factor: gyro white noise rad/s/sqrt(Hz), gyro random walk
+    /// rad/s^2/sqrt(Hz), accelerometer white noise m/s^2/sqrt(Hz), accelerometer random walk
+    /// m/s^3/sqrt(Hz).
+    pub value: f64,
+    /// The estimate before any factor, same unit.
+    pub estimate: f64,
+    /// The overbound factor applied (1 when not overbounded or not needed), when overbounding.
+    pub overbound_factor: Option<f64>,
+    /// How the estimate was obtained.
+    pub source: TermSource,
+}
+
+/// The noise parameters of one IMU record, ready to be written for any stack.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NoiseExport {
+    /// The record (file, and topic of a recording).
+    pub record: String,
+    /// The sample rate, Hz.
+    pub rate_hz: f64,
+    /// The input was simulated (every file says so).
+    pub simulated: bool,
+    /// The estimator of the values: `slopes`, `fit` or `gmwm`.
+    pub estimator: String,
+    /// The factor `--inflate` applied to every value (1: none).
+    pub inflation: f64,
+    /// Gyro white noise (angle random walk N).
+    pub gyro_noise: Option<ExportTerm>,
+    /// Gyro random walk (rate random walk K).
+    pub gyro_walk: Option<ExportTerm>,
+    /// Accelerometer white noise (velocity random walk).
+    pub accel_noise: Option<ExportTerm>,
+    /// Accelerometer random walk.
+    pub accel_walk: Option<ExportTerm>,
+    /// The ROS topic, when the record is a topic of a recording.
+    pub rostopic: Option<String>,
+    /// The writer's version, for the header.
+    pub writer: String,
+}
+
+/// Per-step rate of PX4's EKF2 prediction by default (EKF2_PREDICT_US = 10000 us).
+pub const PX4_DEFAULT_EKF_HZ: f64 = 100.0;
+
+/// The number as text a YAML 1.1 reader (PyYAML), OpenCV FileStorage and JSON all read as a
+/// real: scientific notation with a decimal point and a signed exponent (`1.7e-05`, `2.0e+02`),
+/// the shortest that reads back to the same f64.
+pub fn real_text(v: f64) -> String {
+    if !v.is_finite() {
+        return ".nan".into();
+    }
+    // Rust's `{:e}` is the shortest round-trip form: "1.7e-5", "2e2".
+    let s = format!("{v:e}");
+    let (mantissa, exponent) = s.split_once('e').unwrap_or((s.as_str(), "0"));
+    let mantissa = if mantissa.contains('.') { mantissa.to_string() } else { format!("{mantissa}.0") };
+    let (sign, digits) = match exponent.strip_prefix('-') {
+        Some(d) => ("-", d),
+        None => ("+", exponent),
+    };
+    format!("{mantissa}e{sign}{digits:0>2}")
+}
+
+/// The rate as text with a decimal point (an OpenCV real, a YAML float).
+fn rate_text(v: f64) -> String {
+    let s = format!("{v}");
+    if s.contains('.') || s.contains('e') {
+        s
+    } else {
+        format!("{s}.0")
+    }
+}
+
+fn json_string(s: &str) -> String {
+    let mut out = String::from("\"");
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if (c as u32) < 0x20 => {
+                let _ = write!(out, "\\u{:04x}", c as u32);
+            }
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+/// One line of text with no line breaks (names in comments).
+fn one_line(s: &str) -> String {
+    s.chars().map(|c| if c.is_control() { ' ' } else { c }).collect()
+}
+
+/// What each term is, in the order gyro noise, gyro walk, accel noise, accel walk.
+struct Slot<'a> {
+    term: Option<&'a ExportTerm>,
+    what: &'static str,
+    unit: &'static str,
+}
+
+impl NoiseExport {
+    fn slots(&self) -> [Slot<'_>; 4] {
+        [
+            Slot {
+                term: self.gyro_noise.as_ref(),
+                what: "gyro white noise (angle random walk)",
+                unit: "rad/s/sqrt(Hz)",
+            },
+            Slot {
+                term: self.gyro_walk.as_ref(),
+                what: "gyro bias random walk (rate random walk)",
+                unit: "rad/s^2/sqrt(Hz)",
+            },
+            Slot {
+                term: self.accel_noise.as_ref(),
+                what: "accelerometer white noise (velocity random walk)",
+                unit: "m/s^2/sqrt(Hz)",
+            },
+            Slot { term: self.accel_walk.as_ref(), what: "accelerometer bias random walk", unit: "m/s^3/sqrt(Hz)" },
+        ]
+    }
+
+    /// The per-sample (discrete-time) value of a continuous term at `rate_hz`: white noise
+    /// sigma_c sqrt(rate) (a standard deviation per sample), random walk sigma_c / sqrt(rate)
+    /// (the bias increment per sample).
+    pub fn discrete(value: f64, white: bool, rate_hz: f64) -> f64 {
+        if white {
+            value * rate_hz.sqrt()
+        } else {
+            value / rate_hz.sqrt()
+        }
+    }
+
+    /// The header lines (without comment markers) every file carries.
+    pub fn header_lines(&self, stack: Stack) -> Vec<String> {
+        let mut h = vec![format!("{} noise parameters written by gyrolab {}", stack.name(), self.writer)];
+        if self.simulated {
+            h.push("SIMULATED: the record analysed is a simulated record, not a measured sensor".into());
+        }
+        h.push(format!("record: {}", one_line(&self.record)));
+        h.push(format!("sample rate: {} Hz", rate_text(self.rate_hz)));
+        h.push(format!("estimator: {}", self.estimator));
+        h.push(if stack.per_sample() {
+            format!(
+                "time convention: per sample at {} Hz (white noise: density x sqrt(rate); random walk: see each value)",
+                rate_text(self.rate_hz)
+            )
+        } else {
+            "time convention: continuous time (noise densities; the stack converts with its rate)".into()
+        });
+        h.push(if self.inflation == 1.0 {
+            "inflation: none (factor 1)".into()
+        } else {
+            format!(
+                "inflation: every value x {} (--inflate), variances x {}",
+                self.inflation,
+                self.inflation * self.inflation
+            )
+        });
+        for s in self.slots() {
+            match s.term {
+                Some(t) => {
+                    let mut line = format!(
+                        "{}: {} {} ({}: {})",
+                        s.what,
+                        real_text(t.estimate),
+                        s.unit,
+                        t.source.basis,
+                        one_line(&t.source.detail)
+                    );
+                    if let Some(f) = t.overbound_factor {
+                        let _ = write!(line, "; overbound factor {f:.4}");
+                    }
+                    if t.value != t.estimate {
+                        let _ = write!(line, "; written {}", real_text(t.value));
+                    }
+                    h.push(line);
+                }
+                None => h.push(format!("{}: not estimated (no such channel with noise terms): not written", s.what)),
+            }
+        }
+        h
+    }
+
+    /// The file text for `stack`.
+    pub fn render(&self, stack: Stack) -> String {
+        match stack {
+            Stack::Kalibr => self.kalibr(),
+            Stack::Openvins => self.openvins(),
+            Stack::Vins => self.vins(),
+            Stack::Orbslam3 => self.orbslam3(),
+            Stack::Basalt => self.basalt(),
+            Stack::Px4 => self.px4(false),
+            Stack::Px4Qgc => self.px4(true),
+            Stack::RosCovariance => self.ros_covariance(),
+        }
+    }
+
+    fn comment_header(&self, stack: Stack, prefix: &str) -> String {
+        let mut s = String::new();
+        for l in self.header_lines(stack) {
+            let _ = writeln!(s, "{prefix}{l}");
+        }
+        s
+    }
+
+    /// `key: value   # unit` lines for continuous keys (missing terms as comments).
+    fn yaml_entries(&self, keys: [&str; 4], indent: &str) -> String {
+        let mut s = String::new();
+        for (key, slot) in keys.iter().zip(self.slots()) {
+            match slot.term {
+                Some(t) => {
+                    let _ = writeln!(s, "{indent}{key}: {}   # {}, {}", real_text(t.value), slot.unit, t.source.basis);
+                }
+                None => {
+                    let _ = writeln!(s, "{indent}# {key}: not written ({} not estimated)", slot.what);
+                }
+            }
+        }
+        s
+    }
+
+    fn kalibr(&self) -> String {
+        let mut s = self.comment_header(Stack::Kalibr, "# ");
+        s.push_str(&self.yaml_entries(
+            [
+                "gyroscope_noise_density",
+                "gyroscope_random_walk",
+                "accelerometer_noise_density",
+                "accelerometer_random_walk",
+            ],
+            "",
+        ));
+        let _ = writeln!(s, "update_rate: {}", rate_text(self.rate_hz));
+        match &self.rostopic {
+            Some(t) => {
+                let _ = writeln!(s, "rostopic: {}", one_line(t));
+            }
+            None => s.push_str(
+                "# rostopic: not known from this record; /imu0 is Kalibr's example: set yours\nrostopic: /imu0\n",
+            ),
+        }
+        s
+    }
+
+    fn openvins(&self) -> String {
+        let mut s = String::from("%YAML:1.0 # OpenVINS reads this file with OpenCV FileStorage\n");
+        s.push_str(&self.comment_header(Stack::Openvins, "# "));
+        s.push_str("imu0:\n  T_i_b:\n");
+        for r in 0..4 {
+            let row: Vec<&str> = (0..4).map(|c| if r == c { "1.0" } else { "0.0" }).collect();
+            let _ = writeln!(s, "    - [{}]", row.join(", "));
+        }
+        s.push_str(&self.yaml_entries(
+            [
+                "gyroscope_noise_density",
+                "gyroscope_random_walk",
+                "accelerometer_noise_density",
+                "accelerometer_random_walk",
+            ],
+            "  ",
+        ));
+        let _ = writeln!(s, "  rostopic: {}", self.rostopic.as_deref().map_or("/imu0".into(), one_line));
+        s.push_str("  time_offset: 0.0\n");
+        let _ = writeln!(s, "  update_rate: {}", rate_text(self.rate_hz));
+        s.push_str(
+            "  # intrinsics not estimated by gyrolab: identity (OpenVINS's \"kalibr\" model)\n  model: \"kalibr\"\n",
+        );
+        for key in ["Tw", "R_IMUtoGYRO", "Ta", "R_IMUtoACC"] {
+            let _ = writeln!(s, "  {key}:");
+            for r in 0..3 {
+                let row: Vec<&str> = (0..3).map(|c| if r == c { "1.0" } else { "0.0" }).collect();
+                let _ = writeln!(s, "    - [{}]", row.join(", "));
+            }
+        }
+        s.push_str("  Tg:\n");
+        for _ in 0..3 {
+            s.push_str("    - [0.0, 0.0, 0.0]\n");
+        }
+        s
+    }
+
+    fn vins(&self) -> String {
+        let mut s = String::from("%YAML:1.0\n");
+        s.push_str(&self.comment_header(Stack::Vins, "# "));
+        s.push_str("# The IMU entries of a VINS-Fusion / VINS-Mono config: paste them into yours (its other keys are\n# the cameras'); VINS's own EuRoC config uses values 50 to 60 times the sensor's densities.\n");
+        let keys = ["gyr_n", "gyr_w", "acc_n", "acc_w"];
+        s.push_str(&self.yaml_entries(keys, ""));
+        s.push_str("# g_norm: your local gravity, m/s^2 (not estimated by gyrolab)\n");
+        s
+    }
+
+    fn orbslam3(&self) -> String {
+        let mut s = String::from("%YAML:1.0\n");
+        s.push_str(&self.comment_header(Stack::Orbslam3, "# "));
+        s.push_str("# The IMU entries of an ORB-SLAM3 settings file (continuous time: ORB-SLAM3 multiplies the\n# noises by sqrt(IMU.Frequency) and divides the walks by it).\n");
+        s.push_str(&self.yaml_entries(["IMU.NoiseGyro", "IMU.GyroWalk", "IMU.NoiseAcc", "IMU.AccWalk"], ""));
+        let _ = writeln!(s, "IMU.Frequency: {}", rate_text(self.rate_hz));
+        s
+    }
+
+    fn basalt(&self) -> String {
+        let mut s = String::from("{\n  \"gyrolab_header\": [\n");
+        let lines = self.header_lines(Stack::Basalt);
+        for (i, l) in lines.iter().enumerate() {
+            let _ = writeln!(s, "    {}{}", json_string(l), if i + 1 < lines.len() { "," } else { "" });
+        }
+        s.push_str("  ],\n  \"value0\": {\n");
+        let mut entries = vec![format!("    \"imu_update_rate\": {}", rate_text(self.rate_hz))];
+        for (key, slot) in
+            ["gyro_noise_std", "gyro_bias_std", "accel_noise_std", "accel_bias_std"].iter().zip(self.slots())
+        {
+            if let Some(t) = slot.term {
+                let v = real_text(t.value);
+                entries.push(format!("    \"{key}\": [{v}, {v}, {v}]"));
+            }
+        }
+        s.push_str(&entries.join(",\n"));
+        s.push_str("\n  }\n}\n");
+        s
+    }
+
+    /// PX4 values at the record's rate: white noise N sqrt(rate), random walk K sqrt(rate).
+    fn px4_values(&self) -> Vec<(&'static str, Option<f64>, &'static str)> {
+        let f = self.rate_hz.sqrt();
+        let keys = [
+            ("EKF2_GYR_NOISE", "rad/s"),
+            ("EKF2_GYR_B_NOISE", "rad/s^2"),
+            ("EKF2_ACC_NOISE", "m/s^2"),
+            ("EKF2_ACC_B_NOISE", "m/s^3"),
+        ];
+        keys.iter().zip(self.slots()).map(|(&(k, u), slot)| (k, slot.term.map(|t| t.value * f), u)).collect()
+    }
+
+    fn px4(&self, qgc: bool) -> String {
+        let stack = if qgc { Stack::Px4Qgc } else { Stack::Px4 };
+        let mut s = self.comment_header(stack, "# ");
+        let at100 = PX4_DEFAULT_EKF_HZ.sqrt();
+        let _ = writeln!(
+            s,
+            "# PX4 EKF2 applies these per prediction step dt: delta-angle sigma = dt x EKF2_GYR_NOISE, bias step = dt x EKF2_GYR_B_NOISE,\n\
+             # so each value is the continuous density x sqrt(step rate). Written at the record's rate, {} Hz; if EKF2 predicts at\n\
+             # another rate (EKF2_PREDICT_US, default 10000 us = 100 Hz) use density x sqrt(that rate): at 100 Hz:",
+            rate_text(self.rate_hz)
+        );
+        for ((k, _, u), slot) in self.px4_values().into_iter().zip(self.slots()) {
+            if let Some(t) = slot.term {
+                let _ = writeln!(s, "#   {k} = {} {u}", real_text(t.value * at100));
+            }
+        }
+        if qgc {
+            s.push_str("#\n# Vehicle-Id Component-Id Name Value Type\n");
+        }
+        for (k, v, u) in self.px4_values() {
+            match (v, qgc) {
+                (Some(v), true) => {
+                    // MAV_PARAM_TYPE_REAL32 = 9
+                    let _ = writeln!(s, "1\t1\t{k}\t{}\t9", real_text(v));
+                }
+                (Some(v), false) => {
+                    let _ = writeln!(s, "param set {k} {}", real_text(v));
+                }
+                (None, _) => {
+                    let _ = writeln!(s, "# {k} ({u}): not written (not estimated)");
+                }
+            }
+        }
+        s
+    }
+
+    fn ros_covariance(&self) -> String {
+        let mut s = self.comment_header(Stack::RosCovariance, "# ");
+        s.push_str(
+            "# sensor_msgs/Imu covariances, row-major 3x3, per sample (the variance of one message's value):\n\
+             # diagonal = (density x sqrt(rate))^2; axes combined (same variance on every axis); random walks\n\
+             # are not part of the message. orientation_covariance[0] = -1: no orientation estimate.\n",
+        );
+        let slots = self.slots();
+        let matrix = |t: Option<&ExportTerm>| -> String {
+            match t {
+                Some(t) => {
+                    let v = real_text((t.value * self.rate_hz.sqrt()).powi(2));
+                    let z = "0.0";
+                    format!("[{v}, {z}, {z}, {z}, {v}, {z}, {z}, {z}, {v}]")
+                }
+                None => "[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]".into(),
+            }
+        };
+        s.push_str("orientation_covariance: [-1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]\n");
+        if slots[0].term.is_none() {
+            s.push_str("# angular_velocity_covariance: all zero = unknown (no gyro noise estimated)\n");
+        }
+        let _ = writeln!(s, "angular_velocity_covariance: {}   # (rad/s)^2", matrix(slots[0].term));
+        if slots[2].term.is_none() {
+            s.push_str("# linear_acceleration_covariance: all zero = unknown (no accelerometer noise estimated)\n");
+        }
+        let _ = writeln!(s, "linear_acceleration_covariance: {}   # (m/s^2)^2", matrix(slots[2].term));
+        s
+    }
+}
+
+/// Why the export files could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    /// A file could not be written; no file of the run was (see [`crate::atomic::write_files`]).
+    #[error("{}: {source} (no export file was written)", .path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+}
+
+/// Writes every (stack, file) of a run, all or none.
+pub fn write_exports(noise: &NoiseExport, targets: &[(Stack, PathBuf)]) -> Result<Vec<PathBuf>, ExportError> {
+    let files: Vec<(PathBuf, Vec<u8>)> =
+        targets.iter().map(|(stack, path)| (path.clone(), noise.render(*stack).into_bytes())).collect();
+    crate::atomic::write_files(&files).map_err(|(path, source)| ExportError::Write { path, source })
+}
+
+/// Whether a file was written by gyrolab's simulator (its first line says so), for the
+/// SIMULATED mark of the exports; `false` when it cannot be read.
+pub fn is_gyrolab_simulation(path: &std::path::Path) -> bool {
+    use std::io::Read;
+    let mut head = [0u8; 64];
+    let Ok(mut f) = std::fs::File::open(path) else { return false };
+    let n = f.read(&mut head).unwrap_or(0);
+    let text = String::from_utf8_lossy(&head[..n]);
+    text.trim_start_matches('\u{feff}').starts_with("# gyrolab simulated")
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,149 @@
+use super::*;
+
+fn term(v: f64, basis: &'static str) -> ExportTerm {
+    ExportTerm { value: v, estimate: v, overbound_factor: None, source: TermSource { basis, detail: "test".into() } }
+}
+
+/// N = 1e-3 rad/s/sqrt(Hz), K = 2e-5 rad/s^2/sqrt(Hz), accel 4e-3, 6e-4 at 400 Hz.
+pub(super) fn sample() -> NoiseExport {
+    NoiseExport {
+        record: "imu.csv".into(),
+        rate_hz: 400.0,
+        simulated: true,
+        estimator: "slopes".into(),
+        inflation: 1.0,
+        gyro_noise: Some(term(1e-3, "value")),
+        gyro_walk: Some(term(2e-5, "upper_bound")),
+        accel_noise: Some(term(4e-3, "value")),
+        accel_walk: Some(term(6e-4, "fit_value")),
+        rostopic: None,
+        writer: "test".into(),
+    }
+}
+
+/// The value of `key` in `key: value` or `param set key value` or tab-separated lines.
+fn value_of(text: &str, key: &str) -> Option<f64> {
+    for line in text.lines() {
+        let l = line.trim();
+        if l.starts_with('#') {
+            continue;
+        }
+        if let Some(rest) = l.strip_prefix(&format!("{key}:")) {
+            return rest.split('#').next()?.trim().parse().ok();
+        }
+        if let Some(rest) = l.strip_prefix(&format!("param set {key} ")) {
+            return rest.trim().parse().ok();
+        }
+        let cells: Vec<&str> = l.split('\t').collect();
+        if cells.len() == 5 && cells[2] == key {
+            return cells[3].parse().ok();
+        }
+    }
+    None
+}
+
+#[test]
+fn real_text_reads_back_and_is_a_yaml_1_1_float() {
+    for v in [1e-3, 2e-5, 1.6968e-4, 123.456, 0.1 + 0.2, 5e300, 1.0] {
+        let t = real_text(v);
+        assert_eq!(t.parse::<f64>().unwrap(), v, "{t}");
+        // PyYAML's float: digits '.' digits [eE][-+]digits
+        let (m, e) = t.split_once('e').unwrap();
+        assert!(m.contains('.'), "{t}");
+        assert!(e.starts_with('-') || e.starts_with('+'), "{t}");
+    }
+}
+
+#[test]
+fn continuous_stacks_write_the_densities_under_their_keys() {
+    let n = sample();
+    for (stack, keys) in [
+        (
+            Stack::Kalibr,
+            [
+                "gyroscope_noise_density",
+                "gyroscope_random_walk",
+                "accelerometer_noise_density",
+                "accelerometer_random_walk",
+            ],
+        ),
+        (Stack::Vins, ["gyr_n", "gyr_w", "acc_n", "acc_w"]),
+        (Stack::Orbslam3, ["IMU.NoiseGyro", "IMU.GyroWalk", "IMU.NoiseAcc", "IMU.AccWalk"]),
+    ] {
+        let text = n.render(stack);
+        for (k, want) in keys.iter().zip([1e-3, 2e-5, 4e-3, 6e-4]) {
+            assert_eq!(value_of(&text, k), Some(want), "{stack:?} {k}\n{text}");
+        }
+        assert!(text.contains("SIMULATED"), "{text}");
+        assert!(text.contains("upper_bound"), "{text}");
+    }
+    assert_eq!(value_of(&n.render(Stack::Orbslam3), "IMU.Frequency"), Some(400.0));
+    assert_eq!(value_of(&n.render(Stack::Kalibr), "update_rate"), Some(400.0));
+}
+
+#[test]
+fn px4_values_are_per_step_at_the_rate() {
+    let n = sample();
+    for stack in [Stack::Px4, Stack::Px4Qgc] {
+        let text = n.render(stack);
+        // hand: 1e-3 x sqrt(400) = 0.02 rad/s; 2e-5 x 20 = 4e-4 rad/s^2; 4e-3 x 20 = 0.08; 6e-4 x 20 = 0.012
+        for (k, want) in [
+            ("EKF2_GYR_NOISE", 0.02),
+            ("EKF2_GYR_B_NOISE", 4e-4),
+            ("EKF2_ACC_NOISE", 0.08),
+            ("EKF2_ACC_B_NOISE", 0.012),
+        ] {
+            let got = value_of(&text, k).unwrap_or(f64::NAN);
+            assert!((got / want - 1.0).abs() < 1e-12, "{stack:?} {k}: {got}\n{text}");
+        }
+    }
+}
+
+#[test]
+fn ros_covariance_holds_per_sample_variances() {
+    let text = sample().render(Stack::RosCovariance);
+    let line = text.lines().find(|l| l.starts_with("angular_velocity_covariance:")).unwrap();
+    let inner = line.split('[').nth(1).unwrap().split(']').next().unwrap();
+    let v: Vec<f64> = inner.split(',').map(|x| x.trim().parse().unwrap()).collect();
+    // (1e-3 x sqrt(400))^2 = 4e-4 (rad/s)^2
+    assert!((v[0] / 4e-4 - 1.0).abs() < 1e-12 && v[4] == v[0] && v[8] == v[0] && v[1] == 0.0, "{v:?}");
+    assert!(text.contains("orientation_covariance: [-1.0"));
+}
+
+#[test]
+fn a_missing_term_is_named_not_invented() {
+    let mut n = sample();
+    n.accel_noise = None;
+    n.accel_walk = None;
+    for stack in STACKS {
+        let text = n.render(stack);
+        assert!(text.contains("not written") || text.contains("not estimated"), "{stack:?}\n{text}");
+        assert_eq!(value_of(&text, "acc_n"), None);
+    }
+    assert!(!n.render(Stack::Basalt).contains("accel_noise_std"));
+}
+
+#[test]
+fn exports_are_written_all_or_none() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = sample();
+    let good = dir.path().join("kalibr.yaml");
+    let bad = dir.path().join("no_such_folder").join("px4.params");
+    let err = write_exports(&n, &[(Stack::Kalibr, good.clone()), (Stack::Px4, bad)]).unwrap_err();
+    assert!(err.to_string().contains("no_such_folder"), "{err}");
+    assert!(!good.exists());
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "a temporary was left");
+    let written =
+        write_exports(&n, &[(Stack::Kalibr, good.clone()), (Stack::Basalt, dir.path().join("b.json"))]).unwrap();
+    assert_eq!(written.len(), 2);
+    assert_eq!(std::fs::read_to_string(&good).unwrap(), n.render(Stack::Kalibr));
+}
+
+#[test]
+fn stack_names_parse() {
+    for s in STACKS {
+        assert_eq!(Stack::parse(s.name()), Some(s));
+    }
+    assert_eq!(Stack::parse("ORBSLAM3"), Some(Stack::Orbslam3));
+    assert_eq!(Stack::parse("gtsam"), None);
+}
