@@ -32,6 +32,9 @@ if [ ! -x target/debug/examples/chi2_quantiles ]; then
     echo "test.sh: target/debug/examples/chi2_quantiles not left by cargo test: building it" >&2
     cargo build --quiet -p gyrolab --example chi2_quantiles
 fi
+# The hostile recordings written by crates/gyrolab-cli/tests/hostile.rs, each read again by
+# `allan` and `inspect` under an address-space limit of 2 GiB (issue 31).
+bash scripts/test_hostile_ulimit.sh "$bin"
 if [ "$skip_python" = "1" ]; then
     echo "SKIPPED: GYROLAB_SKIP_PYTHON=1: allantools and scipy equality checks, the Python package's tests" >&2
 else

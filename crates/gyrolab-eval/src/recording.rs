@@ -3,7 +3,7 @@
 
 use crate::error::{EvalError, EvalResult};
 use gyrolab::sampling::estimate_interval;
-use gyrolab_io::recording::{read_recording, sniff_format, RecordingOptions};
+use gyrolab_io::recording::{open, RecordingOptions};
 use gyrolab_report::inventory::{Inventory, TopicInventory};
 use std::path::{Path, PathBuf};
 
@@ -28,11 +28,13 @@ fn timing_of(stamps: &[i64]) -> (Option<f64>, Option<f64>, Option<f64>, usize, u
 /// topics timed by their header stamps, others by their log times); a Parquet or text file is
 /// reported as one table.
 pub fn inspect(path: &Path) -> EvalResult<Inventory> {
-    let format = sniff_format(path)?;
+    // Opened once: the file read is the file whose format was sniffed.
+    let opened = open(path)?;
+    let format = opened.format();
     let file = path.display().to_string();
     let version = env!("CARGO_PKG_VERSION").to_string();
     if !format.is_recording() {
-        let data = gyrolab_io::recording::read_records(path, &Default::default(), &[])?;
+        let data = opened.read_records(&Default::default(), &[])?;
         let record = &data.records[0].data;
         let names: Vec<String> =
             record.header.channels.iter().map(|c| format!("{} [{}]", c.name, c.unit.symbol())).collect();
@@ -63,11 +65,14 @@ pub fn inspect(path: &Path) -> EvalResult<Inventory> {
             truncated: None,
         });
     }
-    let rec = read_recording(path, &RecordingOptions { stamps: true, ..Default::default() });
+    let again = opened.try_clone()?;
+    let rec = opened.read_recording(&RecordingOptions { stamps: true, ..Default::default() });
     let rec = match rec {
         Ok(r) => r,
         // A recording without IMU topics is still inventoried.
-        Err(_) => read_recording(path, &RecordingOptions { stamps: true, inventory_only: true, ..Default::default() })?,
+        Err(_) => {
+            again.read_recording(&RecordingOptions { stamps: true, inventory_only: true, ..Default::default() })?
+        }
     };
     let mut topics = Vec::with_capacity(rec.topics.len());
     for t in &rec.topics {
@@ -135,14 +140,15 @@ pub fn convert(path: &Path, topics: &[String], out: &Path) -> EvalResult<Convert
             ))
         }
     };
-    let kind = sniff_format(path)?;
+    let opened = open(path)?;
+    let kind = opened.format();
     if !kind.is_recording() {
         return Err(EvalError::Data(gyrolab_io::DataError::new(
             path,
             format!("a {} file, not a recording: convert reads MCAP, ROS 1 bags and PX4 ULog files", kind.name()),
         )));
     }
-    let rec = read_recording(path, &RecordingOptions { topics: topics.to_vec(), ..Default::default() })?;
+    let rec = opened.read_recording(&RecordingOptions { topics: topics.to_vec(), ..Default::default() })?;
     let several = rec.imu.len() > 1;
     let mut files = Vec::new();
     for t in &rec.imu {

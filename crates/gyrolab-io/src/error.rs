@@ -60,7 +60,19 @@ impl DataError {
 
     /// An I/O failure while opening or reading a file.
     pub fn io(file: impl AsRef<Path>, err: &std::io::Error) -> Self {
-        DataError::new(file, format!("cannot read the file: {err}"))
+        use std::io::ErrorKind as K;
+        let what = match err.kind() {
+            K::NotFound => "no such file".to_string(),
+            K::PermissionDenied => "permission denied".to_string(),
+            K::IsADirectory => "a directory, not a file".to_string(),
+            K::InvalidInput => "the file cannot be read this way (invalid argument)".to_string(),
+            K::UnexpectedEof => "the file ends early".to_string(),
+            _ => {
+                let t = err.to_string();
+                t.split(" (os error").next().unwrap_or(&t).to_string()
+            }
+        };
+        DataError::new(file, format!("cannot read the file: {what}"))
     }
 }
 

@@ -21,6 +21,7 @@ pub mod atomic;
 pub mod calibration;
 pub mod decimal;
 pub mod error;
+pub mod input_file;
 pub mod pages;
 pub mod parquet_table;
 pub mod rate_table;

@@ -84,14 +84,14 @@ pub const MAX_FOOTER_BYTES: u64 = 64 << 20;
 /// declared count first (2^30 children: 8 GiB) — refused here.
 fn check_footer(path: &Path, file: &mut std::fs::File) -> Result<(), DataError> {
     use std::io::{Read, Seek, SeekFrom};
-    let size = file.metadata().map_err(|e| crate::recording::io_error(path, &e))?.len();
+    let size = file.metadata().map_err(|e| DataError::io(path, &e))?.len();
     let bad = |what: String| DataError::new(path, format!("not a readable Parquet file: {what}"));
     if size < 12 {
         return Err(bad(format!("{size} bytes, too short for a Parquet file")));
     }
     let mut tail = [0u8; 8];
-    file.seek(SeekFrom::End(-8)).map_err(|e| crate::recording::io_error(path, &e))?;
-    file.read_exact(&mut tail).map_err(|e| crate::recording::io_error(path, &e))?;
+    file.seek(SeekFrom::End(-8)).map_err(|e| DataError::io(path, &e))?;
+    file.read_exact(&mut tail).map_err(|e| DataError::io(path, &e))?;
     if &tail[4..] != b"PAR1" {
         return Err(bad("the file does not end with the PAR1 magic (cut off?)".into()));
     }
@@ -102,9 +102,9 @@ fn check_footer(path: &Path, file: &mut std::fs::File) -> Result<(), DataError> 
         )));
     }
     let mut footer = Vec::new();
-    file.seek(SeekFrom::Start(size - 8 - len)).map_err(|e| crate::recording::io_error(path, &e))?;
-    file.by_ref().take(len).read_to_end(&mut footer).map_err(|e| crate::recording::io_error(path, &e))?;
-    file.seek(SeekFrom::Start(0)).map_err(|e| crate::recording::io_error(path, &e))?;
+    file.seek(SeekFrom::Start(size - 8 - len)).map_err(|e| DataError::io(path, &e))?;
+    file.by_ref().take(len).read_to_end(&mut footer).map_err(|e| DataError::io(path, &e))?;
+    file.seek(SeekFrom::Start(0)).map_err(|e| DataError::io(path, &e))?;
     let at = size - 8 - len;
     let counts =
         thrift::schema_children(&footer).map_err(|why| bad(format!("the footer at byte {at} is damaged: {why}")))?;

@@ -18,7 +18,7 @@ pub const TABLE_RATE_NAMES: [&str; 2] = ["table_rate", "rate"];
 
 /// The header names of a delimited text file (first line that is neither blank nor a comment).
 pub fn header_names(path: &Path) -> Result<Vec<String>, DataError> {
-    let f = std::fs::File::open(path).map_err(|e| DataError::io(path, &e))?;
+    let (f, _) = crate::input_file::open_regular(path)?;
     let mut r = BufReader::new(f);
     let mut buf = Vec::new();
     let mut guard = crate::text::TextGuard::default();

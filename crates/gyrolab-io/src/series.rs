@@ -597,7 +597,7 @@ impl SeriesReader<Source> {
         if path == Path::new("-") {
             return SeriesReader::from_reader("<stdin>", Box::new(std::io::stdin()) as Source, options);
         }
-        let f = File::open(path).map_err(|e| DataError::io(path, &e))?;
+        let (f, _) = crate::input_file::open_regular(path)?;
         SeriesReader::from_reader(path, Box::new(f) as Source, options)
     }
 }
@@ -1472,17 +1472,33 @@ pub const PARALLEL_BATCH_BYTES: usize = 4 << 20;
 /// of [`PARALLEL_BATCH_BYTES`] read in turn and split at line ends into one piece per thread.
 pub fn read_series_all(path: impl AsRef<Path>, options: &SeriesOptions) -> Result<SeriesData, DataError> {
     let path = path.as_ref();
-    let r = SeriesReader::open(path, options)?;
+    if path == Path::new("-") {
+        let r = SeriesReader::open(path, options)?;
+        if rayon::current_num_threads() < 2 {
+            return collect_series(r);
+        }
+        return collect_series_parallel(r, rayon::current_num_threads(), u64::MAX, PARALLEL_BATCH_BYTES);
+    }
+    let (file, size) = crate::input_file::open_regular(path)?;
+    read_series_opened(path, file, size, options)
+}
+
+/// [`read_series_all`] of a regular file already opened (once, by
+/// [`crate::input_file::open_regular`] or [`crate::recording::open_sniffed`]) and rewound, of
+/// `size` bytes.
+pub fn read_series_opened(
+    path: &Path,
+    file: File,
+    size: u64,
+    options: &SeriesOptions,
+) -> Result<SeriesData, DataError> {
     let threads = rayon::current_num_threads();
-    let meta = std::fs::metadata(path).ok().filter(|_| path != Path::new("-"));
-    let size = meta.as_ref().map_or(u64::MAX, |m| m.len());
     if threads < 2 || size < (4 << 20) {
-        return collect_series(r);
+        return collect_series(SeriesReader::from_reader(path, Box::new(file) as Source, options)?);
     }
-    if meta.is_some_and(|m| m.is_file()) {
-        return ranges::collect_series_ranges(r, path, size, threads, RANGE_CHUNK_BYTES);
-    }
-    collect_series_parallel(r, threads, size, PARALLEL_BATCH_BYTES)
+    let shared = file.try_clone().map_err(|e| DataError::io(path, &e))?;
+    let r = SeriesReader::from_reader(path, Box::new(file) as Source, options)?;
+    ranges::collect_series_ranges(r, &shared, size, threads, RANGE_CHUNK_BYTES)
 }
 
 /// Reads every row of an open reader into memory like [`collect_series`], parsing batches of

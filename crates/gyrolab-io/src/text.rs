@@ -125,7 +125,7 @@ pub fn long_line(file: &Path, line: u64) -> DataError {
 /// [`TextGuard`]) so that binary data or an endless file (`/dev/zero`) ends the read early;
 /// `what` names the expected kind of file in the size error.
 pub fn read_text_file(path: &Path, max_bytes: u64, what: &str) -> Result<String, DataError> {
-    let f = std::fs::File::open(path).map_err(|e| DataError::io(path, &e))?;
+    let (f, _) = crate::input_file::open_regular(path)?;
     let mut src = f.take(max_bytes + 1);
     let mut bytes = Vec::new();
     let mut guard = TextGuard::default();

@@ -207,7 +207,7 @@ fn open_chunk(head: &[(&[u8], &[u8])], data: &[u8]) -> Result<Vec<u8>, String> {
 /// Reads exactly `n` bytes at the file's position.
 fn read_exact(path: &Path, f: &mut impl Read, n: u64, at: u64) -> Result<Vec<u8>, Stop> {
     let mut buf = Vec::new();
-    f.take(n).read_to_end(&mut buf).map_err(|e| super::io_error(path, &e))?;
+    f.take(n).read_to_end(&mut buf).map_err(|e| DataError::io(path, &e))?;
     if (buf.len() as u64) < n {
         return Err(Stop::Damaged {
             at: format!("byte {at}"),
@@ -273,12 +273,12 @@ pub(super) fn read(path: &Path, file: std::fs::File, size: u64, c: &mut Collecto
                     });
                 }
                 index_pos = p;
-                f.seek_relative(dl as i64).map_err(|e| super::io_error(path, &e))?;
+                f.seek_relative(dl as i64).map_err(|e| DataError::io(path, &e))?;
             }
             Some(OP_CHUNK) => {
                 if dl > MAX_CHUNK_BYTES {
                     c.damaged_chunks.push((at, format!("{dl} bytes, more than the {MAX_CHUNK_BYTES} accepted")));
-                    f.seek(SeekFrom::Current(dl as i64)).map_err(|e| super::io_error(path, &e))?;
+                    f.seek(SeekFrom::Current(dl as i64)).map_err(|e| DataError::io(path, &e))?;
                 } else {
                     let data = read_exact(path, &mut f, dl, at)?;
                     match open_chunk(&head_fields, &data) {
@@ -298,7 +298,7 @@ pub(super) fn read(path: &Path, file: std::fs::File, size: u64, c: &mut Collecto
                     Err(ConnError::Damaged(why)) => return Err(damaged(at, why)),
                 }
             }
-            _ => f.seek(SeekFrom::Current(dl as i64)).map(drop).map_err(|e| super::io_error(path, &e))?,
+            _ => f.seek(SeekFrom::Current(dl as i64)).map(drop).map_err(|e| DataError::io(path, &e))?,
         }
         at += 8 + hl + dl;
     }

@@ -319,7 +319,7 @@ fn read_into(
         match file.read(buf) {
             Ok(k) => break k,
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-            Err(e) => return Err(super::io_error(path, &e).into()),
+            Err(e) => return Err(DataError::io(path, &e).into()),
         }
     };
     *offset += read as u64;

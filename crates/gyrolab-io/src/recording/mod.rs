@@ -3,6 +3,8 @@
 //! their units) and an inventory of every topic.
 //!
 //! - [`sniff_format`]: what a file is, by its first bytes (not its extension);
+//! - [`open`]: a regular file opened once, its format sniffed ([`OpenedFile`]), for the readers
+//!   below without opening it again;
 //! - [`read_recording`]: one pass over a recording: every topic counted, the selected IMU topics
 //!   decoded ([`ros_msg`] for ROS messages, [`ulog`] for PX4 topics);
 //! - [`read_records`]: any file gyrolab reads, by content, as records (a table, or one per
@@ -19,6 +21,7 @@ pub mod ros_msg;
 pub mod ulog;
 
 use crate::error::DataError;
+pub use crate::input_file::{check_regular, open_regular};
 use crate::series::{series_from_columns, RowKind, SeriesData, SeriesOptions};
 use std::io::Read;
 use std::path::Path;
@@ -68,50 +71,11 @@ pub fn sniff_format(path: &Path) -> Result<FileFormat, DataError> {
     Ok(open_sniffed(path)?.1)
 }
 
-/// Refuses a path that is not a regular file (a FIFO, socket, character or block device, or a
-/// directory), from its metadata: nothing is opened, so a FIFO without a writer cannot block.
-pub fn check_regular(path: &Path) -> Result<u64, DataError> {
-    let meta = std::fs::metadata(path).map_err(|e| io_error(path, &e))?;
-    let kind = meta.file_type();
-    if kind.is_file() {
-        return Ok(meta.len());
-    }
-    #[cfg(unix)]
-    let what = {
-        use std::os::unix::fs::FileTypeExt;
-        if kind.is_fifo() {
-            "a FIFO (named pipe)"
-        } else if kind.is_socket() {
-            "a socket"
-        } else if kind.is_char_device() {
-            "a character device"
-        } else if kind.is_block_device() {
-            "a block device"
-        } else if kind.is_dir() {
-            "a directory"
-        } else {
-            "not a regular file"
-        }
-    };
-    #[cfg(not(unix))]
-    let what = if kind.is_dir() { "a directory" } else { "not a regular file" };
-    Err(DataError::new(
-        path,
-        format!("{what}, not a regular file: give a file (standard input is read as `-`, for delimited text)"),
-    ))
-}
-
 /// Opens a regular file once ([`check_regular`] first), reads its first bytes for the format
 /// and rewinds it: (the file, its format, its size in bytes).
 pub fn open_sniffed(path: &Path) -> Result<(std::fs::File, FileFormat, u64), DataError> {
     use std::io::{Seek, SeekFrom};
-    check_regular(path)?;
-    let mut f = std::fs::File::open(path).map_err(|e| io_error(path, &e))?;
-    // The file opened may differ from the one checked (replaced in between): checked again.
-    let meta = f.metadata().map_err(|e| io_error(path, &e))?;
-    if !meta.is_file() {
-        return Err(DataError::new(path, "not a regular file (it changed while being opened)"));
-    }
+    let (mut f, size) = open_regular(path)?;
     let mut head = [0u8; 16];
     let mut n = 0;
     while n < head.len() {
@@ -119,28 +83,11 @@ pub fn open_sniffed(path: &Path) -> Result<(std::fs::File, FileFormat, u64), Dat
             Ok(0) => break,
             Ok(k) => n += k,
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-            Err(e) => return Err(io_error(path, &e)),
+            Err(e) => return Err(DataError::io(path, &e)),
         }
     }
-    f.seek(SeekFrom::Start(0)).map_err(|e| io_error(path, &e))?;
-    Ok((f, format_of(&head[..n]), meta.len()))
-}
-
-/// An I/O error in words: what failed, without the operating system's error number.
-pub(crate) fn io_error(path: &Path, e: &std::io::Error) -> DataError {
-    use std::io::ErrorKind as K;
-    let what = match e.kind() {
-        K::NotFound => "no such file".to_string(),
-        K::PermissionDenied => "permission denied".to_string(),
-        K::IsADirectory => "a directory, not a file".to_string(),
-        K::InvalidInput => "the file cannot be read this way (invalid argument)".to_string(),
-        K::UnexpectedEof => "the file ends early".to_string(),
-        _ => {
-            let t = e.to_string();
-            t.split(" (os error").next().unwrap_or(&t).to_string()
-        }
-    };
-    DataError::new(path, format!("cannot read the file: {what}"))
+    f.seek(SeekFrom::Start(0)).map_err(|e| DataError::io(path, &e))?;
+    Ok((f, format_of(&head[..n]), size))
 }
 
 /// The format of a file that starts with `head`.
@@ -295,45 +242,142 @@ pub struct FileRecords {
 /// Reads any file gyrolab reads, by its content: delimited text and Parquet as one table,
 /// MCAP, ROS 1 bags and ULog as one record per IMU topic (`topics` selects; empty: all).
 pub fn read_records(path: &Path, options: &SeriesOptions, topics: &[String]) -> Result<FileRecords, DataError> {
-    let (file, format, _) = if path.as_os_str() == "-" {
+    if path.as_os_str() == "-" {
         return read_stdin_records(path, options, topics);
-    } else {
-        open_sniffed(path)?
-    };
-    if !format.is_recording() && !topics.is_empty() {
-        return Err(DataError::new(
-            path,
-            format!(
-                "topics were given, but this is a {} file, not a recording (MCAP, ROS 1 bag, PX4 ULog)",
-                format.name()
-            ),
-        ));
     }
-    let table = |data| FileRecords { format, records: vec![FileRecord { topic: None, data }], truncated: None };
-    if format == FileFormat::Sqlite {
-        return Err(sqlite_refused(path));
+    open(path)?.read_records(options, topics)
+}
+
+/// A regular file opened once, its format read from its first bytes ([`open`]); its readers
+/// ([`OpenedFile::read_records`], [`OpenedFile::read_recording`]) read it from there, so that
+/// a file is opened once whatever is done with it.
+#[derive(Debug)]
+pub struct OpenedFile {
+    path: std::path::PathBuf,
+    file: std::fs::File,
+    format: FileFormat,
+    size: u64,
+}
+
+/// Opens a regular file once and reads its format ([`open_sniffed`]).
+pub fn open(path: &Path) -> Result<OpenedFile, DataError> {
+    let (file, format, size) = open_sniffed(path)?;
+    Ok(OpenedFile { path: path.to_path_buf(), file, format, size })
+}
+
+impl OpenedFile {
+    /// The file's format.
+    pub fn format(&self) -> FileFormat {
+        self.format
     }
-    match format {
-        FileFormat::Text => {
-            drop(file);
-            Ok(table(crate::series::read_series_all(path, options)?))
+
+    /// The file's path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The same open file a second time (its descriptor duplicated, not the path opened again),
+    /// for a second read: each read starts at the file's first byte.
+    pub fn try_clone(&self) -> Result<OpenedFile, DataError> {
+        let file = self.file.try_clone().map_err(|e| DataError::io(&self.path, &e))?;
+        Ok(OpenedFile { path: self.path.clone(), file, format: self.format, size: self.size })
+    }
+
+    /// [`read_records`] of this file.
+    pub fn read_records(self, options: &SeriesOptions, topics: &[String]) -> Result<FileRecords, DataError> {
+        let OpenedFile { path, mut file, format, size } = self;
+        let path = path.as_path();
+        rewind(path, &mut file)?;
+        if !format.is_recording() && !topics.is_empty() {
+            return Err(DataError::new(
+                path,
+                format!(
+                    "topics were given, but this is a {} file, not a recording (MCAP, ROS 1 bag, PX4 ULog)",
+                    format.name()
+                ),
+            ));
         }
-        FileFormat::Parquet => Ok(table(crate::parquet_table::read_parquet_file(path, file, options)?)),
-        _ => {
-            drop(file);
-            let rec = read_recording(path, &RecordingOptions { topics: topics.to_vec(), ..Default::default() })?;
-            let mut records = Vec::with_capacity(rec.imu.len());
-            for t in rec.imu {
-                let topic = t.topic.clone();
-                let (meta, data) = t.into_series(path, options).map_err(|mut e| {
-                    e.message = format!("topic '{}': {}", crate::text::excerpt(&topic), e.message);
-                    e
-                })?;
-                records.push(FileRecord { topic: Some(meta), data });
+        let table = |data| FileRecords { format, records: vec![FileRecord { topic: None, data }], truncated: None };
+        match format {
+            FileFormat::Sqlite => Err(sqlite_refused(path)),
+            FileFormat::Text => Ok(table(crate::series::read_series_opened(path, file, size, options)?)),
+            FileFormat::Parquet => Ok(table(crate::parquet_table::read_parquet_file(path, file, options)?)),
+            _ => {
+                let opened = OpenedFile { path: path.to_path_buf(), file, format, size };
+                let rec = opened.read_recording(&RecordingOptions { topics: topics.to_vec(), ..Default::default() })?;
+                let mut records = Vec::with_capacity(rec.imu.len());
+                for t in rec.imu {
+                    let topic = t.topic.clone();
+                    let (meta, data) = t.into_series(path, options).map_err(|mut e| {
+                        e.message = format!("topic '{}': {}", crate::text::excerpt(&topic), e.message);
+                        e
+                    })?;
+                    records.push(FileRecord { topic: Some(meta), data });
+                }
+                Ok(FileRecords { format, records, truncated: rec.truncated })
             }
-            Ok(FileRecords { format, records, truncated: rec.truncated })
         }
     }
+
+    /// [`read_recording`] of this file.
+    pub fn read_recording(self, options: &RecordingOptions) -> Result<Recording, DataError> {
+        let OpenedFile { path, mut file, format, size } = self;
+        let path = path.as_path();
+        rewind(path, &mut file)?;
+        if format == FileFormat::Sqlite {
+            return Err(sqlite_refused(path));
+        }
+        let mut c = Collector::new(options);
+        let end = match format {
+            FileFormat::Mcap => mcap_file::read(path, file, size, &mut c),
+            FileFormat::RosBag => bag::read(path, file, size, &mut c),
+            FileFormat::ULog => ulog::read(path, file, &mut c),
+            _ => {
+                return Err(DataError::new(
+                    path,
+                    format!("a {} file, not a recording: expected MCAP, a ROS 1 bag or a PX4 ULog file", format.name()),
+                ))
+            }
+        };
+        let mut notes = Vec::new();
+        match end {
+            Ok(()) => {}
+            Err(Stop::Damaged { at, what }) if c.decoded_messages() > 0 => notes.push(format!(
+                "the file ends early or is damaged at {at} ({}); the messages before it are analysed",
+                crate::text::short_message(&what)
+            )),
+            Err(Stop::Damaged { at, what }) => {
+                return Err(DataError::new(
+                    path,
+                    format!(
+                        "at {at}: {}: expected a complete {} file",
+                        crate::text::short_message(&what),
+                        format.name()
+                    ),
+                ))
+            }
+            Err(Stop::Error(e)) => return Err(e),
+        };
+        if let Some((at, why)) = c.damaged_chunks.first() {
+            let n = c.damaged_chunks.len();
+            notes.insert(
+                0,
+                format!(
+                    "{n} damaged chunk{} skipped (the first at byte {at}: {}); the messages of the other chunks are analysed",
+                    if n == 1 { "" } else { "s" },
+                    crate::text::short_message(why)
+                ),
+            );
+        }
+        let truncated = (!notes.is_empty()).then(|| notes.join("; "));
+        c.finish(path, format, truncated)
+    }
+}
+
+/// Moves a file's offset back to its first byte.
+fn rewind(path: &Path, file: &mut std::fs::File) -> Result<(), DataError> {
+    use std::io::Seek;
+    file.rewind().map_err(|e| DataError::io(path, &e))
 }
 
 /// Standard input (`-`): delimited text.
@@ -384,50 +428,7 @@ fn sqlite_refused(path: &Path) -> DataError {
 
 /// Reads a recording (MCAP, ROS 1 bag, ULog) in one pass, the file opened once.
 pub fn read_recording(path: &Path, options: &RecordingOptions) -> Result<Recording, DataError> {
-    let (file, format, size) = open_sniffed(path)?;
-    if format == FileFormat::Sqlite {
-        return Err(sqlite_refused(path));
-    }
-    let mut c = Collector::new(options);
-    let end = match format {
-        FileFormat::Mcap => mcap_file::read(path, file, size, &mut c),
-        FileFormat::RosBag => bag::read(path, file, size, &mut c),
-        FileFormat::ULog => ulog::read(path, file, &mut c),
-        _ => {
-            return Err(DataError::new(
-                path,
-                format!("a {} file, not a recording: expected MCAP, a ROS 1 bag or a PX4 ULog file", format.name()),
-            ))
-        }
-    };
-    let mut notes = Vec::new();
-    match end {
-        Ok(()) => {}
-        Err(Stop::Damaged { at, what }) if c.decoded_messages() > 0 => notes.push(format!(
-            "the file ends early or is damaged at {at} ({}); the messages before it are analysed",
-            crate::text::short_message(&what)
-        )),
-        Err(Stop::Damaged { at, what }) => {
-            return Err(DataError::new(
-                path,
-                format!("at {at}: {}: expected a complete {} file", crate::text::short_message(&what), format.name()),
-            ))
-        }
-        Err(Stop::Error(e)) => return Err(e),
-    };
-    if let Some((at, why)) = c.damaged_chunks.first() {
-        let n = c.damaged_chunks.len();
-        notes.insert(
-            0,
-            format!(
-                "{n} damaged chunk{} skipped (the first at byte {at}: {}); the messages of the other chunks are analysed",
-                if n == 1 { "" } else { "s" },
-                crate::text::short_message(why)
-            ),
-        );
-    }
-    let truncated = (!notes.is_empty()).then(|| notes.join("; "));
-    c.finish(path, format, truncated)
+    open(path)?.read_recording(options)
 }
 
 /// Why a pass over a file stopped early.

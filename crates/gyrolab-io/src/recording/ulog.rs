@@ -247,7 +247,7 @@ pub(super) fn read(path: &Path, mut file: std::fs::File, c: &mut Collector) -> R
             Ok(0) => break,
             Ok(n) => n,
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-            Err(e) => return Err(super::io_error(path, &e).into()),
+            Err(e) => return Err(DataError::io(path, &e).into()),
         };
         fed_from.set(offset);
         fed_to.set(offset + n as u64);

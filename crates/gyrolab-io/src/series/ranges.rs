@@ -2,7 +2,7 @@
 //! [`super::read_series_all`] for regular files.
 //!
 //! The data bytes after the header are cut into one range per thread; a line belongs to the
-//! range that holds its first byte. Each thread opens the file, reads its range in chunks into
+//! range that holds its first byte. The file is opened once; each thread reads its range by position in chunks into
 //! its own buffer, parses them with the same row parser as [`SeriesReader::next_block`] and
 //! copies the values, still in cache, into its region of each column. A column is one
 //! allocation for the whole file, sized from the bytes per line of the header's chunk with a
@@ -17,7 +17,6 @@
 
 use super::*;
 use rayon::prelude::*;
-use std::io::{Seek, SeekFrom};
 
 /// Bytes a range's thread reads at once (its buffer stays in the core's cache).
 pub const RANGE_CHUNK_BYTES: usize = 512 << 10;
@@ -75,16 +74,35 @@ pub fn read_series_in_ranges(
     chunk_bytes: usize,
 ) -> Result<SeriesData, DataError> {
     let path = path.as_ref();
-    let r = SeriesReader::open(path, options)?;
-    let size = std::fs::metadata(path).map_err(|e| DataError::io(path, &e))?.len();
-    collect_series_ranges(r, path, size, ranges.max(1), chunk_bytes.max(64))
+    let (file, size) = crate::input_file::open_regular(path)?;
+    let shared = file.try_clone().map_err(|e| DataError::io(path, &e))?;
+    let r = SeriesReader::from_reader(path, Box::new(file) as Source, options)?;
+    collect_series_ranges(r, &shared, size, ranges.max(1), chunk_bytes.max(64))
 }
 
-/// Reads every row of `r` (opened on the regular file `path` of `size` bytes, its header read)
-/// in `ranges` parallel byte ranges.
+/// A reader of one byte range of a file shared by the threads: positional reads, which leave
+/// the file's offset alone (the file is opened once for all ranges).
+struct RangeReader<'a> {
+    file: &'a File,
+    pos: u64,
+}
+
+impl Read for RangeReader<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        #[cfg(unix)]
+        let n = std::os::unix::fs::FileExt::read_at(self.file, buf, self.pos)?;
+        #[cfg(windows)]
+        let n = std::os::windows::fs::FileExt::seek_read(self.file, buf, self.pos)?;
+        self.pos += n as u64;
+        Ok(n)
+    }
+}
+
+/// Reads every row of `r` (reading the regular file `file` of `size` bytes, its header read)
+/// in `ranges` parallel byte ranges, each read from `file` by position.
 pub(super) fn collect_series_ranges(
     r: SeriesReader<Source>,
-    path: &Path,
+    file: &File,
     size: u64,
     ranges: usize,
     chunk_bytes: usize,
@@ -137,7 +155,7 @@ pub(super) fn collect_series_ranges(
                 (range, parser)
             })
             .collect();
-        jobs.into_par_iter().map(|(range, parser)| read_range(path, parser, range, compact_slot, chunk_bytes)).collect()
+        jobs.into_par_iter().map(|(range, parser)| read_range(file, parser, range, compact_slot, chunk_bytes)).collect()
     };
     // In file order: the first error, else each range's lines, findings and stamps joined.
     let mut base = r.line_no;
@@ -205,7 +223,7 @@ pub(super) fn collect_series_ranges(
 /// `parser` and copied into the range's regions. Errors name lines counted from the range's
 /// first line.
 fn read_range(
-    path: &Path,
+    source: &File,
     mut parser: SeriesReader<std::io::Empty>,
     mut range: Range<'_>,
     compact_slot: Option<usize>,
@@ -225,8 +243,7 @@ fn read_range(
     // A range after the first starts one byte early: its first line starts after the first
     // line end from there.
     let from = if range.at_line_start { range.start } else { range.start - 1 };
-    let mut f = File::open(path).map_err(io)?;
-    f.seek(SeekFrom::Start(from)).map_err(io)?;
+    let mut f = RangeReader { file: source, pos: from };
     let mut buf = vec![0u8; chunk_bytes.min(MAX_LINE_BYTES)];
     let (mut filled, mut pos, mut buf_at) = (0usize, 0usize, from);
     let mut started = range.at_line_start;

@@ -399,7 +399,7 @@ pub struct StatedReference {
 /// ```
 pub fn read_stated_reference(path: &std::path::Path) -> Option<StatedReference> {
     use std::io::{BufRead, Read};
-    let file = std::fs::File::open(path).ok()?;
+    let (file, _) = crate::input_file::open_regular(path).ok()?;
     let reader = std::io::BufReader::new(file.take(64 * 1024));
     let mut lines = reader.lines();
     let first = lines.next()?.ok()?;

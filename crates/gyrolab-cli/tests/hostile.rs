@@ -166,32 +166,18 @@ fn plain(err: &str) {
     }
 }
 
-/// The Allan deviations of `allan --json` (every channel), to compare figures.
+/// The Allan deviations of `allan --json` (every channel, every tau), to compare figures.
 fn deviations(path: &Path) -> Vec<f64> {
     let (code, out, err) = run(&["allan", path.to_str().unwrap(), "--json"]);
     assert_eq!(code, Some(0), "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    let mut all = Vec::new();
-    fn walk(v: &serde_json::Value, all: &mut Vec<f64>) {
-        match v {
-            serde_json::Value::Object(m) => {
-                for (k, x) in m {
-                    if k.starts_with("deviation") {
-                        if let Some(a) = x.as_array() {
-                            all.extend(a.iter().filter_map(serde_json::Value::as_f64));
-                        } else if let Some(f) = x.as_f64() {
-                            all.push(f);
-                        }
-                    }
-                    walk(x, all);
-                }
-            }
-            serde_json::Value::Array(a) => a.iter().for_each(|x| walk(x, all)),
-            _ => {}
-        }
-    }
-    walk(&v, &mut all);
-    assert!(!all.is_empty(), "no deviations in {out}");
+    let all: Vec<f64> = v["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|c| c["dev"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()))
+        .collect();
+    assert!(all.len() >= 6 * 5, "too few deviations in {out}");
     all
 }
 
@@ -589,4 +575,149 @@ fn a_parquet_schema_with_2_30_children_is_refused_before_allocation() {
     b[n - 8..n - 4].copy_from_slice(&u32::MAX.to_le_bytes());
     let p = put("parquet_footer_4gib.parquet", &b);
     refused(&["allan", p.to_str().unwrap()], &["the footer declares 4294967295 bytes"]);
+}
+
+/// A ULog file of `head` messages (flag bits, formats, info, subscriptions; as given) and
+/// `data` messages of msg_id 0.
+fn ulog_raw(head: &[Vec<u8>], data: &[Vec<u8>]) -> Vec<u8> {
+    let mut b = b"ULog\x01\x12\x35\x01".to_vec();
+    b.extend_from_slice(&0u64.to_le_bytes());
+    for m in head {
+        b.extend_from_slice(m);
+    }
+    for d in data {
+        let mut m = 0u16.to_le_bytes().to_vec();
+        m.extend_from_slice(d);
+        b.extend(ulog_msg(b'D', &m));
+    }
+    b
+}
+
+fn ulog_subscription(msg_id: u16, name: &str) -> Vec<u8> {
+    let mut add = vec![0u8];
+    add.extend_from_slice(&msg_id.to_le_bytes());
+    add.extend_from_slice(name.as_bytes());
+    ulog_msg(b'A', &add)
+}
+
+#[test]
+fn damaged_ulog_headers_and_definitions_are_messages_in_words() {
+    let ok: Vec<Vec<u8>> = (0..300u64).map(|i| gyro_data(1_000_000 + i * 5000, [0.001, 0.002, 0.003])).collect();
+    let flags = |incompat0: u8| {
+        let mut f = [0u8; 40];
+        f[8] = incompat0;
+        ulog_msg(b'B', &f)
+    };
+    let gyro = || ulog_msg(b'F', SENSOR_GYRO.as_bytes());
+    let mut info_overflow = vec![255u8];
+    info_overflow.extend_from_slice(b"char[4] ab");
+    let cases: Vec<(&str, Vec<Vec<u8>>)> = vec![
+        ("ulog_flag_size.ulg", vec![ulog_msg(b'B', &[0u8; 10]), gyro(), ulog_subscription(0, "sensor_gyro")]),
+        ("ulog_incompat_flag.ulg", vec![flags(0x80), gyro(), ulog_subscription(0, "sensor_gyro")]),
+        (
+            "ulog_key_overflow.ulg",
+            vec![flags(0), ulog_msg(b'I', &info_overflow), gyro(), ulog_subscription(0, "sensor_gyro")],
+        ),
+        (
+            "ulog_mutual_reference.ulg",
+            vec![
+                flags(0),
+                ulog_msg(b'F', b"alpha:uint64_t timestamp;beta inner;"),
+                ulog_msg(b'F', b"beta:uint64_t timestamp;alpha inner;"),
+                gyro(),
+                ulog_subscription(0, "sensor_gyro"),
+                ulog_subscription(1, "alpha"),
+            ],
+        ),
+        (
+            "ulog_nested_size.ulg",
+            vec![
+                flags(0),
+                ulog_msg(b'F', b"inner:uint64_t[65535] x;"),
+                ulog_msg(b'F', b"middle:inner[65535] y;"),
+                ulog_msg(b'F', b"outer:middle[65535] z;"),
+                gyro(),
+                ulog_subscription(0, "sensor_gyro"),
+                ulog_subscription(1, "outer"),
+            ],
+        ),
+        (
+            "ulog_duplicate_msg_id.ulg",
+            vec![
+                flags(0),
+                gyro(),
+                ulog_msg(b'F', b"other:uint64_t timestamp;float v;"),
+                ulog_subscription(0, "sensor_gyro"),
+                ulog_subscription(0, "other"),
+            ],
+        ),
+    ];
+    for (name, head) in cases {
+        let p = put(name, &ulog_raw(&head, &ok));
+        for cmd in ["allan", "inspect"] {
+            let (code, out, err) = run(&[cmd, p.to_str().unwrap()]);
+            assert!(code == Some(2) || code == Some(0), "{name} {cmd}: {out}{err}");
+            plain(&err);
+            plain(&out);
+            if code == Some(2) {
+                assert!(err.contains(name), "{name} {cmd}: the file is not named: {err}");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_stamp_far_in_the_future_in_a_bag_or_a_ulog_sizes_nothing() {
+    // ULog: one sample stamp at 2^62 us... beyond nanoseconds; one at 2^50 us (35 years).
+    let data: Vec<Vec<u8>> = (0..1000u64)
+        .map(|i| gyro_data(if i == 500 { 1 << 50 } else { 1_000_000 + i * 5000 }, [0.001, 0.002, 0.003]))
+        .collect();
+    let p = put("ulog_future_stamp.ulg", &ulog(SENSOR_GYRO, &data));
+    refused(&["allan", p.to_str().unwrap()], &["the time stamps leap"]);
+    // ROS 1 bag: the header stamp of message 150 in 2106 (u32 seconds at their maximum).
+    let mut b = bag(IMU_MD5, ROS1_IMU_DEF, 300, None);
+    let needle = ros1_imu(T0_NS + 150 * 10_000_000, sample(150));
+    let at = b.windows(needle.len()).position(|w| w == needle.as_slice()).unwrap();
+    b[at + 4..at + 8].copy_from_slice(&u32::MAX.to_le_bytes());
+    let p = put("bag_future_stamp.bag", &b);
+    refused(&["allan", p.to_str().unwrap()], &["the time stamps leap"]);
+}
+
+#[test]
+fn counts_at_2_31_are_refused_before_allocation() {
+    // An MCAP channel whose metadata map declares 2^31 bytes.
+    let mut ch = 1u16.to_le_bytes().to_vec();
+    ch.extend_from_slice(&1u16.to_le_bytes());
+    s32(&mut ch, b"/imu");
+    s32(&mut ch, b"cdr");
+    ch.extend_from_slice(&(1u32 << 31).to_le_bytes());
+    let mut b = MCAP_MAGIC.to_vec();
+    b.extend_from_slice(&header());
+    b.extend_from_slice(&schema(IMU_DEF));
+    b.extend_from_slice(&record(0x04, &ch));
+    b.extend_from_slice(&messages(0..100, |i| T0_NS + i * 10_000_000));
+    b.extend_from_slice(&mcap_end());
+    let p = put("mcap_metadata_2_31.mcap", &b);
+    let (code, out, err) = run(&["allan", p.to_str().unwrap()]);
+    plain(&err);
+    // Read (the metadata is not needed; the messages are whole): the figures of the same
+    // messages in a valid file.
+    assert_eq!(code, Some(0), "{out}{err}");
+    let valid = put("valid_100.mcap", &mcap(IMU_DEF, &messages(0..100, |i| T0_NS + i * 10_000_000)));
+    assert_eq!(deviations(&p), deviations(&valid));
+    // A bag whose header declares 2^31 connections and chunks.
+    let mut b = bag(IMU_MD5, ROS1_IMU_DEF, 300, None);
+    for key in [&b"conn_count="[..], &b"chunk_count="[..]] {
+        let at = b.windows(key.len()).position(|w| w == key).unwrap() + key.len();
+        b[at..at + 4].copy_from_slice(&(1u32 << 31).to_le_bytes());
+    }
+    let p = put("bag_counts_2_31.bag", &b);
+    let (code, out, err) = run(&["allan", p.to_str().unwrap(), "--json"]);
+    assert!(code == Some(0) || code == Some(2), "{out}{err}");
+    plain(&err);
+    // A ULog format whose array holds 2^31 - 1 elements of 8 bytes.
+    let p = put("ulog_array_2_31_u64.ulg", &ulog("sensor_gyro:uint64_t timestamp;uint64_t[2147483647] x;", &[]));
+    let (code, out, err) = run(&["allan", p.to_str().unwrap()]);
+    assert_eq!(code, Some(2), "{out}{err}");
+    plain(&err);
 }

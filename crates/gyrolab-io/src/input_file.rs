@@ -1,0 +1,80 @@
+//! Input files, checked before they are opened and opened once.
+//!
+//! Every reader of `gyrolab-io` opens its file here: a path that is not a regular file (a FIFO,
+//! socket, character or block device, or a directory) is refused from its metadata, before any
+//! `open` that could block (a FIFO without a writer) or read forever (`/dev/zero`); the opened
+//! file is checked again (it may have been replaced in between). Standard input is read only
+//! where a reader says so, under the name `-`.
+
+use crate::error::DataError;
+use std::fs::File;
+use std::path::Path;
+
+/// Refuses a path that is not a regular file (a FIFO, socket, character or block device, or a
+/// directory), from its metadata: nothing is opened, so a FIFO without a writer cannot block.
+/// Returns the file's size in bytes.
+///
+/// ```
+/// let e = gyrolab_io::input_file::check_regular(std::path::Path::new("/dev/null")).unwrap_err();
+/// assert!(e.to_string().contains("a character device, not a regular file"));
+/// ```
+pub fn check_regular(path: &Path) -> Result<u64, DataError> {
+    let meta = std::fs::metadata(path).map_err(|e| DataError::io(path, &e))?;
+    let kind = meta.file_type();
+    if kind.is_file() {
+        return Ok(meta.len());
+    }
+    #[cfg(unix)]
+    let what = {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            "a FIFO (named pipe)"
+        } else if kind.is_socket() {
+            "a socket"
+        } else if kind.is_char_device() {
+            "a character device"
+        } else if kind.is_block_device() {
+            "a block device"
+        } else if kind.is_dir() {
+            "a directory"
+        } else {
+            "not a regular file"
+        }
+    };
+    #[cfg(not(unix))]
+    let what = if kind.is_dir() { "a directory" } else { "not a regular file" };
+    Err(DataError::new(
+        path,
+        format!("{what}, not a regular file: give a file (standard input is read as `-`, for delimited text)"),
+    ))
+}
+
+/// Opens a regular file ([`check_regular`] first, and again on the opened file): (the file,
+/// its size in bytes).
+pub fn open_regular(path: &Path) -> Result<(File, u64), DataError> {
+    check_regular(path)?;
+    let f = File::open(path).map_err(|e| DataError::io(path, &e))?;
+    let meta = f.metadata().map_err(|e| DataError::io(path, &e))?;
+    if !meta.is_file() {
+        return Err(DataError::new(path, "not a regular file (it changed while being opened)"));
+    }
+    Ok((f, meta.len()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn regular_files_open_and_others_are_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a.csv");
+        std::fs::write(&p, "t,x\n0,1\n").unwrap();
+        assert_eq!(open_regular(&p).unwrap().1, 8);
+        let e = open_regular(dir.path()).unwrap_err().to_string();
+        assert!(e.contains("a directory, not a regular file"), "{e}");
+        let e = open_regular(&dir.path().join("none.csv")).unwrap_err().to_string();
+        assert!(e.ends_with("cannot read the file: no such file"), "{e}");
+        assert!(!e.contains("os error"), "{e}");
+    }
+}
