@@ -161,6 +161,10 @@ fn refused(args: &[&str], words: &[&str]) {
 }
 
 fn plain(err: &str) {
+    // One line per message: no multi-line dumps of a parser's state.
+    for line in err.lines() {
+        assert!(!line.trim_start().starts_with(['(', ')', '{', '}']), "a dump in: {err}");
+    }
     for debug in ["Error {", "Error:", "{ ", "UlogParseError", "FlattenedFormat", "os error", "rosbag::", "McapError"] {
         assert!(!err.contains(debug), "debug text '{debug}' in: {err}");
     }
@@ -300,6 +304,22 @@ fn leaping_stamps_never_size_an_allocation() {
         &mcap(IMU_DEF, &messages(0..1000, |i| T0_NS + i * 10_000_000 + if i >= 700 { 86_400_000_000_000 } else { 0 })),
     );
     refused(&["allan", p.to_str().unwrap()], &["the time stamps leap"]);
+    // A negative header stamp (sec = -1, a clock before 1970): refused the same way, located.
+    let mut body = Vec::new();
+    for i in 0..1000u64 {
+        let mut m = message(T0_NS + i * 10_000_000, T0_NS + i * 10_000_000, sample(i));
+        if i == 500 {
+            // opcode, length, channel id, sequence, log time, publish time, CDR encapsulation.
+            m[35..39].copy_from_slice(&(-1i32).to_le_bytes());
+        }
+        body.extend(m);
+    }
+    let p = put("mcap_negative_stamp.mcap", &mcap(IMU_DEF, &body));
+    let (code, _, err) = run(&["allan", p.to_str().unwrap()]);
+    assert_eq!(code, Some(2), "{err}");
+    plain(&err);
+    assert!(err.contains("mcap_negative_stamp.mcap"), "{err}");
+    assert!(err.contains("counted in time-stamp order: 1 of the topic's messages came out of order"), "{err}");
     // A short dropout (50 messages of 1000) is still a gap filled on the grid: exit 0.
     let p = put(
         "mcap_short_gap.mcap",

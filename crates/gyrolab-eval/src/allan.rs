@@ -796,7 +796,16 @@ pub fn located_in(e: EvalError, rows: RowKind, topic: Option<&TopicMeta>) -> Eva
         EvalError::Data(mut d) if rows != RowKind::Line || topic.is_some() => {
             if rows != RowKind::Line {
                 if let Some(l) = d.line.take() {
-                    d.message = format!("{} {l}: {}", rows.word(), d.message);
+                    // Messages are counted in time-stamp order; say so where that differs
+                    // from the file's order.
+                    let order = match topic {
+                        Some(t) if t.out_of_order > 0 => format!(
+                            " (counted in time-stamp order: {} of the topic's messages came out of order in the file)",
+                            t.out_of_order
+                        ),
+                        _ => String::new(),
+                    };
+                    d.message = format!("{} {l}{order}: {}", rows.word(), d.message);
                 }
             }
             if let Some(t) = topic {

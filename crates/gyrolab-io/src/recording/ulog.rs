@@ -109,12 +109,16 @@ fn plan_of(f: &FlattenedFormat) -> Option<(ImuLayout, StampSource, Option<Flatte
 /// (`data message had wrong size 50, format: FlattenedFormat { .. }`) or any other debug text.
 fn parse_error_text(description: &str) -> String {
     let mut d = description;
-    for cut in [", format", "FlattenedFormat", "Some(", " {", "Format {"] {
+    if let Some(id) = d.strip_prefix("duplicate registration for msg_id ") {
+        let id: String = id.chars().take_while(char::is_ascii_digit).collect();
+        return format!("two subscriptions (A messages) register msg_id {id}");
+    }
+    for cut in ["\n", ", initial one", ", format", "FlattenedFormat", "Some(", " {", "Format {"] {
         if let Some(i) = d.find(cut) {
             d = &d[..i];
         }
     }
-    let d = d.trim_end_matches([':', ',', ' ', '"']).trim();
+    let d = d.trim_end_matches([':', ',', ' ', '"', '(']).trim();
     if d.is_empty() {
         "a message the ULog parser cannot read".to_string()
     } else {
