@@ -173,23 +173,98 @@ pub(crate) fn modified_allan_sum(s: &[f64], m: usize) -> (f64, usize) {
 }
 
 /// Total variance numerator: the series reflected at both ends (SP1065 eq. 25), second
-/// differences at lag m centred on i = 1..L-2; number of terms L - 2.
-pub(crate) fn total_sum(extended: &[f64], len: usize, m: usize) -> (f64, usize) {
-    // `extended` is x*_{-(L-2)} .. x*_{2L-3}; the original x_0 sits at index L-2.
-    let mid = len - 2;
-    let n = len - 2;
-    let centre = mid + 1;
-    (
-        second_difference_sq_sum(
-            &extended[centre - m..centre - m + n],
-            &extended[centre..centre + n],
-            &extended[centre + m..centre + m + n],
-        ),
-        n,
-    )
+/// differences at lag m centred on i = 1..L-2; number of terms L - 2. The reflected series
+/// x*_{-(L-2)} .. x*_{2L-3} (3L - 4 values) is never built: its values are made from `s` a block
+/// at a time, in the order and with the arithmetic of [`second_difference_sq_sum`] over the
+/// built series (same lanes, same additions, bit for bit; tested against
+/// [`reflect_for_total`]), so TOTDEV needs no memory proportional to N beyond `s`.
+pub(crate) fn total_sum(s: &[f64], m: usize) -> (f64, usize) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU supports AVX2 and FMA (checked just above).
+            return unsafe { total_sum_avx2(s, m) };
+        }
+    }
+    total_sum_body(s, m)
 }
 
-/// Builds the doubly reflected series of SP1065 eq. (25) for the total variance.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn total_sum_avx2(s: &[f64], m: usize) -> (f64, usize) {
+    total_sum_body(s, m)
+}
+
+/// Values of the reflected series per block (a multiple of the 16 lanes).
+const TOTAL_BLOCK: usize = 1024;
+
+#[inline(always)]
+fn total_sum_body(s: &[f64], m: usize) -> (f64, usize) {
+    const LANES: usize = 16;
+    let len = s.len();
+    let n = len - 2;
+    // Index of x*_i in the reflected series is i + L - 2; the centre x*_1 is at L - 1.
+    let centre = len - 1;
+    let mut acc = [0.0f64; LANES];
+    let mut tail = 0.0;
+    let (mut a, mut b, mut c) = ([0.0f64; TOTAL_BLOCK], [0.0f64; TOTAL_BLOCK], [0.0f64; TOTAL_BLOCK]);
+    let mut k0 = 0;
+    while k0 < n {
+        let width = TOTAL_BLOCK.min(n - k0);
+        reflected_into(s, centre - m + k0, &mut a[..width]);
+        reflected_into(s, centre + k0, &mut b[..width]);
+        reflected_into(s, centre + m + k0, &mut c[..width]);
+        let ac = a[..width].chunks_exact(LANES);
+        let bc = b[..width].chunks_exact(LANES);
+        let cc = c[..width].chunks_exact(LANES);
+        let (ar, br, cr) = (ac.remainder(), bc.remainder(), cc.remainder());
+        for ((x, y), z) in ac.zip(bc).zip(cc) {
+            for l in 0..LANES {
+                let d = (z[l] - y[l]) - (y[l] - x[l]);
+                acc[l] += d * d;
+            }
+        }
+        // Only the last block can leave a remainder (a block is a multiple of the lanes).
+        for ((x, y), z) in ar.iter().zip(br).zip(cr) {
+            let d = (z - y) - (y - x);
+            tail += d * d;
+        }
+        k0 += width;
+    }
+    (pairwise_lanes(&acc) + tail, n)
+}
+
+/// Writes x*_j for the reflected-series indices j = e0 .. e0 + out.len() (index L - 2 is x_0):
+/// 2 x_0 - x_{L-2-j} before x_0, x_{j-(L-2)} over the record, 2 x_{L-1} - x_{3L-4-j} after it
+/// (SP1065 eq. 25; the expressions of [`reflect_for_total`]).
+#[inline(always)]
+fn reflected_into(s: &[f64], e0: usize, out: &mut [f64]) {
+    let len = s.len();
+    let (first, last) = (s[0], s[len - 1]);
+    let mut e = e0;
+    let mut i = 0;
+    while i < out.len() && e < len - 2 {
+        out[i] = 2.0 * first - s[len - 2 - e];
+        i += 1;
+        e += 1;
+    }
+    if i < out.len() && e < 2 * len - 2 {
+        let take = (out.len() - i).min(2 * len - 2 - e);
+        let from = e - (len - 2);
+        out[i..i + take].copy_from_slice(&s[from..from + take]);
+        i += take;
+        e += take;
+    }
+    while i < out.len() {
+        out[i] = 2.0 * last - s[3 * len - 4 - e];
+        i += 1;
+        e += 1;
+    }
+}
+
+/// Builds the doubly reflected series of SP1065 eq. (25) for the total variance (the reference
+/// [`total_sum`] is tested against).
+#[cfg(test)]
 pub(crate) fn reflect_for_total(s: &[f64]) -> Vec<f64> {
     let len = s.len();
     let mut out = Vec::with_capacity(3 * len - 4);
@@ -203,6 +278,21 @@ pub(crate) fn reflect_for_total(s: &[f64]) -> Vec<f64> {
         out.push(2.0 * s[len - 1] - s[len - 1 - j]);
     }
     out
+}
+
+/// The total variance numerator over a built reflected series (the reference of the tests).
+#[cfg(test)]
+pub(crate) fn total_sum_reflected(extended: &[f64], len: usize, m: usize) -> (f64, usize) {
+    let n = len - 2;
+    let centre = len - 1;
+    (
+        second_difference_sq_sum(
+            &extended[centre - m..centre - m + n],
+            &extended[centre..centre + n],
+            &extended[centre + m..centre + m + n],
+        ),
+        n,
+    )
 }
 
 /// Four consecutive values as an array (one bounds check; vectorises).
@@ -596,6 +686,35 @@ fn sum_block(s: &[f64], ms: &[usize], runs: &[(usize, usize, bool)], k0: usize, 
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// The streamed total variance sum equals, bit for bit, the sum over the built reflected
+    /// series (SP1065 eq. 25), portable and AVX2, for lengths around the block and lane sizes
+    /// and every lag from 1 to L - 2.
+    #[test]
+    fn total_sum_streamed_equals_the_built_reflection_bit_for_bit() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for len in [3usize, 4, 17, 18, 35, 1023, 1026, 2051, 3000, 5000] {
+            let mut s = vec![0.0];
+            for _ in 1..len {
+                let last = s[s.len() - 1];
+                s.push(last + next());
+            }
+            let extended = reflect_for_total(&s);
+            let lags: Vec<usize> =
+                if len < 40 { (1..=len - 2).collect() } else { vec![1, 2, 7, 16, 100, len / 2, len - 2] };
+            for m in lags {
+                let want = total_sum_reflected(&extended, len, m);
+                assert_eq!(total_sum_body(&s, m).0.to_bits(), want.0.to_bits(), "len {len} m {m}");
+                assert_eq!(total_sum(&s, m), want, "len {len} m {m}");
+            }
+        }
+    }
 
     /// The octave-run kernels (portable, AVX2, AVX-512 where the CPU has them) against the
     /// three-view sum of [`second_difference_sq_sum`] at each tau, on records and ranges that

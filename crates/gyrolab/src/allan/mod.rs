@@ -24,7 +24,8 @@
 //! needs capacity N + 1 to avoid one reallocation); OADEV, ADEV, MDEV, TDEV, HDEV and OHDEV then
 //! allocate nothing proportional to N (the noise identification streams over the record) except
 //! the FFT path of long OADEV tau lists (a few copies of the record) and the B1 fallback's N/m
-//! averages (m > N/30 in practice). TOTDEV builds a reflected copy of 3N values.
+//! averages (m > N/30 in practice). TOTDEV makes the reflected series of SP1065 eq. (25) a block
+//! at a time from the angle series (never 3N values at once).
 
 mod chi2;
 mod confidence;
@@ -673,7 +674,6 @@ fn compute(s: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve,
     let kind = options.kind;
     let n_rate = s.len().saturating_sub(1);
     let ms = averaging_factors(options, n_rate, tau0_s)?;
-    let extended = (kind == DeviationKind::Totdev).then(|| kernels::reflect_for_total(s));
     // OADEV, the common case, is summed for all taus in one cache-blocked sweep
     let oadev_sums = (kind == DeviationKind::Oadev).then(|| oadev_sums(s, &ms));
     let mut points: Vec<AllanPoint> = ms
@@ -685,7 +685,7 @@ fn compute(s: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve,
                     let n = s.len() - 2 * m;
                     (sums[i] / (2.0 * (m as f64).powi(2) * n as f64), n)
                 }
-                None => variance_at(s, extended.as_deref(), kind, m),
+                None => variance_at(s, kind, m),
             };
             let mut deviation = variance.sqrt();
             if kind == DeviationKind::Tdev {
@@ -782,7 +782,7 @@ fn oadev_sums(s: &[f64], ms: &[usize]) -> Vec<f64> {
 }
 
 /// Variance (rate units squared; TDEV: MVAR) and number of terms at averaging factor m.
-fn variance_at(s: &[f64], extended: Option<&[f64]>, kind: DeviationKind, m: usize) -> (f64, usize) {
+fn variance_at(s: &[f64], kind: DeviationKind, m: usize) -> (f64, usize) {
     let mf = m as f64;
     match kind {
         DeviationKind::Oadev => {
@@ -805,13 +805,10 @@ fn variance_at(s: &[f64], extended: Option<&[f64]>, kind: DeviationKind, m: usiz
             let (sum, n) = kernels::hadamard_sum(s, m);
             (sum / (6.0 * mf * mf * n as f64), n)
         }
-        DeviationKind::Totdev => match extended {
-            Some(e) => {
-                let (sum, n) = kernels::total_sum(e, s.len(), m);
-                (sum / (2.0 * mf * mf * n as f64), n)
-            }
-            None => (f64::NAN, 0),
-        },
+        DeviationKind::Totdev => {
+            let (sum, n) = kernels::total_sum(s, m);
+            (sum / (2.0 * mf * mf * n as f64), n)
+        }
     }
 }
 
