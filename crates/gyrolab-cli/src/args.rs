@@ -1,8 +1,13 @@
-//! Argument types shared by several commands: unit parsers and the output-to-rate reference.
+//! Argument types shared by several commands: unit parsers, the output-to-rate reference and
+//! the options of an Allan analysis (`allan`, `batch`).
 
+use crate::error::CliResult;
 use clap::Args;
+use gyrolab::allan::DeviationKind;
 use gyrolab::units::{OutputUnit, RateUnit};
+use gyrolab_eval::allan::{parse_confidence, parse_taus, AllanRequest, GapPolicy};
 use gyrolab_eval::reference::ReferenceRequest;
+use gyrolab_eval::EvalError;
 use std::path::PathBuf;
 
 /// Parses a rate unit option.
@@ -69,6 +74,62 @@ impl ReferenceArgs {
             scale_factor: self.scale_factor,
             null: self.null,
         }
+    }
+}
+
+/// The options of an Allan analysis of a record, shared by `allan` (one file) and `batch`
+/// (many): which topics and columns, their layout and reference, the deviation and its taus.
+#[derive(Debug, Clone, Args)]
+pub struct AnalysisArgs {
+    /// Topic of a recording to analyse (default: every IMU topic), repeatable; `gyrolab inspect
+    /// FILE` lists them.
+    #[arg(long = "topic", value_name = "NAME")]
+    pub topics: Vec<String>,
+    #[command(flatten)]
+    pub layout: LayoutArgs,
+    /// Output columns to analyse (default: every output column), repeatable.
+    #[arg(long = "column", value_name = "NAME")]
+    pub columns: Vec<String>,
+    /// Sample rate in Hz (required when the file has no time column).
+    #[arg(long, value_name = "HZ")]
+    pub sample_rate_hz: Option<f64>,
+    #[command(flatten)]
+    pub reference: ReferenceArgs,
+    /// Deviation: oadev (default), adev, mdev, tdev, hdev, ohdev, totdev.
+    #[arg(long, default_value = "oadev", value_name = "KIND")]
+    pub kind: String,
+    /// Taus: octave (default), decade, N/decade (e.g. 10/decade), all, or seconds (0.1,1,10).
+    #[arg(long, default_value = "octave", value_name = "LIST")]
+    pub taus: String,
+    /// Confidence level of the bounds (default 0.683), or `none`.
+    #[arg(long, default_value = "0.683", value_name = "C")]
+    pub confidence: String,
+    /// Fit the five-term noise model over this tau range only, seconds: LOW,HIGH.
+    #[arg(long, value_name = "LOW,HIGH", value_delimiter = ',', num_args = 1..=2)]
+    pub fit_range: Vec<f64>,
+    /// Missing samples (gaps in the time stamps, NaN or empty cells, dropout rows): `analyse`
+    /// (default: terms that touch one are left out; OADEV, ADEV, OHDEV, HDEV) or `error`.
+    #[arg(long, default_value = "analyse", value_name = "POLICY")]
+    pub gaps: String,
+}
+
+impl AnalysisArgs {
+    /// The analysis request of `file`.
+    pub fn request(&self, file: PathBuf) -> CliResult<AllanRequest> {
+        let kind = DeviationKind::parse(&self.kind).map_err(|e| EvalError::conflict(e.to_string()))?;
+        Ok(AllanRequest {
+            file,
+            columns: self.columns.clone(),
+            sample_rate_hz: self.sample_rate_hz,
+            reference: self.reference.request(),
+            kind,
+            taus: parse_taus(&self.taus)?,
+            confidence: parse_confidence(&self.confidence)?,
+            fit_range_s: gyrolab::validate::increasing_pair("fit_range_s", &self.fit_range)?,
+            layout: self.layout.layout(),
+            gaps: GapPolicy::parse(&self.gaps)?,
+            topics: self.topics.clone(),
+        })
     }
 }
 

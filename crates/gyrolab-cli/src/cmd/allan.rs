@@ -1,14 +1,12 @@
 //! `gyrolab allan FILE`: Allan-variance family with confidence intervals and noise terms, one
 //! result per output channel (channels computed in parallel).
 
-use crate::args::{LayoutArgs, ReferenceArgs};
+use crate::args::AnalysisArgs;
 use crate::error::CliResult;
 use crate::output::{print, to_json, write_file};
 use crate::progress::Bar;
 use clap::Args;
-use gyrolab::allan::DeviationKind;
-use gyrolab::validate;
-use gyrolab_eval::allan::{analyse_records, parse_confidence, parse_taus, AllanRequest};
+use gyrolab_eval::allan::{analyse_records, AllanRequest};
 use gyrolab_eval::simulate::reference_from_headers;
 use gyrolab_eval::EvalError;
 use gyrolab_report::allan::{allan_csv, allan_document, allan_text, imu_utils_yaml, kalibr_yaml};
@@ -24,32 +22,8 @@ pub struct AllanArgs {
     /// every IMU topic, six channels each.
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
-    /// Topic of a recording to analyse (default: every IMU topic), repeatable; `gyrolab inspect
-    /// FILE` lists them.
-    #[arg(long = "topic", value_name = "NAME")]
-    pub topics: Vec<String>,
     #[command(flatten)]
-    pub layout: LayoutArgs,
-    /// Output columns to analyse (default: every output column), repeatable.
-    #[arg(long = "column", value_name = "NAME")]
-    pub columns: Vec<String>,
-    /// Sample rate in Hz (required when the file has no time column).
-    #[arg(long, value_name = "HZ")]
-    pub sample_rate_hz: Option<f64>,
-    #[command(flatten)]
-    pub reference: ReferenceArgs,
-    /// Deviation: oadev (default), adev, mdev, tdev, hdev, ohdev, totdev.
-    #[arg(long, default_value = "oadev", value_name = "KIND")]
-    pub kind: String,
-    /// Taus: octave (default), decade, N/decade (e.g. 10/decade), all, or seconds (0.1,1,10).
-    #[arg(long, default_value = "octave", value_name = "LIST")]
-    pub taus: String,
-    /// Confidence level of the bounds (default 0.683), or `none`.
-    #[arg(long, default_value = "0.683", value_name = "C")]
-    pub confidence: String,
-    /// Fit the five-term noise model over this tau range only, seconds: LOW,HIGH.
-    #[arg(long, value_name = "LOW,HIGH", value_delimiter = ',', num_args = 1..=2)]
-    pub fit_range: Vec<f64>,
+    pub analysis: AnalysisArgs,
     /// Print CSV (file, channel, tau_s, m, dev, ci_low, ci_high, n_terms, alpha).
     #[arg(long, conflicts_with = "json")]
     pub csv: bool,
@@ -62,10 +36,6 @@ pub struct AllanArgs {
     /// `warning:` on stderr.
     #[arg(long, value_name = "FILE.yaml")]
     pub kalibr_yaml: Option<PathBuf>,
-    /// Missing samples (gaps in the time stamps, NaN or empty cells, dropout rows): `analyse`
-    /// (default: terms that touch one are left out; OADEV, ADEV, OHDEV, HDEV) or `error`.
-    #[arg(long, default_value = "analyse", value_name = "POLICY")]
-    pub gaps: String,
     /// Write an imu_utils / VINS-style YAML (gyr_n, gyr_w, acc_n, acc_w), by the same rule.
     #[arg(long, value_name = "FILE.yaml")]
     pub imu_utils_yaml: Option<PathBuf>,
@@ -73,20 +43,7 @@ pub struct AllanArgs {
 
 impl AllanArgs {
     fn request(&self) -> CliResult<AllanRequest> {
-        let kind = DeviationKind::parse(&self.kind).map_err(|e| EvalError::conflict(e.to_string()))?;
-        Ok(AllanRequest {
-            file: self.file.clone(),
-            columns: self.columns.clone(),
-            sample_rate_hz: self.sample_rate_hz,
-            reference: self.reference.request(),
-            kind,
-            taus: parse_taus(&self.taus)?,
-            confidence: parse_confidence(&self.confidence)?,
-            fit_range_s: validate::increasing_pair("fit_range_s", &self.fit_range)?,
-            layout: self.layout.layout(),
-            gaps: gyrolab_eval::allan::GapPolicy::parse(&self.gaps)?,
-            topics: self.topics.clone(),
-        })
+        self.analysis.request(self.file.clone())
     }
 }
 

@@ -8,13 +8,12 @@
 //! others evaluated and written; the failures listed on stderr and in `DIR/failures.csv`);
 //! 2 bad usage (no input found, a journal of other options); 1 an output could not be written.
 
-use crate::args::{LayoutArgs, ReferenceArgs};
+use crate::args::AnalysisArgs;
 use crate::error::{flag, CliError, CliResult};
 use crate::output::print;
 use clap::Args;
-use gyrolab::allan::DeviationKind;
 use gyrolab::validate;
-use gyrolab_eval::allan::{parse_confidence, parse_taus, AllanRequest, GapPolicy};
+use gyrolab_eval::allan::AllanRequest;
 use gyrolab_eval::batch::{
     collect_inputs, journal_header, journal_line, journal_rows, options_fingerprint, results_csv, results_parquet,
     run_batch, BatchRequest, BatchSink, Cell, DoneInput, FailedInput, Journal, ResultRow, Skipped,
@@ -49,52 +48,13 @@ pub struct BatchArgs {
     /// No progress bar and no summary on standard output (failures still go to stderr).
     #[arg(long, short)]
     pub quiet: bool,
-    /// Topic of the recordings to analyse (default: every IMU topic), repeatable.
-    #[arg(long = "topic", value_name = "NAME")]
-    pub topics: Vec<String>,
     #[command(flatten)]
-    pub layout: LayoutArgs,
-    /// Output columns to analyse (default: every output column), repeatable.
-    #[arg(long = "column", value_name = "NAME")]
-    pub columns: Vec<String>,
-    /// Sample rate in Hz (for files without a time column).
-    #[arg(long, value_name = "HZ")]
-    pub sample_rate_hz: Option<f64>,
-    #[command(flatten)]
-    pub reference: ReferenceArgs,
-    /// Deviation: oadev (default), adev, mdev, tdev, hdev, ohdev, totdev.
-    #[arg(long, default_value = "oadev", value_name = "KIND")]
-    pub kind: String,
-    /// Taus: octave (default), decade, N/decade, all, or seconds (0.1,1,10).
-    #[arg(long, default_value = "octave", value_name = "LIST")]
-    pub taus: String,
-    /// Confidence level of the bounds (default 0.683), or `none`.
-    #[arg(long, default_value = "0.683", value_name = "C")]
-    pub confidence: String,
-    /// Fit the five-term noise model over this tau range only, seconds: LOW,HIGH.
-    #[arg(long, value_name = "LOW,HIGH", value_delimiter = ',', num_args = 1..=2)]
-    pub fit_range: Vec<f64>,
-    /// Missing samples: `analyse` (default) or `error` (as `gyrolab allan --gaps`).
-    #[arg(long, default_value = "analyse", value_name = "POLICY")]
-    pub gaps: String,
+    pub analysis: AnalysisArgs,
 }
 
 impl BatchArgs {
     fn allan(&self) -> CliResult<AllanRequest> {
-        let kind = DeviationKind::parse(&self.kind).map_err(|e| EvalError::conflict(e.to_string()))?;
-        Ok(AllanRequest {
-            file: PathBuf::new(),
-            columns: self.columns.clone(),
-            sample_rate_hz: self.sample_rate_hz,
-            reference: self.reference.request(),
-            kind,
-            taus: parse_taus(&self.taus)?,
-            confidence: parse_confidence(&self.confidence)?,
-            fit_range_s: validate::increasing_pair("fit_range_s", &self.fit_range)?,
-            layout: self.layout.layout(),
-            gaps: GapPolicy::parse(&self.gaps)?,
-            topics: self.topics.clone(),
-        })
+        self.analysis.request(PathBuf::new())
     }
 }
 
