@@ -63,8 +63,12 @@ class AllanResult:
         """The curve as a tidy DataFrame."""
     def noise_table(self) -> Any:
         """The noise terms as a DataFrame (channel, term, value, unit, basis, support)."""
-    def plot(self, ax: Any = ..., label: Optional[str] = ..., asymptotes: bool = ...) -> Any:
-        """Log-log curve with bounds and noise-term asymptotes (needs matplotlib); returns the axes."""
+    def plot(
+        self, ax: Any = ..., label: Optional[str] = ..., asymptotes: bool = ..., terms: Optional["AllanResult"] = ...
+    ) -> Any:
+        """Log-log curve with bounds and noise-term asymptotes (needs matplotlib); an MDEV curve
+        draws the asymptotes of `terms` (the OADEV result of the record) scaled to MDEV; returns
+        the axes."""
 
 class AllanResults(Mapping[str, AllanResult]):
     """The channels of one record: channel -> AllanResult."""

@@ -219,12 +219,17 @@ class AllanResult:
 
         return pd.DataFrame(_noise_rows(self), columns=_NOISE_COLUMNS)
 
-    def plot(self, ax: Any = None, label: Optional[str] = None, asymptotes: bool = True) -> Any:
+    def plot(
+        self, ax: Any = None, label: Optional[str] = None, asymptotes: bool = True, terms: Optional["AllanResult"] = None
+    ) -> Any:
         """Draws the log-log curve with its bounds (confidence level in the legend) and the
-        noise-term asymptotes over the tau ranges that support them (gyro: N, B with the
-        Allan minimum marked, K; accelerometer: VRW, B, acceleration random walk), in one
-        colour per result; on ``ax`` (a new figure when None). Needs matplotlib. Returns ax."""
-        return _plot([self], ax, [label], asymptotes)
+        noise-term asymptotes over the tau ranges that support them (gyro: N, the flicker
+        floor of the IEEE B, K, and the Allan minimum marked on the curve; accelerometer: VRW,
+        B, acceleration random walk), in one colour per result; on ``ax`` (a new figure when
+        None). Noise terms are read from the Allan deviation: an MDEV result draws the
+        asymptotes of ``terms``, the OADEV (or ADEV) result of the same record, scaled to MDEV
+        (NIST SP 1065 5.2.5). Needs matplotlib. Returns ax."""
+        return _plot([self], ax, [label], asymptotes, terms)
 
 
 _NOISE_COLUMNS = ["channel", "term", "value", "unit", "basis", "support", "tau_low_s", "tau_high_s"]
@@ -311,37 +316,70 @@ class AllanResults(Mapping[str, AllanResult]):
         return _plot(list(self._results.values()), ax, [None] * len(self), asymptotes)
 
 
-def _asymptotes(r: AllanResult) -> List[Tuple[str, np.ndarray, np.ndarray, str]]:
+# Large-m limits of Mod sigma^2 / sigma^2 (the ratio R(n) of NIST SP 1065, section 5.2.5) for
+# white, flicker and random-walk rate noise: 1/2, 27/40 (= (27/20) ln 2 / (2 ln 2)) and 33/40
+# (= (11/20) pi^2 / ((2/3) pi^2)); their square roots scale the Allan asymptotes to MDEV.
+_MDEV_SCALE = {"white": np.sqrt(0.5), "flicker": np.sqrt(27.0 / 40.0), "random_walk": np.sqrt(33.0 / 40.0)}
+_NOISE_OF_TERM = {
+    "arw": "white",
+    "vrw": "white",
+    "allan_minimum": "flicker",
+    "rrw": "random_walk",
+    "accel_random_walk": "random_walk",
+}
+
+
+def _asymptotes(r: AllanResult, source: Optional[AllanResult] = None) -> List[Tuple[str, np.ndarray, np.ndarray, str]]:
     """The slope lines of the terms read as values, each over its supported tau range:
-    (label, taus, level, line style)."""
-    if r.kind not in ("oadev", "adev") or r.quantity not in ("angular_rate", "acceleration"):
+    (label, taus, level, line style). The terms are those of ``source`` (an OADEV or ADEV
+    result of the same record; ``r`` itself by default), scaled to ``r``'s kind (1 for OADEV
+    and ADEV, the square root of SP 1065's R(n) limit for MDEV); no lines for other kinds."""
+    source = r if source is None else source
+    if source.kind not in ("oadev", "adev") or source.quantity not in ("angular_rate", "acceleration"):
         return []
-    accel = r.quantity == "acceleration"
+    if r.kind in ("oadev", "adev"):
+        scale = {"white": 1.0, "flicker": 1.0, "random_walk": 1.0}
+        prefix = ""
+    elif r.kind == "mdev":
+        scale = _MDEV_SCALE
+        prefix = "MDEV "
+    else:
+        return []
+    if source is not r and (source.unit != r.unit or source.quantity != r.quantity):
+        raise ValueError(f"terms= is in {source.unit} ({source.quantity}), the curve in {r.unit} ({r.quantity})")
+    accel = source.quantity == "acceleration"
     terms = _ACCEL_TERMS if accel else _GYRO_TERMS
-    found = {g["term"]: g for g in r.readings if g["basis"] == "value" and g.get("tau_range_s")}
+    found = {g["term"]: g for g in source.readings if g["basis"] == "value" and g.get("tau_range_s")}
     out = []
     for term, (sym, density_key, key, unit) in terms.items():
         g = found.get(term)
-        v, shown = r.noise.get(density_key), r.noise.get(key)
-        if g is None or v is None or shown is None:
+        v, shown = source.noise.get(density_key), source.noise.get(key)
+        if g is None or v is None or shown is None or term not in _NOISE_OF_TERM:
             continue
+        k = scale[_NOISE_OF_TERM[term]]
         lo, hi = g["tau_range_s"]
         tt = np.geomspace(lo, hi, 24) if hi > lo else np.array([lo, hi])
         if term in ("arw", "vrw"):
-            out.append((f"{sym} = {shown:.3g} {unit}", tt, v / np.sqrt(tt), "--"))
+            out.append((f"{prefix}{sym} = {shown:.3g} {unit}", tt, k * v / np.sqrt(tt), "--"))
         elif term in ("rrw", "accel_random_walk"):
-            out.append((f"{sym} = {shown:.3g} {unit}", tt, v * np.sqrt(tt / 3.0), "-."))
+            out.append((f"{prefix}{sym} = {shown:.3g} {unit}", tt, k * v * np.sqrt(tt / 3.0), "-."))
         elif term == "allan_minimum":
+            # The flicker floor 0.664 B (IEEE Std 952 / 1293): the level of the Allan minimum.
             level = v * _G_N * 1e-6 if accel else v / 3600.0
-            ieee = r.noise.get("bias_instability_ug" if accel else "bias_instability_dph")
-            text = f"Allan minimum = {shown:.3g} {unit} at τ = {g.get('tau_s') or lo:.3g} s"
-            if ieee is not None:
-                text += f"; B (IEEE) = {ieee:.3g} {unit}"
-            out.append((text, tt, np.full_like(tt, level), ":"))
+            ieee = source.noise.get("bias_instability_ug" if accel else "bias_instability_dph")
+            factor = "0.664 B" if not prefix else "0.664·√(27/40) B"
+            text = f"{prefix}B (IEEE) = {ieee:.3g} {unit}: floor {factor}" if ieee is not None else f"{prefix}floor {shown:.3g} {unit}"
+            out.append((text, tt, np.full_like(tt, k * level), ":"))
     return out
 
 
-def _plot(results: List[AllanResult], ax: Any, labels: List[Optional[str]], asymptotes: bool) -> Any:
+def _plot(
+    results: List[AllanResult],
+    ax: Any,
+    labels: List[Optional[str]],
+    asymptotes: bool,
+    terms: Optional[AllanResult] = None,
+) -> Any:
     try:
         import matplotlib.pyplot as plt
     except ImportError as e:  # pragma: no cover - depends on the environment
@@ -363,12 +401,14 @@ def _plot(results: List[AllanResult], ax: Any, labels: List[Optional[str]], asym
         if np.any(lo) or np.any(hi):
             ax.errorbar(t[idx], d[idx], yerr=[lo, hi], fmt="none", ecolor=colour, capsize=2, lw=0.8)
         if asymptotes:
-            for text, tt, yy, style in _asymptotes(r):
+            for text, tt, yy, style in _asymptotes(r, terms):
                 ax.plot(tt, yy, style, color=colour, lw=1, alpha=0.8, label=text)
+            # The Allan minimum (the datasheet's "bias instability"), marked where it was read.
             m = next((g for g in r.readings if g["term"] == "allan_minimum" and g["basis"] == "value"), None)
             if m is not None and m.get("tau_s"):
                 j = int(np.argmin(np.abs(t - m["tau_s"])))
-                ax.plot([t[j]], [d[j]], "v", color=colour, ms=8, mfc="none")
+                text = f"Allan minimum = {m['value']:.3g} {m['unit']} at τ = {t[j]:.3g} s"
+                ax.plot([t[j]], [d[j]], "v", color=colour, ms=8, mfc="none", ls="none", label=text)
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("averaging time τ (s)")
