@@ -229,7 +229,7 @@ class AllanResult:
         None). Noise terms are read from the Allan deviation: an MDEV result draws the
         asymptotes of ``terms``, the OADEV (or ADEV) result of the same record, scaled to MDEV
         (NIST SP 1065 5.2.5). Needs matplotlib. Returns ax."""
-        return _plot([self], ax, [label], asymptotes, terms)
+        return _plot([self], ax, [label], asymptotes, [terms])
 
 
 _NOISE_COLUMNS = ["channel", "term", "value", "unit", "basis", "support", "tau_low_s", "tau_high_s"]
@@ -310,10 +310,13 @@ class AllanResults(Mapping[str, AllanResult]):
         """``{channel: to_dict()}``."""
         return {k: r.to_dict() for k, r in self._results.items()}
 
-    def plot(self, ax: Any = None, asymptotes: bool = False) -> Any:
+    def plot(self, ax: Any = None, asymptotes: bool = False, terms: Optional["AllanResults"] = None) -> Any:
         """Every channel's curve on one axes (one colour each; a gyro and an accelerometer have
-        different units: plot them separately, ``results['gx'].plot()``)."""
-        return _plot(list(self._results.values()), ax, [None] * len(self), asymptotes)
+        different units: plot them separately, ``results['gx'].plot()``). ``terms``: the OADEV
+        results of the same channels, whose asymptotes an MDEV result draws (see
+        :meth:`AllanResult.plot`)."""
+        sources = [None if terms is None else terms.get(k) for k in self._results]
+        return _plot(list(self._results.values()), ax, [None] * len(self), asymptotes, sources)
 
 
 # Large-m limits of Mod sigma^2 / sigma^2 (the ratio R(n) of NIST SP 1065, section 5.2.5) for
@@ -378,7 +381,7 @@ def _plot(
     ax: Any,
     labels: List[Optional[str]],
     asymptotes: bool,
-    terms: Optional[AllanResult] = None,
+    terms: Optional[List[Optional[AllanResult]]] = None,
 ) -> Any:
     try:
         import matplotlib.pyplot as plt
@@ -386,7 +389,8 @@ def _plot(
         raise ImportError("plot() needs matplotlib: pip install matplotlib") from e
     if ax is None:
         _, ax = plt.subplots(figsize=(7, 5))
-    for r, label in zip(results, labels):
+    sources = terms if terms is not None else [None] * len(results)
+    for r, label, source in zip(results, labels, sources):
         t, d = r.taus_s, r.dev
         name = label or (r.channel if len(results) > 1 or r.channel != "x" else r.kind.upper())
         if r.confidence is not None:
@@ -401,7 +405,7 @@ def _plot(
         if np.any(lo) or np.any(hi):
             ax.errorbar(t[idx], d[idx], yerr=[lo, hi], fmt="none", ecolor=colour, capsize=2, lw=0.8)
         if asymptotes:
-            for text, tt, yy, style in _asymptotes(r, terms):
+            for text, tt, yy, style in _asymptotes(r, source):
                 ax.plot(tt, yy, style, color=colour, lw=1, alpha=0.8, label=text)
             # The Allan minimum (the datasheet's "bias instability"), marked where it was read.
             m = next((g for g in r.readings if g["term"] == "allan_minimum" and g["basis"] == "value"), None)

@@ -104,6 +104,17 @@ def test_mdev_flicker_floor_is_the_oadev_floor_scaled_as_sp1065():
     assert np.allclose(md / od, ratio, rtol=0.05), (md / od, ratio)
 
 
+def test_channels_draw_the_mdev_asymptotes_of_their_own_oadev_terms(record):
+    both = {"g1": record, "g2": record * 2.0}
+    oadev = gyrolab.allan(both, rate_hz=100.0)
+    mdev = gyrolab.allan(both, rate_hz=100.0, kind="mdev")
+    ax = mdev.plot(asymptotes=True, terms=oadev)
+    n_lines = [line for line in ax.get_lines() if line.get_label().startswith("MDEV N = ")]
+    assert len(n_lines) == 2
+    levels = sorted(line.get_ydata()[0] for line in n_lines)
+    assert levels[1] / levels[0] == pytest.approx(2.0, rel=1e-9)  # each channel its own N
+
+
 def test_terms_of_another_unit_are_refused(record):
     gyro = gyrolab.allan(record, rate_hz=100.0)
     accel = gyrolab.allan(record, rate_hz=100.0, unit="m/s^2", kind="mdev")
