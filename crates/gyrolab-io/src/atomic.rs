@@ -87,7 +87,10 @@ fn write_and_persist(
 /// Writes a folder of files all or nothing as far as a file system allows: creates `dir`, writes
 /// every file to a temporary file inside it (fsynced), and only when all are written renames
 /// them into place, in order. A failure before the renames leaves the folder as it was (the
-/// temporaries are removed); the error names the file it is about.
+/// temporaries are removed); the error names the file it is about. A target that cannot be
+/// replaced (a folder of that name) is found before any rename; should a rename still fail, the
+/// files already replaced are put back from hard links kept of them (and the new ones removed),
+/// so that the folder never mixes files of two runs. Other files in `dir` are not touched.
 pub fn write_folder(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>, (PathBuf, std::io::Error)> {
     std::fs::create_dir_all(dir).map_err(|e| (dir.to_path_buf(), e))?;
     let mut staged = Vec::with_capacity(files.len());
@@ -117,6 +120,32 @@ pub fn write_folder(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>,
         }
     }
     let temporaries: Vec<PathBuf> = staged.iter().map(|(t, _)| t.path().to_path_buf()).collect();
+    let unregister_all = || temporaries.iter().for_each(|t| unregister(t));
+    // Targets that a rename could not replace, found before the first rename.
+    for (_, path) in &staged {
+        if std::fs::symlink_metadata(path).is_ok_and(|m| m.is_dir()) {
+            unregister_all();
+            return Err((
+                path.clone(),
+                std::io::Error::new(std::io::ErrorKind::IsADirectory, "a folder of this name is in the way"),
+            ));
+        }
+    }
+    // The files being replaced, kept as hard links until every rename is done.
+    let mut kept: Vec<(PathBuf, PathBuf)> = Vec::new();
+    for (_, path) in &staged {
+        if std::fs::symlink_metadata(path).is_ok_and(|m| m.is_file()) {
+            let keep = dir.join(format!(".gyrolab-old-{}-{}.tmp", std::process::id(), kept.len()));
+            let _ = std::fs::remove_file(&keep);
+            if let Err(e) = std::fs::hard_link(path, &keep) {
+                kept.iter().for_each(|(k, _)| drop(std::fs::remove_file(k)));
+                unregister_all();
+                return Err((path.clone(), e));
+            }
+            register(&keep);
+            kept.push((keep, path.clone()));
+        }
+    }
     let mut written = Vec::with_capacity(staged.len());
     let mut result = Ok(());
     for (tmp, path) in staged {
@@ -126,7 +155,20 @@ pub fn write_folder(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>,
         }
         written.push(path);
     }
-    temporaries.iter().for_each(|t| unregister(t));
+    if result.is_err() {
+        // Put the folder back as it was: the new files out, the old ones in.
+        for path in &written {
+            match kept.iter().find(|(_, p)| p == path) {
+                Some((keep, _)) => drop(std::fs::rename(keep, path)),
+                None => drop(std::fs::remove_file(path)),
+            }
+        }
+    }
+    for (keep, _) in &kept {
+        let _ = std::fs::remove_file(keep);
+        unregister(keep);
+    }
+    unregister_all();
     result.map(|()| written)
 }
 
@@ -278,5 +320,25 @@ mod tests {
         assert_eq!(std::fs::read(out.join("a.txt")).unwrap(), b"one");
         let names: Vec<_> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name()).collect();
         assert_eq!(names.len(), 2, "{names:?}");
+        // A folder where a file goes (the third of three): refused before any rename, the
+        // first two keep the earlier run's content; nothing else is left in the folder.
+        std::fs::create_dir(out.join("c.txt")).unwrap();
+        std::fs::write(out.join("mine.txt"), b"user").unwrap();
+        let e = super::write_folder(&out, &[("a.txt", b"new"), ("b.txt", b"new"), ("c.txt", b"new")]).unwrap_err();
+        assert_eq!(e.0, out.join("c.txt"));
+        assert_eq!(std::fs::read(out.join("a.txt")).unwrap(), b"one");
+        assert_eq!(std::fs::read(out.join("b.txt")).unwrap(), b"two");
+        let mut names: Vec<_> =
+            std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+        names.sort();
+        assert_eq!(names, ["a.txt", "b.txt", "c.txt", "mine.txt"]);
+        // Replaced whole: the old content is gone, the user's file stays, no link is left.
+        std::fs::remove_dir(out.join("c.txt")).unwrap();
+        super::write_folder(&out, &[("a.txt", b"new"), ("b.txt", b"new"), ("c.txt", b"new")]).unwrap();
+        for f in ["a.txt", "b.txt", "c.txt"] {
+            assert_eq!(std::fs::read(out.join(f)).unwrap(), b"new");
+        }
+        assert_eq!(std::fs::read(out.join("mine.txt")).unwrap(), b"user");
+        assert_eq!(std::fs::read_dir(&out).unwrap().count(), 4);
     }
 }
