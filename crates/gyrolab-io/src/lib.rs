@@ -19,6 +19,7 @@
 pub mod apply_csv;
 pub mod atomic;
 pub mod calibration;
+pub mod contained;
 pub mod decimal;
 pub mod error;
 pub mod input_file;

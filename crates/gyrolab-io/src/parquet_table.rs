@@ -36,6 +36,15 @@ pub fn read_parquet_file(
     options: &SeriesOptions,
 ) -> Result<SeriesData, DataError> {
     check_footer(path, &mut file)?;
+    // The `parquet` crate panics on some damaged pages (a dictionary-encoded page without its
+    // dictionary, found by fuzzing): contained, as a message in words.
+    crate::contained::contain(|| read_checked_parquet(path, file, options)).unwrap_or_else(|panic| {
+        Err(DataError::new(path, format!("not a readable Parquet file: the Parquet reader failed on it ({panic})")))
+    })
+}
+
+/// [`read_parquet_file`] after its footer is checked.
+fn read_checked_parquet(path: &Path, file: std::fs::File, options: &SeriesOptions) -> Result<SeriesData, DataError> {
     let reader = SerializedFileReader::new(file).map_err(|e| perr(path, e))?;
     let meta = reader.metadata();
     let schema = meta.file_metadata().schema_descr();

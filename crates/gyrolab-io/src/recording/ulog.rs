@@ -153,6 +153,86 @@ fn stamp_value(data: &[u8], f: &FlattenedField) -> Option<Result<i64, u64>> {
 /// Bytes fed to the parser at once.
 const FEED: usize = 64 * 1024;
 
+/// The message headers of a ULog file, walked over the bytes before they are fed to the
+/// `px4-ulog` parser, which indexes the first bytes of a message without checking its size
+/// (an `A` message of 2 bytes panicked, found by fuzzing): each message's size is checked
+/// against what its kind holds (docs.px4.io "ULog File Format") and the key length of info
+/// and parameter messages against the message.
+#[derive(Debug)]
+struct Framer {
+    /// File offset of the next message's header (after the 16-byte file header).
+    next: u64,
+    /// The bytes of that header read so far: size (2), type (1), and the first two data bytes.
+    head: Vec<u8>,
+}
+
+impl Framer {
+    fn new() -> Self {
+        Framer { next: 16, head: Vec::with_capacity(5) }
+    }
+
+    /// Walks `bytes`, which start at file offset `at`: `Err((offset, what))` for the first
+    /// message whose size cannot hold its kind's fields.
+    fn feed(&mut self, bytes: &[u8], at: u64) -> Result<(), (u64, String)> {
+        let end = at + bytes.len() as u64;
+        loop {
+            let mut need = 3;
+            if self.head.len() >= 3 {
+                need = 3 + usize::from(u16::from_le_bytes([self.head[0], self.head[1]])).min(2);
+            }
+            while self.head.len() < need {
+                let pos = self.next + self.head.len() as u64;
+                if pos >= end {
+                    return Ok(());
+                }
+                if pos >= at {
+                    self.head.push(bytes[(pos - at) as usize]);
+                }
+                if self.head.len() == 3 {
+                    need = 3 + usize::from(u16::from_le_bytes([self.head[0], self.head[1]])).min(2);
+                }
+            }
+            let size = usize::from(u16::from_le_bytes([self.head[0], self.head[1]]));
+            if let Some(what) = message_fault(self.head[2], size, &self.head[3..]) {
+                return Err((self.next, what));
+            }
+            self.next += 3 + size as u64;
+            self.head.clear();
+        }
+    }
+}
+
+/// Why a ULog message of kind `kind`, `size` bytes, whose data starts with `first` (its first
+/// two bytes, fewer in a shorter message), cannot be read: `None` when its size holds its kind's
+/// fixed fields.
+fn message_fault(kind: u8, size: usize, first: &[u8]) -> Option<String> {
+    let least = match kind {
+        b'B' => 40,
+        b'S' => 8,
+        b'L' => 9,
+        b'C' => 11,
+        b'A' => 3,
+        b'D' | b'R' | b'O' | b'M' | b'Q' => 2,
+        b'I' | b'P' => 1,
+        _ => 0,
+    };
+    let name = |k: u8| if k.is_ascii_graphic() { format!("'{}'", k as char) } else { format!("of type {k}") };
+    if size < least {
+        return Some(format!("a message {} of {size} bytes, shorter than the {least} bytes of its fields", name(kind)));
+    }
+    let key = match kind {
+        b'I' | b'P' => Some((usize::from(first[0]), 1)),
+        b'M' | b'Q' => Some((usize::from(first[1]), 2)),
+        _ => None,
+    };
+    match key {
+        Some((k, o)) if o + k > size => {
+            Some(format!("a message {} of {size} bytes whose key of {k} bytes runs past its end", name(kind)))
+        }
+        _ => None,
+    }
+}
+
 /// Reads every data message of a ULog file (opened once) into `c`.
 pub(super) fn read(path: &Path, mut file: std::fs::File, c: &mut Collector) -> Result<(), Stop> {
     use std::io::Read;
@@ -246,6 +326,8 @@ pub(super) fn read(path: &Path, mut file: std::fs::File, c: &mut Collector) -> R
     let mut buf = vec![0u8; FEED];
     let mut offset = 0u64;
     let mut parse_error = None;
+    let mut framing_error = None;
+    let mut framer = Framer::new();
     loop {
         let n = match file.read(&mut buf) {
             Ok(0) => break,
@@ -255,9 +337,26 @@ pub(super) fn read(path: &Path, mut file: std::fs::File, c: &mut Collector) -> R
         };
         fed_from.set(offset);
         fed_to.set(offset + n as u64);
-        if let Err(e) = parser.consume_bytes(&buf[..n]) {
-            parse_error = Some((offset, offset + n as u64, parse_error_text(&e.description), parser.in_data()));
+        if let Err((at, what)) = framer.feed(&buf[..n], offset) {
+            // The messages before it are fed; the damaged one is not.
+            let before = (at.saturating_sub(offset) as usize).min(n);
+            let fed = crate::contained::contain(|| parser.consume_bytes(&buf[..before]));
+            let in_data = parser.in_data();
+            drop(fed);
+            framing_error = Some((at, what, in_data));
             break;
+        }
+        match crate::contained::contain(|| parser.consume_bytes(&buf[..n])) {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => {
+                parse_error = Some((offset, offset + n as u64, parse_error_text(&e.description), parser.in_data()));
+                break;
+            }
+            Err(panic) => {
+                let what = format!("a message the ULog parser cannot read ({panic})");
+                parse_error = Some((offset, offset + n as u64, what, parser.in_data()));
+                break;
+            }
         }
         offset += n as u64;
         if stopped.get() {
@@ -268,6 +367,10 @@ pub(super) fn read(path: &Path, mut file: std::fs::File, c: &mut Collector) -> R
     drop(parser);
     if let Some(e) = failure {
         return Err(Stop::Error(e));
+    }
+    if let Some((at, what, in_data)) = framing_error {
+        let part = if in_data { "a data message" } else { "the header or definitions" };
+        return Err(Stop::Damaged { at: format!("{part} at byte {at}"), what });
     }
     match parse_error {
         Some((from, to, what, true)) => {
