@@ -6,9 +6,10 @@
 //! Layout: [`db`] the two back ends behind one interface; [`schema`] tables and migrations;
 //! [`record`] what is kept of one evaluation, read from a finished report folder; [`query`] the
 //! queries and their statistics (computed by the core crate: `gyrolab::process_capability`,
-//! `gyrolab::control_chart`, `gyrolab::two_sample`).
+//! `gyrolab::control_chart`, `gyrolab::two_sample`); [`export`] query tables as CSV and Parquet.
 
 pub mod db;
+pub mod export;
 pub mod query;
 pub mod record;
 pub mod reevaluate;
@@ -460,6 +461,7 @@ impl Store {
                 )
                 .map_err(&dberr)?;
             }
+            pause_for_test();
             Ok(id)
         });
         id.map_err(|e| match e {
@@ -585,6 +587,18 @@ pub struct Changes {
     pub approver: Option<String>,
     /// New test date.
     pub test_date: Option<String>,
+}
+
+/// The environment variable of the kill test (crates/gyrolab-cli/tests/store.rs): milliseconds
+/// to pause inside the transaction of every stored evaluation, after all its rows are written and
+/// before the commit, so that a test can kill the process there. Unset in normal use.
+pub const TEST_PAUSE_ENV: &str = "GYROLAB_STORE_TEST_PAUSE_MS";
+
+fn pause_for_test() {
+    if let Some(ms) = std::env::var(TEST_PAUSE_ENV).ok().and_then(|v| v.parse::<u64>().ok()) {
+        eprintln!("store: pausing {ms} ms inside the transaction ({TEST_PAUSE_ENV})");
+        std::thread::sleep(Duration::from_millis(ms));
+    }
 }
 
 /// Now, RFC 3339 UTC to the microsecond (sortable as text).

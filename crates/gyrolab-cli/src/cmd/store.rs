@@ -1,0 +1,633 @@
+//! `gyrolab store ...`: the records store (crate gyrolab-store, docs/STORE.md): add report
+//! folders, show one evaluation, the history of a serial (table, JSON, CSV, SVG trend plot), lot
+//! statistics, lot comparison, control charts, revisions (correction, approval) and
+//! re-evaluation. Arguments to requests and printing only.
+
+use crate::args::{QueryOutput, StoreLocation};
+use crate::error::{CliError, CliResult};
+use crate::output::{print, to_json, write_file};
+use clap::{Args, Subcommand, ValueEnum};
+use gyrolab_report::format::sig_opt;
+use gyrolab_report::plot::{Axis, Figure, Orientation, Panel, RefLine, Series, SeriesStyle};
+use gyrolab_store::export::{to_csv, to_parquet, Cell, Table};
+use gyrolab_store::{add_report_folder, query, reevaluate, resolve_location, Changes, Revision, RevisionKind, Store};
+use std::path::PathBuf;
+
+/// Kinds of manual revision.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum ReviseKind {
+    /// Correct recorded facts (serial, model, lot, operator, test date).
+    Correction,
+    /// Approve the evaluation (--by is the approver).
+    Approval,
+}
+
+/// `gyrolab store` subcommands.
+#[derive(Debug, Subcommand)]
+pub enum StoreCommand {
+    /// Store finished report folders (results.json, summary.csv; the plan they name and its inputs are hashed).
+    Add(AddArgs),
+    /// One stored evaluation: device, plan hash, inputs, revisions, figures.
+    Show(ShowArgs),
+    /// Every figure of a serial over time and revisions, with limits (`--svg` trend plot).
+    History(HistoryArgs),
+    /// Lot statistics per figure: n, mean, sd, min, max, yield, Cp/Cpk, Pp/Ppk with intervals, outliers.
+    Lot(LotArgs),
+    /// Compare two lots per figure: Welch's t-test of the means, F-test of the spreads.
+    Compare(CompareArgs),
+    /// Control charts of one figure: individuals/moving range and X-bar/S over lots, Nelson rules.
+    Chart(ChartArgs),
+    /// Store a correction or an approval as a new revision of an evaluation.
+    Revise(ReviseArgs),
+    /// Re-run a stored evaluation's plan and inputs (hash-checked) under this version: new revision and diff.
+    Reevaluate(ReevaluateArgs),
+}
+
+/// Options of `gyrolab store add`.
+#[derive(Debug, Args)]
+pub struct AddArgs {
+    /// Report folders written by `gyrolab eval`.
+    #[arg(value_name = "DIR", required = true)]
+    pub dirs: Vec<PathBuf>,
+    /// The plan of the folders (default: the plan_file each results.json names).
+    #[arg(long, value_name = "PLAN.toml")]
+    pub plan: Option<PathBuf>,
+    #[command(flatten)]
+    pub location: StoreLocation,
+}
+
+/// Options of `gyrolab store show`.
+#[derive(Debug, Args)]
+pub struct ShowArgs {
+    /// Evaluation id.
+    pub id: i64,
+    /// Print JSON (with the plan text and results.json).
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub location: StoreLocation,
+}
+
+/// Options of `gyrolab store history`.
+#[derive(Debug, Args)]
+pub struct HistoryArgs {
+    /// Serial number.
+    pub serial: String,
+    /// Only this figure key.
+    #[arg(long, value_name = "KEY")]
+    pub figure: Option<String>,
+    /// Also write an SVG trend plot (one panel per axis and figure, limits as lines).
+    #[arg(long, visible_alias = "plot", value_name = "FILE.svg")]
+    pub svg: Option<PathBuf>,
+    #[command(flatten)]
+    pub format: QueryOutput,
+    #[command(flatten)]
+    pub location: StoreLocation,
+}
+
+/// Options of `gyrolab store lot`.
+#[derive(Debug, Args)]
+pub struct LotArgs {
+    /// Lot name.
+    pub lot: String,
+    /// Confidence level of the capability intervals.
+    #[arg(long, default_value_t = 0.95)]
+    pub confidence: f64,
+    #[command(flatten)]
+    pub format: QueryOutput,
+    #[command(flatten)]
+    pub location: StoreLocation,
+}
+
+/// Options of `gyrolab store compare`.
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// First lot.
+    pub lot1: String,
+    /// Second lot.
+    pub lot2: String,
+    #[command(flatten)]
+    pub format: QueryOutput,
+    #[command(flatten)]
+    pub location: StoreLocation,
+}
+
+/// Options of `gyrolab store chart`.
+#[derive(Debug, Args)]
+pub struct ChartArgs {
+    /// Figure key.
+    #[arg(long, value_name = "KEY")]
+    pub figure: String,
+    /// Axis name.
+    #[arg(long, value_name = "AXIS")]
+    pub axis: String,
+    /// Individuals chart over this lot only (default: every device).
+    #[arg(long, value_name = "LOT")]
+    pub lot: Option<String>,
+    #[command(flatten)]
+    pub format: QueryOutput,
+    #[command(flatten)]
+    pub location: StoreLocation,
+}
+
+/// Options of `gyrolab store revise`.
+#[derive(Debug, Args)]
+pub struct ReviseArgs {
+    /// The evaluation to supersede (a current revision).
+    pub id: i64,
+    /// correction or approval.
+    #[arg(long, value_enum)]
+    pub kind: ReviseKind,
+    /// Who makes the revision (the approver of an approval).
+    #[arg(long, value_name = "NAME")]
+    pub by: String,
+    /// Why.
+    #[arg(long, value_name = "TEXT")]
+    pub reason: String,
+    /// Corrected serial.
+    #[arg(long)]
+    pub serial: Option<String>,
+    /// Corrected model.
+    #[arg(long)]
+    pub model: Option<String>,
+    /// Corrected lot.
+    #[arg(long)]
+    pub lot: Option<String>,
+    /// Corrected operator.
+    #[arg(long)]
+    pub operator: Option<String>,
+    /// Corrected test date.
+    #[arg(long)]
+    pub test_date: Option<String>,
+    #[command(flatten)]
+    pub location: StoreLocation,
+}
+
+/// Options of `gyrolab store reevaluate`.
+#[derive(Debug, Args)]
+pub struct ReevaluateArgs {
+    /// The evaluation to re-run (a current revision).
+    pub id: i64,
+    /// Folder for the new report.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Who re-evaluates.
+    #[arg(long, value_name = "NAME")]
+    pub by: String,
+    /// Why.
+    #[arg(long, value_name = "TEXT")]
+    pub reason: String,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub location: StoreLocation,
+}
+
+fn open(location: &StoreLocation, create: bool) -> CliResult<Store> {
+    Ok(Store::open(&resolve_location(location.store.as_deref(), None), create)?)
+}
+
+/// Runs `gyrolab store`.
+pub fn run(cmd: &StoreCommand) -> CliResult {
+    match cmd {
+        StoreCommand::Add(a) => {
+            let mut out = String::new();
+            for d in &a.dirs {
+                let (id, name) = add_report_folder(d, a.plan.as_deref(), a.location.store.as_deref())?;
+                out.push_str(&format!("stored {} as evaluation {id} in {name}\n", d.display()));
+            }
+            print(&out)
+        }
+        StoreCommand::Show(a) => {
+            let mut s = open(&a.location, false)?;
+            let e = s.evaluation(a.id)?;
+            if a.json {
+                return print(&to_json(&e)?);
+            }
+            print(&show_text(&e))
+        }
+        StoreCommand::History(a) => history(a),
+        StoreCommand::Lot(a) => {
+            if !(a.confidence > 0.0 && a.confidence < 1.0) {
+                return Err(CliError::Usage(format!("--confidence {}: must be between 0 and 1", a.confidence)));
+            }
+            let mut s = open(&a.location, false)?;
+            let rows = query::lot(&mut s, &a.lot, a.confidence)?;
+            emit(&lot_table(&rows), &a.format, || to_json(&rows))
+        }
+        StoreCommand::Compare(a) => {
+            let mut s = open(&a.location, false)?;
+            let rows = query::compare(&mut s, &a.lot1, &a.lot2)?;
+            emit(&compare_table(&rows), &a.format, || to_json(&rows))
+        }
+        StoreCommand::Chart(a) => {
+            let mut s = open(&a.location, false)?;
+            let c = query::control_charts(&mut s, a.lot.as_deref(), &a.axis, &a.figure)?;
+            emit(&chart_table(&c), &a.format, || to_json(&c))
+        }
+        StoreCommand::Revise(a) => {
+            let mut s = open(&a.location, false)?;
+            let kind = match a.kind {
+                ReviseKind::Correction => RevisionKind::Correction,
+                ReviseKind::Approval => RevisionKind::Approval,
+            };
+            let changes = Changes {
+                serial: a.serial.clone(),
+                model: a.model.clone(),
+                lot: a.lot.clone(),
+                operator: a.operator.clone(),
+                approver: None,
+                test_date: a.test_date.clone(),
+            };
+            let r = Revision { supersedes: a.id, kind, by: a.by.clone(), reason: a.reason.clone() };
+            let id = s.revise(&r, &changes, None)?;
+            print(&format!("stored {} of evaluation {} as evaluation {id} in {}\n", kind.as_str(), a.id, s.name()))
+        }
+        StoreCommand::Reevaluate(a) => {
+            let mut s = open(&a.location, false)?;
+            let r = reevaluate::reevaluate(&mut s, a.id, &a.by, &a.reason, &a.out)?;
+            if a.json {
+                return print(&to_json(&r)?);
+            }
+            let mut out = format!(
+                "re-evaluated evaluation {} (gyrolab {}) under gyrolab {}: evaluation {}, report in {}\n\
+                 overall verdict: {} -> {}\n{} figure(s) changed\n",
+                r.superseded,
+                r.software_before,
+                r.software_after,
+                r.revision,
+                a.out.display(),
+                r.verdict_before.as_deref().unwrap_or("none"),
+                r.verdict_after.as_deref().unwrap_or("none"),
+                r.changes.len()
+            );
+            if !r.changes.is_empty() {
+                out.push_str(&text_table(&diff_table(&r.changes)));
+            }
+            print(&out)
+        }
+    }
+}
+
+fn num(v: Option<f64>) -> Cell {
+    Cell::number(v)
+}
+
+fn text(v: &str) -> Cell {
+    Cell::Text(v.to_string())
+}
+
+fn opt(v: &Option<String>) -> Cell {
+    Cell::text(v.as_deref())
+}
+
+/// Prints a query's table as text, CSV or JSON (`json` makes the JSON), and writes the Parquet
+/// file of `--parquet` first (whole or not at all).
+fn emit(table: &Table, output: &QueryOutput, json: impl FnOnce() -> CliResult<String>) -> CliResult {
+    if let Some(path) = &output.parquet {
+        write_file(path, &to_parquet(table)?)?;
+    }
+    if output.json {
+        print(&json()?)
+    } else if output.csv {
+        print(&to_csv(table))
+    } else {
+        print(&text_table(table))
+    }
+}
+
+/// A table as aligned text: numbers with 6 significant digits, control characters escaped.
+fn text_table(table: &Table) -> String {
+    let shown: Vec<Vec<String>> = table
+        .rows
+        .iter()
+        .map(|r| {
+            r.iter()
+                .map(|c| match c {
+                    Cell::Number(x) => sig_opt(Some(*x), 6),
+                    Cell::Text(t) => t
+                        .chars()
+                        .flat_map(|c| if c.is_control() { c.escape_default().collect::<Vec<_>>() } else { vec![c] })
+                        .collect(),
+                    other => other.raw(),
+                })
+                .collect()
+        })
+        .collect();
+    let mut width: Vec<usize> = table.columns.iter().map(|h| h.chars().count()).collect();
+    for r in &shown {
+        for (i, f) in r.iter().enumerate() {
+            if let Some(w) = width.get_mut(i) {
+                *w = (*w).max(f.chars().count());
+            }
+        }
+    }
+    let mut out = String::new();
+    for r in std::iter::once(&table.columns).chain(shown.iter()) {
+        let line: Vec<String> =
+            r.iter().enumerate().map(|(i, f)| format!("{f:<w$}", w = width.get(i).copied().unwrap_or(0))).collect();
+        out.push_str(line.join("  ").trim_end());
+        out.push('\n');
+    }
+    out
+}
+
+fn strings(v: &[&str]) -> Vec<String> {
+    v.iter().map(|s| s.to_string()).collect()
+}
+
+fn history(a: &HistoryArgs) -> CliResult {
+    let mut s = open(&a.location, false)?;
+    let mut rows = query::history(&mut s, &a.serial)?;
+    if let Some(f) = &a.figure {
+        rows.retain(|r| &r.figure.figure == f);
+    }
+    if let Some(path) = &a.svg {
+        write_file(path, history_svg(&a.serial, &rows)?.as_bytes())?;
+    }
+    let head = strings(&[
+        "evaluation",
+        "supersedes",
+        "current",
+        "revision",
+        "tested",
+        "gyrolab",
+        "axis",
+        "figure",
+        "value",
+        "unit",
+        "basis",
+        "U",
+        "k",
+        "limit_min",
+        "limit_max",
+        "verdict",
+        "simulated",
+    ]);
+    let body = rows
+        .iter()
+        .map(|r| {
+            vec![
+                Cell::Count(r.evaluation),
+                r.supersedes.map_or(Cell::Empty, Cell::Count),
+                text(if r.current { "yes" } else { "no" }),
+                text(&r.revision_kind),
+                text(&r.tested),
+                text(&r.software_version),
+                text(&r.figure.axis),
+                text(&r.figure.figure),
+                num(r.figure.value),
+                text(&r.figure.unit),
+                text(&r.figure.basis),
+                num(r.figure.expanded_uncertainty),
+                num(r.figure.coverage_factor),
+                num(r.figure.limit_min),
+                num(r.figure.limit_max),
+                opt(&r.figure.verdict),
+                text(if r.figure.simulated { "SIMULATED" } else { "" }),
+            ]
+        })
+        .collect();
+    emit(&Table { columns: head, rows: body }, &a.format, || to_json(&rows))
+}
+
+/// The trend plot of a history: one panel per (axis, figure), value against evaluation number,
+/// limits as horizontal lines; SIMULATED in the title when any value is.
+fn history_svg(serial: &str, rows: &[query::HistoryRow]) -> CliResult<String> {
+    let mut keys: Vec<(String, String, String)> = Vec::new();
+    for r in rows {
+        let k = (r.figure.axis.clone(), r.figure.figure.clone(), r.figure.unit.clone());
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    let mut panels = Vec::new();
+    for (axis, fig, unit) in &keys {
+        let pts: Vec<&query::HistoryRow> =
+            rows.iter().filter(|r| r.figure.axis == *axis && r.figure.figure == *fig).collect();
+        let points: Vec<(f64, f64)> =
+            pts.iter().filter_map(|r| r.figure.value.map(|v| (r.evaluation as f64, v))).collect();
+        if points.is_empty() {
+            continue;
+        }
+        let mut p = Panel::new(Axis::linear("evaluation id"), Axis::linear(format!("{fig} ({unit})")));
+        p.caption = format!("axis {axis}: {fig}");
+        p.series.push(Series::new(fig.clone(), points, SeriesStyle::LineMarkers, 0));
+        let last = pts.last();
+        for (at, label) in
+            [(last.and_then(|r| r.figure.limit_min), "limit min"), (last.and_then(|r| r.figure.limit_max), "limit max")]
+        {
+            if let Some(at) = at {
+                p.ref_lines.push(RefLine { orientation: Orientation::Horizontal, at, label: label.into() });
+            }
+        }
+        panels.push(p);
+    }
+    if panels.is_empty() {
+        return Err(CliError::Usage(format!("serial {serial:?}: no values to plot")));
+    }
+    let simulated = if rows.iter().any(|r| r.figure.simulated) { " (SIMULATED)" } else { "" };
+    let height = 60 + 260 * panels.len() as u32;
+    let f = Figure { title: format!("History of serial {serial}{simulated}"), panels, width: 760, height };
+    let svg = f.to_svg().map_err(|e| CliError::Output(e.to_string()))?;
+    let svg =
+        if svg.contains("xmlns=") { svg } else { svg.replacen("<svg", "<svg xmlns=\"http://www.w3.org/2000/svg\"", 1) };
+    Ok(format!("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n{svg}\n"))
+}
+
+fn index_cols(i: Option<gyrolab::process_capability::Index>) -> [Cell; 3] {
+    match i {
+        Some(i) => [num(Some(i.value)), num(i.interval.map(|c| c.lower)), num(i.interval.map(|c| c.upper))],
+        None => [Cell::Empty, Cell::Empty, Cell::Empty],
+    }
+}
+
+fn lot_table(rows: &[query::LotFigure]) -> Table {
+    let head = strings(&[
+        "axis",
+        "figure",
+        "unit",
+        "n",
+        "mean",
+        "sd",
+        "min",
+        "max",
+        "limit_min",
+        "limit_max",
+        "yield",
+        "Cp",
+        "Cp_lo",
+        "Cp_hi",
+        "Cpk",
+        "Cpk_lo",
+        "Cpk_hi",
+        "Pp",
+        "Pp_lo",
+        "Pp_hi",
+        "Ppk",
+        "Ppk_lo",
+        "Ppk_hi",
+        "outliers",
+        "simulated",
+    ]);
+    let body = rows
+        .iter()
+        .map(|r| {
+            let s = &r.statistics;
+            let mut v = vec![
+                text(&r.axis),
+                text(&r.figure),
+                text(&r.unit),
+                Cell::Count(s.n as i64),
+                num(Some(s.mean)),
+                num(s.sd),
+                num(Some(s.min)),
+                num(Some(s.max)),
+                num(r.limit_min),
+                num(r.limit_max),
+                num(s.yield_fraction),
+            ];
+            for i in [s.cp, s.cpk, s.pp, s.ppk] {
+                v.extend(index_cols(i));
+            }
+            v.push(text(&r.outlier_serials.join(" ")));
+            v.push(text(if r.simulated { "SIMULATED" } else { "" }));
+            v
+        })
+        .collect();
+    Table { columns: head, rows: body }
+}
+
+fn compare_table(rows: &[query::LotComparison]) -> Table {
+    let head = strings(&[
+        "axis",
+        "figure",
+        "unit",
+        "n1",
+        "n2",
+        "mean1",
+        "mean2",
+        "difference",
+        "welch_t",
+        "dof",
+        "p_means",
+        "sd_ratio",
+        "F",
+        "p_spreads",
+    ]);
+    let body = rows
+        .iter()
+        .map(|r| {
+            let t = r.test;
+            vec![
+                text(&r.axis),
+                text(&r.figure),
+                text(&r.unit),
+                Cell::Count(r.n1 as i64),
+                Cell::Count(r.n2 as i64),
+                num(Some(r.mean1)),
+                num(Some(r.mean2)),
+                num(Some(r.mean1 - r.mean2)),
+                num(t.map(|t| t.t)),
+                num(t.map(|t| t.t_dof)),
+                num(t.map(|t| t.t_p_value)),
+                num(t.map(|t| t.sd_ratio)),
+                num(t.map(|t| t.f)),
+                num(t.map(|t| t.f_p_value)),
+            ]
+        })
+        .collect();
+    Table { columns: head, rows: body }
+}
+
+fn chart_table(c: &query::ControlCharts) -> Table {
+    let head = strings(&["chart", "point", "label", "value", "center", "lcl", "ucl", "violations"]);
+    let mut body = Vec::new();
+    let mut add = |name: &str, chart: &Option<gyrolab::control_chart::Chart>, labels: &dyn Fn(usize) -> String| {
+        if let Some(ch) = chart {
+            for (i, v) in ch.points.iter().enumerate() {
+                let rules: Vec<String> =
+                    ch.violations.iter().filter(|x| x.index == i).map(|x| format!("nelson {}", x.rule)).collect();
+                body.push(vec![
+                    text(name),
+                    Cell::Count(i as i64 + 1),
+                    Cell::Text(labels(i)),
+                    num(Some(*v)),
+                    num(Some(ch.center)),
+                    num(Some(ch.lcl[i])),
+                    num(Some(ch.ucl[i])),
+                    text(&rules.join(" ")),
+                ]);
+            }
+        }
+    };
+    add("individuals", &c.individuals, &|i| c.serials.get(i).cloned().unwrap_or_default());
+    add("moving_range", &c.moving_range, &|i| {
+        format!(
+            "{}-{}",
+            c.serials.get(i).cloned().unwrap_or_default(),
+            c.serials.get(i + 1).cloned().unwrap_or_default()
+        )
+    });
+    add("xbar", &c.xbar, &|i| c.lots.get(i).cloned().unwrap_or_default());
+    add("s", &c.s, &|i| c.lots.get(i).cloned().unwrap_or_default());
+    Table { columns: head, rows: body }
+}
+
+fn diff_table(rows: &[query::FigureChange]) -> Table {
+    let head = strings(&["axis", "figure", "unit", "before", "after", "difference", "verdict_before", "verdict_after"]);
+    let body = rows
+        .iter()
+        .map(|r| {
+            vec![
+                text(&r.axis),
+                text(&r.figure),
+                text(&r.unit),
+                num(r.before),
+                num(r.after),
+                num(r.difference),
+                opt(&r.verdict_before),
+                opt(&r.verdict_after),
+            ]
+        })
+        .collect();
+    Table { columns: head, rows: body }
+}
+
+fn show_text(e: &query::StoredEvaluation) -> String {
+    let r = &e.record;
+    let o = |v: &Option<String>| v.clone().unwrap_or_else(|| "-".into());
+    let mut s = format!(
+        "evaluation {} ({}{}{})\n",
+        e.id,
+        e.revision_kind,
+        e.supersedes.map_or_else(String::new, |x| format!(", supersedes {x}")),
+        e.superseded_by.map_or_else(|| ", current".to_string(), |x| format!(", superseded by {x}"))
+    );
+    if let (Some(by), Some(why)) = (&e.revision_by, &e.revision_reason) {
+        s.push_str(&format!("revision by {by:?}: {why:?}\n"));
+    }
+    s.push_str(&format!(
+        "stored {}\ndevice {:?} serial {:?} lot {}\noperator {} approver {} tested {}\nevaluated {} with gyrolab {}\nplan {} (SHA-256 {})\nverdict {}{}\n",
+        e.stored_at,
+        r.model,
+        r.serial,
+        o(&r.lot),
+        o(&r.operator),
+        o(&r.approver),
+        o(&r.test_date),
+        r.evaluated_at,
+        r.software_version,
+        r.plan_path,
+        r.plan_sha256,
+        o(&r.verdict),
+        if r.simulated { " (SIMULATED inputs)" } else { "" }
+    ));
+    s.push_str("inputs:\n");
+    for f in &r.inputs {
+        s.push_str(&format!("  {} {} bytes SHA-256 {}\n", f.path, f.size_bytes, f.sha256));
+    }
+    s.push_str(&format!("{} figures, {} report files\n", r.figures.len(), r.report_files.len()));
+    s
+}
