@@ -15,7 +15,7 @@ pub mod record;
 pub mod reevaluate;
 pub mod schema;
 
-use db::{Exec, Kind, PgExec, SqliteExec, Val};
+use db::{Exec, Kind, PgExec, PgStatements, SqliteExec, Val};
 use record::EvaluationRecord;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -156,6 +156,7 @@ pub struct Store {
     conn: Conn,
     name: String,
     password: Option<String>,
+    statements: PgStatements,
 }
 
 const SQLITE_HEADER: &[u8; 16] = b"SQLite format 3\0";
@@ -184,7 +185,7 @@ impl Store {
                     e.as_db_error().map_or_else(|| e.to_string(), |d| d.message().to_string())
                 )),
             })?;
-            Store { conn: Conn::Postgres(Box::new(client)), name, password }
+            Store { conn: Conn::Postgres(Box::new(client)), name, password, statements: PgStatements::new() }
         } else {
             let path = Path::new(location);
             let open_err = |m: String| StoreError::Open { store: name.clone(), message: m };
@@ -217,7 +218,7 @@ impl Store {
             }
             let conn = rusqlite::Connection::open(path).map_err(|e| open_err(e.to_string()))?;
             conn.busy_timeout(Duration::from_secs(30)).map_err(|e| open_err(e.to_string()))?;
-            let mut store = Store { conn: Conn::Sqlite(conn), name, password: None };
+            let mut store = Store { conn: Conn::Sqlite(conn), name, password: None, statements: PgStatements::new() };
             store.check_foreign_sqlite()?;
             if let Conn::Sqlite(c) = &store.conn {
                 c.pragma_update(None, "journal_mode", "WAL").map_err(|e| store.open_error(e.to_string()))?;
@@ -293,7 +294,7 @@ impl Store {
             }
             Conn::Postgres(c) => {
                 let mut tx = c.transaction().map_err(|e| dberr(e.to_string()))?;
-                let out = f(&mut PgExec(&mut tx))?;
+                let out = f(&mut PgExec(&mut tx, &mut self.statements))?;
                 tx.commit().map_err(|e| dberr(e.to_string()))?;
                 Ok(out)
             }
@@ -304,7 +305,7 @@ impl Store {
     pub(crate) fn query(&mut self, sql: &str, params: &[Val], kinds: &[Kind]) -> StoreResult<Vec<Vec<Val>>> {
         let r = match &mut self.conn {
             Conn::Sqlite(c) => SqliteExec(c).query(sql, params, kinds),
-            Conn::Postgres(c) => PgExec(c.as_mut()).query(sql, params, kinds),
+            Conn::Postgres(c) => PgExec(c.as_mut(), &mut self.statements).query(sql, params, kinds),
         };
         r.map_err(|e| self.db_error(e))
     }

@@ -255,8 +255,9 @@ pub struct FigureSeries {
     pub simulated: bool,
 }
 
-/// Values (serial, id, test order key, value), limits and id of the latest evaluation, simulated.
-type Group = (Vec<(String, i64, String, f64)>, Option<f64>, Option<f64>, i64, bool);
+/// Values (serial, id, test order key, value), limits and id of the latest evaluation, simulated;
+/// texts borrowed from the query's rows (no copy per row).
+type Group<'a> = (Vec<(&'a str, i64, &'a str, f64)>, Option<f64>, Option<f64>, i64, bool);
 
 /// One series per (axis, figure, unit) of the current evaluations in `lot` (all lots: `None`),
 /// each device once (its latest current evaluation).
@@ -278,7 +279,7 @@ pub fn lot_series(store: &mut Store, lot: Option<&str>) -> StoreResult<Vec<Figur
         let e = latest.entry(r[1].text().unwrap_or_default()).or_insert(i64::MIN);
         *e = (*e).max(r[0].int());
     }
-    let mut groups: BTreeMap<(String, String, String), Group> = BTreeMap::new();
+    let mut groups: BTreeMap<(&str, &str, &str), Group> = BTreeMap::new();
     for r in &rows {
         let serial = r[1].text().unwrap_or_default();
         let id = r[0].int();
@@ -286,14 +287,9 @@ pub fn lot_series(store: &mut Store, lot: Option<&str>) -> StoreResult<Vec<Figur
             continue;
         }
         let Some(v) = r[6].float() else { continue };
-        let g = groups.entry((r[3].string(), r[4].string(), r[5].string())).or_insert((
-            Vec::new(),
-            None,
-            None,
-            i64::MIN,
-            false,
-        ));
-        g.0.push((serial.to_string(), id, r[2].string(), v));
+        let key = (r[3].text().unwrap_or_default(), r[4].text().unwrap_or_default(), r[5].text().unwrap_or_default());
+        let g = groups.entry(key).or_insert((Vec::new(), None, None, i64::MIN, false));
+        g.0.push((serial, id, r[2].text().unwrap_or_default(), v));
         if id > g.3 {
             g.1 = r[7].float();
             g.2 = r[8].float();
@@ -304,14 +300,14 @@ pub fn lot_series(store: &mut Store, lot: Option<&str>) -> StoreResult<Vec<Figur
     Ok(groups
         .into_iter()
         .map(|((axis, figure, unit), (mut v, lo, hi, _, sim))| {
-            v.sort_by(|a, b| a.2.cmp(&b.2).then(a.1.cmp(&b.1)));
+            v.sort_by(|a, b| a.2.cmp(b.2).then(a.1.cmp(&b.1)));
             FigureSeries {
-                axis,
-                figure,
-                unit,
+                axis: axis.to_string(),
+                figure: figure.to_string(),
+                unit: unit.to_string(),
                 limit_min: lo,
                 limit_max: hi,
-                values: v.into_iter().map(|(s, id, _, x)| (s, id, x)).collect(),
+                values: v.into_iter().map(|(s, id, _, x)| (s.to_string(), id, x)).collect(),
                 simulated: sim,
             }
         })

@@ -8,7 +8,7 @@ use crate::folder::write_and_finish;
 use crate::progress::Bar;
 use clap::Args;
 use gyrolab_eval::test_plan::{evaluate_test_plan, read_test_plan};
-use gyrolab_store::record::from_report_folder;
+use gyrolab_store::record::{from_report_folder_with, hash_plan_inputs};
 use gyrolab_store::{resolve_location, Store, StoreError};
 use std::path::PathBuf;
 
@@ -41,27 +41,42 @@ pub struct EvalArgs {
 /// Runs `gyrolab eval`.
 pub fn run(args: &EvalArgs) -> CliResult {
     let plan = read_test_plan(&args.plan)?;
-    // The store is checked before anything is evaluated or written: a corrupt, foreign or newer
-    // store, or a server that is down, ends here with exit 2 and no report folder. A store that
-    // does not exist yet is created once the folder is written.
+    // With --store, a second thread opens and checks the store (connects, migrates) and hashes
+    // the inputs while the plan is evaluated. A corrupt, foreign or newer store, or a server that
+    // is down or refuses the password, ends the run with exit 2 before the report folder is
+    // written. A store that does not exist yet is created once the folder is written.
     let location = args.store.as_deref().map(|s| {
         let plan_dir = args.plan.parent().filter(|p| !p.as_os_str().is_empty());
         resolve_location(Some(s), plan_dir)
     });
-    let mut store = match &location {
-        Some(l) => match Store::open(l, false) {
-            Ok(s) => Some(s),
-            Err(StoreError::NotFound { .. }) => None,
-            Err(e) => return Err(e.into()),
-        },
-        None => None,
-    };
     let bar = Bar::new(args.quiet);
-    let folder = evaluate_test_plan(&plan, &args.plan.display().to_string(), &bar);
+    let (folder, prepared) = std::thread::scope(|scope| {
+        let preparing = location.as_deref().map(|l| {
+            scope.spawn(move || {
+                let store = match Store::open(l, false) {
+                    Ok(s) => Ok(Some(s)),
+                    Err(StoreError::NotFound { .. }) => Ok(None),
+                    Err(e) => Err(e),
+                };
+                (store, hash_plan_inputs(&args.plan))
+            })
+        });
+        let folder = evaluate_test_plan(&plan, &args.plan.display().to_string(), &bar);
+        (folder, preparing.map(|h| h.join()))
+    });
     bar.finish();
+    let (mut store, inputs) = match prepared {
+        None => (None, None),
+        Some(Ok((store, inputs))) => (store?, Some(inputs)),
+        Some(Err(_)) => return Err(CliError::Output("the thread opening the store failed".into())),
+    };
     let result = write_and_finish(&args.out, &folder?, args.quiet, args.pdf);
     if let (Some(l), Ok(()) | Err(CliError::LimitFailed(_))) = (&location, &result) {
-        let record = from_report_folder(&args.out, Some(&args.plan))?;
+        let inputs = match inputs {
+            Some(hashed) => Some(hashed?),
+            None => None,
+        };
+        let record = from_report_folder_with(&args.out, Some(&args.plan), inputs)?;
         let mut s = match store.take() {
             Some(s) => s,
             None => Store::open(l, true)?,
