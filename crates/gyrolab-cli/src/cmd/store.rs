@@ -29,7 +29,7 @@ pub enum StoreCommand {
     Add(AddArgs),
     /// One stored evaluation: device, plan hash, inputs, revisions, figures.
     Show(ShowArgs),
-    /// Every figure of a serial over time and revisions, with limits (`--svg` trend plot).
+    /// Every figure of a serial over time and revisions, with limits (`--plot` SVG trend plot).
     History(HistoryArgs),
     /// Lot statistics per figure: n, mean, sd, min, max, yield, Cp/Cpk, Pp/Ppk with intervals, outliers.
     Lot(LotArgs),
@@ -77,7 +77,7 @@ pub struct HistoryArgs {
     #[arg(long, value_name = "KEY")]
     pub figure: Option<String>,
     /// Also write an SVG trend plot (one panel per axis and figure, limits as lines).
-    #[arg(long, visible_alias = "plot", value_name = "FILE.svg")]
+    #[arg(long = "plot", visible_alias = "svg", value_name = "FILE.svg")]
     pub svg: Option<PathBuf>,
     #[command(flatten)]
     pub format: QueryOutput,
