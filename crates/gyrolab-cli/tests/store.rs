@@ -11,7 +11,6 @@ use assert_cmd::Command;
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -29,48 +28,12 @@ fn gyrolab_process() -> std::process::Command {
     c
 }
 
-/// A store location for one test: an SQLite file in its own folder, or a fresh schema of the
-/// PostgreSQL test server.
-struct Backend {
-    location: String,
-    name: &'static str,
-    _dir: Option<tempfile::TempDir>,
-}
-
-static COUNTER: AtomicUsize = AtomicUsize::new(0);
-
-fn pg_url(test: &str) -> Option<String> {
-    match std::env::var("GYROLAB_TEST_PG_URL") {
-        Ok(u) if !u.is_empty() => Some(u),
-        _ => {
-            if std::env::var("CI").is_ok_and(|v| v == "true") {
-                panic!("GYROLAB_TEST_PG_URL is not set under CI=true: the PostgreSQL CLI store tests must run (scripts/pg-test-server.sh)");
-            }
-            eprintln!(
-                "SKIPPED: {test} on PostgreSQL: GYROLAB_TEST_PG_URL is not set (run under scripts/pg-test-server.sh)"
-            );
-            None
-        }
-    }
-}
-
-fn backends(test: &str) -> Vec<Backend> {
-    let dir = tempfile::tempdir().unwrap();
-    let mut out =
-        vec![Backend { location: dir.path().join("lab.db").display().to_string(), name: "sqlite", _dir: Some(dir) }];
-    if let Some(url) = pg_url(test) {
-        let schema = format!("cli_{test}_{}_{}", std::process::id(), COUNTER.fetch_add(1, Ordering::SeqCst));
-        let mut c = postgres::Client::connect(&url, postgres::NoTls).expect("connect to the test server");
-        c.batch_execute(&format!("CREATE SCHEMA {schema}")).unwrap();
-        let sep = if url.contains('?') { '&' } else { '?' };
-        out.push(Backend {
-            location: format!("{url}{sep}options=-c%20search_path%3D{schema}"),
-            name: "postgres",
-            _dir: None,
-        });
-    }
-    out
-}
+// The back ends of the store's own tests (an SQLite file in a new folder, a new schema of the
+// PostgreSQL test server): one implementation, and the SQL that makes the schema stays in the
+// gyrolab-store crate.
+#[path = "../../gyrolab-store/tests/common/mod.rs"]
+mod common;
+use common::backends;
 
 /// A TOML basic string holding `s` exactly.
 fn toml_str(s: &str) -> String {
