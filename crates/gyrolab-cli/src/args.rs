@@ -142,3 +142,28 @@ pub fn stated_reference_note(file: &str, r: &gyrolab_eval::simulate::StatedRefer
         r.scale_factor_per_dps, r.null
     )
 }
+
+/// Where the records store is (`gyrolab store ...`; docs/STORE.md).
+#[derive(Debug, Clone, Args)]
+pub struct StoreLocation {
+    /// The store: an SQLite file or a postgres:// URL (default: GYROLAB_STORE, else gyrolab.db
+    /// in the current folder; for `store add`, beside the plan).
+    #[arg(long = "store", value_name = "PATH|URL")]
+    pub store: Option<String>,
+}
+
+/// How a store query prints its table: aligned text (default), `--json` or `--csv` on standard
+/// output, and optionally a Parquet file of the same table.
+#[derive(Debug, Clone, Args)]
+pub struct QueryOutput {
+    /// Print JSON instead of the text table.
+    #[arg(long, conflicts_with = "csv")]
+    pub json: bool,
+    /// Print CSV instead of the text table (one header row; units in a column).
+    #[arg(long)]
+    pub csv: bool,
+    /// Also write the table to this Parquet file (same columns as the CSV; numbers DOUBLE,
+    /// counts INT64, empty cells null).
+    #[arg(long, value_name = "FILE.parquet")]
+    pub parquet: Option<PathBuf>,
+}

@@ -22,6 +22,12 @@ pub enum CliError {
     /// Some inputs of a batch failed; the others were evaluated and written (exit 4).
     #[error("{0}")]
     SomeFailed(String),
+    /// An error of the records store (exit 2 for the store or data, 1 for a database failure).
+    #[error("{0}")]
+    Store(#[from] gyrolab_store::StoreError),
+    /// A bad argument found after parsing (exit 2).
+    #[error("{0}")]
+    Usage(String),
 }
 
 impl CliError {
@@ -32,6 +38,8 @@ impl CliError {
             CliError::Eval(_) => ExitCode::from(2),
             CliError::LimitFailed(_) => ExitCode::from(3),
             CliError::SomeFailed(_) => ExitCode::from(4),
+            CliError::Store(e) if !e.is_bad_input() => ExitCode::from(1),
+            CliError::Store(_) | CliError::Usage(_) => ExitCode::from(2),
         }
     }
 }

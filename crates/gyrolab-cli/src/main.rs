@@ -51,6 +51,9 @@ enum Command {
     Batch(Box<cmd::batch::BatchArgs>),
     /// Run the paper's worked example on its data (built in) and compare with its printed tables.
     Demo(cmd::demo::DemoArgs),
+    /// The records store: add report folders; history, lot statistics, comparison, control charts, revisions.
+    #[command(subcommand)]
+    Store(cmd::store::StoreCommand),
 }
 
 fn main() -> ExitCode {
@@ -74,6 +77,7 @@ fn main() -> ExitCode {
         Command::Convert(a) => cmd::convert::run(a),
         Command::Simulate(c) => cmd::simulate::run(c),
         Command::Plan(c) => cmd::record_length::run(c),
+        Command::Store(c) => cmd::store::run(c),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

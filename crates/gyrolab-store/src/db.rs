@@ -136,19 +136,37 @@ fn pg_error(e: postgres::Error) -> String {
     }
 }
 
-/// PostgreSQL statements on a client or a transaction.
-pub struct PgExec<'a, C: postgres::GenericClient>(pub &'a mut C);
+/// Prepared statements of one PostgreSQL connection, by their SQL text (a statement is prepared
+/// once per connection, then each use is one round trip instead of two; prepared statements are
+/// not undone by a rollback).
+pub type PgStatements = std::collections::HashMap<String, postgres::Statement>;
+
+/// PostgreSQL statements on a client or a transaction, with the connection's prepared statements.
+pub struct PgExec<'a, C: postgres::GenericClient>(pub &'a mut C, pub &'a mut PgStatements);
+
+impl<C: postgres::GenericClient> PgExec<'_, C> {
+    fn statement(&mut self, sql: &str) -> Result<postgres::Statement, String> {
+        if let Some(st) = self.1.get(sql) {
+            return Ok(st.clone());
+        }
+        let st = self.0.prepare(sql).map_err(pg_error)?;
+        self.1.insert(sql.to_string(), st.clone());
+        Ok(st)
+    }
+}
 
 impl<C: postgres::GenericClient> Exec for PgExec<'_, C> {
     fn exec(&mut self, sql: &str, params: &[Val]) -> Result<u64, String> {
+        let st = self.statement(sql)?;
         let p = pg_params(params);
         let refs: Vec<&(dyn postgres::types::ToSql + Sync)> = p.iter().map(|b| b.as_ref()).collect();
-        self.0.execute(sql, &refs).map_err(pg_error)
+        self.0.execute(&st, &refs).map_err(pg_error)
     }
     fn query(&mut self, sql: &str, params: &[Val], kinds: &[Kind]) -> Result<Vec<Vec<Val>>, String> {
+        let st = self.statement(sql)?;
         let p = pg_params(params);
         let refs: Vec<&(dyn postgres::types::ToSql + Sync)> = p.iter().map(|b| b.as_ref()).collect();
-        let rows = self.0.query(sql, &refs).map_err(pg_error)?;
+        let rows = self.0.query(&st, &refs).map_err(pg_error)?;
         rows.iter()
             .map(|r| {
                 kinds

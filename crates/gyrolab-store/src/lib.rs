@@ -6,15 +6,16 @@
 //! Layout: [`db`] the two back ends behind one interface; [`schema`] tables and migrations;
 //! [`record`] what is kept of one evaluation, read from a finished report folder; [`query`] the
 //! queries and their statistics (computed by the core crate: `gyrolab::process_capability`,
-//! `gyrolab::control_chart`, `gyrolab::two_sample`).
+//! `gyrolab::control_chart`, `gyrolab::two_sample`); [`export`] query tables as CSV and Parquet.
 
 pub mod db;
+pub mod export;
 pub mod query;
 pub mod record;
 pub mod reevaluate;
 pub mod schema;
 
-use db::{Exec, Kind, PgExec, SqliteExec, Val};
+use db::{Exec, Kind, PgExec, PgStatements, SqliteExec, Val};
 use record::EvaluationRecord;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -155,6 +156,7 @@ pub struct Store {
     conn: Conn,
     name: String,
     password: Option<String>,
+    statements: PgStatements,
 }
 
 const SQLITE_HEADER: &[u8; 16] = b"SQLite format 3\0";
@@ -183,7 +185,7 @@ impl Store {
                     e.as_db_error().map_or_else(|| e.to_string(), |d| d.message().to_string())
                 )),
             })?;
-            Store { conn: Conn::Postgres(Box::new(client)), name, password }
+            Store { conn: Conn::Postgres(Box::new(client)), name, password, statements: PgStatements::new() }
         } else {
             let path = Path::new(location);
             let open_err = |m: String| StoreError::Open { store: name.clone(), message: m };
@@ -216,7 +218,7 @@ impl Store {
             }
             let conn = rusqlite::Connection::open(path).map_err(|e| open_err(e.to_string()))?;
             conn.busy_timeout(Duration::from_secs(30)).map_err(|e| open_err(e.to_string()))?;
-            let mut store = Store { conn: Conn::Sqlite(conn), name, password: None };
+            let mut store = Store { conn: Conn::Sqlite(conn), name, password: None, statements: PgStatements::new() };
             store.check_foreign_sqlite()?;
             if let Conn::Sqlite(c) = &store.conn {
                 c.pragma_update(None, "journal_mode", "WAL").map_err(|e| store.open_error(e.to_string()))?;
@@ -292,7 +294,7 @@ impl Store {
             }
             Conn::Postgres(c) => {
                 let mut tx = c.transaction().map_err(|e| dberr(e.to_string()))?;
-                let out = f(&mut PgExec(&mut tx))?;
+                let out = f(&mut PgExec(&mut tx, &mut self.statements))?;
                 tx.commit().map_err(|e| dberr(e.to_string()))?;
                 Ok(out)
             }
@@ -303,7 +305,7 @@ impl Store {
     pub(crate) fn query(&mut self, sql: &str, params: &[Val], kinds: &[Kind]) -> StoreResult<Vec<Vec<Val>>> {
         let r = match &mut self.conn {
             Conn::Sqlite(c) => SqliteExec(c).query(sql, params, kinds),
-            Conn::Postgres(c) => PgExec(c.as_mut()).query(sql, params, kinds),
+            Conn::Postgres(c) => PgExec(c.as_mut(), &mut self.statements).query(sql, params, kinds),
         };
         r.map_err(|e| self.db_error(e))
     }
@@ -460,6 +462,7 @@ impl Store {
                 )
                 .map_err(&dberr)?;
             }
+            pause_for_test();
             Ok(id)
         });
         id.map_err(|e| match e {
@@ -585,6 +588,18 @@ pub struct Changes {
     pub approver: Option<String>,
     /// New test date.
     pub test_date: Option<String>,
+}
+
+/// The environment variable of the kill test (crates/gyrolab-cli/tests/store.rs): milliseconds
+/// to pause inside the transaction of every stored evaluation, after all its rows are written and
+/// before the commit, so that a test can kill the process there. Unset in normal use.
+pub const TEST_PAUSE_ENV: &str = "GYROLAB_STORE_TEST_PAUSE_MS";
+
+fn pause_for_test() {
+    if let Some(ms) = std::env::var(TEST_PAUSE_ENV).ok().and_then(|v| v.parse::<u64>().ok()) {
+        eprintln!("store: pausing {ms} ms inside the transaction ({TEST_PAUSE_ENV})");
+        std::thread::sleep(Duration::from_millis(ms));
+    }
 }
 
 /// Now, RFC 3339 UTC to the microsecond (sortable as text).

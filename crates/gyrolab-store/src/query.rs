@@ -14,7 +14,7 @@ use gyrolab::control_chart::{individuals_moving_range, xbar_s, Chart};
 use gyrolab::process_capability::{lot_statistics, LotStatistics};
 use gyrolab::two_sample::{compare_samples, TwoSampleComparison};
 use serde::Serialize;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 
 /// One stored evaluation and its place among the revisions.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -255,63 +255,75 @@ pub struct FigureSeries {
     pub simulated: bool,
 }
 
-/// Values (serial, id, test order key, value), limits and id of the latest evaluation, simulated.
-type Group = (Vec<(String, i64, String, f64)>, Option<f64>, Option<f64>, i64, bool);
+/// Values (serial, id, test order key, value), limits and id of the latest evaluation, simulated;
+/// texts borrowed from the query's rows (no copy per row).
+type Group<'a> = (Vec<(&'a str, i64, &'a str, f64)>, Option<f64>, Option<f64>, i64, bool);
 
 /// One series per (axis, figure, unit) of the current evaluations in `lot` (all lots: `None`),
 /// each device once (its latest current evaluation).
 pub fn lot_series(store: &mut Store, lot: Option<&str>) -> StoreResult<Vec<FigureSeries>> {
-    const SQL_LOT: &str = "SELECT e.id, e.serial, COALESCE(e.test_date, e.evaluated_at), f.axis, f.figure, f.unit, f.value, f.limit_min, \
-         f.limit_max, f.simulated FROM evaluation e JOIN figure f ON f.evaluation_id = e.id \
-         WHERE e.lot = $1 AND NOT EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id) AND f.value IS NOT NULL";
-    const SQL_ALL: &str = "SELECT e.id, e.serial, COALESCE(e.test_date, e.evaluated_at), f.axis, f.figure, f.unit, f.value, f.limit_min, \
-         f.limit_max, f.simulated FROM evaluation e JOIN figure f ON f.evaluation_id = e.id \
-         WHERE NOT EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id) AND f.value IS NOT NULL";
-    let kinds = [Kind::I, Kind::T, Kind::T, Kind::T, Kind::T, Kind::T, Kind::F, Kind::F, Kind::F, Kind::I];
-    let rows = match lot {
-        Some(l) => store.query(SQL_LOT, &[Val::T(Some(l.to_string()))], &kinds)?,
-        None => store.query(SQL_ALL, &[], &kinds)?,
+    // Two queries: the lot's current evaluations (one row each), then their figures (only the
+    // columns that change per figure). Figures of evaluations not chosen by the first query
+    // (superseded ones, or ones stored in between) are passed over.
+    const EVAL_LOT: &str = "SELECT e.id, e.serial, COALESCE(e.test_date, e.evaluated_at) FROM evaluation e \
+         WHERE e.lot = $1 AND NOT EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id)";
+    const EVAL_ALL: &str = "SELECT e.id, e.serial, COALESCE(e.test_date, e.evaluated_at) FROM evaluation e \
+         WHERE NOT EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id)";
+    const FIG_LOT: &str =
+        "SELECT f.evaluation_id, f.axis, f.figure, f.unit, f.value, f.limit_min, f.limit_max, f.simulated \
+         FROM figure f JOIN evaluation e ON e.id = f.evaluation_id WHERE e.lot = $1 AND f.value IS NOT NULL";
+    const FIG_ALL: &str =
+        "SELECT f.evaluation_id, f.axis, f.figure, f.unit, f.value, f.limit_min, f.limit_max, f.simulated \
+         FROM figure f WHERE f.value IS NOT NULL";
+    let eval_kinds = [Kind::I, Kind::T, Kind::T];
+    let fig_kinds = [Kind::I, Kind::T, Kind::T, Kind::T, Kind::F, Kind::F, Kind::F, Kind::I];
+    let lot_param = [Val::T(lot.map(str::to_string))];
+    let (evals, rows) = match lot {
+        Some(_) => (store.query(EVAL_LOT, &lot_param, &eval_kinds)?, store.query(FIG_LOT, &lot_param, &fig_kinds)?),
+        None => (store.query(EVAL_ALL, &[], &eval_kinds)?, store.query(FIG_ALL, &[], &fig_kinds)?),
     };
-    // The latest current evaluation per serial.
-    let mut latest: BTreeMap<&str, i64> = BTreeMap::new();
-    for r in &rows {
-        let e = latest.entry(r[1].text().unwrap_or_default()).or_insert(i64::MIN);
-        *e = (*e).max(r[0].int());
-    }
-    let mut groups: BTreeMap<(String, String, String), Group> = BTreeMap::new();
-    for r in &rows {
-        let serial = r[1].text().unwrap_or_default();
-        let id = r[0].int();
-        if latest.get(serial) != Some(&id) {
-            continue;
+    // The latest current evaluation per serial: id -> (serial, test order key).
+    let mut latest: HashMap<&str, (i64, &str)> = HashMap::with_capacity(evals.len());
+    for r in &evals {
+        let (id, serial, date) = (r[0].int(), r[1].text().unwrap_or_default(), r[2].text().unwrap_or_default());
+        let e = latest.entry(serial).or_insert((id, date));
+        if id > e.0 {
+            *e = (id, date);
         }
-        let Some(v) = r[6].float() else { continue };
-        let g = groups.entry((r[3].string(), r[4].string(), r[5].string())).or_insert((
-            Vec::new(),
-            None,
-            None,
-            i64::MIN,
-            false,
-        ));
-        g.0.push((serial.to_string(), id, r[2].string(), v));
+    }
+    let chosen: HashMap<i64, (&str, &str)> = latest.into_iter().map(|(s, (id, d))| (id, (s, d))).collect();
+    let mut index: HashMap<(&str, &str, &str), usize> = HashMap::new();
+    let mut groups: Vec<((&str, &str, &str), Group)> = Vec::new();
+    for r in &rows {
+        let id = r[0].int();
+        let Some(&(serial, date)) = chosen.get(&id) else { continue };
+        let Some(v) = r[4].float() else { continue };
+        let key = (r[1].text().unwrap_or_default(), r[2].text().unwrap_or_default(), r[3].text().unwrap_or_default());
+        let i = *index.entry(key).or_insert_with(|| {
+            groups.push((key, (Vec::new(), None, None, i64::MIN, false)));
+            groups.len() - 1
+        });
+        let g = &mut groups[i].1;
+        g.0.push((serial, id, date, v));
         if id > g.3 {
-            g.1 = r[7].float();
-            g.2 = r[8].float();
+            g.1 = r[5].float();
+            g.2 = r[6].float();
             g.3 = id;
         }
-        g.4 |= r[9].int() != 0;
+        g.4 |= r[7].int() != 0;
     }
+    groups.sort_by(|a, b| a.0.cmp(&b.0));
     Ok(groups
         .into_iter()
         .map(|((axis, figure, unit), (mut v, lo, hi, _, sim))| {
-            v.sort_by(|a, b| a.2.cmp(&b.2).then(a.1.cmp(&b.1)));
+            v.sort_by(|a, b| a.2.cmp(b.2).then(a.1.cmp(&b.1)));
             FigureSeries {
-                axis,
-                figure,
-                unit,
+                axis: axis.to_string(),
+                figure: figure.to_string(),
+                unit: unit.to_string(),
                 limit_min: lo,
                 limit_max: hi,
-                values: v.into_iter().map(|(s, id, _, x)| (s, id, x)).collect(),
+                values: v.into_iter().map(|(s, id, _, x)| (s.to_string(), id, x)).collect(),
                 simulated: sim,
             }
         })

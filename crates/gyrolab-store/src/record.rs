@@ -372,6 +372,33 @@ fn json_text(v: &serde_json::Value, keys: &[&str]) -> Option<String> {
 /// Reads the record of a finished report folder. `plan`: the plan file (default: the
 /// `plan_file` results.json names, as written, relative to the current folder).
 pub fn from_report_folder(dir: &Path, plan: Option<&Path>) -> StoreResult<EvaluationRecord> {
+    from_report_folder_with(dir, plan, None)
+}
+
+/// SHA-256 and size of every input file the plan at `plan_path` names, in plan order.
+pub fn hash_plan_inputs(plan_path: &Path) -> StoreResult<Vec<FileRecord>> {
+    let parsed = read_test_plan(plan_path)
+        .map_err(|e| StoreError::Input { path: plan_path.display().to_string(), message: e.to_string() })?;
+    hash_inputs(&parsed)
+}
+
+fn hash_inputs(parsed: &gyrolab_io_plan::TestPlan) -> StoreResult<Vec<FileRecord>> {
+    let mut inputs = Vec::new();
+    for p in plan_inputs(parsed) {
+        let (sha256, size_bytes) = hash_file(&p)?;
+        inputs.push(FileRecord { path: p.display().to_string(), sha256, size_bytes });
+    }
+    Ok(inputs)
+}
+
+/// [`from_report_folder`] with the inputs' hashes already made by [`hash_plan_inputs`] of the
+/// same plan (`gyrolab eval --store` makes them on a second thread while it evaluates); `None`:
+/// hashed here.
+pub fn from_report_folder_with(
+    dir: &Path,
+    plan: Option<&Path>,
+    inputs: Option<Vec<FileRecord>>,
+) -> StoreResult<EvaluationRecord> {
     let results_path = dir.join("results.json");
     let results_json = read_text(&results_path)?;
     let bad = |m: String| StoreError::Input { path: results_path.display().to_string(), message: m };
@@ -395,11 +422,10 @@ pub fn from_report_folder(dir: &Path, plan: Option<&Path>) -> StoreResult<Evalua
     let plan_text = read_text(&plan_path)?;
     let parsed = read_test_plan(&plan_path)
         .map_err(|e| StoreError::Input { path: plan_path.display().to_string(), message: e.to_string() })?;
-    let mut inputs = Vec::new();
-    for p in plan_inputs(&parsed) {
-        let (sha256, size_bytes) = hash_file(&p)?;
-        inputs.push(FileRecord { path: p.display().to_string(), sha256, size_bytes });
-    }
+    let inputs = match inputs {
+        Some(i) => i,
+        None => hash_inputs(&parsed)?,
+    };
     let mut report_files = Vec::new();
     let mut names: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|e| StoreError::Input { path: dir.display().to_string(), message: format!("cannot list: {e}") })?

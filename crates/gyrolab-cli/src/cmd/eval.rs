@@ -1,12 +1,15 @@
 //! `gyrolab eval PLAN.toml --out DIR`: evaluate a test plan and write the report folder
 //! (report.html, results.json, calibration.toml, CSV tables; report.pdf with `--pdf`). Exit code 3
-//! when a limit fails, 1 when `--pdf` could not make the PDF.
+//! when a limit fails, 1 when `--pdf` could not make the PDF. `--store` also keeps the evaluation
+//! in the records store (docs/STORE.md).
 
-use crate::error::CliResult;
+use crate::error::{CliError, CliResult};
 use crate::folder::write_and_finish;
 use crate::progress::Bar;
 use clap::Args;
 use gyrolab_eval::test_plan::{evaluate_test_plan, read_test_plan};
+use gyrolab_store::record::{from_report_folder_with, hash_plan_inputs};
+use gyrolab_store::{resolve_location, Store, StoreError};
 use std::path::PathBuf;
 
 /// Options of `gyrolab eval`.
@@ -28,13 +31,60 @@ pub struct EvalArgs {
     /// and the exit code is 1 with a message saying how to get the PDF.
     #[arg(long)]
     pub pdf: bool,
+    /// Also keep the evaluation in the records store (docs/STORE.md): an SQLite file or a
+    /// postgres:// URL; without a value GYROLAB_STORE, else gyrolab.db beside the plan. Stored
+    /// after the folder is written, also when a limit fails.
+    #[arg(long, value_name = "PATH|URL", num_args = 0..=1, default_missing_value = "")]
+    pub store: Option<String>,
 }
 
 /// Runs `gyrolab eval`.
 pub fn run(args: &EvalArgs) -> CliResult {
     let plan = read_test_plan(&args.plan)?;
+    // With --store, a second thread opens and checks the store (connects, migrates) and hashes
+    // the inputs while the plan is evaluated. A corrupt, foreign or newer store, or a server that
+    // is down or refuses the password, ends the run with exit 2 before the report folder is
+    // written. A store that does not exist yet is created once the folder is written.
+    let location = args.store.as_deref().map(|s| {
+        let plan_dir = args.plan.parent().filter(|p| !p.as_os_str().is_empty());
+        resolve_location(Some(s), plan_dir)
+    });
     let bar = Bar::new(args.quiet);
-    let folder = evaluate_test_plan(&plan, &args.plan.display().to_string(), &bar);
+    let (folder, prepared) = std::thread::scope(|scope| {
+        let preparing = location.as_deref().map(|l| {
+            scope.spawn(move || {
+                let store = match Store::open(l, false) {
+                    Ok(s) => Ok(Some(s)),
+                    Err(StoreError::NotFound { .. }) => Ok(None),
+                    Err(e) => Err(e),
+                };
+                (store, hash_plan_inputs(&args.plan))
+            })
+        });
+        let folder = evaluate_test_plan(&plan, &args.plan.display().to_string(), &bar);
+        (folder, preparing.map(|h| h.join()))
+    });
     bar.finish();
-    write_and_finish(&args.out, &folder?, args.quiet, args.pdf)
+    let (mut store, inputs) = match prepared {
+        None => (None, None),
+        Some(Ok((store, inputs))) => (store?, Some(inputs)),
+        Some(Err(_)) => return Err(CliError::Output("the thread opening the store failed".into())),
+    };
+    let result = write_and_finish(&args.out, &folder?, args.quiet, args.pdf);
+    if let (Some(l), Ok(()) | Err(CliError::LimitFailed(_))) = (&location, &result) {
+        let inputs = match inputs {
+            Some(hashed) => Some(hashed?),
+            None => None,
+        };
+        let record = from_report_folder_with(&args.out, Some(&args.plan), inputs)?;
+        let mut s = match store.take() {
+            Some(s) => s,
+            None => Store::open(l, true)?,
+        };
+        let id = s.add(&record)?;
+        if !args.quiet {
+            eprintln!("Stored as evaluation {id} in {}", s.name());
+        }
+    }
+    result
 }

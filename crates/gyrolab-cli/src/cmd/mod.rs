@@ -11,3 +11,4 @@ pub mod inspect;
 pub mod rate;
 pub mod record_length;
 pub mod simulate;
+pub mod store;

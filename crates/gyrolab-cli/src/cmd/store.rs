@@ -3,33 +3,15 @@
 //! statistics, lot comparison, control charts, revisions (correction, approval) and
 //! re-evaluation. Arguments to requests and printing only.
 
+use crate::args::{QueryOutput, StoreLocation};
 use crate::error::{CliError, CliResult};
 use crate::output::{print, to_json, write_file};
 use clap::{Args, Subcommand, ValueEnum};
 use gyrolab_report::format::sig_opt;
 use gyrolab_report::plot::{Axis, Figure, Orientation, Panel, RefLine, Series, SeriesStyle};
+use gyrolab_store::export::{to_csv, to_parquet, Cell, Table};
 use gyrolab_store::{add_report_folder, query, reevaluate, resolve_location, Changes, Revision, RevisionKind, Store};
-use std::path::{Path, PathBuf};
-
-/// Where the store is.
-#[derive(Debug, Clone, Args)]
-pub struct StoreLocation {
-    /// The store: an SQLite file or a postgres:// URL (default: GYROLAB_STORE, else gyrolab.db
-    /// in the current folder; for `add`, beside the plan).
-    #[arg(long = "store", value_name = "PATH|URL")]
-    pub store: Option<String>,
-}
-
-/// Output format of a query.
-#[derive(Debug, Clone, Copy, Args)]
-pub struct Format {
-    /// Print JSON.
-    #[arg(long, conflicts_with = "csv")]
-    pub json: bool,
-    /// Print CSV (one header row; units in the columns).
-    #[arg(long)]
-    pub csv: bool,
-}
+use std::path::PathBuf;
 
 /// Kinds of manual revision.
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -47,7 +29,7 @@ pub enum StoreCommand {
     Add(AddArgs),
     /// One stored evaluation: device, plan hash, inputs, revisions, figures.
     Show(ShowArgs),
-    /// Every figure of a serial over time and revisions, with limits (`--svg` trend plot).
+    /// Every figure of a serial over time and revisions, with limits (`--plot` SVG trend plot).
     History(HistoryArgs),
     /// Lot statistics per figure: n, mean, sd, min, max, yield, Cp/Cpk, Pp/Ppk with intervals, outliers.
     Lot(LotArgs),
@@ -95,10 +77,10 @@ pub struct HistoryArgs {
     #[arg(long, value_name = "KEY")]
     pub figure: Option<String>,
     /// Also write an SVG trend plot (one panel per axis and figure, limits as lines).
-    #[arg(long, value_name = "FILE.svg")]
+    #[arg(long = "plot", visible_alias = "svg", value_name = "FILE.svg")]
     pub svg: Option<PathBuf>,
     #[command(flatten)]
-    pub format: Format,
+    pub format: QueryOutput,
     #[command(flatten)]
     pub location: StoreLocation,
 }
@@ -112,7 +94,7 @@ pub struct LotArgs {
     #[arg(long, default_value_t = 0.95)]
     pub confidence: f64,
     #[command(flatten)]
-    pub format: Format,
+    pub format: QueryOutput,
     #[command(flatten)]
     pub location: StoreLocation,
 }
@@ -125,7 +107,7 @@ pub struct CompareArgs {
     /// Second lot.
     pub lot2: String,
     #[command(flatten)]
-    pub format: Format,
+    pub format: QueryOutput,
     #[command(flatten)]
     pub location: StoreLocation,
 }
@@ -143,7 +125,7 @@ pub struct ChartArgs {
     #[arg(long, value_name = "LOT")]
     pub lot: Option<String>,
     #[command(flatten)]
-    pub format: Format,
+    pub format: QueryOutput,
     #[command(flatten)]
     pub location: StoreLocation,
 }
@@ -232,26 +214,17 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
             }
             let mut s = open(&a.location, false)?;
             let rows = query::lot(&mut s, &a.lot, a.confidence)?;
-            if a.format.json {
-                return print(&to_json(&rows)?);
-            }
-            print(&render(&lot_table(&rows), a.format.csv))
+            emit(&lot_table(&rows), &a.format, || to_json(&rows))
         }
         StoreCommand::Compare(a) => {
             let mut s = open(&a.location, false)?;
             let rows = query::compare(&mut s, &a.lot1, &a.lot2)?;
-            if a.format.json {
-                return print(&to_json(&rows)?);
-            }
-            print(&render(&compare_table(&rows), a.format.csv))
+            emit(&compare_table(&rows), &a.format, || to_json(&rows))
         }
         StoreCommand::Chart(a) => {
             let mut s = open(&a.location, false)?;
             let c = query::control_charts(&mut s, a.lot.as_deref(), &a.axis, &a.figure)?;
-            if a.format.json {
-                return print(&to_json(&c)?);
-            }
-            print(&render(&chart_table(&c), a.format.csv))
+            emit(&chart_table(&c), &a.format, || to_json(&c))
         }
         StoreCommand::Revise(a) => {
             let mut s = open(&a.location, false)?;
@@ -290,60 +263,70 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
                 r.changes.len()
             );
             if !r.changes.is_empty() {
-                out.push_str(&render(&diff_table(&r.changes), false));
+                out.push_str(&text_table(&diff_table(&r.changes)));
             }
             print(&out)
         }
     }
 }
 
-type Table = (Vec<String>, Vec<Vec<String>>);
-
-fn num(v: Option<f64>) -> String {
-    v.map_or_else(String::new, |x| format!("{x}"))
+fn num(v: Option<f64>) -> Cell {
+    Cell::number(v)
 }
 
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
+fn text(v: &str) -> Cell {
+    Cell::Text(v.to_string())
+}
+
+fn opt(v: &Option<String>) -> Cell {
+    Cell::text(v.as_deref())
+}
+
+/// Prints a query's table as text, CSV or JSON (`json` makes the JSON), and writes the Parquet
+/// file of `--parquet` first (whole or not at all).
+fn emit(table: &Table, output: &QueryOutput, json: impl FnOnce() -> CliResult<String>) -> CliResult {
+    if let Some(path) = &output.parquet {
+        write_file(path, &to_parquet(table)?)?;
+    }
+    if output.json {
+        print(&json()?)
+    } else if output.csv {
+        print(&to_csv(table))
     } else {
-        s.to_string()
+        print(&text_table(table))
     }
 }
 
-/// A table as aligned text or as CSV.
-fn render((head, rows): &Table, csv: bool) -> String {
-    let mut out = String::new();
-    if csv {
-        for r in std::iter::once(head).chain(rows.iter()) {
-            out.push_str(&r.iter().map(|f| csv_field(f)).collect::<Vec<_>>().join(","));
-            out.push('\n');
-        }
-        return out;
-    }
-    // Text: numbers with 6 significant digits, columns aligned.
-    let shown: Vec<Vec<String>> = rows
+/// A table as aligned text: numbers with 6 significant digits, control characters escaped.
+fn text_table(table: &Table) -> String {
+    let shown: Vec<Vec<String>> = table
+        .rows
         .iter()
         .map(|r| {
             r.iter()
-                .map(|f| match f.parse::<f64>() {
-                    Ok(x) if f.contains(['.', 'e']) => sig_opt(Some(x), 6),
-                    _ => f
+                .map(|c| match c {
+                    Cell::Number(x) => sig_opt(Some(*x), 6),
+                    Cell::Text(t) => t
                         .chars()
                         .flat_map(|c| if c.is_control() { c.escape_default().collect::<Vec<_>>() } else { vec![c] })
                         .collect(),
+                    other => other.raw(),
                 })
                 .collect()
         })
         .collect();
-    let mut width: Vec<usize> = head.iter().map(|h| h.chars().count()).collect();
+    let mut width: Vec<usize> = table.columns.iter().map(|h| h.chars().count()).collect();
     for r in &shown {
         for (i, f) in r.iter().enumerate() {
-            width[i] = width[i].max(f.chars().count());
+            if let Some(w) = width.get_mut(i) {
+                *w = (*w).max(f.chars().count());
+            }
         }
     }
-    for r in std::iter::once(head).chain(shown.iter()) {
-        let line: Vec<String> = r.iter().enumerate().map(|(i, f)| format!("{f:<w$}", w = width[i])).collect();
+    let mut out = String::new();
+    for r in std::iter::once(&table.columns).chain(shown.iter()) {
+        let line: Vec<String> =
+            r.iter().enumerate().map(|(i, f)| format!("{f:<w$}", w = width.get(i).copied().unwrap_or(0))).collect();
         out.push_str(line.join("  ").trim_end());
         out.push('\n');
     }
@@ -362,9 +345,6 @@ fn history(a: &HistoryArgs) -> CliResult {
     }
     if let Some(path) = &a.svg {
         write_file(path, history_svg(&a.serial, &rows)?.as_bytes())?;
-    }
-    if a.format.json {
-        return print(&to_json(&rows)?);
     }
     let head = strings(&[
         "evaluation",
@@ -389,27 +369,27 @@ fn history(a: &HistoryArgs) -> CliResult {
         .iter()
         .map(|r| {
             vec![
-                r.evaluation.to_string(),
-                r.supersedes.map_or_else(String::new, |s| s.to_string()),
-                if r.current { "yes" } else { "no" }.into(),
-                r.revision_kind.clone(),
-                r.tested.clone(),
-                r.software_version.clone(),
-                r.figure.axis.clone(),
-                r.figure.figure.clone(),
+                Cell::Count(r.evaluation),
+                r.supersedes.map_or(Cell::Empty, Cell::Count),
+                text(if r.current { "yes" } else { "no" }),
+                text(&r.revision_kind),
+                text(&r.tested),
+                text(&r.software_version),
+                text(&r.figure.axis),
+                text(&r.figure.figure),
                 num(r.figure.value),
-                r.figure.unit.clone(),
-                r.figure.basis.clone(),
+                text(&r.figure.unit),
+                text(&r.figure.basis),
                 num(r.figure.expanded_uncertainty),
                 num(r.figure.coverage_factor),
                 num(r.figure.limit_min),
                 num(r.figure.limit_max),
-                r.figure.verdict.clone().unwrap_or_default(),
-                if r.figure.simulated { "SIMULATED" } else { "" }.into(),
+                opt(&r.figure.verdict),
+                text(if r.figure.simulated { "SIMULATED" } else { "" }),
             ]
         })
         .collect();
-    print(&render(&(head, body), a.format.csv))
+    emit(&Table { columns: head, rows: body }, &a.format, || to_json(&rows))
 }
 
 /// The trend plot of a history: one panel per (axis, figure), value against evaluation number,
@@ -456,10 +436,10 @@ fn history_svg(serial: &str, rows: &[query::HistoryRow]) -> CliResult<String> {
     Ok(format!("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n{svg}\n"))
 }
 
-fn index_cols(i: Option<gyrolab::process_capability::Index>) -> [String; 3] {
+fn index_cols(i: Option<gyrolab::process_capability::Index>) -> [Cell; 3] {
     match i {
         Some(i) => [num(Some(i.value)), num(i.interval.map(|c| c.lower)), num(i.interval.map(|c| c.upper))],
-        None => Default::default(),
+        None => [Cell::Empty, Cell::Empty, Cell::Empty],
     }
 }
 
@@ -496,10 +476,10 @@ fn lot_table(rows: &[query::LotFigure]) -> Table {
         .map(|r| {
             let s = &r.statistics;
             let mut v = vec![
-                r.axis.clone(),
-                r.figure.clone(),
-                r.unit.clone(),
-                s.n.to_string(),
+                text(&r.axis),
+                text(&r.figure),
+                text(&r.unit),
+                Cell::Count(s.n as i64),
                 num(Some(s.mean)),
                 num(s.sd),
                 num(Some(s.min)),
@@ -511,12 +491,12 @@ fn lot_table(rows: &[query::LotFigure]) -> Table {
             for i in [s.cp, s.cpk, s.pp, s.ppk] {
                 v.extend(index_cols(i));
             }
-            v.push(r.outlier_serials.join(" "));
-            v.push(if r.simulated { "SIMULATED" } else { "" }.into());
+            v.push(text(&r.outlier_serials.join(" ")));
+            v.push(text(if r.simulated { "SIMULATED" } else { "" }));
             v
         })
         .collect();
-    (head, body)
+    Table { columns: head, rows: body }
 }
 
 fn compare_table(rows: &[query::LotComparison]) -> Table {
@@ -541,11 +521,11 @@ fn compare_table(rows: &[query::LotComparison]) -> Table {
         .map(|r| {
             let t = r.test;
             vec![
-                r.axis.clone(),
-                r.figure.clone(),
-                r.unit.clone(),
-                r.n1.to_string(),
-                r.n2.to_string(),
+                text(&r.axis),
+                text(&r.figure),
+                text(&r.unit),
+                Cell::Count(r.n1 as i64),
+                Cell::Count(r.n2 as i64),
                 num(Some(r.mean1)),
                 num(Some(r.mean2)),
                 num(Some(r.mean1 - r.mean2)),
@@ -558,7 +538,7 @@ fn compare_table(rows: &[query::LotComparison]) -> Table {
             ]
         })
         .collect();
-    (head, body)
+    Table { columns: head, rows: body }
 }
 
 fn chart_table(c: &query::ControlCharts) -> Table {
@@ -570,14 +550,14 @@ fn chart_table(c: &query::ControlCharts) -> Table {
                 let rules: Vec<String> =
                     ch.violations.iter().filter(|x| x.index == i).map(|x| format!("nelson {}", x.rule)).collect();
                 body.push(vec![
-                    name.to_string(),
-                    (i + 1).to_string(),
-                    labels(i),
+                    text(name),
+                    Cell::Count(i as i64 + 1),
+                    Cell::Text(labels(i)),
                     num(Some(*v)),
                     num(Some(ch.center)),
                     num(Some(ch.lcl[i])),
                     num(Some(ch.ucl[i])),
-                    rules.join(" "),
+                    text(&rules.join(" ")),
                 ]);
             }
         }
@@ -592,7 +572,7 @@ fn chart_table(c: &query::ControlCharts) -> Table {
     });
     add("xbar", &c.xbar, &|i| c.lots.get(i).cloned().unwrap_or_default());
     add("s", &c.s, &|i| c.lots.get(i).cloned().unwrap_or_default());
-    (head, body)
+    Table { columns: head, rows: body }
 }
 
 fn diff_table(rows: &[query::FigureChange]) -> Table {
@@ -601,18 +581,18 @@ fn diff_table(rows: &[query::FigureChange]) -> Table {
         .iter()
         .map(|r| {
             vec![
-                r.axis.clone(),
-                r.figure.clone(),
-                r.unit.clone(),
+                text(&r.axis),
+                text(&r.figure),
+                text(&r.unit),
                 num(r.before),
                 num(r.after),
                 num(r.difference),
-                r.verdict_before.clone().unwrap_or_default(),
-                r.verdict_after.clone().unwrap_or_default(),
+                opt(&r.verdict_before),
+                opt(&r.verdict_after),
             ]
         })
         .collect();
-    (head, body)
+    Table { columns: head, rows: body }
 }
 
 fn show_text(e: &query::StoredEvaluation) -> String {

@@ -1,0 +1,237 @@
+//! Query results as tables, and their export: CSV text (RFC 4180 quoting) and Parquet files
+//! (one row group, zstd). Every `gyrolab store` query is turned into a [`Table`] by the front
+//! end; the writers live here so that the command line and Python share them (the command line
+//! reaches Parquet only through this module).
+
+use crate::{StoreError, StoreResult};
+use std::sync::Arc;
+
+/// One cell of a table.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Cell {
+    /// No value (empty in CSV, null in Parquet).
+    Empty,
+    /// Text.
+    Text(String),
+    /// A real number (shortest text that reads back to the same `f64` in CSV; DOUBLE in Parquet).
+    Number(f64),
+    /// A whole number (INT64 in Parquet).
+    Count(i64),
+}
+
+impl Cell {
+    /// A number or empty.
+    pub fn number(v: Option<f64>) -> Cell {
+        v.map_or(Cell::Empty, Cell::Number)
+    }
+
+    /// A text or empty.
+    pub fn text(v: Option<&str>) -> Cell {
+        v.map_or(Cell::Empty, |s| Cell::Text(s.to_string()))
+    }
+
+    /// The cell as CSV text before quoting (numbers exactly, `f64` shortest round trip).
+    pub fn raw(&self) -> String {
+        match self {
+            Cell::Empty => String::new(),
+            Cell::Text(t) => t.clone(),
+            Cell::Number(x) => format!("{x}"),
+            Cell::Count(n) => n.to_string(),
+        }
+    }
+}
+
+/// A query result: named columns (units in the names or in a `unit` column) and rows.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Table {
+    /// Column names.
+    pub columns: Vec<String>,
+    /// Rows, each with one cell per column.
+    pub rows: Vec<Vec<Cell>>,
+}
+
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// The table as CSV: a header row, then one line per row; fields holding a comma, quote or line
+/// break quoted, quotes doubled.
+pub fn to_csv(table: &Table) -> String {
+    let mut out = String::new();
+    let head: Vec<String> = table.columns.iter().map(|c| csv_field(c)).collect();
+    out.push_str(&head.join(","));
+    out.push('\n');
+    for r in &table.rows {
+        let fields: Vec<String> = r.iter().map(|c| csv_field(&c.raw())).collect();
+        out.push_str(&fields.join(","));
+        out.push('\n');
+    }
+    out
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum ColumnType {
+    Text,
+    Double,
+    Int,
+}
+
+/// A column's Parquet type from its cells: INT64 when every value is a count, DOUBLE when every
+/// value is a number (counts among them widened), else UTF-8 text (numbers as their CSV text).
+fn column_type(table: &Table, i: usize) -> ColumnType {
+    let cells = table.rows.iter().filter_map(|r| r.get(i)).filter(|c| **c != Cell::Empty);
+    let mut ty = ColumnType::Int;
+    for c in cells {
+        match c {
+            Cell::Text(_) => return ColumnType::Text,
+            Cell::Number(_) => ty = ColumnType::Double,
+            Cell::Count(_) | Cell::Empty => {}
+        }
+    }
+    ty
+}
+
+/// The table as a Parquet file (bytes): one optional column per table column, of the same name,
+/// typed by [`Cell`] (text UTF-8, numbers DOUBLE, counts INT64; a column mixing text and numbers
+/// is text), empty cells null; one row group, zstd.
+pub fn to_parquet(table: &Table) -> StoreResult<Vec<u8>> {
+    use parquet::basic::{Compression, ConvertedType, Repetition, Type as Physical, ZstdLevel};
+    use parquet::data_type::{ByteArray, ByteArrayType, DoubleType, Int64Type};
+    use parquet::file::properties::WriterProperties;
+    use parquet::file::writer::SerializedFileWriter;
+    use parquet::schema::types::Type;
+    let err = |e: parquet::errors::ParquetError| StoreError::Input {
+        path: "Parquet export".into(),
+        message: format!("cannot write the Parquet table: {e}"),
+    };
+    if let Some(bad) = table.rows.iter().position(|r| r.len() != table.columns.len()) {
+        return Err(StoreError::Input {
+            path: "Parquet export".into(),
+            message: format!("row {} has {} cells for {} columns", bad + 1, table.rows[bad].len(), table.columns.len()),
+        });
+    }
+    let types: Vec<ColumnType> = (0..table.columns.len()).map(|i| column_type(table, i)).collect();
+    let mut fields = Vec::new();
+    for (name, ty) in table.columns.iter().zip(&types) {
+        let b = match ty {
+            ColumnType::Text => {
+                Type::primitive_type_builder(name, Physical::BYTE_ARRAY).with_converted_type(ConvertedType::UTF8)
+            }
+            ColumnType::Double => Type::primitive_type_builder(name, Physical::DOUBLE),
+            ColumnType::Int => Type::primitive_type_builder(name, Physical::INT64),
+        };
+        fields.push(Arc::new(b.with_repetition(Repetition::OPTIONAL).build().map_err(err)?));
+    }
+    let schema = Arc::new(Type::group_type_builder("gyrolab_store_query").with_fields(fields).build().map_err(err)?);
+    let level = ZstdLevel::try_new(3).map_err(err)?;
+    let props = Arc::new(WriterProperties::builder().set_compression(Compression::ZSTD(level)).build());
+    let mut bytes = Vec::new();
+    {
+        let mut w = SerializedFileWriter::new(&mut bytes, schema, props).map_err(err)?;
+        let mut g = w.next_row_group().map_err(err)?;
+        for (i, ty) in types.iter().enumerate() {
+            let Some(mut c) = g.next_column().map_err(err)? else { break };
+            let cells: Vec<&Cell> = table.rows.iter().map(|r| &r[i]).collect();
+            let defs: Vec<i16> = cells.iter().map(|c| i16::from(**c != Cell::Empty)).collect();
+            match ty {
+                ColumnType::Text => {
+                    let v: Vec<ByteArray> = cells
+                        .iter()
+                        .filter(|c| ***c != Cell::Empty)
+                        .map(|c| ByteArray::from(c.raw().as_str()))
+                        .collect();
+                    c.typed::<ByteArrayType>().write_batch(&v, Some(&defs), None).map_err(err)?;
+                }
+                ColumnType::Double => {
+                    let v: Vec<f64> = cells
+                        .iter()
+                        .filter_map(|c| match c {
+                            Cell::Number(x) => Some(*x),
+                            Cell::Count(n) => Some(*n as f64),
+                            _ => None,
+                        })
+                        .collect();
+                    c.typed::<DoubleType>().write_batch(&v, Some(&defs), None).map_err(err)?;
+                }
+                ColumnType::Int => {
+                    let v: Vec<i64> = cells
+                        .iter()
+                        .filter_map(|c| match c {
+                            Cell::Count(n) => Some(*n),
+                            _ => None,
+                        })
+                        .collect();
+                    c.typed::<Int64Type>().write_batch(&v, Some(&defs), None).map_err(err)?;
+                }
+            }
+            c.close().map_err(err)?;
+        }
+        g.close().map_err(err)?;
+        w.close().map_err(err)?;
+    }
+    Ok(bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use parquet::file::reader::{FileReader, SerializedFileReader};
+    use parquet::record::Field;
+
+    fn table() -> Table {
+        Table {
+            columns: vec!["serial".into(), "value".into(), "n".into(), "note".into()],
+            rows: vec![
+                vec![
+                    Cell::Text("SN-1, \"a\"".into()),
+                    Cell::Number(0.1 + 0.2),
+                    Cell::Count(3),
+                    Cell::Text("'; DROP TABLE figure; --".into()),
+                ],
+                vec![Cell::Text("SN-2 ∮ \u{202e}".into()), Cell::Empty, Cell::Empty, Cell::Empty],
+            ],
+        }
+    }
+
+    #[test]
+    fn csv_quotes_and_keeps_numbers_exact() {
+        let csv = to_csv(&table());
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines[0], "serial,value,n,note");
+        assert_eq!(lines[1], "\"SN-1, \"\"a\"\"\",0.30000000000000004,3,'; DROP TABLE figure; --");
+        assert_eq!(lines[2], "SN-2 ∮ \u{202e},,,");
+        assert_eq!(lines[1].split(',').nth(2).map(|v| v.parse::<f64>().ok()), Some(Some(0.1 + 0.2)));
+    }
+
+    #[test]
+    fn parquet_reads_back_the_same_cells_with_types_and_nulls() {
+        let t = table();
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.parquet");
+        std::fs::write(&p, to_parquet(&t).unwrap()).unwrap();
+        let r = SerializedFileReader::new(std::fs::File::open(&p).unwrap()).unwrap();
+        assert_eq!(r.metadata().file_metadata().num_rows(), 2);
+        let rows: Vec<_> = r.get_row_iter(None).unwrap().map(|x| x.unwrap()).collect();
+        let cols: Vec<Vec<(String, Field)>> =
+            rows.iter().map(|row| row.get_column_iter().map(|(n, f)| (n.clone(), f.clone())).collect()).collect();
+        assert_eq!(cols[0][0], ("serial".into(), Field::Str("SN-1, \"a\"".into())));
+        assert_eq!(cols[0][1], ("value".into(), Field::Double(0.1 + 0.2)));
+        assert_eq!(cols[0][2], ("n".into(), Field::Long(3)));
+        assert_eq!(cols[0][3].1, Field::Str("'; DROP TABLE figure; --".into()));
+        assert_eq!(cols[1][0].1, Field::Str("SN-2 ∮ \u{202e}".into()));
+        assert_eq!(cols[1][1].1, Field::Null);
+        assert_eq!(cols[1][2].1, Field::Null);
+    }
+
+    #[test]
+    fn a_row_of_the_wrong_width_is_an_error() {
+        let mut t = table();
+        t.rows[1].pop();
+        let e = to_parquet(&t).unwrap_err().to_string();
+        assert!(e.contains("row 2 has 3 cells for 4 columns"), "{e}");
+    }
+}
