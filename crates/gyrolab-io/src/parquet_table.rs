@@ -8,7 +8,7 @@ use parquet::basic::{Compression, Type as PhysicalType, ZstdLevel};
 use parquet::column::reader::ColumnReader;
 use parquet::data_type::{DoubleType, Int64Type};
 use parquet::file::properties::WriterProperties;
-use parquet::file::reader::{FileReader, SerializedFileReader};
+use parquet::file::reader::{ChunkReader, FileReader, Length, SerializedFileReader};
 use parquet::file::writer::SerializedFileWriter;
 use std::path::Path;
 use std::sync::Arc;
@@ -16,8 +16,15 @@ use std::sync::Arc;
 /// Rows read from a column at once.
 const BATCH: usize = 64 * 1024;
 
+/// A `parquet` crate error in words: without the crate's variant names (`External: `,
+/// `Parquet error: `, `EOF: `).
 fn perr(path: &Path, e: impl std::fmt::Display) -> DataError {
-    DataError::new(path, format!("not a readable Parquet file: {e}"))
+    let text = e.to_string();
+    let mut t = text.as_str();
+    for prefix in ["External: ", "Parquet error: ", "EOF: ", "General: ", "NYI: ", "Index out of bound: "] {
+        t = t.strip_prefix(prefix).unwrap_or(t);
+    }
+    DataError::new(path, format!("not a readable Parquet file: {}", crate::text::short_message(t)))
 }
 
 /// Reads the numeric columns (INT32, INT64, FLOAT, DOUBLE; nulls as missing cells) of a
@@ -45,7 +52,8 @@ pub fn read_parquet_file(
 
 /// [`read_parquet_file`] after its footer is checked.
 fn read_checked_parquet(path: &Path, file: std::fs::File, options: &SeriesOptions) -> Result<SeriesData, DataError> {
-    let reader = SerializedFileReader::new(file).map_err(|e| perr(path, e))?;
+    let len = file.metadata().map_err(|e| DataError::io(path, &e))?.len();
+    let reader = SerializedFileReader::new(BoundedFile { file, len }).map_err(|e| perr(path, e))?;
     let meta = reader.metadata();
     let schema = meta.file_metadata().schema_descr();
     let rows = meta.file_metadata().num_rows().max(0) as u64;
@@ -81,6 +89,76 @@ fn read_checked_parquet(path: &Path, file: std::fs::File, options: &SeriesOption
     let mut data = series_from_columns(path, &names, columns, RowKind::Row, options)?;
     data.header.skipped.extend(skipped);
     Ok(data)
+}
+
+/// The file as the `parquet` crate reads it, bounded by its length. The crate's own reader of a
+/// `File` reserves a byte range's declared length before reading it, and returns nothing (not
+/// an error) past the end of the file, so a damaged page header whose Thrift list declares
+/// 2^31 elements was skipped element by element with a read each (over 20 s, found by fuzzing).
+/// Here a range beyond the file is an error before any allocation, and reading at the end of
+/// the file is an error.
+struct BoundedFile {
+    file: std::fs::File,
+    len: u64,
+}
+
+impl Length for BoundedFile {
+    fn len(&self) -> u64 {
+        self.len
+    }
+}
+
+impl ChunkReader for BoundedFile {
+    type T = EndIsError<std::io::BufReader<std::fs::File>>;
+
+    fn get_read(&self, start: u64) -> parquet::errors::Result<Self::T> {
+        use std::io::{Seek, SeekFrom};
+        if start > self.len {
+            return Err(beyond_end(start, 0, self.len));
+        }
+        let mut f = self.file.try_clone()?;
+        f.seek(SeekFrom::Start(start))?;
+        Ok(EndIsError { inner: std::io::BufReader::new(f), left: self.len - start })
+    }
+
+    fn get_bytes(&self, start: u64, length: usize) -> parquet::errors::Result<bytes::Bytes> {
+        use std::io::{Read, Seek, SeekFrom};
+        if start.checked_add(length as u64).is_none_or(|end| end > self.len) {
+            return Err(beyond_end(start, length, self.len));
+        }
+        let mut f = self.file.try_clone()?;
+        f.seek(SeekFrom::Start(start))?;
+        let mut buf = vec![0u8; length];
+        f.read_exact(&mut buf)?;
+        Ok(buf.into())
+    }
+}
+
+fn beyond_end(start: u64, length: usize, len: u64) -> parquet::errors::ParquetError {
+    parquet::errors::ParquetError::EOF(format!(
+        "{length} bytes at byte {start} declared, beyond the end of the file ({len} bytes)"
+    ))
+}
+
+/// A reader of the rest of a file (`left` bytes) for which reading at its end is an error.
+struct EndIsError<R> {
+    inner: R,
+    left: u64,
+}
+
+impl<R: std::io::Read> std::io::Read for EndIsError<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        if buf.is_empty() {
+            return Ok(0);
+        }
+        let want = buf.len().min(usize::try_from(self.left).unwrap_or(usize::MAX));
+        let n = if want == 0 { 0 } else { self.inner.read(&mut buf[..want])? };
+        if n == 0 {
+            return Err(std::io::Error::new(std::io::ErrorKind::UnexpectedEof, "the file ends here"));
+        }
+        self.left -= n as u64;
+        Ok(n)
+    }
 }
 
 /// Longest footer (file metadata) read, bytes: 64 MiB.
