@@ -1,19 +1,8 @@
-//! The Parquet reader (`read_records`: footer, schema, row groups, pages) on arbitrary bytes, written to a file (the readers open paths) that starts with
-//! the format's magic (prepended when the input lacks it, so every input reaches the reader).
+//! The Parquet reader (footer, schema, row groups, pages) on arbitrary bytes: `recording_input.rs`.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 
-const MAGIC: &[u8] = b"PAR1";
+#[path = "recording_input.rs"]
+mod recording_input;
 
-fuzz_target!(|data: &[u8]| {
-    let path = std::env::temp_dir().join(format!("gyrolab-fuzz-{}-parquet", std::process::id()));
-    let bytes = if data.starts_with(MAGIC) { data.to_vec() } else { [MAGIC, data].concat() };
-    if std::fs::write(&path, &bytes).is_err() {
-        return;
-    }
-    let options = gyrolab_io::series::SeriesOptions::default();
-    if let Err(e) = gyrolab_io::recording::read_records(&path, &options, &[]) {
-        let text = e.to_string();
-        assert!(text.len() < 2000, "error text of {} bytes", text.len());
-    }
-});
+fuzz_target!(|data: &[u8]| recording_input::read_recording("parquet", b"PAR1", data));

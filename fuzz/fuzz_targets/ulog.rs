@@ -1,19 +1,8 @@
-//! The PX4 ULog reader (`read_records`: definitions, formats, data messages) on arbitrary bytes, written to a file (the readers open paths) that starts with
-//! the format's magic (prepended when the input lacks it, so every input reaches the reader).
+//! The PX4 ULog reader (definitions, formats, data messages) on arbitrary bytes: `recording_input.rs`.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 
-const MAGIC: &[u8] = b"ULog\x01\x12\x35\x01";
+#[path = "recording_input.rs"]
+mod recording_input;
 
-fuzz_target!(|data: &[u8]| {
-    let path = std::env::temp_dir().join(format!("gyrolab-fuzz-{}-ulog", std::process::id()));
-    let bytes = if data.starts_with(MAGIC) { data.to_vec() } else { [MAGIC, data].concat() };
-    if std::fs::write(&path, &bytes).is_err() {
-        return;
-    }
-    let options = gyrolab_io::series::SeriesOptions::default();
-    if let Err(e) = gyrolab_io::recording::read_records(&path, &options, &[]) {
-        let text = e.to_string();
-        assert!(text.len() < 2000, "error text of {} bytes", text.len());
-    }
-});
+fuzz_target!(|data: &[u8]| recording_input::read_recording("ulog", b"ULog\x01\x12\x35\x01", data));
