@@ -77,17 +77,17 @@ impl ReferenceArgs {
     }
 }
 
-/// The options of an Allan analysis of a record, shared by `allan` (one file) and `batch`
-/// (many): which topics and columns, their layout and reference, the deviation and its taus.
+/// What to read of a static record and how to turn its outputs into rates, shared by `bias`,
+/// `allan` and `batch`: topics, columns, their layout, the sample rate and the reference.
 #[derive(Debug, Clone, Args)]
-pub struct AnalysisArgs {
-    /// Topic of a recording to analyse (default: every IMU topic), repeatable; `gyrolab inspect
+pub struct RecordArgs {
+    /// Topic of a recording to read (default: every IMU topic), repeatable; `gyrolab inspect
     /// FILE` lists them.
     #[arg(long = "topic", value_name = "NAME")]
     pub topics: Vec<String>,
     #[command(flatten)]
     pub layout: LayoutArgs,
-    /// Output columns to analyse (default: every output column), repeatable.
+    /// Output columns to read (default: every output column), repeatable.
     #[arg(long = "column", value_name = "NAME")]
     pub columns: Vec<String>,
     /// Sample rate in Hz (required when the file has no time column).
@@ -95,6 +95,14 @@ pub struct AnalysisArgs {
     pub sample_rate_hz: Option<f64>,
     #[command(flatten)]
     pub reference: ReferenceArgs,
+}
+
+/// The options of an Allan analysis of a record, shared by `allan` (one file) and `batch`
+/// (many): the record's options ([`RecordArgs`]), the deviation and its taus.
+#[derive(Debug, Clone, Args)]
+pub struct AnalysisArgs {
+    #[command(flatten)]
+    pub record: RecordArgs,
     /// Deviation: oadev (default), adev, mdev, tdev, hdev, ohdev, totdev.
     #[arg(long, default_value = "oadev", value_name = "KIND")]
     pub kind: String,
@@ -117,18 +125,19 @@ impl AnalysisArgs {
     /// The analysis request of `file`.
     pub fn request(&self, file: PathBuf) -> CliResult<AllanRequest> {
         let kind = DeviationKind::parse(&self.kind).map_err(|e| EvalError::conflict(e.to_string()))?;
+        let record = &self.record;
         Ok(AllanRequest {
             file,
-            columns: self.columns.clone(),
-            sample_rate_hz: self.sample_rate_hz,
-            reference: self.reference.request(),
+            columns: record.columns.clone(),
+            sample_rate_hz: record.sample_rate_hz,
+            reference: record.reference.request(),
             kind,
             taus: parse_taus(&self.taus)?,
             confidence: parse_confidence(&self.confidence)?,
             fit_range_s: gyrolab::validate::increasing_pair("fit_range_s", &self.fit_range)?,
-            layout: self.layout.layout(),
+            layout: record.layout.layout(),
             gaps: GapPolicy::parse(&self.gaps)?,
-            topics: self.topics.clone(),
+            topics: record.topics.clone(),
         })
     }
 }

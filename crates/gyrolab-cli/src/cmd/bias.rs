@@ -1,7 +1,7 @@
 //! `gyrolab bias FILE...`: static tests, one file per test (for example one per power-up), one
 //! result per output channel, and the bias repeatability across the files.
 
-use crate::args::{LayoutArgs, ReferenceArgs};
+use crate::args::RecordArgs;
 use crate::error::CliResult;
 use crate::output::{print, to_json};
 use clap::Args;
@@ -20,22 +20,11 @@ pub struct BiasArgs {
     /// topic, one test per topic.
     #[arg(required = true, value_name = "FILE")]
     pub files: Vec<PathBuf>,
-    /// Topic of a recording to evaluate (default: every IMU topic), repeatable.
-    #[arg(long = "topic", value_name = "NAME")]
-    pub topics: Vec<String>,
     #[command(flatten)]
-    pub layout: LayoutArgs,
-    /// Output columns to evaluate (default: every output column), repeatable.
-    #[arg(long = "column", value_name = "NAME")]
-    pub columns: Vec<String>,
+    pub record: RecordArgs,
     /// Unit of the --column outputs when their names carry no suffix: v, mv, lsb, dps, rad_s.
     #[arg(long, value_name = "UNIT", value_parser = crate::args::parse_output_unit, requires = "columns")]
     pub output_unit: Option<OutputUnit>,
-    /// Sample rate in Hz (required when the file has no time column).
-    #[arg(long, value_name = "HZ")]
-    pub sample_rate_hz: Option<f64>,
-    #[command(flatten)]
-    pub reference: ReferenceArgs,
     /// Latitude in degrees (input axis vertical, up): subtract the earth rate from the bias.
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     pub latitude: Option<f64>,
@@ -67,17 +56,17 @@ pub struct BiasArgs {
 pub fn run(args: &BiasArgs) -> CliResult {
     let mut request = StaticTestRequest {
         files: args.files.clone(),
-        columns: args.columns.clone(),
+        columns: args.record.columns.clone(),
         output_unit: args.output_unit,
-        sample_rate_hz: args.sample_rate_hz,
-        reference: args.reference.request(),
+        sample_rate_hz: args.record.sample_rate_hz,
+        reference: args.record.reference.request(),
         latitude_deg: args.latitude,
         smoothing_s: args.smoothing.clone(),
         temperature_quadratic: args.temp_quadratic,
         drop_outliers: args.drop_outliers,
         tolerant: args.tolerant,
-        layout: args.layout.layout(),
-        topics: args.topics.clone(),
+        layout: args.record.layout.layout(),
+        topics: args.record.topics.clone(),
         warmup: args.warmup_band_dph.map(|b| gyrolab::warmup::WarmupConfig {
             window_s: args.warmup_window_s.unwrap_or(10.0),
             ..gyrolab::warmup::WarmupConfig::new(b)
