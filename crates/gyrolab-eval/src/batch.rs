@@ -576,65 +576,31 @@ fn csv_field(t: &str) -> String {
 /// The results as a Parquet file (one row group, zstd): the [`COLUMNS`] as optional UTF-8,
 /// DOUBLE or INT64 columns of the same names, empty cells null.
 pub fn results_parquet(rows: &[ResultRow]) -> EvalResult<Vec<u8>> {
-    use parquet::basic::{Compression, ZstdLevel};
-    use parquet::data_type::{ByteArray, ByteArrayType, DoubleType, Int64Type};
-    use parquet::file::properties::WriterProperties;
-    use parquet::file::writer::SerializedFileWriter;
-    let err = |e: parquet::errors::ParquetError| EvalError::Output(format!("cannot write the Parquet results: {e}"));
-    let mut schema = String::from("message batch_results { ");
-    for (name, ty) in COLUMNS {
-        schema.push_str(match ty {
-            ColumnType::Text => "optional binary ",
-            ColumnType::Number => "optional double ",
-            ColumnType::Count => "optional int64 ",
-        });
-        schema.push_str(name);
-        schema.push_str(if ty == ColumnType::Text { " (UTF8); " } else { "; " });
-    }
-    schema.push('}');
-    let schema = Arc::new(parquet::schema::parser::parse_message_type(&schema).map_err(err)?);
-    let level = ZstdLevel::try_new(3).map_err(err)?;
-    let props = Arc::new(WriterProperties::builder().set_compression(Compression::ZSTD(level)).build());
-    let mut bytes = Vec::new();
-    {
-        let mut w = SerializedFileWriter::new(&mut bytes, schema, props).map_err(err)?;
-        let mut g = w.next_row_group().map_err(err)?;
-        for (i, (_, ty)) in COLUMNS.iter().enumerate() {
-            let Some(mut c) = g.next_column().map_err(err)? else { break };
-            let cells: Vec<&Cell> = rows.iter().filter_map(|r| r.0.get(i)).collect();
-            let defs: Vec<i16> = cells.iter().map(|c| i16::from(**c != Cell::Empty)).collect();
-            match ty {
-                ColumnType::Text => {
-                    let v: Vec<ByteArray> = cells
-                        .iter()
-                        .filter_map(|c| match c {
-                            Cell::Text(t) => Some(ByteArray::from(t.as_str())),
-                            _ => None,
-                        })
-                        .collect();
-                    c.typed::<ByteArrayType>().write_batch(&v, Some(&defs), None).map_err(err)?;
-                }
-                ColumnType::Number => {
-                    let v: Vec<f64> = cells.iter().filter_map(|c| c.number()).collect();
-                    c.typed::<DoubleType>().write_batch(&v, Some(&defs), None).map_err(err)?;
-                }
-                ColumnType::Count => {
-                    let v: Vec<i64> = cells
-                        .iter()
-                        .filter_map(|c| match c {
+    use gyrolab_io::parquet_table::{write_table, ColumnValues};
+    let cells = |i: usize| rows.iter().map(move |r| r.0.get(i).unwrap_or(&Cell::Empty));
+    let columns: Vec<(String, ColumnValues)> = COLUMNS
+        .iter()
+        .enumerate()
+        .map(|(i, (name, ty))| {
+            let values = match ty {
+                ColumnType::Text => ColumnValues::Text(
+                    cells(i).map(|c| if *c == Cell::Empty { None } else { Some(c.text()) }).collect(),
+                ),
+                ColumnType::Number => ColumnValues::Double(cells(i).map(Cell::number).collect()),
+                ColumnType::Count => ColumnValues::Int(
+                    cells(i)
+                        .map(|c| match c {
                             Cell::Count(n) => Some(i64::try_from(*n).unwrap_or(i64::MAX)),
                             _ => None,
                         })
-                        .collect();
-                    c.typed::<Int64Type>().write_batch(&v, Some(&defs), None).map_err(err)?;
-                }
-            }
-            c.close().map_err(err)?;
-        }
-        g.close().map_err(err)?;
-        w.close().map_err(err)?;
-    }
-    Ok(bytes)
+                        .collect(),
+                ),
+            };
+            (name.to_string(), values)
+        })
+        .collect();
+    write_table("batch_results", &columns)
+        .map_err(|e| EvalError::Output(format!("cannot write the Parquet results: {e}")))
 }
 
 #[cfg(test)]

@@ -412,6 +412,96 @@ fn read_column(col: ColumnReader, max_def: i16, out: &mut Vec<f64>) -> parquet::
     Ok(())
 }
 
+/// The values of one column of a table written by [`write_table`]; `None` is a null cell.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ColumnValues {
+    /// UTF-8 text.
+    Text(Vec<Option<String>>),
+    /// 64-bit floats.
+    Double(Vec<Option<f64>>),
+    /// 64-bit integers.
+    Int(Vec<Option<i64>>),
+}
+
+impl ColumnValues {
+    fn len(&self) -> usize {
+        match self {
+            ColumnValues::Text(v) => v.len(),
+            ColumnValues::Double(v) => v.len(),
+            ColumnValues::Int(v) => v.len(),
+        }
+    }
+}
+
+/// Writes a table of named, optional columns (UTF-8, DOUBLE or INT64; `None` as null) as a
+/// Parquet file in one row group, zstd-compressed (`schema` names its message), for the
+/// results tables of `batch` and the store's query exports. Columns of different lengths are
+/// an error.
+///
+/// ```
+/// use gyrolab_io::parquet_table::{write_table, ColumnValues};
+/// let bytes = write_table(
+///     "t",
+///     &[("serial".into(), ColumnValues::Text(vec![Some("SN-1".into()), None])),
+///       ("value".into(), ColumnValues::Double(vec![Some(0.5), Some(1.5)]))],
+/// )?;
+/// assert!(bytes.starts_with(b"PAR1") && bytes.ends_with(b"PAR1"));
+/// # Ok::<(), std::io::Error>(())
+/// ```
+pub fn write_table(schema: &str, columns: &[(String, ColumnValues)]) -> std::io::Result<Vec<u8>> {
+    use parquet::basic::{ConvertedType, Repetition, Type as Physical};
+    use parquet::data_type::{ByteArray, ByteArrayType};
+    use parquet::schema::types::Type;
+    let err = |e: parquet::errors::ParquetError| std::io::Error::other(e.to_string());
+    let rows = columns.first().map_or(0, |(_, c)| c.len());
+    if let Some((name, c)) = columns.iter().find(|(_, c)| c.len() != rows) {
+        return Err(std::io::Error::other(format!("column '{name}' has {} rows, the first {rows}", c.len())));
+    }
+    let mut fields = Vec::with_capacity(columns.len());
+    for (name, values) in columns {
+        let b = match values {
+            ColumnValues::Text(_) => {
+                Type::primitive_type_builder(name, Physical::BYTE_ARRAY).with_converted_type(ConvertedType::UTF8)
+            }
+            ColumnValues::Double(_) => Type::primitive_type_builder(name, Physical::DOUBLE),
+            ColumnValues::Int(_) => Type::primitive_type_builder(name, Physical::INT64),
+        };
+        fields.push(Arc::new(b.with_repetition(Repetition::OPTIONAL).build().map_err(err)?));
+    }
+    let schema = Arc::new(Type::group_type_builder(schema).with_fields(fields).build().map_err(err)?);
+    let level = ZstdLevel::try_new(3).map_err(err)?;
+    let props = Arc::new(WriterProperties::builder().set_compression(Compression::ZSTD(level)).build());
+    let mut bytes = Vec::new();
+    {
+        let mut w = SerializedFileWriter::new(&mut bytes, schema, props).map_err(err)?;
+        let mut g = w.next_row_group().map_err(err)?;
+        for (_, values) in columns {
+            let Some(mut c) = g.next_column().map_err(err)? else { break };
+            fn defs<T>(v: &[Option<T>]) -> Vec<i16> {
+                v.iter().map(|x| i16::from(x.is_some())).collect()
+            }
+            match values {
+                ColumnValues::Text(v) => {
+                    let present: Vec<ByteArray> = v.iter().flatten().map(|t| ByteArray::from(t.as_str())).collect();
+                    c.typed::<ByteArrayType>().write_batch(&present, Some(&defs(v)), None).map_err(err)?;
+                }
+                ColumnValues::Double(v) => {
+                    let present: Vec<f64> = v.iter().flatten().copied().collect();
+                    c.typed::<DoubleType>().write_batch(&present, Some(&defs(v)), None).map_err(err)?;
+                }
+                ColumnValues::Int(v) => {
+                    let present: Vec<i64> = v.iter().flatten().copied().collect();
+                    c.typed::<Int64Type>().write_batch(&present, Some(&defs(v)), None).map_err(err)?;
+                }
+            }
+            c.close().map_err(err)?;
+        }
+        g.close().map_err(err)?;
+        w.close().map_err(err)?;
+    }
+    Ok(bytes)
+}
+
 /// Writes a table: an INT64 time column (`time_name`, such as `timestamp_ns`) and DOUBLE
 /// columns, zstd-compressed, in row groups of one million rows, to `out`.
 pub fn write_parquet(

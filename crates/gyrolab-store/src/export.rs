@@ -4,7 +4,6 @@
 //! reaches Parquet only through this module).
 
 use crate::{StoreError, StoreResult};
-use std::sync::Arc;
 
 /// One cell of a table.
 #[derive(Debug, Clone, PartialEq)]
@@ -99,81 +98,48 @@ fn column_type(table: &Table, i: usize) -> ColumnType {
 /// typed by [`Cell`] (text UTF-8, numbers DOUBLE, counts INT64; a column mixing text and numbers
 /// is text), empty cells null; one row group, zstd.
 pub fn to_parquet(table: &Table) -> StoreResult<Vec<u8>> {
-    use parquet::basic::{Compression, ConvertedType, Repetition, Type as Physical, ZstdLevel};
-    use parquet::data_type::{ByteArray, ByteArrayType, DoubleType, Int64Type};
-    use parquet::file::properties::WriterProperties;
-    use parquet::file::writer::SerializedFileWriter;
-    use parquet::schema::types::Type;
-    let err = |e: parquet::errors::ParquetError| StoreError::Input {
-        path: "Parquet export".into(),
-        message: format!("cannot write the Parquet table: {e}"),
-    };
+    use gyrolab_io::parquet_table::{write_table, ColumnValues};
+    let failed = |message: String| StoreError::Input { path: "Parquet export".into(), message };
     if let Some(bad) = table.rows.iter().position(|r| r.len() != table.columns.len()) {
-        return Err(StoreError::Input {
-            path: "Parquet export".into(),
-            message: format!("row {} has {} cells for {} columns", bad + 1, table.rows[bad].len(), table.columns.len()),
-        });
+        return Err(failed(format!(
+            "row {} has {} cells for {} columns",
+            bad + 1,
+            table.rows[bad].len(),
+            table.columns.len()
+        )));
     }
-    let types: Vec<ColumnType> = (0..table.columns.len()).map(|i| column_type(table, i)).collect();
-    let mut fields = Vec::new();
-    for (name, ty) in table.columns.iter().zip(&types) {
-        let b = match ty {
-            ColumnType::Text => {
-                Type::primitive_type_builder(name, Physical::BYTE_ARRAY).with_converted_type(ConvertedType::UTF8)
-            }
-            ColumnType::Double => Type::primitive_type_builder(name, Physical::DOUBLE),
-            ColumnType::Int => Type::primitive_type_builder(name, Physical::INT64),
-        };
-        fields.push(Arc::new(b.with_repetition(Repetition::OPTIONAL).build().map_err(err)?));
-    }
-    let schema = Arc::new(Type::group_type_builder("gyrolab_store_query").with_fields(fields).build().map_err(err)?);
-    let level = ZstdLevel::try_new(3).map_err(err)?;
-    let props = Arc::new(WriterProperties::builder().set_compression(Compression::ZSTD(level)).build());
-    let mut bytes = Vec::new();
-    {
-        let mut w = SerializedFileWriter::new(&mut bytes, schema, props).map_err(err)?;
-        let mut g = w.next_row_group().map_err(err)?;
-        for (i, ty) in types.iter().enumerate() {
-            let Some(mut c) = g.next_column().map_err(err)? else { break };
-            let cells: Vec<&Cell> = table.rows.iter().map(|r| &r[i]).collect();
-            let defs: Vec<i16> = cells.iter().map(|c| i16::from(**c != Cell::Empty)).collect();
-            match ty {
+    let columns: Vec<(String, ColumnValues)> = table
+        .columns
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            let cells = table.rows.iter().map(|r| &r[i]);
+            let values = match column_type(table, i) {
                 ColumnType::Text => {
-                    let v: Vec<ByteArray> = cells
-                        .iter()
-                        .filter(|c| ***c != Cell::Empty)
-                        .map(|c| ByteArray::from(c.raw().as_str()))
-                        .collect();
-                    c.typed::<ByteArrayType>().write_batch(&v, Some(&defs), None).map_err(err)?;
+                    ColumnValues::Text(cells.map(|c| if *c == Cell::Empty { None } else { Some(c.raw()) }).collect())
                 }
-                ColumnType::Double => {
-                    let v: Vec<f64> = cells
-                        .iter()
-                        .filter_map(|c| match c {
+                ColumnType::Double => ColumnValues::Double(
+                    cells
+                        .map(|c| match c {
                             Cell::Number(x) => Some(*x),
                             Cell::Count(n) => Some(*n as f64),
                             _ => None,
                         })
-                        .collect();
-                    c.typed::<DoubleType>().write_batch(&v, Some(&defs), None).map_err(err)?;
-                }
-                ColumnType::Int => {
-                    let v: Vec<i64> = cells
-                        .iter()
-                        .filter_map(|c| match c {
+                        .collect(),
+                ),
+                ColumnType::Int => ColumnValues::Int(
+                    cells
+                        .map(|c| match c {
                             Cell::Count(n) => Some(*n),
                             _ => None,
                         })
-                        .collect();
-                    c.typed::<Int64Type>().write_batch(&v, Some(&defs), None).map_err(err)?;
-                }
-            }
-            c.close().map_err(err)?;
-        }
-        g.close().map_err(err)?;
-        w.close().map_err(err)?;
-    }
-    Ok(bytes)
+                        .collect(),
+                ),
+            };
+            (name.clone(), values)
+        })
+        .collect();
+    write_table("gyrolab_store_query", &columns).map_err(|e| failed(format!("cannot write the Parquet table: {e}")))
 }
 
 #[cfg(test)]
