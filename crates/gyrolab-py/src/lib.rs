@@ -26,6 +26,8 @@ use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
+mod store;
+
 /// The Python class of every failure, `gyrolab.Error` (defined in `gyrolab/_errors.py` so that
 /// it pickles: its module imports).
 static ERROR_TYPE: PyOnceLock<Py<PyType>> = PyOnceLock::new();
@@ -671,5 +673,13 @@ fn _gyrolab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate_plan, m)?)?;
     m.add_function(wrap_pyfunction!(apply, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_history, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_lot, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_compare, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_chart, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_figures, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_evaluation, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_add, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_masked, m)?)?;
     Ok(())
 }

@@ -40,11 +40,37 @@ impl Cell {
     }
 }
 
-/// A query result: named columns (units in the names or in a `unit` column) and rows.
+/// What a column holds, declared by the query that makes the table (so that a column whose cells
+/// are all empty still has its type in Parquet and in a DataFrame).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ColumnKind {
+    /// Text (UTF-8 in Parquet, object in a DataFrame).
+    Text,
+    /// Real numbers (DOUBLE, float64).
+    Number,
+    /// Whole numbers (INT64, nullable Int64).
+    Count,
+}
+
+impl ColumnKind {
+    /// The kind's name: `text`, `number` or `count`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ColumnKind::Text => "text",
+            ColumnKind::Number => "number",
+            ColumnKind::Count => "count",
+        }
+    }
+}
+
+/// A query result: named columns (units in the names or in a `unit` column) of declared kinds,
+/// and rows.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Table {
     /// Column names.
     pub columns: Vec<String>,
+    /// The kind of each column, in column order.
+    pub kinds: Vec<ColumnKind>,
     /// Rows, each with one cell per column.
     pub rows: Vec<Vec<Cell>>,
 }
@@ -72,34 +98,15 @@ pub fn to_csv(table: &Table) -> String {
     out
 }
 
-#[derive(Clone, Copy, PartialEq)]
-enum ColumnType {
-    Text,
-    Double,
-    Int,
-}
-
-/// A column's Parquet type from its cells: INT64 when every value is a count, DOUBLE when every
-/// value is a number (counts among them widened), else UTF-8 text (numbers as their CSV text).
-fn column_type(table: &Table, i: usize) -> ColumnType {
-    let cells = table.rows.iter().filter_map(|r| r.get(i)).filter(|c| **c != Cell::Empty);
-    let mut ty = ColumnType::Int;
-    for c in cells {
-        match c {
-            Cell::Text(_) => return ColumnType::Text,
-            Cell::Number(_) => ty = ColumnType::Double,
-            Cell::Count(_) | Cell::Empty => {}
-        }
-    }
-    ty
-}
-
 /// The table as a Parquet file (bytes): one optional column per table column, of the same name,
-/// typed by [`Cell`] (text UTF-8, numbers DOUBLE, counts INT64; a column mixing text and numbers
-/// is text), empty cells null; one row group, zstd.
+/// typed by its [`ColumnKind`] (text UTF-8, numbers DOUBLE, counts INT64; a text cell in a
+/// number column is an error), empty cells null; one row group, zstd.
 pub fn to_parquet(table: &Table) -> StoreResult<Vec<u8>> {
     use gyrolab_io::parquet_table::{write_table, ColumnValues};
     let failed = |message: String| StoreError::Input { path: "Parquet export".into(), message };
+    if table.kinds.len() != table.columns.len() {
+        return Err(failed(format!("{} column kinds for {} columns", table.kinds.len(), table.columns.len())));
+    }
     if let Some(bad) = table.rows.iter().position(|r| r.len() != table.columns.len()) {
         return Err(failed(format!(
             "row {} has {} cells for {} columns",
@@ -108,17 +115,37 @@ pub fn to_parquet(table: &Table) -> StoreResult<Vec<u8>> {
             table.columns.len()
         )));
     }
+    for (r, row) in table.rows.iter().enumerate() {
+        for (i, (cell, kind)) in row.iter().zip(&table.kinds).enumerate() {
+            let fits = matches!(
+                (kind, cell),
+                (ColumnKind::Text, _)
+                    | (_, Cell::Empty)
+                    | (ColumnKind::Number, Cell::Number(_) | Cell::Count(_))
+                    | (ColumnKind::Count, Cell::Count(_))
+            );
+            if !fits {
+                return Err(failed(format!(
+                    "row {}, column {:?}: {:?} in a {} column",
+                    r + 1,
+                    table.columns[i],
+                    cell,
+                    kind.as_str()
+                )));
+            }
+        }
+    }
     let columns: Vec<(String, ColumnValues)> = table
         .columns
         .iter()
         .enumerate()
         .map(|(i, name)| {
             let cells = table.rows.iter().map(|r| &r[i]);
-            let values = match column_type(table, i) {
-                ColumnType::Text => {
+            let values = match table.kinds[i] {
+                ColumnKind::Text => {
                     ColumnValues::Text(cells.map(|c| if *c == Cell::Empty { None } else { Some(c.raw()) }).collect())
                 }
-                ColumnType::Double => ColumnValues::Double(
+                ColumnKind::Number => ColumnValues::Double(
                     cells
                         .map(|c| match c {
                             Cell::Number(x) => Some(*x),
@@ -127,7 +154,7 @@ pub fn to_parquet(table: &Table) -> StoreResult<Vec<u8>> {
                         })
                         .collect(),
                 ),
-                ColumnType::Int => ColumnValues::Int(
+                ColumnKind::Count => ColumnValues::Int(
                     cells
                         .map(|c| match c {
                             Cell::Count(n) => Some(*n),
@@ -151,6 +178,7 @@ mod tests {
     fn table() -> Table {
         Table {
             columns: vec!["serial".into(), "value".into(), "n".into(), "note".into()],
+            kinds: vec![ColumnKind::Text, ColumnKind::Number, ColumnKind::Count, ColumnKind::Text],
             rows: vec![
                 vec![
                     Cell::Text("SN-1, \"a\"".into()),
@@ -191,6 +219,22 @@ mod tests {
         assert_eq!(cols[1][0].1, Field::Str("SN-2 ∮ \u{202e}".into()));
         assert_eq!(cols[1][1].1, Field::Null);
         assert_eq!(cols[1][2].1, Field::Null);
+    }
+
+    #[test]
+    fn a_cell_of_the_wrong_kind_is_an_error_and_an_empty_column_keeps_its_type() {
+        let mut t = table();
+        t.rows[0][2] = Cell::Text("three".into());
+        let e = to_parquet(&t).unwrap_err().to_string();
+        assert!(e.contains("row 1, column \"n\""), "{e}");
+        let mut t = table();
+        t.rows[0][1] = Cell::Empty;
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.parquet");
+        std::fs::write(&p, to_parquet(&t).unwrap()).unwrap();
+        let r = SerializedFileReader::new(std::fs::File::open(&p).unwrap()).unwrap();
+        let col = r.metadata().file_metadata().schema_descr().column(1);
+        assert_eq!(col.physical_type(), parquet::basic::Type::DOUBLE);
     }
 
     #[test]

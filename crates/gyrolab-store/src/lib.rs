@@ -6,7 +6,8 @@
 //! Layout: [`db`] the two back ends behind one interface; [`schema`] tables and migrations;
 //! [`record`] what is kept of one evaluation, read from a finished report folder; [`query`] the
 //! queries and their statistics (computed by the core crate: `gyrolab::process_capability`,
-//! `gyrolab::control_chart`, `gyrolab::two_sample`); [`export`] query tables as CSV and Parquet.
+//! `gyrolab::control_chart`, `gyrolab::two_sample`); [`tables`] query results as tables;
+//! [`export`] tables as CSV and Parquet.
 
 pub mod db;
 pub mod export;
@@ -14,6 +15,7 @@ pub mod query;
 pub mod record;
 pub mod reevaluate;
 pub mod schema;
+pub mod tables;
 
 use db::{Exec, Kind, PgExec, PgStatements, SqliteExec, Val};
 use record::EvaluationRecord;

@@ -10,6 +10,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use gyrolab_report::format::sig_opt;
 use gyrolab_report::plot::{Axis, Figure, Orientation, Panel, RefLine, Series, SeriesStyle};
 use gyrolab_store::export::{to_csv, to_parquet, Cell, Table};
+use gyrolab_store::tables::{chart_table, compare_table, diff_table, history_table, lot_table};
 use gyrolab_store::{add_report_folder, query, reevaluate, resolve_location, Changes, Revision, RevisionKind, Store};
 use std::path::PathBuf;
 
@@ -270,18 +271,6 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
     }
 }
 
-fn num(v: Option<f64>) -> Cell {
-    Cell::number(v)
-}
-
-fn text(v: &str) -> Cell {
-    Cell::Text(v.to_string())
-}
-
-fn opt(v: &Option<String>) -> Cell {
-    Cell::text(v.as_deref())
-}
-
 /// Prints a query's table as text, CSV or JSON (`json` makes the JSON), and writes the Parquet
 /// file of `--parquet` first (whole or not at all).
 fn emit(table: &Table, output: &QueryOutput, json: impl FnOnce() -> CliResult<String>) -> CliResult {
@@ -333,10 +322,6 @@ fn text_table(table: &Table) -> String {
     out
 }
 
-fn strings(v: &[&str]) -> Vec<String> {
-    v.iter().map(|s| s.to_string()).collect()
-}
-
 fn history(a: &HistoryArgs) -> CliResult {
     let mut s = open(&a.location, false)?;
     let mut rows = query::history(&mut s, &a.serial)?;
@@ -346,50 +331,7 @@ fn history(a: &HistoryArgs) -> CliResult {
     if let Some(path) = &a.svg {
         write_file(path, history_svg(&a.serial, &rows)?.as_bytes())?;
     }
-    let head = strings(&[
-        "evaluation",
-        "supersedes",
-        "current",
-        "revision",
-        "tested",
-        "gyrolab",
-        "axis",
-        "figure",
-        "value",
-        "unit",
-        "basis",
-        "U",
-        "k",
-        "limit_min",
-        "limit_max",
-        "verdict",
-        "simulated",
-    ]);
-    let body = rows
-        .iter()
-        .map(|r| {
-            vec![
-                Cell::Count(r.evaluation),
-                r.supersedes.map_or(Cell::Empty, Cell::Count),
-                text(if r.current { "yes" } else { "no" }),
-                text(&r.revision_kind),
-                text(&r.tested),
-                text(&r.software_version),
-                text(&r.figure.axis),
-                text(&r.figure.figure),
-                num(r.figure.value),
-                text(&r.figure.unit),
-                text(&r.figure.basis),
-                num(r.figure.expanded_uncertainty),
-                num(r.figure.coverage_factor),
-                num(r.figure.limit_min),
-                num(r.figure.limit_max),
-                opt(&r.figure.verdict),
-                text(if r.figure.simulated { "SIMULATED" } else { "" }),
-            ]
-        })
-        .collect();
-    emit(&Table { columns: head, rows: body }, &a.format, || to_json(&rows))
+    emit(&history_table(&rows), &a.format, || to_json(&rows))
 }
 
 /// The trend plot of a history: one panel per (axis, figure), value against evaluation number,
@@ -434,165 +376,6 @@ fn history_svg(serial: &str, rows: &[query::HistoryRow]) -> CliResult<String> {
     let svg =
         if svg.contains("xmlns=") { svg } else { svg.replacen("<svg", "<svg xmlns=\"http://www.w3.org/2000/svg\"", 1) };
     Ok(format!("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n{svg}\n"))
-}
-
-fn index_cols(i: Option<gyrolab::process_capability::Index>) -> [Cell; 3] {
-    match i {
-        Some(i) => [num(Some(i.value)), num(i.interval.map(|c| c.lower)), num(i.interval.map(|c| c.upper))],
-        None => [Cell::Empty, Cell::Empty, Cell::Empty],
-    }
-}
-
-fn lot_table(rows: &[query::LotFigure]) -> Table {
-    let head = strings(&[
-        "axis",
-        "figure",
-        "unit",
-        "n",
-        "mean",
-        "sd",
-        "min",
-        "max",
-        "limit_min",
-        "limit_max",
-        "yield",
-        "Cp",
-        "Cp_lo",
-        "Cp_hi",
-        "Cpk",
-        "Cpk_lo",
-        "Cpk_hi",
-        "Pp",
-        "Pp_lo",
-        "Pp_hi",
-        "Ppk",
-        "Ppk_lo",
-        "Ppk_hi",
-        "outliers",
-        "simulated",
-    ]);
-    let body = rows
-        .iter()
-        .map(|r| {
-            let s = &r.statistics;
-            let mut v = vec![
-                text(&r.axis),
-                text(&r.figure),
-                text(&r.unit),
-                Cell::Count(s.n as i64),
-                num(Some(s.mean)),
-                num(s.sd),
-                num(Some(s.min)),
-                num(Some(s.max)),
-                num(r.limit_min),
-                num(r.limit_max),
-                num(s.yield_fraction),
-            ];
-            for i in [s.cp, s.cpk, s.pp, s.ppk] {
-                v.extend(index_cols(i));
-            }
-            v.push(text(&r.outlier_serials.join(" ")));
-            v.push(text(if r.simulated { "SIMULATED" } else { "" }));
-            v
-        })
-        .collect();
-    Table { columns: head, rows: body }
-}
-
-fn compare_table(rows: &[query::LotComparison]) -> Table {
-    let head = strings(&[
-        "axis",
-        "figure",
-        "unit",
-        "n1",
-        "n2",
-        "mean1",
-        "mean2",
-        "difference",
-        "welch_t",
-        "dof",
-        "p_means",
-        "sd_ratio",
-        "F",
-        "p_spreads",
-    ]);
-    let body = rows
-        .iter()
-        .map(|r| {
-            let t = r.test;
-            vec![
-                text(&r.axis),
-                text(&r.figure),
-                text(&r.unit),
-                Cell::Count(r.n1 as i64),
-                Cell::Count(r.n2 as i64),
-                num(Some(r.mean1)),
-                num(Some(r.mean2)),
-                num(Some(r.mean1 - r.mean2)),
-                num(t.map(|t| t.t)),
-                num(t.map(|t| t.t_dof)),
-                num(t.map(|t| t.t_p_value)),
-                num(t.map(|t| t.sd_ratio)),
-                num(t.map(|t| t.f)),
-                num(t.map(|t| t.f_p_value)),
-            ]
-        })
-        .collect();
-    Table { columns: head, rows: body }
-}
-
-fn chart_table(c: &query::ControlCharts) -> Table {
-    let head = strings(&["chart", "point", "label", "value", "center", "lcl", "ucl", "violations"]);
-    let mut body = Vec::new();
-    let mut add = |name: &str, chart: &Option<gyrolab::control_chart::Chart>, labels: &dyn Fn(usize) -> String| {
-        if let Some(ch) = chart {
-            for (i, v) in ch.points.iter().enumerate() {
-                let rules: Vec<String> =
-                    ch.violations.iter().filter(|x| x.index == i).map(|x| format!("nelson {}", x.rule)).collect();
-                body.push(vec![
-                    text(name),
-                    Cell::Count(i as i64 + 1),
-                    Cell::Text(labels(i)),
-                    num(Some(*v)),
-                    num(Some(ch.center)),
-                    num(Some(ch.lcl[i])),
-                    num(Some(ch.ucl[i])),
-                    text(&rules.join(" ")),
-                ]);
-            }
-        }
-    };
-    add("individuals", &c.individuals, &|i| c.serials.get(i).cloned().unwrap_or_default());
-    add("moving_range", &c.moving_range, &|i| {
-        format!(
-            "{}-{}",
-            c.serials.get(i).cloned().unwrap_or_default(),
-            c.serials.get(i + 1).cloned().unwrap_or_default()
-        )
-    });
-    add("xbar", &c.xbar, &|i| c.lots.get(i).cloned().unwrap_or_default());
-    add("s", &c.s, &|i| c.lots.get(i).cloned().unwrap_or_default());
-    Table { columns: head, rows: body }
-}
-
-fn diff_table(rows: &[query::FigureChange]) -> Table {
-    let head = strings(&["axis", "figure", "unit", "before", "after", "difference", "verdict_before", "verdict_after"]);
-    let body = rows
-        .iter()
-        .map(|r| {
-            vec![
-                text(&r.axis),
-                text(&r.figure),
-                text(&r.unit),
-                num(r.before),
-                num(r.after),
-                num(r.difference),
-                opt(&r.verdict_before),
-                opt(&r.verdict_after),
-            ]
-        })
-        .collect();
-    Table { columns: head, rows: body }
 }
 
 fn show_text(e: &query::StoredEvaluation) -> String {

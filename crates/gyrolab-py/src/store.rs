@@ -1,0 +1,145 @@
+//! The records store from Python (crate `gyrolab-store`, docs/STORE.md): the queries of `gyrolab
+//! store` as tables (column names, column kinds, one Python list per column) that
+//! `gyrolab.store.Store` turns into DataFrames, the stored evaluation as JSON, and storing a
+//! report folder. Each call opens the store and closes it again with the interpreter released
+//! (no connection outlives a call, so a process made by `fork` never shares one).
+
+use gyrolab_store::export::{Cell, Table};
+use gyrolab_store::{query, resolve_location, tables, Store, StoreError};
+use pyo3::prelude::*;
+use pyo3::types::PyList;
+use std::path::PathBuf;
+
+/// A query's table for Python: column names, column kinds (`text`, `number`, `count`) and the
+/// values of each column (text or None, float or None, int or None).
+type PyTable<'py> = (Vec<String>, Vec<&'static str>, Vec<Bound<'py, PyList>>);
+
+/// The `gyrolab.Error` of a store failure (its message names the store, password masked).
+fn store_err(e: StoreError) -> PyErr {
+    crate::error(e.to_string())
+}
+
+/// Opens the store at `location` (None: `GYROLAB_STORE`, else `gyrolab.db` in the current
+/// folder), runs `query` on it with the interpreter released, and closes it.
+fn with_store<T: Send>(
+    py: Python<'_>,
+    location: Option<String>,
+    create: bool,
+    query: impl FnOnce(&mut Store) -> Result<T, StoreError> + Send,
+) -> PyResult<T> {
+    py.detach(|| {
+        let mut store = Store::open(&resolve_location(location.as_deref(), None), create)?;
+        query(&mut store)
+    })
+    .map_err(store_err)
+}
+
+/// A table as Python lists, one per column.
+fn table_out(py: Python<'_>, table: Table) -> PyResult<PyTable<'_>> {
+    let mut columns: Vec<Vec<Py<PyAny>>> =
+        (0..table.columns.len()).map(|_| Vec::with_capacity(table.rows.len())).collect();
+    for row in table.rows {
+        for (i, cell) in row.into_iter().enumerate() {
+            let v = match cell {
+                Cell::Empty => py.None(),
+                Cell::Text(t) => t.into_pyobject(py)?.into_any().unbind(),
+                Cell::Number(x) => x.into_pyobject(py)?.into_any().unbind(),
+                Cell::Count(n) => n.into_pyobject(py)?.into_any().unbind(),
+            };
+            if let Some(c) = columns.get_mut(i) {
+                c.push(v);
+            }
+        }
+    }
+    let lists = columns.into_iter().map(|c| PyList::new(py, c)).collect::<PyResult<Vec<_>>>()?;
+    Ok((table.columns, table.kinds.iter().map(|k| k.as_str()).collect(), lists))
+}
+
+/// Every figure of every evaluation (all revisions) of a serial, oldest first; only `figure`
+/// when given.
+#[pyfunction]
+#[pyo3(signature = (location, serial, figure=None))]
+pub fn store_history(
+    py: Python<'_>,
+    location: Option<String>,
+    serial: String,
+    figure: Option<String>,
+) -> PyResult<PyTable<'_>> {
+    let rows = with_store(py, location, false, |s| {
+        let mut rows = query::history(s, &serial)?;
+        if let Some(f) = &figure {
+            rows.retain(|r| &r.figure.figure == f);
+        }
+        Ok(rows)
+    })?;
+    table_out(py, tables::history_table(&rows))
+}
+
+/// Lot statistics per figure (capability intervals at `confidence`).
+#[pyfunction]
+#[pyo3(signature = (location, lot, confidence))]
+pub fn store_lot(py: Python<'_>, location: Option<String>, lot: String, confidence: f64) -> PyResult<PyTable<'_>> {
+    if !(confidence > 0.0 && confidence < 1.0) {
+        return Err(crate::keyword_error("confidence", format!("confidence {confidence}: must be between 0 and 1")));
+    }
+    let rows = with_store(py, location, false, |s| query::lot(s, &lot, confidence))?;
+    table_out(py, tables::lot_table(&rows))
+}
+
+/// Two lots compared per figure.
+#[pyfunction]
+pub fn store_compare(py: Python<'_>, location: Option<String>, lot1: String, lot2: String) -> PyResult<PyTable<'_>> {
+    let rows = with_store(py, location, false, |s| query::compare(s, &lot1, &lot2))?;
+    table_out(py, tables::compare_table(&rows))
+}
+
+/// Control charts of one figure of one axis (individuals over `lot`, or every device).
+#[pyfunction]
+#[pyo3(signature = (location, axis, figure, lot=None))]
+pub fn store_chart(
+    py: Python<'_>,
+    location: Option<String>,
+    axis: String,
+    figure: String,
+    lot: Option<String>,
+) -> PyResult<PyTable<'_>> {
+    let charts = with_store(py, location, false, |s| query::control_charts(s, lot.as_deref(), &axis, &figure))?;
+    table_out(py, tables::chart_table(&charts))
+}
+
+/// The current figures of a lot's devices (every device: `lot` None), one row per device and
+/// figure.
+#[pyfunction]
+#[pyo3(signature = (location, lot=None))]
+pub fn store_figures(py: Python<'_>, location: Option<String>, lot: Option<String>) -> PyResult<PyTable<'_>> {
+    let series = with_store(py, location, false, |s| query::lot_series(s, lot.as_deref()))?;
+    table_out(py, tables::figures_table(&series))
+}
+
+/// One stored evaluation (device, plan, inputs, revisions, figures) as the JSON of `gyrolab
+/// store show --json`.
+#[pyfunction]
+pub fn store_evaluation(py: Python<'_>, location: Option<String>, id: i64) -> PyResult<String> {
+    let e = with_store(py, location, false, |s| s.evaluation(id))?;
+    serde_json::to_string(&e).map_err(crate::json_err)
+}
+
+/// Stores a finished report folder (its plan: `plan`, else the one its results.json names), the
+/// store created when missing: (evaluation id, store name with the password masked).
+#[pyfunction]
+#[pyo3(signature = (location, folder, plan=None))]
+pub fn store_add(
+    py: Python<'_>,
+    location: Option<String>,
+    folder: PathBuf,
+    plan: Option<PathBuf>,
+) -> PyResult<(i64, String)> {
+    py.detach(|| gyrolab_store::add_report_folder(&folder, plan.as_deref(), location.as_deref())).map_err(store_err)
+}
+
+/// The location with any password replaced by `***` (URL user info and `password=` parameters),
+/// as the store's messages show it.
+#[pyfunction]
+pub fn store_masked(location: &str) -> String {
+    gyrolab_store::mask_location(location)
+}

@@ -1,0 +1,291 @@
+//! Query results as [`Table`]s, one builder per query, shared by every front end (the command
+//! line prints or exports them; Python turns them into DataFrames). Column names are the keys of
+//! the JSON output; units are in a `unit` column beside each value.
+
+use crate::export::ColumnKind::{self, Count as C, Number as N, Text as T};
+use crate::export::{Cell, Table};
+use crate::query;
+
+fn num(v: Option<f64>) -> Cell {
+    Cell::number(v)
+}
+
+fn text(v: &str) -> Cell {
+    Cell::Text(v.to_string())
+}
+
+fn opt(v: &Option<String>) -> Cell {
+    Cell::text(v.as_deref())
+}
+
+/// Column names and kinds from (name, kind) pairs.
+fn columns(v: &[(&str, ColumnKind)]) -> (Vec<String>, Vec<ColumnKind>) {
+    (v.iter().map(|(n, _)| n.to_string()).collect(), v.iter().map(|(_, k)| *k).collect())
+}
+
+/// The history of a serial: one row per figure of each evaluation (all revisions), oldest first.
+pub fn history_table(rows: &[query::HistoryRow]) -> Table {
+    let (head, kinds) = columns(&[
+        ("evaluation", C),
+        ("supersedes", C),
+        ("current", T),
+        ("revision", T),
+        ("tested", T),
+        ("gyrolab", T),
+        ("axis", T),
+        ("figure", T),
+        ("value", N),
+        ("unit", T),
+        ("basis", T),
+        ("U", N),
+        ("k", N),
+        ("limit_min", N),
+        ("limit_max", N),
+        ("verdict", T),
+        ("simulated", T),
+    ]);
+    let body = rows
+        .iter()
+        .map(|r| {
+            vec![
+                Cell::Count(r.evaluation),
+                r.supersedes.map_or(Cell::Empty, Cell::Count),
+                text(if r.current { "yes" } else { "no" }),
+                text(&r.revision_kind),
+                text(&r.tested),
+                text(&r.software_version),
+                text(&r.figure.axis),
+                text(&r.figure.figure),
+                num(r.figure.value),
+                text(&r.figure.unit),
+                text(&r.figure.basis),
+                num(r.figure.expanded_uncertainty),
+                num(r.figure.coverage_factor),
+                num(r.figure.limit_min),
+                num(r.figure.limit_max),
+                opt(&r.figure.verdict),
+                text(if r.figure.simulated { "SIMULATED" } else { "" }),
+            ]
+        })
+        .collect();
+    Table { columns: head, kinds, rows: body }
+}
+
+fn index_cols(i: Option<gyrolab::process_capability::Index>) -> [Cell; 3] {
+    match i {
+        Some(i) => [num(Some(i.value)), num(i.interval.map(|c| c.lower)), num(i.interval.map(|c| c.upper))],
+        None => [Cell::Empty, Cell::Empty, Cell::Empty],
+    }
+}
+
+/// Lot statistics: one row per (axis, figure) with n, mean, sd, range, limits, yield, the four
+/// capability indices with their confidence intervals, outliers and the SIMULATED mark.
+pub fn lot_table(rows: &[query::LotFigure]) -> Table {
+    let (head, kinds) = columns(&[
+        ("axis", T),
+        ("figure", T),
+        ("unit", T),
+        ("n", C),
+        ("mean", N),
+        ("sd", N),
+        ("min", N),
+        ("max", N),
+        ("limit_min", N),
+        ("limit_max", N),
+        ("yield", N),
+        ("Cp", N),
+        ("Cp_lo", N),
+        ("Cp_hi", N),
+        ("Cpk", N),
+        ("Cpk_lo", N),
+        ("Cpk_hi", N),
+        ("Pp", N),
+        ("Pp_lo", N),
+        ("Pp_hi", N),
+        ("Ppk", N),
+        ("Ppk_lo", N),
+        ("Ppk_hi", N),
+        ("outliers", T),
+        ("simulated", T),
+    ]);
+    let body = rows
+        .iter()
+        .map(|r| {
+            let s = &r.statistics;
+            let mut v = vec![
+                text(&r.axis),
+                text(&r.figure),
+                text(&r.unit),
+                Cell::Count(s.n as i64),
+                num(Some(s.mean)),
+                num(s.sd),
+                num(Some(s.min)),
+                num(Some(s.max)),
+                num(r.limit_min),
+                num(r.limit_max),
+                num(s.yield_fraction),
+            ];
+            for i in [s.cp, s.cpk, s.pp, s.ppk] {
+                v.extend(index_cols(i));
+            }
+            v.push(text(&r.outlier_serials.join(" ")));
+            v.push(text(if r.simulated { "SIMULATED" } else { "" }));
+            v
+        })
+        .collect();
+    Table { columns: head, kinds, rows: body }
+}
+
+/// Two lots compared: one row per (axis, figure) with both means, their difference, Welch's t-test
+/// and the F-test of the spreads.
+pub fn compare_table(rows: &[query::LotComparison]) -> Table {
+    let (head, kinds) = columns(&[
+        ("axis", T),
+        ("figure", T),
+        ("unit", T),
+        ("n1", C),
+        ("n2", C),
+        ("mean1", N),
+        ("mean2", N),
+        ("difference", N),
+        ("welch_t", N),
+        ("dof", N),
+        ("p_means", N),
+        ("sd_ratio", N),
+        ("F", N),
+        ("p_spreads", N),
+    ]);
+    let body = rows
+        .iter()
+        .map(|r| {
+            let t = r.test;
+            vec![
+                text(&r.axis),
+                text(&r.figure),
+                text(&r.unit),
+                Cell::Count(r.n1 as i64),
+                Cell::Count(r.n2 as i64),
+                num(Some(r.mean1)),
+                num(Some(r.mean2)),
+                num(Some(r.mean1 - r.mean2)),
+                num(t.map(|t| t.t)),
+                num(t.map(|t| t.t_dof)),
+                num(t.map(|t| t.t_p_value)),
+                num(t.map(|t| t.sd_ratio)),
+                num(t.map(|t| t.f)),
+                num(t.map(|t| t.f_p_value)),
+            ]
+        })
+        .collect();
+    Table { columns: head, kinds, rows: body }
+}
+
+/// Control charts: one row per point of each chart (individuals, moving range, X-bar, S) with its
+/// centre line, limits and the Nelson rules it violates.
+pub fn chart_table(c: &query::ControlCharts) -> Table {
+    let (head, kinds) = columns(&[
+        ("chart", T),
+        ("point", C),
+        ("label", T),
+        ("value", N),
+        ("center", N),
+        ("lcl", N),
+        ("ucl", N),
+        ("violations", T),
+    ]);
+    let mut body = Vec::new();
+    let mut add = |name: &str, chart: &Option<gyrolab::control_chart::Chart>, labels: &dyn Fn(usize) -> String| {
+        if let Some(ch) = chart {
+            for (i, v) in ch.points.iter().enumerate() {
+                let rules: Vec<String> =
+                    ch.violations.iter().filter(|x| x.index == i).map(|x| format!("nelson {}", x.rule)).collect();
+                body.push(vec![
+                    text(name),
+                    Cell::Count(i as i64 + 1),
+                    Cell::Text(labels(i)),
+                    num(Some(*v)),
+                    num(Some(ch.center)),
+                    num(Some(ch.lcl[i])),
+                    num(Some(ch.ucl[i])),
+                    text(&rules.join(" ")),
+                ]);
+            }
+        }
+    };
+    add("individuals", &c.individuals, &|i| c.serials.get(i).cloned().unwrap_or_default());
+    add("moving_range", &c.moving_range, &|i| {
+        format!(
+            "{}-{}",
+            c.serials.get(i).cloned().unwrap_or_default(),
+            c.serials.get(i + 1).cloned().unwrap_or_default()
+        )
+    });
+    add("xbar", &c.xbar, &|i| c.lots.get(i).cloned().unwrap_or_default());
+    add("s", &c.s, &|i| c.lots.get(i).cloned().unwrap_or_default());
+    Table { columns: head, kinds, rows: body }
+}
+
+/// A re-evaluation's changes: one row per figure whose value or verdict changed.
+pub fn diff_table(rows: &[query::FigureChange]) -> Table {
+    let (head, kinds) = columns(&[
+        ("axis", T),
+        ("figure", T),
+        ("unit", T),
+        ("before", N),
+        ("after", N),
+        ("difference", N),
+        ("verdict_before", T),
+        ("verdict_after", T),
+    ]);
+    let body = rows
+        .iter()
+        .map(|r| {
+            vec![
+                text(&r.axis),
+                text(&r.figure),
+                text(&r.unit),
+                num(r.before),
+                num(r.after),
+                num(r.difference),
+                opt(&r.verdict_before),
+                opt(&r.verdict_after),
+            ]
+        })
+        .collect();
+    Table { columns: head, kinds, rows: body }
+}
+
+/// The current figures of a lot's devices (every lot: `lot_series(store, None)`), long form: one
+/// row per device and (axis, figure), in test order within each figure, with the limits of the
+/// latest evaluation; `series_simulated` is SIMULATED when any value of that figure in the lot
+/// comes from SIMULATED records.
+pub fn figures_table(series: &[query::FigureSeries]) -> Table {
+    let (head, kinds) = columns(&[
+        ("axis", T),
+        ("figure", T),
+        ("unit", T),
+        ("serial", T),
+        ("evaluation", C),
+        ("value", N),
+        ("limit_min", N),
+        ("limit_max", N),
+        ("series_simulated", T),
+    ]);
+    let mut body = Vec::new();
+    for s in series {
+        for (serial, id, value) in &s.values {
+            body.push(vec![
+                text(&s.axis),
+                text(&s.figure),
+                text(&s.unit),
+                text(serial),
+                Cell::Count(*id),
+                num(Some(*value)),
+                num(s.limit_min),
+                num(s.limit_max),
+                text(if s.simulated { "SIMULATED" } else { "" }),
+            ]);
+        }
+    }
+    Table { columns: head, kinds, rows: body }
+}
