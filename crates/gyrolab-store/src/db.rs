@@ -60,6 +60,45 @@ pub enum Kind {
     T,
 }
 
+/// One column of rows inserted together: a typed array (PostgreSQL receives it as one array
+/// parameter).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Column {
+    /// 64-bit integers (BIGINT[]).
+    I(Vec<i64>),
+    /// Optional doubles (DOUBLE PRECISION[]).
+    F(Vec<Option<f64>>),
+    /// Optional texts (TEXT[]).
+    T(Vec<Option<String>>),
+}
+
+impl Column {
+    fn len(&self) -> usize {
+        match self {
+            Column::I(v) => v.len(),
+            Column::F(v) => v.len(),
+            Column::T(v) => v.len(),
+        }
+    }
+
+    fn value(&self, row: usize) -> Val {
+        match self {
+            Column::I(v) => Val::I(v[row]),
+            Column::F(v) => Val::F(v[row]),
+            Column::T(v) => Val::T(v[row].clone()),
+        }
+    }
+}
+
+/// The number of rows of equal-length columns, or why not.
+fn rows_of(columns: &[Column]) -> Result<usize, String> {
+    let n = columns.first().map_or(0, Column::len);
+    if columns.iter().any(|c| c.len() != n) {
+        return Err("columns of unequal length in one insert".into());
+    }
+    Ok(n)
+}
+
 /// Something that runs statements: a connection or a transaction of either back end.
 pub trait Exec {
     /// Runs a statement; the number of rows changed.
@@ -68,6 +107,11 @@ pub trait Exec {
     fn query(&mut self, sql: &str, params: &[Val], kinds: &[Kind]) -> Result<Vec<Vec<Val>>, String>;
     /// Runs several statements without parameters (schema changes).
     fn batch(&mut self, sql: &str) -> Result<(), String>;
+    /// Inserts rows given as columns: SQLite runs `row_sql` (one row's `$1..$n`) once per row
+    /// (prepared once, in process); PostgreSQL runs `array_sql` once, with each column as one
+    /// array parameter (`INSERT ... SELECT * FROM unnest($1::bigint[], ...)`), one round trip
+    /// whatever the number of rows. The number of rows inserted.
+    fn insert_columns(&mut self, row_sql: &str, array_sql: &str, columns: &[Column]) -> Result<u64, String>;
 }
 
 impl SqliteToSql for Val {
@@ -112,6 +156,15 @@ impl Exec for SqliteExec<'_> {
     }
     fn batch(&mut self, sql: &str) -> Result<(), String> {
         self.0.execute_batch(sql).map_err(|e| e.to_string())
+    }
+    fn insert_columns(&mut self, row_sql: &str, _array_sql: &str, columns: &[Column]) -> Result<u64, String> {
+        let n = rows_of(columns)?;
+        let mut st = self.0.prepare_cached(row_sql).map_err(|e| e.to_string())?;
+        for row in 0..n {
+            let params: Vec<Val> = columns.iter().map(|c| c.value(row)).collect();
+            st.execute(rusqlite::params_from_iter(params.iter())).map_err(|e| e.to_string())?;
+        }
+        Ok(n as u64)
     }
 }
 
@@ -185,5 +238,23 @@ impl<C: postgres::GenericClient> Exec for PgExec<'_, C> {
     }
     fn batch(&mut self, sql: &str) -> Result<(), String> {
         self.0.batch_execute(sql).map_err(pg_error)
+    }
+    fn insert_columns(&mut self, _row_sql: &str, array_sql: &str, columns: &[Column]) -> Result<u64, String> {
+        if rows_of(columns)? == 0 {
+            return Ok(0);
+        }
+        let st = self.statement(array_sql)?;
+        let p: Vec<Box<dyn postgres::types::ToSql + Sync>> = columns
+            .iter()
+            .map(|c| -> Box<dyn postgres::types::ToSql + Sync> {
+                match c {
+                    Column::I(v) => Box::new(v.clone()),
+                    Column::F(v) => Box::new(v.clone()),
+                    Column::T(v) => Box::new(v.clone()),
+                }
+            })
+            .collect();
+        let refs: Vec<&(dyn postgres::types::ToSql + Sync)> = p.iter().map(|b| b.as_ref()).collect();
+        self.0.execute(&st, &refs).map_err(pg_error)
     }
 }

@@ -17,7 +17,7 @@ pub mod reevaluate;
 pub mod schema;
 pub mod tables;
 
-use db::{Exec, Kind, PgExec, PgStatements, SqliteExec, Val};
+use db::{Column, Exec, Kind, PgExec, PgStatements, SqliteExec, Val};
 use record::EvaluationRecord;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -429,41 +429,56 @@ impl Store {
                 )
                 .map_err(&dberr)?;
             let id = rows.first().map(|r| r[0].int()).ok_or_else(|| dberr("no id returned".into()))?;
-            for f in &record.inputs {
-                x.exec(
+            // One statement per table (PostgreSQL: one round trip each, the rows as arrays).
+            for (files, row_sql, array_sql) in [
+                (
+                    &record.inputs,
                     "INSERT INTO input_file (evaluation_id, path, sha256, size_bytes) VALUES ($1, $2, $3, $4)",
-                    &[Val::I(id), t(&f.path), t(&f.sha256), Val::I(f.size_bytes as i64)],
-                )
-                .map_err(&dberr)?;
-            }
-            for f in &record.report_files {
-                x.exec(
+                    "INSERT INTO input_file (evaluation_id, path, sha256, size_bytes) \
+                     SELECT * FROM unnest($1::bigint[], $2::text[], $3::text[], $4::bigint[])",
+                ),
+                (
+                    &record.report_files,
                     "INSERT INTO report_file (evaluation_id, name, sha256, size_bytes) VALUES ($1, $2, $3, $4)",
-                    &[Val::I(id), t(&f.path), t(&f.sha256), Val::I(f.size_bytes as i64)],
-                )
-                .map_err(&dberr)?;
+                    "INSERT INTO report_file (evaluation_id, name, sha256, size_bytes) \
+                     SELECT * FROM unnest($1::bigint[], $2::text[], $3::text[], $4::bigint[])",
+                ),
+            ] {
+                let columns = [
+                    Column::I(vec![id; files.len()]),
+                    Column::T(files.iter().map(|f| Some(f.path.clone())).collect()),
+                    Column::T(files.iter().map(|f| Some(f.sha256.clone())).collect()),
+                    Column::I(files.iter().map(|f| f.size_bytes as i64).collect()),
+                ];
+                x.insert_columns(row_sql, array_sql, &columns).map_err(&dberr)?;
             }
-            for f in &record.figures {
-                x.exec(
-                    "INSERT INTO figure (evaluation_id, axis, figure, value, unit, basis, expanded_uncertainty, coverage_factor, \
-                     limit_min, limit_max, verdict, simulated) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12)",
-                    &[
-                        Val::I(id),
-                        t(&f.axis),
-                        t(&f.figure),
-                        Val::F(f.value),
-                        t(&f.unit),
-                        t(&f.basis),
-                        Val::F(f.expanded_uncertainty),
-                        Val::F(f.coverage_factor),
-                        Val::F(f.limit_min),
-                        Val::F(f.limit_max),
-                        o(&f.verdict),
-                        Val::I(f.simulated as i64),
-                    ],
-                )
-                .map_err(&dberr)?;
-            }
+            let figs = &record.figures;
+            let text = |g: fn(&record::FigureRecord) -> &str| Column::T(figs.iter().map(|f| Some(g(f).to_string())).collect());
+            let number = |g: fn(&record::FigureRecord) -> Option<f64>| Column::F(figs.iter().map(g).collect());
+            let columns = [
+                Column::I(vec![id; figs.len()]),
+                text(|f| &f.axis),
+                text(|f| &f.figure),
+                number(|f| f.value),
+                text(|f| &f.unit),
+                text(|f| &f.basis),
+                number(|f| f.expanded_uncertainty),
+                number(|f| f.coverage_factor),
+                number(|f| f.limit_min),
+                number(|f| f.limit_max),
+                Column::T(figs.iter().map(|f| f.verdict.clone()).collect()),
+                Column::I(figs.iter().map(|f| f.simulated as i64).collect()),
+            ];
+            x.insert_columns(
+                "INSERT INTO figure (evaluation_id, axis, figure, value, unit, basis, expanded_uncertainty, coverage_factor, \
+                 limit_min, limit_max, verdict, simulated) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12)",
+                "INSERT INTO figure (evaluation_id, axis, figure, value, unit, basis, expanded_uncertainty, coverage_factor, \
+                 limit_min, limit_max, verdict, simulated) SELECT * FROM unnest($1::bigint[], $2::text[], $3::text[], \
+                 $4::float8[], $5::text[], $6::text[], $7::float8[], $8::float8[], $9::float8[], $10::float8[], $11::text[], \
+                 $12::bigint[])",
+                &columns,
+            )
+            .map_err(&dberr)?;
             pause_for_test();
             Ok(id)
         });
