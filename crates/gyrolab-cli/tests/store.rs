@@ -33,7 +33,7 @@ fn gyrolab_process() -> std::process::Command {
 // gyrolab-store crate.
 #[path = "../../gyrolab-store/tests/common/mod.rs"]
 mod common;
-use common::backends;
+use common::{backends, mark_newer_schema};
 
 /// A TOML basic string holding `s` exactly.
 fn toml_str(s: &str) -> String {
@@ -429,5 +429,32 @@ fn bad_stores_exit_2_naming_the_store_without_the_password_and_write_nothing() {
         assert_eq!(o.status.code(), Some(3));
         let all = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
         assert!(all.contains("Stored as evaluation") && all.contains(":***@") && !all.contains(&right), "{all}");
+    }
+}
+
+#[test]
+fn a_store_of_a_newer_schema_exits_2_naming_both_versions_and_writes_nothing() {
+    for b in backends("cli_newer_schema") {
+        let dir = tempfile::tempdir().unwrap();
+        let p = plan(dir.path(), "N1", "L");
+        eval(&p, &dir.path().join("first"), Some(&b.location));
+        mark_newer_schema(&b, 9);
+        let report = dir.path().join("second");
+        let o = gyrolab()
+            .args(["eval", p.to_str().unwrap(), "--out", report.to_str().unwrap(), "-q", "--store", &b.location])
+            .output()
+            .unwrap_or_else(|e| panic!("{}: {e}", b.name));
+        assert_eq!(o.status.code(), Some(2), "{}", b.name);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("schema version 9") && err.contains("up to 1"), "{}: {err}", b.name);
+        assert!(!report.exists(), "{}: nothing written", b.name);
+        for args in [vec!["store", "lot", "L"], vec!["store", "history", "N1"]] {
+            gyrolab()
+                .args(&args)
+                .args(["--store", &b.location])
+                .assert()
+                .code(2)
+                .stderr(predicates::str::contains("schema version 9"));
+        }
     }
 }

@@ -7,7 +7,7 @@
 mod common;
 
 use approx::assert_relative_eq;
-use common::{backends, pg_url, record};
+use common::{backends, mark_newer_schema, pg_url, record};
 use gyrolab_store::{query, Changes, Revision, RevisionKind, Store, StoreError};
 
 fn count(store: &mut Store) -> usize {
@@ -259,15 +259,7 @@ fn a_newer_schema_is_refused_naming_both_versions() {
         let mut s = Store::open(&b.location, true).unwrap();
         s.add(&record("SN1", None, &[("x", "bias_dph", 10.0)])).unwrap();
         drop(s);
-        if b.name == "sqlite" {
-            let c = rusqlite::Connection::open(&b.location).unwrap();
-            c.execute("INSERT INTO gyrolab_schema VALUES (7, 'later', '9.9.9')", []).unwrap();
-        } else {
-            let url = pg_url("newer_schema").unwrap();
-            let schema = b.location.rsplit("search_path%3D").next().unwrap().to_string();
-            let mut c = postgres::Client::connect(&url, postgres::NoTls).unwrap();
-            c.batch_execute(&format!("INSERT INTO {schema}.gyrolab_schema VALUES (7, 'later', '9.9.9')")).unwrap();
-        }
+        mark_newer_schema(&b, 7);
         let e = Store::open(&b.location, true).err().unwrap();
         let m = e.to_string();
         assert!(matches!(e, StoreError::NewerSchema { found: 7, known: 1, .. }), "{m}");

@@ -62,6 +62,19 @@ pub fn backends(test: &str) -> Vec<Backend> {
     out
 }
 
+/// Makes the store at `b` look written by a later gyrolab: a row of schema `version` in its
+/// `gyrolab_schema` table (test set-up only).
+pub fn mark_newer_schema(b: &Backend, version: i64) {
+    let row = format!("INSERT INTO gyrolab_schema VALUES ({version}, 'later', '9.9.9')");
+    if b.name == "sqlite" {
+        let c = rusqlite::Connection::open(&b.location).expect("open the SQLite store");
+        c.execute(&row, []).expect("insert the schema row");
+    } else {
+        let mut c = postgres::Client::connect(&b.location, postgres::NoTls).expect("connect to the test server");
+        c.batch_execute(&row).expect("insert the schema row");
+    }
+}
+
 /// A synthetic record of `serial` in `lot` with figures `(axis, key, value)`, limits 9 .. 11.
 pub fn record(serial: &str, lot: Option<&str>, figures: &[(&str, &str, f64)]) -> EvaluationRecord {
     EvaluationRecord {
