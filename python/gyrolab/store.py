@@ -119,6 +119,11 @@ class Store:
         plan text and SHA-256, inputs with their SHA-256, revision, every figure."""
         return json.loads(_gyrolab.store_evaluation(self.location, int(id)))
 
+    def report(self, id: int, out: PathLike) -> List[str]:
+        """Writes the stored report folder of evaluation ``id`` to ``out`` (every file checked
+        against its SHA-256 first; all files or none). Returns the files written."""
+        return [str(p) for p in _gyrolab.store_report(self.location, int(id), os.fspath(out))]
+
     def _name(self) -> str:
         return _masked(self.location)
 

@@ -160,6 +160,16 @@ def test_history_has_every_summary_row_and_evaluation_json(filled):
     assert all(len(f["sha256"]) == 64 for f in e["record"]["inputs"])
 
 
+def test_the_report_folder_comes_back_byte_for_byte(filled, tmp_path):
+    store, folders = filled
+    eid = int(store.history("PY-3")["evaluation"].iloc[0])
+    written = store.report(eid, tmp_path / "back")
+    names = sorted(os.listdir(folders["PY-3"]))
+    assert sorted(os.path.basename(p) for p in written) == names
+    for n in names:
+        assert (tmp_path / "back" / n).read_bytes() == (folders["PY-3"] / n).read_bytes(), n
+
+
 def test_store_and_frames_pickle(filled):
     store, _ = filled
     again = pickle.loads(pickle.dumps(store))

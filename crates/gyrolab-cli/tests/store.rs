@@ -446,7 +446,7 @@ fn a_store_of_a_newer_schema_exits_2_naming_both_versions_and_writes_nothing() {
             .unwrap_or_else(|e| panic!("{}: {e}", b.name));
         assert_eq!(o.status.code(), Some(2), "{}", b.name);
         let err = String::from_utf8_lossy(&o.stderr);
-        assert!(err.contains("schema version 9") && err.contains("up to 1"), "{}: {err}", b.name);
+        assert!(err.contains("schema version 9") && err.contains("up to 2"), "{}: {err}", b.name);
         assert!(!report.exists(), "{}: nothing written", b.name);
         for args in [vec!["store", "lot", "L"], vec!["store", "history", "N1"]] {
             gyrolab()
@@ -456,5 +456,55 @@ fn a_store_of_a_newer_schema_exits_2_naming_both_versions_and_writes_nothing() {
                 .code(2)
                 .stderr(predicates::str::contains("schema version 9"));
         }
+    }
+}
+
+/// Every file of folder `a` has the same bytes in folder `b`, and `b` has no other file.
+fn same_folder(a: &Path, b: &Path) {
+    let names = |d: &Path| -> BTreeSet<String> {
+        std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect()
+    };
+    assert_eq!(names(a), names(b), "{} vs {}", a.display(), b.display());
+    for n in names(a) {
+        assert!(std::fs::read(a.join(&n)).unwrap() == std::fs::read(b.join(&n)).unwrap(), "{n} differs");
+    }
+}
+
+#[test]
+fn the_stored_report_folder_is_written_back_byte_for_byte_also_from_a_revision() {
+    for b in backends("cli_report_back") {
+        let dir = tempfile::tempdir().unwrap();
+        let p = plan(dir.path(), "R1", "L");
+        let report = dir.path().join("report");
+        eval(&p, &report, Some(&b.location));
+        let id = *history_ids(&b.location, "R1").keys().next().unwrap();
+        let back = dir.path().join("back");
+        gyrolab()
+            .args(["store", "report", &id.to_string(), "--out", back.to_str().unwrap(), "--store", &b.location])
+            .assert()
+            .success();
+        same_folder(&report, &back);
+        // An approval is a new revision that keeps the same report.
+        gyrolab()
+            .args(["store", "revise", &id.to_string(), "--kind", "approval", "--by", "Q. Manager"])
+            .args(["--reason", "reviewed", "--store", &b.location])
+            .assert()
+            .success();
+        let approved = *history_ids(&b.location, "R1").keys().last().unwrap();
+        assert_ne!(approved, id);
+        let back2 = dir.path().join("back2");
+        gyrolab()
+            .args(["store", "report", &approved.to_string(), "--out", back2.to_str().unwrap(), "--store", &b.location])
+            .assert()
+            .success();
+        same_folder(&report, &back2);
+        // No such evaluation: exit 2, nothing written.
+        let none = dir.path().join("none");
+        gyrolab()
+            .args(["store", "report", "999999", "--out", none.to_str().unwrap(), "--store", &b.location])
+            .assert()
+            .code(2)
+            .stderr(predicates::str::contains("no evaluation 999999"));
+        assert!(!none.exists());
     }
 }

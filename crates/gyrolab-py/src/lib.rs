@@ -681,5 +681,6 @@ fn _gyrolab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(store::store_evaluation, m)?)?;
     m.add_function(wrap_pyfunction!(store::store_add, m)?)?;
     m.add_function(wrap_pyfunction!(store::store_masked, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_report, m)?)?;
     Ok(())
 }

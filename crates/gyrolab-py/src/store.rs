@@ -143,3 +143,10 @@ pub fn store_add(
 pub fn store_masked(location: &str) -> String {
     gyrolab_store::mask_location(location)
 }
+
+/// Writes the stored report folder of evaluation `id` to `out` (every file checked against its
+/// SHA-256; all files or none): the files written.
+#[pyfunction]
+pub fn store_report(py: Python<'_>, location: Option<String>, id: i64, out: PathBuf) -> PyResult<Vec<PathBuf>> {
+    with_store(py, location, false, |s| s.write_report(id, &out))
+}

@@ -16,6 +16,8 @@ pub enum Val {
     F(Option<f64>),
     /// Optional text (TEXT).
     T(Option<String>),
+    /// Optional bytes (BLOB / BYTEA).
+    B(Option<Vec<u8>>),
 }
 
 impl Val {
@@ -47,6 +49,13 @@ impl Val {
     pub fn string(&self) -> String {
         self.text().unwrap_or_default().to_string()
     }
+    /// Bytes of a value (`None` for null or anything else).
+    pub fn bytes(&self) -> Option<&[u8]> {
+        match self {
+            Val::B(b) => b.as_deref(),
+            _ => None,
+        }
+    }
 }
 
 /// The kind of a result column, to read it on either back end.
@@ -58,6 +67,8 @@ pub enum Kind {
     F,
     /// Optional text.
     T,
+    /// Optional bytes.
+    B,
 }
 
 /// One column of rows inserted together: a typed array (PostgreSQL receives it as one array
@@ -70,6 +81,8 @@ pub enum Column {
     F(Vec<Option<f64>>),
     /// Optional texts (TEXT[]).
     T(Vec<Option<String>>),
+    /// Optional bytes (BYTEA[]).
+    B(Vec<Option<Vec<u8>>>),
 }
 
 impl Column {
@@ -78,6 +91,7 @@ impl Column {
             Column::I(v) => v.len(),
             Column::F(v) => v.len(),
             Column::T(v) => v.len(),
+            Column::B(v) => v.len(),
         }
     }
 
@@ -86,6 +100,7 @@ impl Column {
             Column::I(v) => Val::I(v[row]),
             Column::F(v) => Val::F(v[row]),
             Column::T(v) => Val::T(v[row].clone()),
+            Column::B(v) => Val::B(v[row].clone()),
         }
     }
 }
@@ -121,6 +136,7 @@ impl SqliteToSql for Val {
             Val::IOpt(i) => i.to_sql(),
             Val::F(f) => f.to_sql(),
             Val::T(t) => t.to_sql(),
+            Val::B(b) => b.to_sql(),
         }
     }
 }
@@ -134,6 +150,7 @@ fn sqlite_row(row: &rusqlite::Row<'_>, kinds: &[Kind]) -> rusqlite::Result<Vec<V
                 Kind::I => Val::I(row.get::<_, Option<i64>>(i)?.unwrap_or(0)),
                 Kind::F => Val::F(row.get(i)?),
                 Kind::T => Val::T(row.get(i)?),
+                Kind::B => Val::B(row.get(i)?),
             })
         })
         .collect()
@@ -177,6 +194,7 @@ fn pg_params(params: &[Val]) -> Vec<Box<dyn postgres::types::ToSql + Sync>> {
                 Val::IOpt(i) => Box::new(*i),
                 Val::F(f) => Box::new(*f),
                 Val::T(t) => Box::new(t.clone()),
+                Val::B(b) => Box::new(b.clone()),
             }
         })
         .collect()
@@ -230,6 +248,7 @@ impl<C: postgres::GenericClient> Exec for PgExec<'_, C> {
                             Kind::I => Val::I(r.try_get::<_, Option<i64>>(i).map_err(pg_error)?.unwrap_or(0)),
                             Kind::F => Val::F(r.try_get(i).map_err(pg_error)?),
                             Kind::T => Val::T(r.try_get(i).map_err(pg_error)?),
+                            Kind::B => Val::B(r.try_get(i).map_err(pg_error)?),
                         })
                     })
                     .collect()
@@ -251,6 +270,7 @@ impl<C: postgres::GenericClient> Exec for PgExec<'_, C> {
                     Column::I(v) => Box::new(v.clone()),
                     Column::F(v) => Box::new(v.clone()),
                     Column::T(v) => Box::new(v.clone()),
+                    Column::B(v) => Box::new(v.clone()),
                 }
             })
             .collect();

@@ -430,28 +430,40 @@ impl Store {
                 .map_err(&dberr)?;
             let id = rows.first().map(|r| r[0].int()).ok_or_else(|| dberr("no id returned".into()))?;
             // One statement per table (PostgreSQL: one round trip each, the rows as arrays).
-            for (files, row_sql, array_sql) in [
-                (
-                    &record.inputs,
-                    "INSERT INTO input_file (evaluation_id, path, sha256, size_bytes) VALUES ($1, $2, $3, $4)",
-                    "INSERT INTO input_file (evaluation_id, path, sha256, size_bytes) \
-                     SELECT * FROM unnest($1::bigint[], $2::text[], $3::text[], $4::bigint[])",
-                ),
-                (
-                    &record.report_files,
-                    "INSERT INTO report_file (evaluation_id, name, sha256, size_bytes) VALUES ($1, $2, $3, $4)",
-                    "INSERT INTO report_file (evaluation_id, name, sha256, size_bytes) \
-                     SELECT * FROM unnest($1::bigint[], $2::text[], $3::text[], $4::bigint[])",
-                ),
-            ] {
-                let columns = [
-                    Column::I(vec![id; files.len()]),
-                    Column::T(files.iter().map(|f| Some(f.path.clone())).collect()),
-                    Column::T(files.iter().map(|f| Some(f.sha256.clone())).collect()),
-                    Column::I(files.iter().map(|f| f.size_bytes as i64).collect()),
-                ];
-                x.insert_columns(row_sql, array_sql, &columns).map_err(&dberr)?;
-            }
+            let files = &record.inputs;
+            let columns = [
+                Column::I(vec![id; files.len()]),
+                Column::T(files.iter().map(|f| Some(f.path.clone())).collect()),
+                Column::T(files.iter().map(|f| Some(f.sha256.clone())).collect()),
+                Column::I(files.iter().map(|f| f.size_bytes as i64).collect()),
+            ];
+            x.insert_columns(
+                "INSERT INTO input_file (evaluation_id, path, sha256, size_bytes) VALUES ($1, $2, $3, $4)",
+                "INSERT INTO input_file (evaluation_id, path, sha256, size_bytes) \
+                 SELECT * FROM unnest($1::bigint[], $2::text[], $3::text[], $4::bigint[])",
+                &columns,
+            )
+            .map_err(&dberr)?;
+            let files = &record.report_files;
+            let packed = files
+                .iter()
+                .map(|f| f.content.as_deref().map(|b| zstd::bulk::compress(b, 3)).transpose())
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| dberr(format!("cannot compress a report file: {e}")))?;
+            let columns = [
+                Column::I(vec![id; files.len()]),
+                Column::T(files.iter().map(|f| Some(f.path.clone())).collect()),
+                Column::T(files.iter().map(|f| Some(f.sha256.clone())).collect()),
+                Column::I(files.iter().map(|f| f.size_bytes as i64).collect()),
+                Column::B(packed),
+            ];
+            x.insert_columns(
+                "INSERT INTO report_file (evaluation_id, name, sha256, size_bytes, content_zstd) VALUES ($1, $2, $3, $4, $5)",
+                "INSERT INTO report_file (evaluation_id, name, sha256, size_bytes, content_zstd) \
+                 SELECT * FROM unnest($1::bigint[], $2::text[], $3::text[], $4::bigint[], $5::bytea[])",
+                &columns,
+            )
+            .map_err(&dberr)?;
             let figs = &record.figures;
             let text = |g: fn(&record::FigureRecord) -> &str| Column::T(figs.iter().map(|f| Some(g(f).to_string())).collect());
             let number = |g: fn(&record::FigureRecord) -> Option<f64>| Column::F(figs.iter().map(g).collect());
@@ -522,6 +534,11 @@ impl Store {
             rec.approver = Some(v.clone());
         }
         self.insert(&rec, Some(revision))
+    }
+
+    /// Writes the stored report folder of evaluation `id` to `out` (see [`query::write_report`]).
+    pub fn write_report(&mut self, id: i64, out: &Path) -> StoreResult<Vec<PathBuf>> {
+        query::write_report(self, id, out)
     }
 
     /// One stored evaluation with its files and figures.

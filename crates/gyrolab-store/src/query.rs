@@ -77,13 +77,23 @@ pub fn evaluation(store: &mut Store, id: i64) -> StoreResult<StoredEvaluation> {
         Ok(store
             .query(sql, &[Val::I(id)], &[Kind::T, Kind::T, Kind::I])?
             .into_iter()
-            .map(|f| FileRecord { path: f[0].string(), sha256: f[1].string(), size_bytes: f[2].int() as u64 })
+            .map(|f| FileRecord {
+                path: f[0].string(),
+                sha256: f[1].string(),
+                size_bytes: f[2].int() as u64,
+                content: None,
+            })
             .collect())
     };
     let inputs =
         files(store, "SELECT path, sha256, size_bytes FROM input_file WHERE evaluation_id = $1 ORDER BY path")?;
-    let report_files =
+    let mut report_files =
         files(store, "SELECT name, sha256, size_bytes FROM report_file WHERE evaluation_id = $1 ORDER BY name")?;
+    let mut contents: HashMap<String, Vec<u8>> =
+        read_report_files(store, id)?.into_iter().filter_map(|(n, b)| b.map(|b| (n, b))).collect();
+    for f in &mut report_files {
+        f.content = contents.remove(&f.path);
+    }
     let figures = store
         .query(
             "SELECT axis, figure, value, unit, basis, expanded_uncertainty, coverage_factor, limit_min, limit_max, verdict, simulated \
@@ -561,4 +571,67 @@ pub fn diff_figures(before: &[FigureRecord], after: &[FigureRecord]) -> Vec<Figu
         });
     }
     out
+}
+
+/// The report files of evaluation `id` with their bytes (decompressed, each checked against its
+/// recorded size and SHA-256), by name. A file stored without its bytes (stored under schema
+/// version 1, or larger than [`crate::record::MAX_KEPT_FILE_BYTES`]) is an error naming it.
+pub fn report_files(store: &mut Store, id: i64) -> StoreResult<Vec<(String, Vec<u8>)>> {
+    evaluation(store, id)?; // exists
+    let name = store.name().to_string();
+    read_report_files(store, id)?
+        .into_iter()
+        .map(|(file, bytes)| {
+            bytes.map(|b| (file.clone(), b)).ok_or_else(|| StoreError::NotFound {
+                store: name.clone(),
+                message: format!(
+                    "evaluation {id}: report file {file:?} was stored as a hash only (stored before schema version 2, \
+                     or larger than {} bytes)",
+                    crate::record::MAX_KEPT_FILE_BYTES
+                ),
+            })
+        })
+        .collect()
+}
+
+/// Every report file of evaluation `id` by name, with its bytes when stored (decompressed and
+/// checked against the recorded size and SHA-256: a mismatch is an error).
+fn read_report_files(store: &mut Store, id: i64) -> StoreResult<Vec<(String, Option<Vec<u8>>)>> {
+    let rows = store.query(
+        "SELECT name, sha256, size_bytes, content_zstd FROM report_file WHERE evaluation_id = $1 ORDER BY name",
+        &[Val::I(id)],
+        &[Kind::T, Kind::T, Kind::I, Kind::B],
+    )?;
+    let name = store.name().to_string();
+    let mut out = Vec::with_capacity(rows.len());
+    for r in rows {
+        let (file, sha256, size) = (r[0].string(), r[1].string(), r[2].int());
+        let Some(packed) = r[3].bytes() else {
+            out.push((file, None));
+            continue;
+        };
+        let size = usize::try_from(size).ok().filter(|s| *s as u64 <= crate::record::MAX_KEPT_FILE_BYTES);
+        let bytes = size
+            .and_then(|s| zstd::bulk::decompress(packed, s.max(1)).ok())
+            .filter(|b| Some(b.len()) == size && crate::record::hash_bytes(b) == sha256)
+            .ok_or_else(|| StoreError::Database {
+                store: name.clone(),
+                message: format!(
+                    "evaluation {id}: report file {file:?} does not match its recorded size and SHA-256 {sha256}"
+                ),
+            })?;
+        out.push((file, Some(bytes)));
+    }
+    Ok(out)
+}
+
+/// Writes the stored report folder of evaluation `id` to `out` (every file or none; each checked
+/// against its SHA-256 first); the files written.
+pub fn write_report(store: &mut Store, id: i64, out: &std::path::Path) -> StoreResult<Vec<std::path::PathBuf>> {
+    let files = report_files(store, id)?;
+    let refs: Vec<(&str, &[u8])> = files.iter().map(|(n, b)| (n.as_str(), b.as_slice())).collect();
+    gyrolab_io::atomic::write_folder(out, &refs).map_err(|(p, e)| StoreError::Input {
+        path: p.display().to_string(),
+        message: format!("cannot write the file: {e}"),
+    })
 }

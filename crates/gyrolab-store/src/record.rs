@@ -12,6 +12,9 @@ use std::path::{Path, PathBuf};
 /// Longest text accepted in one field (a plan, a serial...): 16 MiB.
 pub const MAX_TEXT_BYTES: usize = 16 << 20;
 
+/// Largest report file whose bytes the store keeps (larger ones are hashed only): 64 MiB.
+pub const MAX_KEPT_FILE_BYTES: u64 = 64 << 20;
+
 /// A file of an evaluation: an input record or a report file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FileRecord {
@@ -21,6 +24,10 @@ pub struct FileRecord {
     pub sha256: String,
     /// Size, bytes.
     pub size_bytes: u64,
+    /// The file's bytes, kept for report files up to [`MAX_KEPT_FILE_BYTES`] (`None`: inputs,
+    /// which are hashed only, and larger report files).
+    #[serde(skip)]
+    pub content: Option<Vec<u8>>,
 }
 
 /// One figure of one axis.
@@ -386,7 +393,7 @@ fn hash_inputs(parsed: &gyrolab_io_plan::TestPlan) -> StoreResult<Vec<FileRecord
     let mut inputs = Vec::new();
     for p in plan_inputs(parsed) {
         let (sha256, size_bytes) = hash_file(&p)?;
-        inputs.push(FileRecord { path: p.display().to_string(), sha256, size_bytes });
+        inputs.push(FileRecord { path: p.display().to_string(), sha256, size_bytes, content: None });
     }
     Ok(inputs)
 }
@@ -434,9 +441,23 @@ pub fn from_report_folder_with(
         .collect();
     names.sort();
     for p in names {
-        let (sha256, size_bytes) = hash_file(&p)?;
         let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        report_files.push(FileRecord { path: name, sha256, size_bytes });
+        let size = std::fs::metadata(&p).map(|m| m.len()).unwrap_or(u64::MAX);
+        if size <= MAX_KEPT_FILE_BYTES {
+            let bytes = std::fs::read(&p).map_err(|e| StoreError::Input {
+                path: p.display().to_string(),
+                message: format!("cannot read: {e}"),
+            })?;
+            report_files.push(FileRecord {
+                path: name,
+                sha256: hash_bytes(&bytes),
+                size_bytes: bytes.len() as u64,
+                content: Some(bytes),
+            });
+        } else {
+            let (sha256, size_bytes) = hash_file(&p)?;
+            report_files.push(FileRecord { path: name, sha256, size_bytes, content: None });
+        }
     }
     let simulated = parsed.device.simulated.is_some();
     let summary_path = dir.join("summary.csv");

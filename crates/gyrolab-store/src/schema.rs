@@ -3,10 +3,11 @@
 //! from version N - 1 to N; `gyrolab_schema` keeps one row per applied version (docs/STORE.md).
 
 /// The schema version this build writes and reads.
-pub const SCHEMA_VERSION: i64 = 1;
+pub const SCHEMA_VERSION: i64 = 2;
 
 /// SQLite migrations, by version (index 0 = version 1).
-pub const SQLITE_MIGRATIONS: &[&str] = &[r#"
+pub const SQLITE_MIGRATIONS: &[&str] = &[
+    r#"
 CREATE TABLE evaluation (
     id INTEGER PRIMARY KEY AUTOINCREMENT,
     supersedes INTEGER UNIQUE REFERENCES evaluation(id),
@@ -64,10 +65,15 @@ CREATE TRIGGER evaluation_kept BEFORE UPDATE ON evaluation BEGIN SELECT RAISE(AB
 CREATE TRIGGER evaluation_kept_d BEFORE DELETE ON evaluation BEGIN SELECT RAISE(ABORT, 'gyrolab records are never deleted'); END;
 CREATE TRIGGER figure_kept BEFORE UPDATE ON figure BEGIN SELECT RAISE(ABORT, 'gyrolab records are never changed: store a revision'); END;
 CREATE TRIGGER figure_kept_d BEFORE DELETE ON figure BEGIN SELECT RAISE(ABORT, 'gyrolab records are never deleted'); END;
-"#];
+"#,
+    // 2: the report files themselves (zstd-compressed), so that a stored report can be written
+    // back; rows stored under version 1 keep a null (their files were hashed only).
+    "ALTER TABLE report_file ADD COLUMN content_zstd BLOB;",
+];
 
 /// PostgreSQL migrations, by version (index 0 = version 1).
-pub const POSTGRES_MIGRATIONS: &[&str] = &[r#"
+pub const POSTGRES_MIGRATIONS: &[&str] = &[
+    r#"
 CREATE TABLE evaluation (
     id BIGINT GENERATED ALWAYS AS IDENTITY PRIMARY KEY,
     supersedes BIGINT UNIQUE REFERENCES evaluation(id),
@@ -127,7 +133,10 @@ BEGIN
 END $$;
 CREATE TRIGGER evaluation_kept BEFORE UPDATE OR DELETE ON evaluation FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
 CREATE TRIGGER figure_kept BEFORE UPDATE OR DELETE ON figure FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
-"#];
+"#,
+    // 2: the report files themselves (zstd-compressed; see SQLITE_MIGRATIONS).
+    "ALTER TABLE report_file ADD COLUMN content_zstd BYTEA;",
+];
 
 /// The version table (both back ends).
 pub const VERSION_TABLE: &str =

@@ -7,7 +7,7 @@
 mod common;
 
 use approx::assert_relative_eq;
-use common::{backends, mark_newer_schema, pg_url, record};
+use common::{backends, make_version_1_store, mark_newer_schema, pg_url, record};
 use gyrolab_store::{query, Changes, Revision, RevisionKind, Store, StoreError};
 
 fn count(store: &mut Store) -> usize {
@@ -262,9 +262,12 @@ fn a_newer_schema_is_refused_naming_both_versions() {
         mark_newer_schema(&b, 7);
         let e = Store::open(&b.location, true).err().unwrap();
         let m = e.to_string();
-        assert!(matches!(e, StoreError::NewerSchema { found: 7, known: 1, .. }), "{m}");
         assert!(
-            m.contains("schema version 7") && m.contains("up to 1") && m.contains(gyrolab_store::SOFTWARE_VERSION),
+            matches!(e, StoreError::NewerSchema { found: 7, known: gyrolab_store::schema::SCHEMA_VERSION, .. }),
+            "{m}"
+        );
+        assert!(
+            m.contains("schema version 7") && m.contains("up to 2") && m.contains(gyrolab_store::SOFTWARE_VERSION),
             "{m}"
         );
     }
@@ -331,4 +334,33 @@ fn masking_covers_urls_and_keywords() {
     assert_eq!(mask_location("postgres://u@h/db?password=secret&x=1"), "postgres://u@h/db?password=***&x=1");
     assert_eq!(mask_location("postgres://h/db"), "postgres://h/db");
     assert_eq!(mask_location("/tmp/gyrolab.db"), "/tmp/gyrolab.db");
+}
+
+#[test]
+fn a_version_1_store_is_migrated_on_first_use_and_keeps_its_records() {
+    for b in backends("migrate_v1") {
+        make_version_1_store(&b);
+        // A record as version 1 stored it: its report files hashed only (no bytes).
+        let mut old = record("OLD1", Some("L"), &[("x", "bias_dph", 10.0)]);
+        {
+            let mut s = Store::open(&b.location, false).unwrap();
+            assert_eq!(s.schema_version().unwrap(), gyrolab_store::schema::SCHEMA_VERSION, "{}", b.name);
+            for f in &mut old.report_files {
+                f.content = None;
+            }
+            s.add(&old).unwrap();
+        }
+        let mut s = Store::open(&b.location, false).unwrap();
+        let e = s.evaluation(1).unwrap();
+        assert_eq!(e.record.serial, "OLD1");
+        let m = query::report_files(&mut s, 1).unwrap_err().to_string();
+        assert!(m.contains("stored as a hash only") && m.contains("results.json"), "{}: {m}", b.name);
+        // A record stored now keeps its report files: written back equal.
+        let new = record("NEW1", Some("L"), &[("x", "bias_dph", 10.5)]);
+        let id = s.add(&new).unwrap();
+        let files = query::report_files(&mut s, id).unwrap();
+        assert_eq!(files, vec![("results.json".to_string(), b"{}".to_vec())], "{}", b.name);
+        let lot = query::lot(&mut s, "L", 0.95).unwrap();
+        assert_eq!(lot[0].statistics.n, 2, "{}", b.name);
+    }
 }

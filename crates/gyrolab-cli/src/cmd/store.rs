@@ -30,6 +30,8 @@ pub enum StoreCommand {
     Add(AddArgs),
     /// One stored evaluation: device, plan hash, inputs, revisions, figures.
     Show(ShowArgs),
+    /// Write a stored evaluation's report folder back, every file checked against its SHA-256.
+    Report(ReportArgs),
     /// Every figure of a serial over time and revisions, with limits (`--plot` SVG trend plot).
     History(HistoryArgs),
     /// Lot statistics per figure: n, mean, sd, min, max, yield, Cp/Cpk, Pp/Ppk with intervals, outliers.
@@ -164,6 +166,18 @@ pub struct ReviseArgs {
     pub location: StoreLocation,
 }
 
+/// Options of `gyrolab store report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// Evaluation id.
+    pub id: i64,
+    /// Folder to write the report files into (all of them or none).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub location: StoreLocation,
+}
+
 /// Options of `gyrolab store reevaluate`.
 #[derive(Debug, Args)]
 pub struct ReevaluateArgs {
@@ -207,6 +221,16 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
                 return print(&to_json(&e)?);
             }
             print(&show_text(&e))
+        }
+        StoreCommand::Report(a) => {
+            let mut s = open(&a.location, false)?;
+            let written = s.write_report(a.id, &a.out)?;
+            print(&format!(
+                "wrote the {} report file(s) of evaluation {} to {} (each equal to its stored SHA-256)\n",
+                written.len(),
+                a.id,
+                a.out.display()
+            ))
         }
         StoreCommand::History(a) => history(a),
         StoreCommand::Lot(a) => {

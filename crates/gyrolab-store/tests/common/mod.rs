@@ -75,6 +75,28 @@ pub fn mark_newer_schema(b: &Backend, version: i64) {
     }
 }
 
+/// Makes an empty store at `b` as a gyrolab of schema version 1 made it: its migration 1 only
+/// (test set-up for the migration test).
+pub fn make_version_1_store(b: &Backend) {
+    let sqlite = b.name == "sqlite";
+    let migration = if sqlite {
+        gyrolab_store::schema::SQLITE_MIGRATIONS[0]
+    } else {
+        gyrolab_store::schema::POSTGRES_MIGRATIONS[0]
+    };
+    let script = format!(
+        "{};\n{migration}\nINSERT INTO gyrolab_schema VALUES (1, 'earlier', '0.0.1');",
+        gyrolab_store::schema::VERSION_TABLE
+    );
+    if sqlite {
+        let c = rusqlite::Connection::open(&b.location).expect("create the SQLite store");
+        c.execute_batch(&script).expect("schema version 1");
+    } else {
+        let mut c = postgres::Client::connect(&b.location, postgres::NoTls).expect("connect to the test server");
+        c.batch_execute(&script).expect("schema version 1");
+    }
+}
+
 /// A synthetic record of `serial` in `lot` with figures `(axis, key, value)`, limits 9 .. 11.
 pub fn record(serial: &str, lot: Option<&str>, figures: &[(&str, &str, f64)]) -> EvaluationRecord {
     EvaluationRecord {
@@ -92,8 +114,18 @@ pub fn record(serial: &str, lot: Option<&str>, figures: &[(&str, &str, f64)]) ->
         results_json: "{}".into(),
         verdict: Some("PASS".into()),
         simulated: true,
-        inputs: vec![FileRecord { path: "/lab/x.csv".into(), sha256: "ab".repeat(32), size_bytes: 1234 }],
-        report_files: vec![FileRecord { path: "results.json".into(), sha256: "cd".repeat(32), size_bytes: 2 }],
+        inputs: vec![FileRecord {
+            path: "/lab/x.csv".into(),
+            sha256: "ab".repeat(32),
+            size_bytes: 1234,
+            content: None,
+        }],
+        report_files: vec![FileRecord {
+            path: "results.json".into(),
+            sha256: gyrolab_store::record::hash_bytes(b"{}"),
+            size_bytes: 2,
+            content: Some(b"{}".to_vec()),
+        }],
         figures: figures
             .iter()
             .map(|(axis, key, v)| FigureRecord {
