@@ -10,7 +10,8 @@
 #      devices) and `gyrolab store history BENCH-05000` (a device
 #      in the middle, 3 revisions), best of RUNS, on SQLite and
 #      on PostgreSQL (a throw-away server started by scripts/pg-test-server.sh, fsync off).
-# Usage: bench/store_speed.sh [N] [RUNS]   (PROFILE=dev for the dev build; default release)
+# Usage: bench/store_speed.sh [N] [RUNS]   (PROFILE=dev for the dev build; default release;
+#        N = 0 runs part 1 only)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 N=${1:-10000}
@@ -52,6 +53,7 @@ overhead() { # $1 = store location, $2 = label
 }
 
 echo "== 1. gyrolab eval (example test program), without and with --store, $RUNS runs each, alternating"
+echo "   (load average before: $(cut -d' ' -f1-3 /proc/loadavg))"
 eval_ok "$BIN" eval "$PLAN" --out "$WORK/warm" -q
 overhead "$WORK/eval.db" "SQLite"
 overhead "$GYROLAB_TEST_PG_URL" "PostgreSQL"
@@ -66,6 +68,7 @@ query_times() { # $1 = store location, $2 = label
     echo "$2: store lot BENCH ($N devices) median $(median "${lot[@]}") s (best $(best "${lot[@]}")); store history $HS median $(median "${hist[@]}") s (best $(best "${hist[@]}"))"
 }
 
+[ "$N" -gt 0 ] || exit 0
 echo "== 2. $N stored evaluations, then lot and history, $RUNS runs each"
 "$FILL" "$WORK/bench.db" "$N" "$WORK/warm" "$PLAN"
 query_times "$WORK/bench.db" "SQLite ($(du -h "$WORK/bench.db" | cut -f1))"
