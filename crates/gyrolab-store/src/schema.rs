@@ -68,7 +68,14 @@ CREATE TRIGGER figure_kept_d BEFORE DELETE ON figure BEGIN SELECT RAISE(ABORT, '
 "#,
     // 2: the report files themselves (zstd-compressed), so that a stored report can be written
     // back; rows stored under version 1 keep a null (their files were hashed only).
-    "ALTER TABLE report_file ADD COLUMN content_zstd BLOB;",
+    // Input and report file rows are kept like evaluations and figures.
+    r#"
+ALTER TABLE report_file ADD COLUMN content_zstd BLOB;
+CREATE TRIGGER input_file_kept BEFORE UPDATE ON input_file BEGIN SELECT RAISE(ABORT, 'gyrolab records are never changed: store a revision'); END;
+CREATE TRIGGER input_file_kept_d BEFORE DELETE ON input_file BEGIN SELECT RAISE(ABORT, 'gyrolab records are never deleted'); END;
+CREATE TRIGGER report_file_kept BEFORE UPDATE ON report_file BEGIN SELECT RAISE(ABORT, 'gyrolab records are never changed: store a revision'); END;
+CREATE TRIGGER report_file_kept_d BEFORE DELETE ON report_file BEGIN SELECT RAISE(ABORT, 'gyrolab records are never deleted'); END;
+"#,
 ];
 
 /// PostgreSQL migrations, by version (index 0 = version 1).
@@ -134,8 +141,13 @@ END $$;
 CREATE TRIGGER evaluation_kept BEFORE UPDATE OR DELETE ON evaluation FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
 CREATE TRIGGER figure_kept BEFORE UPDATE OR DELETE ON figure FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
 "#,
-    // 2: the report files themselves (zstd-compressed; see SQLITE_MIGRATIONS).
-    "ALTER TABLE report_file ADD COLUMN content_zstd BYTEA;",
+    // 2: the report files themselves (zstd-compressed; see SQLITE_MIGRATIONS); input and report
+    // file rows kept like evaluations and figures.
+    r#"
+ALTER TABLE report_file ADD COLUMN content_zstd BYTEA;
+CREATE TRIGGER input_file_kept BEFORE UPDATE OR DELETE ON input_file FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER report_file_kept BEFORE UPDATE OR DELETE ON report_file FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
+"#,
 ];
 
 /// The version table (both back ends).

@@ -116,6 +116,15 @@ fn records_cannot_be_updated_or_deleted_in_the_database() {
     let e = c.execute("UPDATE evaluation SET serial = 'forged'", []).unwrap_err();
     assert!(e.to_string().contains("never changed"), "{e}");
     assert!(c.execute("DELETE FROM figure", []).is_err());
+    for sql in [
+        "UPDATE report_file SET content_zstd = NULL",
+        "DELETE FROM report_file",
+        "UPDATE input_file SET sha256 = 'forged'",
+        "DELETE FROM input_file",
+    ] {
+        let e = c.execute(sql, []).unwrap_err();
+        assert!(e.to_string().contains("gyrolab records are never"), "{sql}: {e}");
+    }
     if let Some(url) = pg_url("immutable") {
         let pg = &backends("immutable_pg")[1];
         let mut s = Store::open(&pg.location, true).unwrap();
@@ -123,8 +132,14 @@ fn records_cannot_be_updated_or_deleted_in_the_database() {
         drop(s);
         let schema = pg.location.rsplit("search_path%3D").next().unwrap().to_string();
         let mut c = postgres::Client::connect(&url, postgres::NoTls).unwrap();
-        let e = c.batch_execute(&format!("DELETE FROM {schema}.evaluation")).unwrap_err();
-        assert!(format!("{e:?}").contains("never changed or deleted"), "{e:?}");
+        for sql in [
+            "DELETE FROM {s}.evaluation",
+            "UPDATE {s}.report_file SET content_zstd = NULL",
+            "DELETE FROM {s}.input_file",
+        ] {
+            let e = c.batch_execute(&sql.replace("{s}", &schema)).unwrap_err();
+            assert!(format!("{e:?}").contains("never changed or deleted"), "{sql}: {e:?}");
+        }
     }
 }
 
