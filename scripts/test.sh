@@ -43,6 +43,10 @@ else
     # Chi-squared quantiles (the confidence bounds) equal to scipy's chi2.ppf from 1 to 1e9 degrees
     # of freedom at relative 1e-9.
     .venv/bin/python scripts/check_chi2_scipy.py target/debug/examples/chi2_quantiles
+    # The clock model's reference for the real PX4 log (crates/gyrolab-eval/tests/clock.rs) read
+    # again by pyulog + numpy: the committed JSON must equal a fresh independent reading.
+    .venv/bin/python scripts/px4_clock_reference.py --check examples/recordings/px4_sample_log_small.ulg \
+        crates/gyrolab-eval/tests/data/px4_clock_reference.json
     # The Python package: built with maturin and installed into .venv, then its pytest suite
     # (equality with allantools and with the command line, simulated truth, malformed inputs).
     PATH="$PWD/.venv/bin:$PATH" .venv/bin/pip install --quiet --disable-pip-version-check --no-build-isolation ./python

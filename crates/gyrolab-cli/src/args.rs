@@ -115,9 +115,12 @@ pub struct AnalysisArgs {
     /// Fit the five-term noise model over this tau range only, seconds: LOW,HIGH.
     #[arg(long, value_name = "LOW,HIGH", value_delimiter = ',', num_args = 1..=2)]
     pub fit_range: Vec<f64>,
-    /// Missing samples (gaps in the time stamps, NaN or empty cells, dropout rows): `analyse`
-    /// (default: terms that touch one are left out; OADEV, ADEV, OHDEV, HDEV) or `error`.
-    #[arg(long, default_value = "analyse", value_name = "POLICY")]
+    /// Missing samples (gaps in the time stamps, NaN or empty cells, dropout rows): `fill`
+    /// (default: runs of up to 3 missing samples filled by linear interpolation when at most 1 %
+    /// of the record is missing, else as `analyse`), `analyse` (terms that touch one are left
+    /// out; OADEV, ADEV, OHDEV, HDEV), `contiguous` (the samples read taken as consecutive) or
+    /// `error`.
+    #[arg(long, default_value = "fill", value_name = "POLICY")]
     pub gaps: String,
 }
 

@@ -304,17 +304,19 @@ fn record_100hz(n: usize) -> String {
 }
 
 #[test]
-fn a_given_rate_that_contradicts_the_time_stamps_is_an_error() {
+fn a_given_rate_that_contradicts_the_time_stamps_is_used_with_a_warning() {
+    // Issue 30: the user may know better than the stamps (a sensor clock read by a logger that
+    // drops messages); the warning gives the stamps' reading.
     let dir = tempfile::tempdir().unwrap();
     let p = write(dir.path(), "r100.csv", &record_100hz(2000));
-    let e = error_of(&["allan".as_ref(), "--sample-rate-hz".as_ref(), "1000".as_ref(), p.as_os_str()]);
-    assert!(
-        e.contains("--sample-rate-hz = 1000 Hz disagrees with the time column of") && e.contains("r100.csv"),
-        "{e}"
-    );
-    assert!(e.contains("100.000000 Hz"), "{e}");
-    // Within 1 %: accepted.
-    gyrolab().args(["allan", "--sample-rate-hz", "100.5"]).arg(&p).assert().success();
+    let out = gyrolab().args(["allan", "--sample-rate-hz", "1000"]).arg(&p).assert().success().get_output().clone();
+    let e = String::from_utf8(out.stderr).unwrap();
+    assert!(e.contains("warning: sample rate 1000 Hz as given (--sample-rate-hz)"), "{e}");
+    assert!(e.contains("the time stamps say 100.000000 Hz (+900.000 %): the given rate is used"), "{e}");
+    // Within 1 %: a plain note.
+    let out = gyrolab().args(["allan", "--sample-rate-hz", "100.5"]).arg(&p).assert().success().get_output().clone();
+    let e = String::from_utf8(out.stderr).unwrap();
+    assert!(e.contains("note: sample rate 100.5 Hz as given") && !e.contains("warning: sample rate"), "{e}");
 }
 
 #[test]

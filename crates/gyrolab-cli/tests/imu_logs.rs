@@ -222,9 +222,10 @@ fn two_hours_with_jitter_and_dropped_samples_give_truth_and_a_complete_yaml() {
     for c in &ch[..3] {
         let n = c["noise"]["arw_deg_rt_h"].as_f64().unwrap();
         assert!(rel(n, 0.3) < 0.03, "N {n}");
-        // 1 440 000 slots, 12 missing: m = 1 has every pair of neighbours without a gap.
+        // 1 440 000 slots, 12 missing, each filled by the default --gaps fill: m = 1 has every
+        // pair of neighbours.
         assert_eq!(c["samples"], 1_440_000);
-        assert_eq!(c["n_terms"][0], 1_440_000 - 1 - 2 * 12);
+        assert_eq!(c["n_terms"][0], 1_440_000 - 1);
     }
     for c in &ch[3..] {
         let vrw = c["accel_noise"]["vrw_m_s_rt_h"].as_f64().unwrap();
@@ -268,7 +269,7 @@ fn dropouts_and_nan_cells_are_missing_samples() {
     let out = gyrolab()
         .arg("allan")
         .arg(&p)
-        .args(["--json", "--taus", "0.01", "--confidence", "none"])
+        .args(["--json", "--taus", "0.01", "--confidence", "none", "--gaps", "analyse"])
         .assert()
         .success()
         .get_output()

@@ -5,12 +5,13 @@
 use crate::error::{EvalError, EvalResult};
 use crate::layout::LogLayout;
 use crate::reference::{Conversion, Reference, ReferenceRequest};
+use gyrolab::allan::gap_fill::{fill_isolated, FillCount, MAX_FILLED_SHARE};
 use gyrolab::allan::{
     deviation_from_rate, deviation_from_rate_into, deviation_from_rate_with_gaps, deviation_from_rate_with_gaps_into,
     AllanCurve, AllanError, AllanOptions, DeviationKind, TauList,
 };
 use gyrolab::noise::{fit_noise_model, slope_line_terms};
-use gyrolab::sampling::{estimate_interval, estimate_interval_of, SamplingError};
+use gyrolab::sampling::{estimate_interval, estimate_interval_of, ClockModel, Reset, SamplingError};
 use gyrolab::units::{OutputUnit, Quantity, TimeUnit};
 use gyrolab::validate::{self, InvalidOption};
 use gyrolab_io::recording::{read_records, TopicMeta};
@@ -66,24 +67,43 @@ pub struct AllanRequest {
     pub topics: Vec<String>,
 }
 
-/// What the Allan analysis does with missing samples.
+/// What the Allan analysis does with missing samples (docs/METHODS.md, "Gap policies").
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum GapPolicy {
     /// Compute over them: terms that touch a missing sample are left out (OADEV, ADEV, OHDEV,
     /// HDEV), as Stable32 and allantools' gradev.
-    #[default]
     Analyse,
     /// Refuse a record with missing samples, naming the first.
     Error,
+    /// Fill runs of up to three missing samples by linear interpolation between their
+    /// neighbours ([`gyrolab::allan::gap_fill`]), counted in a note; longer runs as `Analyse`.
+    /// The default: sparse drops then keep the long taus.
+    #[default]
+    Fill,
+    /// Close the gaps of the time stamps up: the samples read are taken as consecutive at the
+    /// record's interval (NaN cells and dropout rows stay missing, as `Analyse`).
+    Contiguous,
 }
 
 impl GapPolicy {
-    /// Parses `analyse` (or `analyze`) or `error`.
+    /// Parses `fill`, `analyse` (or `analyze`), `contiguous` or `error`.
     pub fn parse(text: &str) -> Result<GapPolicy, InvalidOption> {
         match text.trim() {
             "analyse" | "analyze" => Ok(GapPolicy::Analyse),
             "error" => Ok(GapPolicy::Error),
-            other => Err(InvalidOption::new("gaps", format!("'{other}': expected analyse or error"))),
+            "fill" => Ok(GapPolicy::Fill),
+            "contiguous" => Ok(GapPolicy::Contiguous),
+            other => Err(InvalidOption::new("gaps", format!("'{other}': expected fill, analyse, contiguous or error"))),
+        }
+    }
+
+    /// The policy's name, as parsed.
+    pub fn name(self) -> &'static str {
+        match self {
+            GapPolicy::Analyse => "analyse",
+            GapPolicy::Error => "error",
+            GapPolicy::Fill => "fill",
+            GapPolicy::Contiguous => "contiguous",
         }
     }
 }
@@ -101,7 +121,7 @@ impl AllanRequest {
             confidence: Some(0.683),
             fit_range_s: None,
             layout: LogLayout::default(),
-            gaps: GapPolicy::Analyse,
+            gaps: GapPolicy::default(),
             topics: Vec::new(),
         }
     }
@@ -167,6 +187,46 @@ pub enum ReadNote {
         first: Vec<(u64, usize)>,
         /// What the rows count.
         rows: RowKind,
+        /// What was done with them.
+        policy: GapPolicy,
+    },
+    /// The clock model of the time stamps and the evidence it was decided on.
+    Clock(ClockModel),
+    /// A time stamp going back to or before the first one (a clock reset, a trailer of zeros)
+    /// ended the record: the rows before it are analysed. Shown as a warning.
+    Reset {
+        /// The reset.
+        reset: Reset,
+        /// Row of the stamp that goes back.
+        row: u64,
+        /// What the rows count.
+        rows: RowKind,
+    },
+    /// Isolated missing samples filled (gap policy `fill`).
+    Filled {
+        /// Samples filled, per channel (the most of any channel).
+        filled: usize,
+        /// Runs filled.
+        runs: usize,
+        /// Samples left missing (runs longer than three, or at an end).
+        left: usize,
+        /// Samples of that channel's record (on its grid), filled ones included.
+        samples: usize,
+    },
+    /// Gap policy `fill` declined: more samples missing than the fill rule is checked for
+    /// ([`MAX_FILLED_SHARE`]); the record is analysed with the gaps left out.
+    FillDeclined {
+        /// Samples missing on the record's grid.
+        missing: usize,
+        /// Samples of the grid, missing ones included.
+        samples: usize,
+    },
+    /// The gaps left out the long taus: the curve stops before a quarter of the record.
+    LongTausLost {
+        /// The longest tau of the curve, s.
+        longest_s: f64,
+        /// A quarter of the record's length, s.
+        quarter_s: f64,
     },
     /// NaN or empty cells, treated as missing samples.
     MissingCells {
@@ -238,15 +298,43 @@ impl std::fmt::Display for ReadNote {
                 1.0 / step,
                 1000.0 / step
             ),
-            ReadNote::Gaps { count, missing, first, rows } => {
+            ReadNote::Gaps { count, missing, first, rows, policy } => {
                 let shown: Vec<String> =
                     first.iter().map(|(l, m)| format!("{} {l} ({m} missing)", rows.word())).collect();
+                let done = match policy {
+                    GapPolicy::Contiguous => "closed up ({gaps} contiguous: the samples taken as consecutive)",
+                    GapPolicy::Fill => "runs of up to 3 filled by linear interpolation, longer ones computed over (terms that touch a missing sample are left out)",
+                    _ => "computed over them (terms that touch a missing sample are left out)",
+                };
                 write!(
                     f,
-                    "{count} gap(s) in the time stamps, {missing} sample(s) missing, first at {}: computed over them (terms that touch a missing sample are left out); {{gaps}} error refuses such records",
+                    "{count} gap(s) in the time stamps, {missing} sample(s) missing, first at {}: {done}; {{gaps}} fill, analyse, contiguous or error chooses",
                     shown.join(", ")
                 )
             }
+            ReadNote::Clock(c) => write!(f, "clock: {c}"),
+            ReadNote::Reset { reset, row, rows } => write!(
+                f,
+                "the time stamps go back at {} {row} (from {} s to {} s: a clock reset or a trailer of zeros): the record ends before it, {} row(s) from there left out",
+                rows.word(),
+                reset.from_s,
+                reset.to_s,
+                reset.left_out
+            ),
+            ReadNote::Filled { filled, runs, left, .. } => write!(
+                f,
+                "{filled} missing sample(s) in {runs} run(s) of up to 3 filled by linear interpolation between their neighbours ({{gaps}} fill; {left} left missing); {{gaps}} analyse leaves them out instead"
+            ),
+            ReadNote::FillDeclined { missing, samples } => write!(
+                f,
+                "{missing} missing sample(s), {:.2} % of the record: more than the {:.0} % the fill rule is checked for, so none is filled and the terms that touch them are left out (as {{gaps}} analyse)",
+                100.0 * *missing as f64 / (*samples).max(1) as f64,
+                100.0 * MAX_FILLED_SHARE
+            ),
+            ReadNote::LongTausLost { longest_s, quarter_s } => write!(
+                f,
+                "the missing samples leave out the long taus: the curve stops at {longest_s:.6} s, a quarter of the record is {quarter_s:.6} s; {{gaps}} fill (isolated samples) or contiguous keeps them"
+            ),
             ReadNote::MissingCells { count, first_line, rows } => write!(
                 f,
                 "{count} NaN or empty cell(s), first at {} {first_line}: treated as missing samples",
@@ -265,10 +353,13 @@ impl std::fmt::Display for ReadNote {
                 gyrolab_io::text::excerpt(&read.join(", ")),
                 gyrolab_io::text::excerpt(&not_read.join(", "))
             ),
-            ReadNote::SampleRateGiven { given_hz, stamps_hz } => write!(
-                f,
-                "sample rate {given_hz} Hz as given ({{sample_rate_hz}}); the time stamps say {stamps_hz:.6} Hz"
-            ),
+            ReadNote::SampleRateGiven { given_hz, stamps_hz } => {
+                write!(f, "sample rate {given_hz} Hz as given ({{sample_rate_hz}}); the time stamps say {stamps_hz:.6} Hz")?;
+                if self.is_warning() {
+                    write!(f, " ({:+.3} %): the given rate is used", (given_hz / stamps_hz - 1.0) * 100.0)?;
+                }
+                Ok(())
+            }
             ReadNote::Topic(t) => {
                 write!(
                     f,
@@ -305,7 +396,19 @@ impl std::fmt::Display for ReadNote {
 impl ReadNote {
     /// Whether the note is a warning (the figures may be wrong as read) rather than information.
     pub fn is_warning(&self) -> bool {
-        matches!(self, ReadNote::Truncated(_) | ReadNote::TimeUnitDoubt { .. })
+        match self {
+            ReadNote::SampleRateGiven { given_hz, stamps_hz } => {
+                let off = (given_hz / stamps_hz - 1.0).abs();
+                off.is_nan() || off > RATE_TOLERANCE
+            }
+            _ => matches!(
+                self,
+                ReadNote::Truncated(_)
+                    | ReadNote::TimeUnitDoubt { .. }
+                    | ReadNote::Reset { .. }
+                    | ReadNote::LongTausLost { .. }
+            ),
+        }
     }
 
     /// The note with its option placeholders (`{units}`) spelled by the front end.
@@ -423,12 +526,17 @@ pub struct Timing {
     pub missing: usize,
     /// The note saying which rate was used.
     pub note: Option<ReadNote>,
+    /// The clock model of the time stamps (none without a time column).
+    pub clock: Option<ClockModel>,
+    /// A stamp going back that ends the record: samples from its index on are left out.
+    pub reset: Option<Reset>,
 }
 
-/// The timing of a record: the given rate (checked against the time stamps), else the time
-/// column's by the one estimator ([`gyrolab::sampling`]), with the gaps of the stamps. A stamp
-/// that does not increase is an error naming its line; gaps are an error under
-/// [`GapPolicy::Error`].
+/// The timing of a record: the given rate (a warning note gives the stamps' reading when they
+/// disagree), else the time column's by the one estimator and clock model
+/// ([`gyrolab::sampling`]), with the gaps of the stamps. A stamp that does not increase is an
+/// error naming its line, unless it goes back to or before the first stamp (a reset: the
+/// record ends before it, [`Timing::reset`]); gaps are an error under [`GapPolicy::Error`].
 pub fn record_timing(data: &SeriesData, path: &Path, given_hz: Option<f64>, policy: GapPolicy) -> EvalResult<Timing> {
     // The stamps as read, or kept compactly by the reader (the same estimate either way).
     let estimate = match &data.time {
@@ -472,24 +580,26 @@ pub fn record_timing(data: &SeriesData, path: &Path, given_hz: Option<f64>, poli
     }
     let (gaps, missing) = estimate.as_ref().map_or((Vec::new(), 0), |e| (e.gaps.clone(), e.missing));
     check_grid_size(data, path, &gaps, missing)?;
+    let clock = estimate.as_ref().map(|e| e.clock);
+    let reset = estimate.as_ref().and_then(|e| e.reset);
     match (given_hz, &estimate) {
-        (Some(f), Some(e)) => {
-            if let Some(msg) = disagreement(e, f, "{sample_rate_hz}", path) {
-                return Err(EvalError::conflict_on(&["sample_rate_hz"], msg));
-            }
-            Ok(Timing {
-                tau0_s: 1.0 / f,
-                gaps,
-                missing,
-                note: Some(ReadNote::SampleRateGiven { given_hz: f, stamps_hz: e.rate_hz() }),
-            })
-        }
-        (Some(f), None) => Ok(Timing { tau0_s: 1.0 / f, gaps, missing, note: None }),
+        // A given rate is used; the note (a warning when they disagree) gives the stamps'.
+        (Some(f), Some(e)) => Ok(Timing {
+            tau0_s: 1.0 / f,
+            gaps,
+            missing,
+            note: Some(ReadNote::SampleRateGiven { given_hz: f, stamps_hz: e.rate_hz() }),
+            clock,
+            reset,
+        }),
+        (Some(f), None) => Ok(Timing { tau0_s: 1.0 / f, gaps, missing, note: None, clock, reset }),
         (None, Some(e)) => Ok(Timing {
             tau0_s: e.interval_s,
             gaps,
             missing,
             note: Some(ReadNote::SampleRateEstimated { hz: e.rate_hz() }),
+            clock,
+            reset,
         }),
         (None, None) => Err(EvalError::conflict_on(
             &["sample_rate_hz"],
@@ -640,14 +750,16 @@ pub fn analyse_channel_borrowed(
         buffer.extend_from_slice(values);
         conversion.apply(&mut buffer);
         let curve = match missing {
-            GapPolicy::Analyse => channel_curve(setup.path, info, buffer, setup.lines, setup.tau0_s, setup.options)?,
+            GapPolicy::Analyse | GapPolicy::Fill | GapPolicy::Contiguous => {
+                channel_curve(setup.path, info, buffer, setup.lines, setup.tau0_s, setup.options)?
+            }
             GapPolicy::Error => deviation_from_rate(buffer, setup.tau0_s, setup.options)
                 .map_err(|e| curve_error(setup.path, info, setup.lines, e))?,
         };
         return Ok(channel_analysis(setup, info, quantity, curve));
     }
     match missing {
-        GapPolicy::Analyse => {
+        GapPolicy::Analyse | GapPolicy::Fill | GapPolicy::Contiguous => {
             let curve = deviation_from_rate_with_gaps_into(values, buffer, setup.tau0_s, setup.options)
                 .map_err(|e| curve_error(setup.path, info, setup.lines, e))?;
             Ok(channel_analysis(setup, info, quantity, curve))
@@ -829,6 +941,13 @@ pub fn analyse_data(
     let mut notes = read_notes(&data.header);
     let timing = record_timing(&data, path, request.sample_rate_hz, request.gaps)?;
     let tau0 = timing.tau0_s;
+    // A stamp going back ends the record: the rows before it are analysed.
+    if let Some(r) = timing.reset {
+        notes.push(ReadNote::Reset { reset: r, row: data.lines.get(r.index).unwrap_or(0), rows });
+        for c in &mut data.channels {
+            c.truncate(r.index);
+        }
+    }
     // Seconds assumed, and a whole number of them between samples (1 Hz or slower): more likely
     // a millisecond counter than an IMU logged at 1 Hz; the warning replaces the plain note.
     if data.header.time_unit_source == Some(UnitSource::Assumed)
@@ -842,10 +961,17 @@ pub fn analyse_data(
             }
         }
     }
+    notes.extend(timing.clock.map(ReadNote::Clock));
     notes.extend(timing.note.clone());
     if timing.missing > 0 {
         let first = timing.gaps.iter().take(5).map(|g| (data.lines.get(g.index).unwrap_or(0), g.missing)).collect();
-        notes.push(ReadNote::Gaps { count: timing.gaps.len(), missing: timing.missing, first, rows });
+        notes.push(ReadNote::Gaps {
+            count: timing.gaps.len(),
+            missing: timing.missing,
+            first,
+            rows,
+            policy: request.gaps,
+        });
     }
     if data.quality.missing_cells > 0 {
         let first_line = data.quality.first_missing.first().map_or(0, |c| c.line);
@@ -912,11 +1038,49 @@ pub fn analyse_data(
         fit_range_s: request.fit_range_s,
         uncalibrated_hint: "give a calibration or a scale factor for noise terms in deg units",
     };
-    let results: Vec<EvalResult<ChannelAnalysis>> = channels
+    let mut policy = request.gaps;
+    if policy == GapPolicy::Fill {
+        let samples = channels.first().map_or(0, |c| c.len() + timing.missing);
+        if timing.missing as f64 > MAX_FILLED_SHARE * samples as f64 {
+            notes.push(ReadNote::FillDeclined { missing: timing.missing, samples });
+            policy = GapPolicy::Analyse;
+        }
+    }
+    let results: Vec<EvalResult<(ChannelAnalysis, FillCount, usize)>> = channels
         .into_par_iter()
         .zip(infos.into_par_iter())
-        .map(|(values, info)| analyse_channel(&setup, &info, on_grid(values, &timing.gaps, timing.missing)))
+        .map(|(values, info)| {
+            let mut values = match policy {
+                GapPolicy::Contiguous => values,
+                _ => on_grid(values, &timing.gaps, timing.missing),
+            };
+            let fill = if policy == GapPolicy::Fill { fill_isolated(&mut values) } else { FillCount::default() };
+            let n = values.len();
+            Ok((analyse_channel(&setup, &info, values)?, fill, n))
+        })
         .collect();
-    let analyses = results.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let results = results.into_iter().collect::<Result<Vec<_>, _>>()?;
+    if let Some(most) = results.iter().map(|r| r.1).max_by_key(|f| f.filled).filter(|f| f.filled > 0) {
+        let samples = results.iter().map(|r| r.2).max().unwrap_or(0);
+        notes.push(ReadNote::Filled { filled: most.filled, runs: most.runs, left: most.left, samples });
+    }
+    // The gaps left out the long taus of a channel: said once.
+    let lost = results.iter().find_map(|(a, _, n)| {
+        let quarter_s = *n as f64 * tau0 / 4.0;
+        let longest_s = a.curve.points.last().map_or(0.0, |p| p.tau_s);
+        let complete = deviation_reaches(&opts, *n, tau0, quarter_s);
+        (complete && longest_s < quarter_s / 2.0).then_some(ReadNote::LongTausLost { longest_s, quarter_s })
+    });
+    notes.extend(lost);
+    let analyses = results.into_iter().map(|r| r.0).collect();
     Ok(AllanOutcome { topic: None, analyses, sample_interval_s: tau0, notes })
+}
+
+/// Whether the averaging times of `opts` over a complete record of `n` samples reach half of
+/// `quarter_s` (else a short curve is the tau list's doing, not the gaps').
+fn deviation_reaches(opts: &AllanOptions, n: usize, tau0_s: f64, quarter_s: f64) -> bool {
+    gyrolab::allan::averaging_factors(opts, n, tau0_s)
+        .ok()
+        .and_then(|ms| ms.last().copied())
+        .is_some_and(|m| m as f64 * tau0_s >= quarter_s / 2.0)
 }

@@ -19,6 +19,21 @@
 //! - a stamp that does not increase (repeated, reversed, not finite) is irregular: counted and
 //!   the first one reported; it is no gap.
 //!
+//! The clock model (docs/METHODS.md, "Clock model"), decided from the intervals themselves
+//! before the gap search:
+//! - a **sample clock**: at least [`ON_GRID_SHARE`] of the intervals lie within
+//!   [`GRID_TOLERANCE`] of a whole multiple of one base interval (the median of the intervals
+//!   up to 1.5 times their 5th percentile). Each interval of k > 1 base intervals is a gap of
+//!   k - 1 dropped samples (a PX4 `sensor_combined` topic stepping by 4.000 and 8.000 ms is
+//!   250 Hz with its drops, not 211.7 Hz);
+//! - else **arrival stamps** (jitter and bursts about a steady mean, stamped by a host): the
+//!   floor rule below finds gaps only where the time line shifts by more than the stamps' own
+//!   spread (the range of the lateness over the windows on either side), so bursts of 0.5 to
+//!   1 ms every 30 to 70 ms invent no gaps; the rate is the samples over the span.
+//! - a stamp going back to or before the record's first stamp (a clock reset, a trailer of
+//!   zeros) ends the record: the estimate is that of the stamps before it, and
+//!   [`IntervalEstimate::reset`] says where (the reader's clean part is never refused).
+//!
 //! The mean rather than the median: stamps written with a few decimals or by a host clock
 //! jitter around the true interval; their median is one of the jittered values (0.9 ms for the
 //! MPU6050 log, 1125 Hz), their mean over the span converges on the true one.
@@ -104,6 +119,10 @@ pub struct IntervalEstimate {
     pub missing: usize,
     /// The first stamp that does not increase (repeated, reversed or not finite), if any.
     pub first_non_increasing: Option<IrregularInterval>,
+    /// The clock model the gaps were found with.
+    pub clock: ClockModel,
+    /// A stamp going back that ended the record (the estimate covers the stamps before it).
+    pub reset: Option<Reset>,
 }
 
 impl IntervalEstimate {
@@ -111,6 +130,90 @@ impl IntervalEstimate {
     pub fn rate_hz(&self) -> f64 {
         1.0 / self.interval_s
     }
+}
+
+/// Share of the examined intervals that must lie on the grid of one base interval for a
+/// sample clock.
+pub const ON_GRID_SHARE: f64 = 0.99;
+
+/// Largest distance of an interval from a whole multiple of the base interval, in base
+/// intervals, for it to lie on the grid.
+pub const GRID_TOLERANCE: f64 = 0.1;
+
+/// Intervals examined for the clock model: all of them up to this many, else this many in
+/// eight windows spread over the record.
+pub const CLOCK_EXAMINED: usize = 1 << 16;
+
+/// What kind of clock made a record's time stamps (see the module's rule).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ClockKind {
+    /// Intervals at whole multiples of one base interval: drops counted from the multiples.
+    SampleClock,
+    /// Jitter and bursts about a steady mean: rate = samples / span, gaps only where the
+    /// stream stopped.
+    ArrivalStamps,
+}
+
+/// The clock model of a record and the evidence it was decided on.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ClockModel {
+    /// The kind decided.
+    pub kind: ClockKind,
+    /// The base interval the grid was tried with (the median of the intervals up to 1.5
+    /// times their 5th percentile), s.
+    pub base_s: f64,
+    /// Intervals examined.
+    pub examined: usize,
+    /// Share of them within [`GRID_TOLERANCE`] of a whole multiple of `base_s`.
+    pub on_grid: f64,
+    /// The shortest examined interval, s.
+    pub shortest_s: f64,
+    /// The longest examined interval, s.
+    pub longest_s: f64,
+}
+
+impl std::fmt::Display for ClockModel {
+    /// The decision with its evidence, as a note.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let ms = |s: f64| s * 1e3;
+        match self.kind {
+            ClockKind::SampleClock => write!(
+                f,
+                "sample clock: {:.2} % of {} intervals lie within {} % of a whole multiple of {:.6} ms (intervals {:.6} to {:.6} ms); longer multiples are dropped samples",
+                self.on_grid * 100.0,
+                self.examined,
+                GRID_TOLERANCE * 100.0,
+                ms(self.base_s),
+                ms(self.shortest_s),
+                ms(self.longest_s)
+            ),
+            ClockKind::ArrivalStamps => write!(
+                f,
+                "arrival stamps: only {:.2} % of {} intervals lie within {} % of a whole multiple of the shortest regular one ({:.6} ms; intervals {:.6} to {:.6} ms): the rate is the samples over the span, jitter and bursts are no gaps, only a stop of the stream is",
+                self.on_grid * 100.0,
+                self.examined,
+                GRID_TOLERANCE * 100.0,
+                ms(self.base_s),
+                ms(self.shortest_s),
+                ms(self.longest_s)
+            ),
+        }
+    }
+}
+
+/// A stamp that goes back to or before the record's first stamp (a clock reset, a trailer of
+/// zeros): the record ends before it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Reset {
+    /// Index of the stamp that goes back (the first one left out).
+    pub index: usize,
+    /// The stamp before it, s.
+    pub from_s: f64,
+    /// The stamp, s.
+    pub to_s: f64,
+    /// Stamps left out (from `index` to the end).
+    pub left_out: usize,
 }
 
 /// Why no interval could be estimated.
@@ -439,6 +542,47 @@ pub fn estimate_interval(t: &[f64]) -> Result<IntervalEstimate, SamplingError> {
 /// [`estimate_interval`] over stamps of either kind (a slice, or [`CompactStamps`] a reader
 /// filled block by block): the same rule, the same arithmetic, the same result.
 pub fn estimate_interval_of<S: Stamps + Sync + ?Sized>(t: &S) -> Result<IntervalEstimate, SamplingError> {
+    match estimate_core(t)? {
+        Core::Estimate(e) => Ok(e),
+        Core::Reset(r) => {
+            // The stamps before the reset have no stamp that does not increase: no second reset.
+            let mut e = match estimate_core(&Prefix { t, n: r.index })? {
+                Core::Estimate(e) => e,
+                Core::Reset(_) => return Err(SamplingError::NotIncreasing),
+            };
+            e.reset = Some(r);
+            Ok(e)
+        }
+    }
+}
+
+/// The first `n` stamps of `t`.
+struct Prefix<'a, S: ?Sized> {
+    t: &'a S,
+    n: usize,
+}
+
+impl<S: Stamps + ?Sized> Stamps for Prefix<'_, S> {
+    fn len(&self) -> usize {
+        self.n
+    }
+    fn as_slice(&self) -> Option<&[f64]> {
+        self.t.as_slice().map(|s| &s[..self.n])
+    }
+    fn copy_range(&self, from: usize, to: usize, out: &mut Vec<f64>) {
+        self.t.copy_range(from, to.min(self.n), out);
+    }
+}
+
+/// The estimate, or the reset that ends the record first.
+enum Core {
+    Estimate(IntervalEstimate),
+    Reset(Reset),
+}
+
+/// The estimator's rule over all of `t`, stopping at a stamp that goes back to or before the
+/// first one.
+fn estimate_core<S: Stamps + Sync + ?Sized>(t: &S) -> Result<Core, SamplingError> {
     let n = t.len();
     if n < 2 {
         return Err(SamplingError::TooShort);
@@ -448,6 +592,23 @@ pub fn estimate_interval_of<S: Stamps + Sync + ?Sized>(t: &S) -> Result<Interval
     // last finite stamps, and every BLOCK-th stamp for the block means.
     let pass = parallel_parts(n, |from, to| first_pass(t, from, to)).into_iter().reduce(FirstPass::join);
     let FirstPass { first, last, non_increasing, first_non_increasing, marks, longest } = pass.unwrap_or_default();
+    // A stamp going back to or before the first one: the record ends there.
+    if let (Some(g), Some((_, t_first))) = (first_non_increasing, first) {
+        if g.index >= 2 && g.interval_s < 0.0 {
+            let mut one = Vec::with_capacity(1);
+            t.copy_range(g.index, g.index + 1, &mut one);
+            if let Some(&to_s) = one.first() {
+                if to_s <= t_first {
+                    return Ok(Core::Reset(Reset {
+                        index: g.index,
+                        from_s: to_s - g.interval_s,
+                        to_s,
+                        left_out: n - g.index,
+                    }));
+                }
+            }
+        }
+    }
     // First interval: the span over the count, or the median block mean when a long gap
     // stretches the span.
     let (Some((first, t_first)), Some((last, t_last))) = (first, last) else {
@@ -485,31 +646,44 @@ pub fn estimate_interval_of<S: Stamps + Sync + ?Sized>(t: &S) -> Result<Interval
         }
     };
     drop(marks);
-    // No interval over 1.5 times the nominal one: no gap, and no second pass to find one.
-    let mut gaps = if longest > GAP_FACTOR * nominal { find_gaps(t, nominal) } else { Vec::new() };
-    let mut missing: usize = gaps.iter().map(|g| g.missing).sum();
-    let mut interval_s = span / ((last - first) + missing) as f64;
-    // Again with the interval that counts the missing samples, until the count holds.
-    for _ in 0..3 {
-        if missing == 0 {
-            break;
+    let clock = clock_model(t, nominal);
+    let count = (last - first) as f64;
+    let (gaps, nominal) = if clock.kind == ClockKind::SampleClock {
+        // Drops from the multiples of the base interval, then once more with the mean interval
+        // that counts them (a base read from a few windows may be off in its last digits).
+        let mut gaps = if longest > GAP_FACTOR * clock.base_s { grid_gaps(t, clock.base_s) } else { Vec::new() };
+        let missing: usize = gaps.iter().map(|g| g.missing).sum();
+        if missing > 0 {
+            gaps = grid_gaps(t, span / (count + missing as f64));
         }
-        let again = find_gaps(t, interval_s);
-        let m: usize = again.iter().map(|g| g.missing).sum();
-        gaps = again;
-        interval_s = span / ((last - first) + m) as f64;
-        if m == missing {
-            break;
+        (gaps, clock.base_s)
+    } else {
+        // No interval over 1.5 times the nominal one: no gap, and no second pass to find one.
+        let mut gaps = if longest > GAP_FACTOR * nominal { find_gaps(t, nominal) } else { Vec::new() };
+        let mut missing: usize = gaps.iter().map(|g| g.missing).sum();
+        // Again with the interval that counts the missing samples, until the count holds.
+        for _ in 0..3 {
+            if missing == 0 {
+                break;
+            }
+            let again = find_gaps(t, span / (count + missing as f64));
+            let m: usize = again.iter().map(|g| g.missing).sum();
+            gaps = again;
+            if m == missing {
+                break;
+            }
+            missing = m;
         }
-        missing = m;
-    }
-    missing = gaps.iter().map(|g| g.missing).sum();
+        (gaps, nominal)
+    };
+    let missing: usize = gaps.iter().map(|g| g.missing).sum();
+    let interval_s = span / (count + missing as f64);
     let gap_irregular = gaps.first().map(|g| IrregularInterval { index: g.index, interval_s: g.interval_s });
     let first_irregular = match (gap_irregular, first_non_increasing) {
         (Some(a), Some(b)) => Some(if a.index <= b.index { a } else { b }),
         (a, b) => a.or(b),
     };
-    Ok(IntervalEstimate {
+    Ok(Core::Estimate(IntervalEstimate {
         interval_s,
         nominal_s: nominal,
         first_irregular,
@@ -517,7 +691,75 @@ pub fn estimate_interval_of<S: Stamps + Sync + ?Sized>(t: &S) -> Result<Interval
         gaps,
         missing,
         first_non_increasing,
-    })
+        clock,
+        reset: None,
+    }))
+}
+
+/// The clock model of `t` (see the module's rule) from its increasing intervals: all of them
+/// up to [`CLOCK_EXAMINED`], else that many in eight windows spread over the record.
+/// `nominal` stands in when no interval increases.
+fn clock_model<S: Stamps + ?Sized>(t: &S, nominal: f64) -> ClockModel {
+    let n = t.len();
+    let mut stamps = Vec::new();
+    let mut d: Vec<f64> = Vec::with_capacity(CLOCK_EXAMINED.min(n));
+    let windows = if n <= CLOCK_EXAMINED + 1 { 1 } else { 8 };
+    let width = (CLOCK_EXAMINED / windows + 1).min(n);
+    for w in 0..windows {
+        let from = if windows == 1 { 0 } else { (n - width) * w / (windows - 1) };
+        stamps.clear();
+        t.copy_range(from, (from + width).min(n), &mut stamps);
+        d.extend(stamps.windows(2).map(|p| p[1] - p[0]).filter(|x| x.is_finite() && *x > 0.0));
+    }
+    let fallback = ClockModel {
+        kind: ClockKind::ArrivalStamps,
+        base_s: nominal,
+        examined: d.len(),
+        on_grid: 0.0,
+        shortest_s: nominal,
+        longest_s: nominal,
+    };
+    if d.is_empty() {
+        return fallback;
+    }
+    let shortest = d.iter().copied().fold(f64::INFINITY, f64::min);
+    let longest = d.iter().copied().fold(0.0, f64::max);
+    let q05 = {
+        let k = d.len() / 20;
+        *d.select_nth_unstable_by(k, f64::total_cmp).1
+    };
+    let mut low: Vec<f64> = d.iter().copied().filter(|&x| x <= 1.5 * q05).collect();
+    let mid = low.len() / 2;
+    let base = *low.select_nth_unstable_by(mid, f64::total_cmp).1;
+    let on = d
+        .iter()
+        .filter(|&&x| {
+            let m = x / base;
+            m.round() >= 1.0 && (m - m.round()).abs() <= GRID_TOLERANCE
+        })
+        .count();
+    let on_grid = on as f64 / d.len() as f64;
+    let kind = if on_grid >= ON_GRID_SHARE { ClockKind::SampleClock } else { ClockKind::ArrivalStamps };
+    ClockModel { kind, base_s: base, examined: d.len(), on_grid, shortest_s: shortest, longest_s: longest }
+}
+
+/// The gaps of stamps on a sample clock of base interval `base`: every interval of k > 1 base
+/// intervals (rounded) holds k - 1 dropped samples.
+fn grid_gaps<S: Stamps + Sync + ?Sized>(t: &S, base: f64) -> Vec<Gap> {
+    let n = t.len();
+    let mut c = Cursor::new(t);
+    let mut gaps = Vec::new();
+    let mut i = 1;
+    while i < n {
+        let Some(next) = next_long_interval(t, i, GAP_FACTOR * base) else { break };
+        let d = c.get(next) - c.get(next - 1);
+        let k = (d / base).round();
+        if d.is_finite() && k >= 2.0 {
+            gaps.push(Gap { index: next, missing: k as usize - 1, interval_s: d });
+        }
+        i = next + 1;
+    }
+    gaps
 }
 
 /// Stamps from which the passes over them run in parallel parts (few in tests, so that parts
@@ -765,19 +1007,31 @@ fn find_gaps<S: Stamps + Sync + ?Sized>(t: &S, dt: f64) -> Vec<Gap> {
     let mut gaps = Vec::new();
     let mut previous = 0usize;
     let mut i = 1;
+    // The floor (minimum) and the range of the lateness over samples from..to.
     let floor = |c: &mut Cursor<'_, S>, from: usize, to: usize| {
-        (from..to).map(|j| c.get(j) - t0 - j as f64 * dt).filter(|e| e.is_finite()).fold(f64::INFINITY, f64::min)
+        (from..to)
+            .map(|j| c.get(j) - t0 - j as f64 * dt)
+            .filter(|e| e.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), e| (lo.min(e), hi.max(e)))
     };
     while i < n {
         // The next interval longer than 1.5 dt (read chunk by chunk).
         let Some(next) = next_long_interval(t, i, GAP_FACTOR * dt) else { break };
         i = next;
         let d = c.get(i) - c.get(i - 1);
+        // The floor of the lateness needs samples on both sides: within WINDOW / 2 samples of
+        // either end of the record no gap is judged (a late last stamp is not a stop).
+        if i < WINDOW / 2 || n - i < WINDOW / 2 {
+            i += 1;
+            continue;
+        }
         if d.is_finite() && d > GAP_FACTOR * dt {
-            let before = floor(&mut c, previous.max(i.saturating_sub(WINDOW)), i);
-            let after = floor(&mut c, i, (i + WINDOW).min(n));
+            let (before, top_before) = floor(&mut c, previous.max(i.saturating_sub(WINDOW)), i);
+            let (after, top_after) = floor(&mut c, i, (i + WINDOW).min(n));
             let shift = (after - before) / dt;
-            if shift.is_finite() && shift >= 0.5 {
+            // A shift within the stamps' own spread on either side is jitter or a burst.
+            let spread = ((top_before - before).max(top_after - after) / dt).max(0.0);
+            if shift.is_finite() && shift >= 0.5 && shift > spread {
                 let missing = shift.round() as usize;
                 // The gap sits at the longest interval among the next few (a host stamp may
                 // hold the delay over a burst).
@@ -922,6 +1176,137 @@ mod tests {
                 assert!((e.interval_s - 0.01).abs() < 1e-12);
             }
         }
+    }
+
+    /// PX4 `sensor_combined` as a logger writes it: 250 Hz stamps in whole microseconds, a
+    /// run of 1 to 3 messages dropped after about one message in twelve (intervals of 4.000,
+    /// 8.000, 12.000, 16.000 ms). The true rate is 250 Hz and the drops are known.
+    #[test]
+    fn a_sample_clock_with_drops_reads_its_base_rate_and_every_drop() {
+        let mut st = 3u64;
+        let (mut t, mut expected, mut i) = (Vec::new(), Vec::new(), 0u64);
+        while t.len() < 30_000 {
+            t.push((1_234_567 + i * 4000) as f64 * 1e-6);
+            i += 1;
+            if uniform(&mut st) < 0.08 {
+                let k = 1 + (uniform(&mut st) * 3.0) as usize;
+                expected.push((t.len(), k));
+                i += k as u64;
+            }
+        }
+        for e in [estimate_interval(&t).unwrap(), {
+            let mut c = CompactStamps::default();
+            c.extend_from_slice(&t);
+            estimate_interval_of(&c).unwrap()
+        }] {
+            assert_eq!(e.clock.kind, ClockKind::SampleClock, "{}", e.clock);
+            assert!((e.rate_hz() - 250.0).abs() < 1e-6, "{} Hz", e.rate_hz());
+            let found: Vec<(usize, usize)> = e.gaps.iter().map(|g| (g.index, g.missing)).collect();
+            assert_eq!(found, expected);
+            assert_eq!(e.missing, expected.iter().map(|x| x.1).sum::<usize>());
+        }
+    }
+
+    /// A host stamping a 100.22 Hz sensor when the driver hands samples over: bursts every 30
+    /// to 70 ms, 0.5 to 1 ms apart inside a burst. The rate is the samples over the span; no
+    /// gap is invented.
+    fn burst_stamps(rate: f64, n: usize, seed: u64) -> Vec<f64> {
+        let mut st = seed;
+        let (mut t, mut next_burst, mut last) = (Vec::with_capacity(n), 0.0f64, f64::NEG_INFINITY);
+        let mut i = 0usize;
+        while t.len() < n {
+            next_burst += 0.03 + 0.04 * uniform(&mut st);
+            // Every sample taken by then is handed over in this burst.
+            while t.len() < n && i as f64 / rate <= next_burst {
+                let stamp = next_burst.max(last + 0.0005 + 0.0005 * uniform(&mut st));
+                t.push(stamp);
+                last = stamp;
+                i += 1;
+            }
+        }
+        t
+    }
+
+    #[test]
+    fn bursts_of_arrival_stamps_invent_no_gaps() {
+        for seed in [1u64, 2, 3, 4] {
+            let t = burst_stamps(100.22, 7000, seed);
+            let e = estimate_interval(&t).unwrap();
+            assert_eq!(e.clock.kind, ClockKind::ArrivalStamps, "{}", e.clock);
+            assert_eq!(e.missing, 0, "seed {seed}: {:?}", &e.gaps[..e.gaps.len().min(5)]);
+            assert_eq!(e.interval_s, (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64);
+            assert!((e.rate_hz() / 100.22 - 1.0).abs() < 2e-3, "{} Hz", e.rate_hz());
+        }
+    }
+
+    #[test]
+    fn a_stopped_stream_of_arrival_stamps_is_a_gap() {
+        // The bursty stream of the test above stops for 2 s (about 200 samples) after 3500.
+        let mut t = burst_stamps(100.22, 7000, 9);
+        for v in t.iter_mut().skip(3500) {
+            *v += 2.0;
+        }
+        let e = estimate_interval(&t).unwrap();
+        assert_eq!(e.clock.kind, ClockKind::ArrivalStamps);
+        assert_eq!(e.gaps.len(), 1, "{:?}", e.gaps);
+        assert!((e.gaps[0].index as i64 - 3500).abs() <= 8, "{:?}", e.gaps);
+        assert!((e.gaps[0].missing as f64 - 200.4).abs() <= 8.0, "{:?}", e.gaps);
+        assert!((e.rate_hz() / 100.22 - 1.0).abs() < 2e-3, "{} Hz", e.rate_hz());
+    }
+
+    #[test]
+    fn a_zero_trailer_ends_the_record() {
+        // 6280 clean rows at 100 Hz, then 720 rows of zeros (stamp included).
+        let mut t: Vec<f64> = (0..6280).map(|i| 12.5 + i as f64 * 0.01).collect();
+        t.extend(std::iter::repeat_n(0.0, 720));
+        let e = estimate_interval(&t).unwrap();
+        let r = e.reset.unwrap();
+        assert_eq!((r.index, r.left_out, r.to_s), (6280, 720, 0.0));
+        assert!((r.from_s - 75.29).abs() < 1e-9);
+        assert!((e.rate_hz() - 100.0).abs() < 1e-9);
+        assert_eq!((e.missing, e.irregular, e.first_non_increasing), (0, 0, None));
+    }
+
+    #[test]
+    fn a_clock_reset_ends_the_record_there() {
+        // A 200 Hz clock reset to zero after 5000 samples, then running on for 3000.
+        let mut t: Vec<f64> = (0..5000).map(|i| 40.0 + i as f64 * 0.005).collect();
+        t.extend((0..3000).map(|i| i as f64 * 0.005));
+        let mut c = CompactStamps::default();
+        c.extend_from_slice(&t);
+        for e in [estimate_interval(&t).unwrap(), estimate_interval_of(&c).unwrap()] {
+            let r = e.reset.unwrap();
+            assert_eq!((r.index, r.left_out), (5000, 3000));
+            assert!((e.rate_hz() - 200.0).abs() < 1e-9);
+        }
+        // A stamp going back but not to the start stays a stamp that does not increase.
+        let mut t: Vec<f64> = (0..1000).map(|i| i as f64 * 0.01).collect();
+        t[500] = t[498];
+        let e = estimate_interval(&t).unwrap();
+        assert_eq!(e.reset, None);
+        assert_eq!(e.first_non_increasing.map(|g| g.index), Some(500));
+    }
+
+    #[test]
+    fn sparse_drops_in_host_stamps_over_twenty_minutes_are_found() {
+        // A ROS bag: 250 Hz, 20 min, stamps on arrival jittered by +-10 % of the interval,
+        // one message dropped about every 150.
+        let (rate, n) = (250.0, 300_000usize);
+        let mut st = 5u64;
+        let (mut t, mut expected, mut i) = (Vec::with_capacity(n), Vec::new(), 0usize);
+        while t.len() < n {
+            if i > 0 && uniform(&mut st) < 1.0 / 150.0 && expected.last().is_none_or(|&(k, _)| t.len() > k + 40) {
+                expected.push((t.len(), 1usize));
+                i += 1;
+            }
+            t.push((i as f64 + 0.2 * (uniform(&mut st) - 0.5)) / rate);
+            i += 1;
+        }
+        let e = estimate_interval(&t).unwrap();
+        let found: Vec<(usize, usize)> = e.gaps.iter().map(|g| (g.index, g.missing)).collect();
+        assert_eq!(found.len(), expected.len());
+        assert_eq!(found, expected);
+        assert!((e.rate_hz() / rate - 1.0).abs() < 1e-6, "{}", e.rate_hz());
     }
 
     #[test]

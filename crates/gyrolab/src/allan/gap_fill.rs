@@ -21,6 +21,10 @@
 /// Longest run of missing samples filled.
 pub const MAX_FILLED_RUN: usize = 3;
 
+/// Largest share of a record's samples the fill rule is checked for (1 %): a record with more
+/// samples filled gets a warning that its short-tau deviations and N are biased.
+pub const MAX_FILLED_SHARE: f64 = 0.01;
+
 /// Largest relative change of a deviation point that filling a share of at most 1 % of the
 /// samples may cause (the bound the test checks, at every tau).
 pub const FILL_TOLERANCE: f64 = 0.02;

@@ -395,6 +395,15 @@ impl StaticTestAccumulator {
                 p.output.len()
             ))
         })?;
+        if let Some(r) = estimate.reset {
+            // The clean part ends there; reading past it would take the trailer as data.
+            return Err(StaticTestError::SampleRateUnknown(format!(
+                "the time stamps go back at sample {} (from {} s to {} s: a clock reset or a trailer of zeros); cut the record before it",
+                r.index + 1,
+                r.from_s,
+                r.to_s
+            )));
+        }
         self.set_rate(estimate.rate_hz());
         let block = SampleBlock {
             output: &p.output,

@@ -83,10 +83,18 @@ fn a_sample_clock_with_drops_reads_250_hz_and_its_drops() {
         assert_eq!(gaps_of(&o), Some((runs, dropped)));
         let n = arw(&o);
         assert!((n / N_DEG_RT_H - 1.0).abs() < 0.03, "{gaps:?}: N = {n}");
+        if gaps == GapPolicy::Fill {
+            // About 20 % of the grid missing: beyond the 1 % the fill rule is checked for, so
+            // nothing is filled and the note says why.
+            let declined = o.notes.iter().find(|n| matches!(n, ReadNote::FillDeclined { .. })).expect("declined");
+            assert!(declined.to_string().contains("more than the 1 %"), "{declined}");
+            assert!(!o.notes.iter().any(|n| matches!(n, ReadNote::Filled { .. })));
+        }
     }
-    // A given rate of 250 Hz agrees with the stamps: no warning.
+    // A given rate of 250 Hz agrees with the stamps: no warning about it.
     let o = analyse_file(&AllanRequest { sample_rate_hz: Some(250.0), ..AllanRequest::new(&path) }).unwrap();
-    assert!(o.notes.iter().all(|n| !n.is_warning()), "{:?}", o.notes);
+    let given = o.notes.iter().find(|n| matches!(n, ReadNote::SampleRateGiven { .. })).expect("a note on the rate");
+    assert!(!given.is_warning(), "{given}");
 }
 
 /// A host stamping a 100.22 Hz sensor when the driver hands samples over: bursts every 30 to
@@ -112,7 +120,13 @@ fn bursts_of_host_stamps_read_samples_over_span_and_keep_the_long_taus() {
     write(&path, &t, &y);
     let o = analyse_file(&AllanRequest { taus: TauList::Decade, ..AllanRequest::new(&path) }).unwrap();
     assert_eq!(clock_of(&o), ClockKind::ArrivalStamps);
-    assert_eq!(gaps_of(&o), None, "{:?}", o.notes);
+    assert_eq!(
+        gaps_of(&o),
+        None,
+        "{:?} {}",
+        o.notes,
+        o.notes.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(" | ")
+    );
     let span = t[n - 1] - t[0];
     assert_eq!(o.sample_interval_s, span / (n - 1) as f64);
     assert!((1.0 / o.sample_interval_s / rate - 1.0).abs() < 2e-3);
@@ -211,7 +225,9 @@ fn sparse_drops_over_twenty_minutes_keep_the_long_taus() {
     assert_eq!(gaps_of(&fill), Some((dropped, dropped)));
     assert!((1.0 / fill.sample_interval_s / rate - 1.0).abs() < 1e-5);
     assert!(fill.notes.iter().any(|n| matches!(n, ReadNote::Filled { filled, left: 0, .. } if *filled == dropped)));
-    assert!(fill.analyses[0].curve.points.last().unwrap().tau_s >= quarter, "{quarter}");
+    // Octave taus: the last factor is the largest power of two within a quarter of the record.
+    let last = fill.analyses[0].curve.points.last().unwrap().tau_s;
+    assert!(last > quarter / 2.0, "{last} of {quarter}");
     assert!(!fill.notes.iter().any(|n| matches!(n, ReadNote::LongTausLost { .. })));
     let n = arw(&fill);
     assert!((n / N_DEG_RT_H - 1.0).abs() < 0.03, "N = {n}");
@@ -220,7 +236,10 @@ fn sparse_drops_over_twenty_minutes_keep_the_long_taus() {
     assert!(analyse.notes.iter().any(|n| matches!(n, ReadNote::LongTausLost { .. }) && n.is_warning()));
     let contiguous = analyse_file(&AllanRequest { gaps: GapPolicy::Contiguous, ..AllanRequest::new(&path) }).unwrap();
     assert_eq!(contiguous.analyses[0].curve.points[0].terms, t.len() - 1);
-    assert!(contiguous.analyses[0].curve.points.last().unwrap().tau_s >= quarter * (t.len() as f64 / grid as f64));
+    // The curve reaches a quarter of the closed-up record (floor((n - 1) / 4) samples).
+    let contiguous_quarter = ((t.len() - 1) / 4) as f64 / rate;
+    let last = contiguous.analyses[0].curve.points.last().unwrap().tau_s;
+    assert!(last > contiguous_quarter / 2.0, "{last} of {contiguous_quarter}");
 }
 
 /// The REAL PX4 log of examples/recordings (PX4/pyulog's test log, BSD-3-Clause): topic
