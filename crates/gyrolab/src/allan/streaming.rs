@@ -18,7 +18,7 @@
 
 use super::{
     averaging_factors, deviation_bounds, deviation_from_angle, equivalent_dof, two_sum, AllanCurve, AllanError,
-    AllanOptions, AllanPoint, DeviationKind, TauList,
+    AllanOptions, AllanPoint, DeviationKind, NoiseIdMethod, TauList,
 };
 
 /// Octaves of full resolution above the stride: factors m >= 2^4 x stride come from the kept
@@ -90,7 +90,6 @@ impl StreamedPoint {
 /// finished ([`StreamingOadev::finish`]).
 #[derive(Debug, Clone)]
 pub struct StreamingOadev {
-    tau0_s: f64,
     options: AllanOptions,
     plan: StreamingPlan,
     /// Factors summed at full resolution (1, 2, 4, ... below `plan.full_resolution_below`).
@@ -115,11 +114,9 @@ pub struct StreamingOadev {
 }
 
 impl StreamingOadev {
-    /// A streamed OADEV at interval `tau0_s` (octave taus only; `options.kind` must be OADEV).
-    pub fn new(tau0_s: f64, options: &AllanOptions, plan: StreamingPlan) -> Result<StreamingOadev, AllanError> {
-        if !(tau0_s.is_finite() && tau0_s > 0.0) {
-            return Err(AllanError::BadTau0(tau0_s));
-        }
+    /// A streamed OADEV (octave taus only; `options.kind` must be OADEV). The sampling interval
+    /// is given to [`StreamingOadev::finish`] (a reader knows it once the stamps are read).
+    pub fn new(options: &AllanOptions, plan: StreamingPlan) -> Result<StreamingOadev, AllanError> {
         if let Some(c) = options.confidence {
             if !(c > 0.0 && c < 1.0) {
                 return Err(AllanError::BadConfidence(c));
@@ -135,7 +132,6 @@ impl StreamingOadev {
             .collect();
         let span = (2 * exact.last().copied().unwrap_or(0) + 1).next_power_of_two();
         let mut s = StreamingOadev {
-            tau0_s,
             options: options.clone(),
             plan,
             sums: vec![(0.0, 0.0); exact.len()],
@@ -187,9 +183,12 @@ impl StreamingOadev {
         if let Some(i) = rate.iter().position(|v| !v.is_finite()) {
             return Err(AllanError::NonFinite { index: self.samples() + i, value: rate[i] });
         }
+        if rate.is_empty() {
+            return Ok(());
+        }
         let room = self.plan.head_samples.saturating_sub(self.head.len()).min(rate.len());
         self.head.extend_from_slice(&rate[..room]);
-        let offset = *self.offset.get_or_insert(rate.first().copied().unwrap_or(0.0));
+        let offset = *self.offset.get_or_insert(rate[0]);
         for &y in rate {
             let (s, e) = two_sum(self.hi, y - offset);
             self.hi = s;
@@ -201,9 +200,13 @@ impl StreamingOadev {
 
     /// The curve: the factors of [`averaging_factors`] for the whole record, each at full
     /// resolution when below the plan's limit (or when the stride is 1), else from the kept angle.
-    pub fn finish(self) -> Result<(AllanCurve, Vec<StreamedPoint>), AllanError> {
+    /// `tau0_s` is the sampling interval (positive, finite).
+    pub fn finish(self, tau0_s: f64) -> Result<(AllanCurve, Vec<StreamedPoint>), AllanError> {
+        if !(tau0_s.is_finite() && tau0_s > 0.0) {
+            return Err(AllanError::BadTau0(tau0_s));
+        }
         let n_rate = self.samples();
-        let ms = averaging_factors(&self.options, n_rate, self.tau0_s)?;
+        let ms = averaging_factors(&self.options, n_rate, tau0_s)?;
         let b = self.plan.stride;
         let mut out: Vec<StreamedPoint> = Vec::with_capacity(ms.len());
         // Short taus: the full-resolution sums; noise type from the head, EDF for the whole record.
@@ -212,27 +215,38 @@ impl StreamingOadev {
             let head_curve = match self.options.confidence {
                 Some(_) => {
                     let opts = AllanOptions { taus: TauList::Factors(exact_ms.clone()), ..self.options.clone() };
-                    super::deviation_from_rate_slice(&self.head, self.tau0_s, &opts).ok()
+                    super::deviation_from_rate_slice(&self.head, tau0_s, &opts).ok()
                 }
                 None => None,
             };
+            // The in-memory rule: a tau whose noise type is not identified (here: beyond the
+            // head) takes the previous tau's.
+            let mut previous: Option<i32> = None;
             for &m in &exact_ms {
                 let i = self.exact.iter().position(|&e| e == m).unwrap_or(0); // ok: exact_ms is a subset of exact
                 let terms = self.points - 2 * m;
                 let variance = (self.sums[i].0 + self.sums[i].1) / (2.0 * (m as f64).powi(2) * terms as f64);
                 let deviation = variance.sqrt();
-                let alpha = head_curve.as_ref().and_then(|c| c.points.iter().find(|p| p.m == m)).and_then(|p| p.alpha);
+                let identified = head_curve
+                    .as_ref()
+                    .and_then(|c| c.points.iter().find(|p| p.m == m))
+                    .and_then(|p| p.alpha.zip(p.noise_id));
+                let (alpha, noise_id) = match identified {
+                    Some((a, id)) => (Some(a), Some(id)),
+                    None if deviation > 0.0 && previous.is_some() => (previous, Some(NoiseIdMethod::Previous)),
+                    None => (None, None),
+                };
+                previous = alpha.or(previous);
                 let edf = alpha.map(|a| equivalent_dof(DeviationKind::Oadev, a, m, self.points));
                 let bounds = match (edf, self.options.confidence) {
                     (Some(e), Some(c)) => deviation_bounds(deviation, e, c),
+                    (None, Some(_)) if deviation == 0.0 => Some((0.0, 0.0)),
                     _ => None,
                 };
-                let noise_id =
-                    head_curve.as_ref().and_then(|c| c.points.iter().find(|p| p.m == m)).and_then(|p| p.noise_id);
                 out.push(StreamedPoint {
                     point: AllanPoint {
                         m,
-                        tau_s: m as f64 * self.tau0_s,
+                        tau_s: m as f64 * tau0_s,
                         deviation,
                         terms,
                         alpha,
@@ -251,8 +265,8 @@ impl StreamingOadev {
         if !long.is_empty() {
             let (eh, el) = (self.hi, self.lo);
             let n = n_rate as f64;
-            let angle: Vec<f64> = self
-                .kept
+            let kept = self.kept;
+            let scaled: Vec<f64> = kept
                 .iter()
                 .enumerate()
                 .map(|(k, &(h, l))| {
@@ -261,32 +275,28 @@ impl StreamingOadev {
                     let p = eh * f;
                     let p_err = eh.mul_add(f, -p) + el * f;
                     let (s, e) = two_sum(h, -p);
-                    s + (e + l - p_err)
+                    // In sample units (sums of rate samples): times tau0 it is the angle in
+                    // rate x seconds that deviation_from_angle takes at its interval b tau0.
+                    (s + (e + l - p_err)) * tau0_s
                 })
                 .collect();
+            drop(kept);
             let opts = AllanOptions {
                 taus: TauList::Factors(long.iter().map(|m| m / b).collect()),
                 max_factor: None,
                 ..self.options.clone()
             };
-            // The kept angle is in sample units (sums of rate samples): times tau0 it is the
-            // angle in rate x seconds that deviation_from_angle takes at its interval b tau0.
-            let scaled: Vec<f64> = angle.iter().map(|x| x * self.tau0_s).collect();
-            let curve = deviation_from_angle(scaled, b as f64 * self.tau0_s, &opts)?;
+            let curve = deviation_from_angle(scaled, b as f64 * tau0_s, &opts)?;
             for p in curve.points {
                 let m = p.m * b;
                 let edf_full = p.alpha.map(|a| equivalent_dof(DeviationKind::Oadev, a, m, self.points));
-                out.push(StreamedPoint {
-                    point: AllanPoint { m, tau_s: m as f64 * self.tau0_s, ..p },
-                    stride: b,
-                    edf_full,
-                });
+                out.push(StreamedPoint { point: AllanPoint { m, tau_s: m as f64 * tau0_s, ..p }, stride: b, edf_full });
             }
         }
         out.sort_by_key(|p| p.point.m);
         let curve = AllanCurve {
             kind: DeviationKind::Oadev,
-            tau0_s: self.tau0_s,
+            tau0_s,
             n_rate,
             confidence: self.options.confidence,
             points: out.iter().map(|p| p.point).collect(),
@@ -333,11 +343,11 @@ mod tests {
         plan: StreamingPlan,
         options: &AllanOptions,
     ) -> (AllanCurve, Vec<StreamedPoint>) {
-        let mut s = StreamingOadev::new(tau0, options, plan).unwrap();
+        let mut s = StreamingOadev::new(options, plan).unwrap();
         for block in rate.chunks(4099) {
             s.push(block).unwrap();
         }
-        s.finish().unwrap()
+        s.finish(tau0).unwrap()
     }
 
     fn rel(a: f64, b: f64) -> f64 {
@@ -438,14 +448,15 @@ mod tests {
     #[test]
     fn a_bad_sample_or_option_is_an_error() {
         let plan = StreamingPlan { stride: 4, full_resolution_below: 32, head_samples: 10 };
-        let mut s = StreamingOadev::new(0.01, &AllanOptions::default(), plan).unwrap();
+        let mut s = StreamingOadev::new(&AllanOptions::default(), plan).unwrap();
         s.push(&[1.0, 2.0]).unwrap();
         match s.push(&[3.0, f64::NAN]) {
             Err(AllanError::NonFinite { index, value }) => assert!(index == 3 && value.is_nan()),
             other => panic!("{other:?}"),
         }
         let mdev = AllanOptions::new(DeviationKind::Mdev);
-        assert!(StreamingOadev::new(0.01, &mdev, plan).is_err());
-        assert!(StreamingOadev::new(0.0, &AllanOptions::default(), plan).is_err());
+        assert!(StreamingOadev::new(&mdev, plan).is_err());
+        let s = StreamingOadev::new(&AllanOptions::default(), plan).unwrap();
+        assert_eq!(s.finish(0.0).unwrap_err(), AllanError::BadTau0(0.0));
     }
 }
