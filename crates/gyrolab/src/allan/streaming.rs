@@ -99,10 +99,12 @@ pub struct StreamingOadev {
     /// The current angle (double-double, sample units).
     hi: f64,
     lo: f64,
-    /// The last 2 m_max + 1 angle points (double-double), as a ring of a power-of-two length.
-    ring: Vec<(f64, f64)>,
-    /// Ring length - 1 (index mask).
-    mask: usize,
+    /// Recent angle points, double-double (high and low parts apart): at least the last
+    /// 2 m_max before the next block, then the block's own.
+    hist_hi: Vec<f64>,
+    hist_lo: Vec<f64>,
+    /// Index in the record of the first point of `hist_hi`/`hist_lo`.
+    base: usize,
     /// Angle points seen.
     points: usize,
     /// Neumaier sums (sum, carry) of squared second differences per exact factor.
@@ -130,7 +132,6 @@ impl StreamingOadev {
         let exact: Vec<usize> = std::iter::successors(Some(1usize), |m| m.checked_mul(2))
             .take_while(|&m| m < plan.full_resolution_below)
             .collect();
-        let span = (2 * exact.last().copied().unwrap_or(0) + 1).next_power_of_two();
         let mut s = StreamingOadev {
             options: options.clone(),
             plan,
@@ -139,43 +140,21 @@ impl StreamingOadev {
             offset: None,
             hi: 0.0,
             lo: 0.0,
-            ring: vec![(0.0, 0.0); span],
-            mask: span - 1,
-            points: 0,
-            kept: Vec::new(),
+            hist_hi: vec![0.0],
+            hist_lo: vec![0.0],
+            base: 0,
+            points: 1,
+            kept: vec![(0.0, 0.0)],
             head: Vec::new(),
         };
-        s.add_point();
+        s.hist_hi.reserve(1 << 16);
+        s.hist_lo.reserve(1 << 16);
         Ok(s)
     }
 
     /// Rate samples pushed so far.
     pub fn samples(&self) -> usize {
         self.points - 1
-    }
-
-    /// Adds the current angle as the next point: ring, second differences, kept angle.
-    #[inline]
-    fn add_point(&mut self) {
-        let k = self.points;
-        let mask = self.mask;
-        self.ring[k & mask] = (self.hi, self.lo);
-        for (i, &m) in self.exact.iter().enumerate() {
-            if k < 2 * m {
-                break;
-            }
-            let (a, b, c) = (self.ring[k & mask], self.ring[(k - m) & mask], self.ring[(k - 2 * m) & mask]);
-            let d = second_difference(a, b, c);
-            let (sum, carry) = &mut self.sums[i];
-            let v = d * d;
-            let t = *sum + v;
-            *carry += if sum.abs() >= v { (*sum - t) + v } else { (v - t) + *sum };
-            *sum = t;
-        }
-        if k.is_multiple_of(self.plan.stride) {
-            self.kept.push((self.hi, self.lo));
-        }
-        self.points += 1;
     }
 
     /// Pushes the next rate samples; a non-finite sample is an error (its index in the record).
@@ -189,11 +168,47 @@ impl StreamingOadev {
         let room = self.plan.head_samples.saturating_sub(self.head.len()).min(rate.len());
         self.head.extend_from_slice(&rate[..room]);
         let offset = *self.offset.get_or_insert(rate[0]);
+        let start = self.points;
+        let end = start + rate.len();
         for &y in rate {
             let (s, e) = two_sum(self.hi, y - offset);
             self.hi = s;
             self.lo += e;
-            self.add_point();
+            self.hist_hi.push(self.hi);
+            self.hist_lo.push(self.lo);
+        }
+        let (h, l, o) = (&self.hist_hi, &self.hist_lo, self.base);
+        let b = self.plan.stride;
+        for k in (start.next_multiple_of(b)..end).step_by(b) {
+            self.kept.push((h[k - o], l[k - o]));
+        }
+        for (i, &m) in self.exact.iter().enumerate() {
+            let from = start.max(2 * m);
+            if from >= end {
+                break;
+            }
+            let n = end - from;
+            let (a, bb, c) = (from - o, from - m - o, from - 2 * m - o);
+            let sub = sum_of_squared_differences(
+                (&h[a..a + n], &l[a..a + n]),
+                (&h[bb..bb + n], &l[bb..bb + n]),
+                (&h[c..c + n], &l[c..c + n]),
+            );
+            let (sum, carry) = &mut self.sums[i];
+            for v in sub {
+                let t = *sum + v;
+                *carry += if sum.abs() >= v { (*sum - t) + v } else { (v - t) + *sum };
+                *sum = t;
+            }
+        }
+        self.points = end;
+        // Keep the last 2 m_max points for the next block.
+        let keep = 2 * self.exact.last().copied().unwrap_or(0);
+        if self.hist_hi.len() > keep {
+            let cut = self.hist_hi.len() - keep;
+            self.hist_hi.drain(..cut);
+            self.hist_lo.drain(..cut);
+            self.base += cut;
         }
         Ok(())
     }
@@ -303,6 +318,40 @@ impl StreamingOadev {
         };
         Ok((curve, out))
     }
+}
+
+/// Terms of each sub-sum of [`sum_of_squared_differences`] (plain sums in 4 lanes: relative
+/// rounding at most about 256 units, then joined by the caller's compensated sum).
+const SUB_SUM: usize = 1024;
+
+/// Sums of the squared second differences (a_j - b_j) - (b_j - c_j) of double-double points given
+/// as (high parts, low parts), one per run of [`SUB_SUM`] terms (independent terms, 4 lanes:
+/// vectorisable).
+fn sum_of_squared_differences(a: (&[f64], &[f64]), b: (&[f64], &[f64]), c: (&[f64], &[f64])) -> Vec<f64> {
+    let n = a.0.len();
+    let mut out = Vec::with_capacity(n / SUB_SUM + 1);
+    let mut from = 0;
+    while from < n {
+        let to = (from + SUB_SUM).min(n);
+        let mut lanes = [0.0f64; 4];
+        let mut j = from;
+        while j + 4 <= to {
+            for (lane, acc) in lanes.iter_mut().enumerate() {
+                let k = j + lane;
+                let d = second_difference((a.0[k], a.1[k]), (b.0[k], b.1[k]), (c.0[k], c.1[k]));
+                *acc += d * d;
+            }
+            j += 4;
+        }
+        let mut rest = 0.0;
+        for k in j..to {
+            let d = second_difference((a.0[k], a.1[k]), (b.0[k], b.1[k]), (c.0[k], c.1[k]));
+            rest += d * d;
+        }
+        out.push((lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + rest);
+        from = to;
+    }
+    out
 }
 
 /// (a - b) - (b - c) of double-double values, rounded once.
