@@ -47,7 +47,7 @@ start=$(date +%s.%N)
 gen_s=$(echo "$(date +%s.%N) - $start" | bc)
 size=$(stat -c %s "$WORK/long.csv")
 read -r wall rss path stride < <(run long "$WORK/long.csv" --memory "$MEMORY")
-echo "record: $(echo "scale=2; $size / 10^9" | bc) GB of CSV, written in ${gen_s%.*} s"
+echo "record: $(echo "scale=2; $size / 10^9" | bc) GB of CSV, written in ${gen_s} s"
 echo "long: path $path, stride $stride, wall ${wall} s, peak RSS ${rss} MiB, $(echo "scale=0; $size / 10^6 / $wall" | bc) MB/s"
 python3 - "$WORK/long.json" <<'EOF'
 import json, sys
@@ -62,7 +62,7 @@ echo "== 2. ${FIT_HOURS} h at ${RATE} Hz: in memory against streamed, best of ${
 "$GEN" "$FIT_HOURS" "$RATE" 2 >"$WORK/fit.csv"
 size=$(stat -c %s "$WORK/fit.csv")
 best() {
-    local name=$1 best_wall=1e9 line=""
+    local name=$1 best_wall=999999 line=""
     shift
     for _ in $(seq "$RUNS"); do
         read -r wall rss path stride < <(run "$name" "$WORK/fit.csv" "$@")
