@@ -467,3 +467,23 @@ fn analyse_streaming(
     };
     Ok((AllanOutcome { topic: None, analyses, sample_interval_s: tau0, notes }, summary))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn memory_sizes_parse_in_iec_and_si_units_and_bad_ones_are_refused() {
+        assert_eq!(parse_memory("1GiB"), Ok(1 << 30));
+        assert_eq!(parse_memory(" 512 MiB "), Ok(512 << 20));
+        assert_eq!(parse_memory("2GB"), Ok(2_000_000_000));
+        assert_eq!(parse_memory("1.5G"), Ok(3 << 29));
+        assert_eq!(parse_memory("1m"), Ok(1 << 20));
+        for bad in ["lots", "", "GiB", "1 PiB", "100k", "-1G", "1e3G"] {
+            let e = parse_memory(bad).unwrap_err();
+            assert_eq!(e.field, "memory", "{bad}");
+        }
+        assert_eq!(size_text(3 << 29), "1.50 GiB");
+        assert_eq!(size_text(512 << 20), "512.0 MiB");
+    }
+}
