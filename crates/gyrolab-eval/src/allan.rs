@@ -782,7 +782,7 @@ fn analyse_complete(
 }
 
 /// What the channel's samples are in physical terms, and the conversion that makes them so.
-fn physical_conversion(setup: &ChannelSetup<'_>, info: &ChannelInfo) -> EvalResult<(Quantity, Conversion)> {
+pub(crate) fn physical_conversion(setup: &ChannelSetup<'_>, info: &ChannelInfo) -> EvalResult<(Quantity, Conversion)> {
     setup.reference.physical_conversion(info.unit).map_err(|m| {
         EvalError::conflict(format!(
             "{}: channel '{}': {m}",
@@ -793,7 +793,7 @@ fn physical_conversion(setup: &ChannelSetup<'_>, info: &ChannelInfo) -> EvalResu
 }
 
 /// The noise terms of a channel's curve (when its data and kind allow them), with the curve.
-fn channel_analysis(
+pub(crate) fn channel_analysis(
     setup: &ChannelSetup<'_>,
     info: &ChannelInfo,
     quantity: Quantity,

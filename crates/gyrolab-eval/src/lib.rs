@@ -8,6 +8,7 @@
 //! - [`triad`]: three-axis calibration sets;
 //! - [`static_test`]: static tests (bias, bias stability, repeatability, drift, temperature);
 //! - [`allan`]: Allan-variance analyses of time series, with noise terms;
+//! - [`allan_memory`]: the same within a memory ceiling, streaming records beyond it;
 //! - [`apply`]: a calibration applied to a time series, streaming;
 //! - [`batch`]: many records on every core, resumable by input hash, one result row per channel;
 //! - [`simulate`]: simulator configurations from a file and overrides;
@@ -26,6 +27,7 @@
 //! their sources); the readers and writers in `gyrolab-io`; rendering in `gyrolab-report`.
 
 pub mod allan;
+pub mod allan_memory;
 pub mod apply;
 pub mod batch;
 pub mod demo;

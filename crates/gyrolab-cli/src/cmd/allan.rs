@@ -6,7 +6,8 @@ use crate::error::CliResult;
 use crate::output::{print, to_json, write_file};
 use crate::progress::Bar;
 use clap::Args;
-use gyrolab_eval::allan::{analyse_records, AllanRequest};
+use gyrolab_eval::allan::AllanRequest;
+use gyrolab_eval::allan_memory::{analyse_records_within, default_memory_bytes, parse_memory, size_text, MemoryPath};
 use gyrolab_eval::simulate::reference_from_headers;
 use gyrolab_eval::EvalError;
 use gyrolab_report::allan::{allan_csv, allan_document, allan_text, imu_utils_yaml, kalibr_yaml};
@@ -39,6 +40,11 @@ pub struct AllanArgs {
     /// Write an imu_utils / VINS-style YAML (gyr_n, gyr_w, acc_n, acc_w), by the same rule.
     #[arg(long, value_name = "FILE.yaml")]
     pub imu_utils_yaml: Option<PathBuf>,
+    /// Memory ceiling (such as 1GiB, 512MiB, 2GB; default: half the machine's memory): a
+    /// delimited text file whose estimated in-memory size exceeds it is streamed (octave OADEV;
+    /// long taus from every stride-th angle point, their EDF loss reported; docs/METHODS.md 3.2).
+    #[arg(long, value_name = "SIZE")]
+    pub memory: Option<String>,
 }
 
 impl AllanArgs {
@@ -54,10 +60,21 @@ pub fn run(args: &AllanArgs) -> CliResult {
         eprintln!("note: {}", crate::args::stated_reference_note(&args.file.display().to_string(), &stated));
         request.reference = reference;
     }
+    let memory = match &args.memory {
+        Some(text) => parse_memory(text)?,
+        None => default_memory_bytes(),
+    };
     let spinner = Bar::spinner(format!("analysing {}", args.file.display()));
-    let outcomes = analyse_records(&request);
+    let outcomes = analyse_records_within(&request, memory);
     spinner.finish();
-    let outcomes = outcomes?;
+    let (outcomes, path) = outcomes?;
+    let streamed = match &path {
+        MemoryPath::Streaming(s) => {
+            eprintln!("note: {}", streaming_note(&args.file.display().to_string(), s));
+            Some(s)
+        }
+        MemoryPath::InMemory { .. } => None,
+    };
     let several = outcomes.len() > 1;
     for outcome in &outcomes {
         for n in &outcome.notes {
@@ -106,13 +123,44 @@ pub fn run(args: &AllanArgs) -> CliResult {
     }
     if args.json {
         let doc = allan_document(analyses).ok_or_else(|| EvalError::conflict("no channel to analyse"))?;
-        return print(&to_json(&doc)?);
+        let value = WithMemory { doc: &doc, memory: &path };
+        return print(&to_json(&value)?);
     }
     if args.csv {
         return print(&allan_csv(analyses));
     }
-    let text: Vec<String> = analyses.iter().map(allan_text).collect();
+    let mut text: Vec<String> = analyses.iter().map(allan_text).collect();
+    if let Some(s) = streamed {
+        text.push(format!("memory: {}", streaming_note(&args.file.display().to_string(), s)));
+    }
     print(&(text.join("\n") + "\n"))
+}
+
+/// The JSON document with the `memory` object (which path; docs/JSON.md) after its keys.
+#[derive(serde::Serialize)]
+struct WithMemory<'a, D: serde::Serialize> {
+    #[serde(flatten)]
+    doc: &'a D,
+    memory: &'a MemoryPath,
+}
+
+/// The line that says a record was streamed, with its stride and EDF loss.
+fn streaming_note(file: &str, s: &gyrolab_eval::allan_memory::StreamingSummary) -> String {
+    let loss =
+        s.max_edf_loss.map_or("not evaluated (no confidence level)".to_string(), |l| format!("{:.1} %", 100.0 * l));
+    let how = if s.stride == 1 {
+        "every tau at full resolution".to_string()
+    } else {
+        format!(
+            "taus with m < {} at full resolution, longer ones from every {}th angle point (largest EDF loss {loss})",
+            s.full_resolution_below_m, s.stride
+        )
+    };
+    format!(
+        "{file}: streamed (about {} in memory, above the ceiling {}; --memory raises it): {how}",
+        size_text(s.estimated_in_memory_bytes),
+        size_text(s.memory_ceiling_bytes)
+    )
 }
 
 /// Whether a channel's curve is flat at zero: every deviation at or below 1e-9 (in the

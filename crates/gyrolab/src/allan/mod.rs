@@ -34,6 +34,7 @@ pub mod gap_fill;
 mod gaps;
 mod kernels;
 mod lag1_sweep;
+pub mod streaming;
 
 pub use gaps::{deviation_from_rate_with_gaps, deviation_from_rate_with_gaps_into};
 

@@ -1,0 +1,489 @@
+//! The Allan analysis of a record of any length within a memory ceiling (issue 37 part 2;
+//! docs/METHODS.md section 3.2): a delimited text file whose estimated in-memory size exceeds the
+//! ceiling is read block by block into [`gyrolab::allan::streaming::StreamingOadev`] (octave
+//! OADEV, full resolution for the short taus, every `stride`-th angle point for the long ones);
+//! every other record takes the in-memory path of [`crate::allan::analyse_records`] unchanged.
+//!
+//! The streamed record must be complete: a gap in the time stamps, a NaN or empty cell, or
+//! dropout rows (found by the same tally as the in-memory path) are refused, naming the memory
+//! ceiling that would let the in-memory path analyse them; never a different number in silence.
+
+use crate::allan::{
+    analyse_records, channel_analysis, physical_conversion, read_notes, record_timing, AllanOutcome, AllanRequest,
+    ChannelSetup, ReadNote,
+};
+use crate::error::{EvalError, EvalResult};
+use gyrolab::allan::streaming::{StreamedPoint, StreamingOadev, StreamingPlan};
+use gyrolab::allan::{AllanError, AllanOptions, DeviationKind, TauList};
+use gyrolab::dropout::DropoutTally;
+use gyrolab::sampling::{estimate_interval_of, CompactStamps};
+use gyrolab::validate::InvalidOption;
+use gyrolab_io::recording::FileFormat;
+use gyrolab_io::series::{LineMap, SeriesData, SeriesOptions, SeriesReader, SkipReason};
+use gyrolab_io::DataError;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::io::Read;
+use std::path::Path;
+
+/// The ceiling used when the machine's memory cannot be read: 2 GiB.
+pub const FALLBACK_MEMORY_BYTES: u64 = 2 << 30;
+
+/// Smallest ceiling accepted: 1 MiB.
+pub const MIN_MEMORY_BYTES: u64 = 1 << 20;
+
+/// Rows per block of the streamed read.
+const BLOCK_ROWS: usize = 1 << 16;
+
+/// Bytes the in-memory path holds per row of a delimited text file: 8 per channel (the samples,
+/// turned into the angle series in place) and 8 for the stamps and line map (generous).
+fn in_memory_bytes_per_row(channels: usize) -> u64 {
+    8 * channels as u64 + 8
+}
+
+/// The default ceiling: half the machine's physical memory (`MemTotal` of /proc/meminfo), else
+/// [`FALLBACK_MEMORY_BYTES`].
+pub fn default_memory_bytes() -> u64 {
+    let total = std::fs::read_to_string("/proc/meminfo").ok().and_then(|text| {
+        let line = text.lines().find(|l| l.starts_with("MemTotal:"))?;
+        let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+        Some(kib.saturating_mul(1024))
+    });
+    match total {
+        Some(t) if t / 2 >= MIN_MEMORY_BYTES => t / 2,
+        _ => FALLBACK_MEMORY_BYTES,
+    }
+}
+
+/// Parses a memory size: a number and a unit, `B`, SI `kB`/`MB`/`GB`/`TB` (powers of 1000) or
+/// IEC `KiB`/`MiB`/`GiB`/`TiB` (powers of 1024; `K`, `M`, `G`, `T` alone are IEC too), such as
+/// `1GiB`, `512 MiB`, `1.5G`; at least [`MIN_MEMORY_BYTES`].
+pub fn parse_memory(text: &str) -> Result<u64, InvalidOption> {
+    let t = text.trim();
+    let split = t.find(|c: char| !(c.is_ascii_digit() || c == '.')).unwrap_or(t.len());
+    let (number, unit) = t.split_at(split);
+    let bad = || InvalidOption::new("memory", format!("'{text}': expected a size such as 1GiB, 512MiB or 2GB"));
+    let value: f64 = number.parse().map_err(|_| bad())?;
+    let scale: f64 = match unit.trim().to_ascii_lowercase().as_str() {
+        "" | "b" => 1.0,
+        "k" | "kib" => 1024.0,
+        "m" | "mib" => 1024f64.powi(2),
+        "g" | "gib" => 1024f64.powi(3),
+        "t" | "tib" => 1024f64.powi(4),
+        "kb" => 1e3,
+        "mb" => 1e6,
+        "gb" => 1e9,
+        "tb" => 1e12,
+        _ => return Err(bad()),
+    };
+    let bytes = value * scale;
+    if !(bytes.is_finite() && bytes < 2f64.powi(63)) {
+        return Err(bad());
+    }
+    let bytes = bytes as u64;
+    if bytes < MIN_MEMORY_BYTES {
+        return Err(InvalidOption::new("memory", format!("'{text}' is below the smallest ceiling, 1 MiB")));
+    }
+    Ok(bytes)
+}
+
+/// A size for messages: `1.50 GiB`, `512.0 MiB`.
+pub fn size_text(bytes: u64) -> String {
+    let b = bytes as f64;
+    if b >= 1024f64.powi(3) {
+        format!("{:.2} GiB", b / 1024f64.powi(3))
+    } else if b >= 1024f64.powi(2) {
+        format!("{:.1} MiB", b / 1024f64.powi(2))
+    } else {
+        format!("{bytes} B")
+    }
+}
+
+/// How the record was analysed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "path", rename_all = "snake_case")]
+pub enum MemoryPath {
+    /// Whole in memory, as without a ceiling.
+    InMemory {
+        /// The ceiling, bytes.
+        memory_ceiling_bytes: u64,
+        /// The estimated in-memory size, bytes (`None`: not estimated: standard input, or a
+        /// recording or Parquet file, which are always read in memory).
+        estimated_in_memory_bytes: Option<u64>,
+    },
+    /// Streamed in blocks.
+    Streaming(StreamingSummary),
+}
+
+/// What a streamed analysis did (JSON: the `memory` object, docs/JSON.md).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StreamingSummary {
+    /// The ceiling, bytes.
+    pub memory_ceiling_bytes: u64,
+    /// The estimated in-memory size that exceeded it, bytes.
+    pub estimated_in_memory_bytes: u64,
+    /// Every `stride`-th angle point was kept for the long taus.
+    pub stride: usize,
+    /// Averaging factors below this were computed at full resolution (every term).
+    pub full_resolution_below_m: usize,
+    /// Rate samples at the start of the record on which the short taus' noise type was
+    /// identified.
+    pub noise_id_head_samples: usize,
+    /// Largest EDF loss of any point of any channel (0 with stride 1).
+    pub max_edf_loss: Option<f64>,
+    /// Per channel, per tau.
+    pub channels: Vec<StreamedChannel>,
+}
+
+/// The streamed taus of one channel.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StreamedChannel {
+    /// The channel's name.
+    pub channel: String,
+    /// One per point of its curve, in order.
+    pub taus: Vec<StreamedTau>,
+}
+
+/// How one point was estimated.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct StreamedTau {
+    /// Averaging factor.
+    pub m: usize,
+    /// Stride of its terms (1: every term of the in-memory estimator).
+    pub stride: usize,
+    /// EDF of the full-resolution estimator for the same noise type.
+    pub edf_full: Option<f64>,
+    /// 1 - edf / edf_full.
+    pub edf_loss: Option<f64>,
+}
+
+impl StreamedTau {
+    fn of(p: &StreamedPoint) -> StreamedTau {
+        StreamedTau { m: p.point.m, stride: p.stride, edf_full: p.edf_full, edf_loss: p.edf_loss() }
+    }
+}
+
+/// [`analyse_records`] within `memory_bytes`: a delimited text file whose estimated in-memory
+/// size is above the ceiling is streamed (octave OADEV only; other kinds and tau lists are
+/// refused there, naming the ceiling to raise), every other record is read in memory.
+pub fn analyse_records_within(
+    request: &AllanRequest,
+    memory_bytes: u64,
+) -> EvalResult<(Vec<AllanOutcome>, MemoryPath)> {
+    let in_memory = |estimate: Option<u64>| MemoryPath::InMemory {
+        memory_ceiling_bytes: memory_bytes,
+        estimated_in_memory_bytes: estimate,
+    };
+    let path = &request.file;
+    if path == Path::new("-") {
+        return Ok((analyse_records(request)?, in_memory(None)));
+    }
+    let (_, format, size) = gyrolab_io::recording::open_sniffed(path)?;
+    if format != FileFormat::Text {
+        return Ok((analyse_records(request)?, in_memory(None)));
+    }
+    // A file the reader refuses goes to the in-memory path, whose error the user gets as before.
+    let Ok(options) = series_options(request) else { return Ok((analyse_records(request)?, in_memory(None))) };
+    let Ok(reader) = SeriesReader::open(path, &options) else {
+        return Ok((analyse_records(request)?, in_memory(None)));
+    };
+    let channels = reader.header().channels.len().max(1);
+    let rows = estimated_rows(path, size)?;
+    let estimate = rows.saturating_mul(in_memory_bytes_per_row(channels));
+    if estimate <= memory_bytes {
+        drop(reader);
+        return Ok((analyse_records(request)?, in_memory(Some(estimate))));
+    }
+    if request.kind != DeviationKind::Oadev || request.taus != TauList::Octave {
+        return Err(EvalError::conflict_on(
+            &["memory", "kind", "taus"],
+            format!(
+                "{}: about {} in memory, above the ceiling {{memory}} {}: records beyond it are streamed, which computes octave OADEV only (give {{kind}} oadev and {{taus}} octave, or raise {{memory}} above {})",
+                path.display(),
+                size_text(estimate),
+                size_text(memory_bytes),
+                size_text(estimate)
+            ),
+        ));
+    }
+    let (outcome, summary) = analyse_streaming(request, reader, rows, memory_bytes, estimate)?;
+    Ok((vec![outcome], MemoryPath::Streaming(summary)))
+}
+
+/// The reader options of the in-memory path ([`analyse_records`]), in blocks of [`BLOCK_ROWS`].
+fn series_options(request: &AllanRequest) -> EvalResult<SeriesOptions> {
+    request.layout.apply(SeriesOptions {
+        sample_rate_hz: request.sample_rate_hz,
+        channels: if request.columns.is_empty() { None } else { Some(request.columns.clone()) },
+        tolerant: true,
+        block_rows: BLOCK_ROWS,
+        ..SeriesOptions::default()
+    })
+}
+
+/// Rows of a text file estimated from the line ends in its first MiB (exact for a file that
+/// short).
+fn estimated_rows(path: &Path, size: u64) -> EvalResult<u64> {
+    let (file, _) = gyrolab_io::input_file::open_regular(path)?;
+    let mut head = Vec::with_capacity(1 << 20);
+    file.take(1 << 20).read_to_end(&mut head).map_err(|e| DataError::io(path, &e))?;
+    let lines = head.iter().filter(|&&b| b == b'\n').count() as u64;
+    if head.is_empty() {
+        return Ok(0);
+    }
+    if head.len() as u64 >= size {
+        return Ok(lines);
+    }
+    Ok((size as f64 * lines.max(1) as f64 / head.len() as f64).ceil() as u64)
+}
+
+/// Why a streamed record is refused: it is incomplete, which only the in-memory path analyses.
+fn incomplete(path: &Path, what: &str, estimate: u64) -> DataError {
+    DataError::new(
+        path,
+        format!(
+            "{what}: a record streamed within the memory ceiling must be complete (its gaps are analysed in memory only): raise the ceiling (--memory) above the record's estimated in-memory size, {}",
+            size_text(estimate)
+        ),
+    )
+}
+
+/// Streams one delimited text file through the estimators of its channels: the reader parses
+/// blocks on this thread, the estimators take them on another (channels in parallel).
+fn analyse_streaming(
+    request: &AllanRequest,
+    mut reader: SeriesReader<gyrolab_io::series::Source>,
+    rows: u64,
+    memory_bytes: u64,
+    estimate: u64,
+) -> EvalResult<(AllanOutcome, StreamingSummary)> {
+    let path = request.file.as_path();
+    let reference = request.reference.resolve()?;
+    let header = reader.header().clone();
+    let infos = header.channels.clone();
+    let options = AllanOptions {
+        kind: request.kind,
+        taus: request.taus.clone(),
+        confidence: request.confidence,
+        max_factor: None,
+    };
+    // The stamps (about a byte a row), the blocks in flight and the reader's buffers come off
+    // the ceiling before the plan shares it among the channels.
+    let overhead = rows + 4 * (BLOCK_ROWS as u64) * 8 * (infos.len() as u64 + 2);
+    let budget = memory_bytes.saturating_sub(overhead).max(MIN_MEMORY_BYTES / 2);
+    let plan = StreamingPlan::for_memory(
+        usize::try_from(rows).unwrap_or(usize::MAX),
+        infos.len(),
+        usize::try_from(budget).unwrap_or(usize::MAX),
+    );
+    let lines_probe = LineMap::default();
+    let probe = ChannelSetup {
+        path,
+        shown: path.display().to_string(),
+        topic: None,
+        lines: &lines_probe,
+        tau0_s: 1.0,
+        options: &options,
+        reference: &reference,
+        fit_range_s: request.fit_range_s,
+        uncalibrated_hint: "",
+    };
+    let conversions = infos.iter().map(|i| physical_conversion(&probe, i)).collect::<EvalResult<Vec<_>>>()?;
+    let mut estimators = infos
+        .iter()
+        .map(|_| StreamingOadev::new(&options, plan))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| EvalError::conflict(format!("{}: {e}", path.display())))?;
+
+    let mut stamps = CompactStamps::default();
+    let mut lines = LineMap::default();
+    let mut tally = DropoutTally::new(infos.len());
+    let has_time = header.time_column.is_some();
+    let (read, pushed) = std::thread::scope(|scope| {
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Vec<f64>>>(2);
+        let conversions = &conversions;
+        let estimators = &mut estimators;
+        let consumer = scope.spawn(move || -> Result<(), (usize, AllanError)> {
+            for mut block in rx {
+                let failed = estimators
+                    .par_iter_mut()
+                    .zip(block.par_iter_mut())
+                    .zip(conversions.par_iter())
+                    .enumerate()
+                    .map(|(c, ((est, values), (_, conversion)))| {
+                        conversion.apply(values);
+                        est.push(values).err().map(|e| (c, e))
+                    })
+                    .collect::<Vec<_>>()
+                    .into_iter()
+                    .flatten()
+                    .min_by_key(|(c, _)| *c);
+                if let Some(f) = failed {
+                    return Err(f);
+                }
+            }
+            Ok(())
+        });
+        let read = (|| -> Result<(), DataError> {
+            while let Some(block) = reader.next_block()? {
+                let refs: Vec<&[f64]> = block.channels.iter().map(|c| &c[..]).collect();
+                tally.push_block(&refs);
+                if has_time {
+                    if let Some(t) = block.time {
+                        stamps.extend_from_slice(t);
+                    }
+                }
+                lines.extend_from_slice(block.lines);
+                if tx.send(block.channels.to_vec()).is_err() {
+                    break; // the estimators stopped on an error, reported below
+                }
+            }
+            Ok(())
+        })();
+        drop(tx);
+        let pushed = consumer.join();
+        (read, pushed)
+    });
+    // A sample the estimators refused comes before any later reader error.
+    match pushed {
+        Ok(Ok(())) => {}
+        Ok(Err((c, AllanError::NonFinite { index, value }))) => {
+            let info = &infos[c];
+            let line = lines.get(index).unwrap_or(0);
+            let e = if value.is_nan() {
+                incomplete(path, "a NaN or empty cell (a missing sample)", estimate)
+            } else {
+                DataError::new(
+                    path,
+                    format!("sample {value} is not a finite number: the Allan variance needs a complete record"),
+                )
+            };
+            return Err(e.at_line(line).at_column(info.column, Some(&info.name)).into());
+        }
+        Ok(Err((c, e))) => {
+            return Err(
+                DataError::new(path, format!("channel '{}': {e}", gyrolab_io::text::excerpt(&infos[c].name))).into()
+            )
+        }
+        Err(_) => return Err(EvalError::conflict(format!("{}: the streamed analysis failed", path.display()))),
+    }
+    read?;
+    let quality = reader.quality().clone();
+    drop(reader);
+    // Gaps in the stamps: refused (the in-memory path places the samples on their grid).
+    if has_time {
+        if let Ok(e) = estimate_interval_of(&stamps) {
+            if e.first_non_increasing.is_none() {
+                if let Some(g) = e.gaps.first() {
+                    let what = format!(
+                        "a gap in the time stamps: {} sample(s) missing (interval {} s where the record's is {} s; {} missing in {} gap(s))",
+                        g.missing,
+                        g.interval_s,
+                        e.interval_s,
+                        e.missing,
+                        e.gaps.len()
+                    );
+                    return Err(incomplete(path, &what, estimate).at_line(lines.get(g.index).unwrap_or(0)).into());
+                }
+            }
+        }
+    }
+    // Dropout rows (every channel zero, or repeating the row before, beyond chance): the
+    // in-memory path analyses them as missing samples; the streamed one had them in its sums.
+    let verdict = tally.verdict();
+    if verdict.any() {
+        return Err(incomplete(
+            path,
+            "dropout rows (every channel zero, or repeating the row before, more often than chance)",
+            estimate,
+        )
+        .into());
+    }
+    // The timing of the in-memory path on the stamps and lines kept (no samples).
+    let mut stub = SeriesData {
+        header: header.clone(),
+        lines,
+        time: None,
+        time_compact: has_time.then_some(stamps),
+        temperature: None,
+        table_rate: None,
+        channels: Vec::new(),
+        quality,
+    };
+    let timing = record_timing(&stub, path, request.sample_rate_hz, request.gaps)?;
+    let lines = std::mem::take(&mut stub.lines);
+    drop(stub);
+    let tau0 = timing.tau0_s;
+    let mut notes = read_notes(&header);
+    notes.extend(timing.note.clone());
+    let not_read: Vec<String> =
+        header.skipped.iter().filter(|s| s.reason == SkipReason::NotSelected).map(|s| s.name.clone()).collect();
+    if infos.len() < 2 && !not_read.is_empty() {
+        notes.push(ReadNote::DropoutsUnchecked { read: infos.iter().map(|c| c.name.clone()).collect(), not_read });
+    }
+    let setup = ChannelSetup {
+        path,
+        shown: path.display().to_string(),
+        topic: None,
+        lines: &lines,
+        tau0_s: tau0,
+        options: &options,
+        reference: &reference,
+        fit_range_s: request.fit_range_s,
+        uncalibrated_hint: "give a calibration or a scale factor for noise terms in deg units",
+    };
+    let finished: Vec<EvalResult<_>> = estimators
+        .into_par_iter()
+        .zip(infos.par_iter())
+        .zip(conversions.par_iter())
+        .map(|((est, info), (quantity, _))| {
+            let (curve, points) = est.finish(tau0).map_err(|e| {
+                EvalError::Data(DataError::new(
+                    path,
+                    format!("channel '{}': {e}", gyrolab_io::text::excerpt(&info.name)),
+                ))
+            })?;
+            let streamed =
+                StreamedChannel { channel: info.name.clone(), taus: points.iter().map(StreamedTau::of).collect() };
+            Ok((channel_analysis(&setup, info, *quantity, curve), streamed))
+        })
+        .collect();
+    let mut analyses = Vec::with_capacity(finished.len());
+    let mut streamed = Vec::with_capacity(finished.len());
+    for f in finished {
+        let (a, s) = f?;
+        analyses.push(a);
+        streamed.push(s);
+    }
+    let max_edf_loss = streamed.iter().flat_map(|c| c.taus.iter().filter_map(|t| t.edf_loss)).reduce(f64::max);
+    let summary = StreamingSummary {
+        memory_ceiling_bytes: memory_bytes,
+        estimated_in_memory_bytes: estimate,
+        stride: plan.stride,
+        full_resolution_below_m: plan.full_resolution_below,
+        noise_id_head_samples: plan.head_samples,
+        max_edf_loss,
+        channels: streamed,
+    };
+    Ok((AllanOutcome { topic: None, analyses, sample_interval_s: tau0, notes }, summary))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn memory_sizes_parse_in_iec_and_si_units_and_bad_ones_are_refused() {
+        assert_eq!(parse_memory("1GiB"), Ok(1 << 30));
+        assert_eq!(parse_memory(" 512 MiB "), Ok(512 << 20));
+        assert_eq!(parse_memory("2GB"), Ok(2_000_000_000));
+        assert_eq!(parse_memory("1.5G"), Ok(3 << 29));
+        assert_eq!(parse_memory("1m"), Ok(1 << 20));
+        for bad in ["lots", "", "GiB", "1 PiB", "100k", "-1G", "1e3G"] {
+            let e = parse_memory(bad).unwrap_err();
+            assert_eq!(e.field, "memory", "{bad}");
+        }
+        assert_eq!(size_text(3 << 29), "1.50 GiB");
+        assert_eq!(size_text(512 << 20), "512.0 MiB");
+    }
+}
