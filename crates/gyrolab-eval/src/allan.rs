@@ -1044,6 +1044,11 @@ pub fn analyse_data(
         if timing.missing as f64 > MAX_FILLED_SHARE * samples as f64 {
             notes.push(ReadNote::FillDeclined { missing: timing.missing, samples });
             policy = GapPolicy::Analyse;
+            for n in notes.iter_mut() {
+                if let ReadNote::Gaps { policy: said, .. } = n {
+                    *said = GapPolicy::Analyse;
+                }
+            }
         }
     }
     let results: Vec<EvalResult<(ChannelAnalysis, FillCount, usize)>> = channels
