@@ -577,12 +577,15 @@ pub fn diff_figures(before: &[FigureRecord], after: &[FigureRecord]) -> Vec<Figu
 /// recorded size and SHA-256), by name. A file stored without its bytes (stored under schema
 /// version 1, or larger than [`crate::record::MAX_KEPT_FILE_BYTES`]) is an error naming it.
 pub fn report_files(store: &mut Store, id: i64) -> StoreResult<Vec<(String, Vec<u8>)>> {
-    evaluation(store, id)?; // exists
+    // The evaluation reads (and checks) its report files' bytes already: they are used as read.
     let name = store.name().to_string();
-    read_report_files(store, id)?
+    evaluation(store, id)?
+        .record
+        .report_files
         .into_iter()
-        .map(|(file, bytes)| {
-            bytes.map(|b| (file.clone(), b)).ok_or_else(|| StoreError::NotFound {
+        .map(|f| {
+            let file = f.path;
+            f.content.map(|b| (file.clone(), b)).ok_or_else(|| StoreError::NotFound {
                 store: name.clone(),
                 message: format!(
                     "evaluation {id}: report file {file:?} was stored as a hash only (stored before schema version 2, \
