@@ -82,6 +82,42 @@ pub enum StoreError {
     },
 }
 
+/// How long an SQLite connection waits for another writer before "database is locked".
+const BUSY_TIMEOUT: Duration = Duration::from_secs(30);
+
+/// Puts an SQLite store into WAL mode. WAL is a property of the file, so it is read first and
+/// nothing is locked once a store has been converted. The conversion itself needs the file to
+/// itself and SQLite does not run the busy handler for it, so two processes opening a new store
+/// at once (tests/store.rs `two_processes_storing_at_once_both_land`) retry here, with backoff,
+/// within the busy timeout.
+fn set_wal(c: &rusqlite::Connection, budget: Duration) -> Result<(), String> {
+    let start = std::time::Instant::now();
+    let mut pause = Duration::from_millis(5);
+    loop {
+        let attempt = c
+            .query_row("PRAGMA journal_mode", [], |r| r.get::<_, String>(0))
+            .and_then(|mode| {
+                if mode.eq_ignore_ascii_case("wal") {
+                    Ok(mode)
+                } else {
+                    c.query_row("PRAGMA journal_mode = WAL", [], |r| r.get::<_, String>(0))
+                }
+            });
+        match attempt {
+            Ok(mode) if mode.eq_ignore_ascii_case("wal") => return Ok(()),
+            Ok(mode) => return Err(format!("cannot use write-ahead logging (journal mode stays '{mode}')")),
+            Err(rusqlite::Error::SqliteFailure(e, _))
+                if matches!(e.code, rusqlite::ErrorCode::DatabaseBusy | rusqlite::ErrorCode::DatabaseLocked)
+                    && start.elapsed() < budget =>
+            {
+                std::thread::sleep(pause);
+                pause = (pause * 2).min(Duration::from_millis(200));
+            }
+            Err(e) => return Err(e.to_string()),
+        }
+    }
+}
+
 impl StoreError {
     /// True for errors of the user's data or store (exit code 2), false for failures (exit code 1).
     pub fn is_bad_input(&self) -> bool {
@@ -219,11 +255,11 @@ impl Store {
                 Err(e) => return Err(open_err(format!("cannot open: {e}"))),
             }
             let conn = rusqlite::Connection::open(path).map_err(|e| open_err(e.to_string()))?;
-            conn.busy_timeout(Duration::from_secs(30)).map_err(|e| open_err(e.to_string()))?;
+            conn.busy_timeout(BUSY_TIMEOUT).map_err(|e| open_err(e.to_string()))?;
             let mut store = Store { conn: Conn::Sqlite(conn), name, password: None, statements: PgStatements::new() };
             store.check_foreign_sqlite()?;
             if let Conn::Sqlite(c) = &store.conn {
-                c.pragma_update(None, "journal_mode", "WAL").map_err(|e| store.open_error(e.to_string()))?;
+                set_wal(c, BUSY_TIMEOUT).map_err(|e| store.open_error(e))?;
                 c.pragma_update(None, "foreign_keys", "ON").map_err(|e| store.open_error(e.to_string()))?;
             }
             store

@@ -268,6 +268,54 @@ fn first_use_by_two_clients_at_once_migrates_once() {
     }
 }
 
+/// Many processes opening one new SQLite file at once: the conversion to WAL is the one step for
+/// which SQLite runs no busy handler, so without the retry in `set_wal` some opens failed with
+/// "database is locked" (seen in CI through the CLI's two-process test; without the retry this
+/// test failed in most runs). Each round starts eight processes (this test binary again, running
+/// only this test in child mode) on a fresh file, each opening the store and then storing five
+/// evaluations, so that later processes open while earlier ones write. Threads of one process do
+/// not show the race (SQLite shares one file lock among them).
+#[test]
+fn many_processes_opening_a_new_sqlite_store_at_once_all_open() {
+    const CHILD: &str = "GYROLAB_TEST_STORE_OPEN_CHILD";
+    if let Ok(loc) = std::env::var(CHILD) {
+        // Open, then write: later processes open while earlier ones hold write transactions.
+        let mut s = Store::open(&loc, true).unwrap_or_else(|e| panic!("child open: {e}"));
+        assert_eq!(s.schema_version().unwrap(), gyrolab_store::schema::SCHEMA_VERSION);
+        for i in 0..5 {
+            let serial = format!("P{}-{i}", std::process::id());
+            s.add(&record(&serial, Some("C"), &[("x", "bias_dph", 10.0)])).unwrap_or_else(|e| panic!("child add: {e}"));
+        }
+        return;
+    }
+    let exe = std::env::current_exe().unwrap();
+    let mut failures = Vec::new();
+    for round in 0..12 {
+        let dir = tempfile::tempdir().unwrap();
+        let loc = dir.path().join("gyrolab.db").display().to_string();
+        let children: Vec<_> = (0..8)
+            .map(|_| {
+                std::process::Command::new(&exe)
+                    .args(["many_processes_opening_a_new_sqlite_store_at_once_all_open", "--exact", "--nocapture"])
+                    .env(CHILD, &loc)
+                    .stdout(std::process::Stdio::null())
+                    .stderr(std::process::Stdio::piped())
+                    .spawn()
+                    .unwrap()
+            })
+            .collect();
+        for c in children {
+            let o = c.wait_with_output().unwrap();
+            if !o.status.success() {
+                failures.push(format!("round {round}: {}", String::from_utf8_lossy(&o.stderr)));
+            }
+        }
+        let mut s = Store::open(&loc, false).unwrap();
+        assert_eq!(count(&mut s), 40 - 5 * failures.iter().filter(|f| f.starts_with(&format!("round {round}:"))).count());
+    }
+    assert!(failures.is_empty(), "{} of 96 opens failed:\n{}", failures.len(), failures.join("\n"));
+}
+
 #[test]
 fn a_newer_schema_is_refused_naming_both_versions() {
     for b in backends("newer_schema") {
