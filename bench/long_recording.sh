@@ -6,7 +6,8 @@
 #    --memory $MEMORY` (default 1GiB): peak RSS and wall time by /usr/bin/time -v, reading speed
 #    in MB/s of CSV, the path taken and the stride from the JSON.
 # 2. Reading speed on a record that fits both ways (FIT_HOURS, default 1 h, same rate): the
-#    in-memory path (default ceiling) against the streamed one (--memory 64MiB), best of RUNS.
+#    in-memory path (default ceiling) against the streamed one (--memory 64MiB), alternating,
+#    best of RUNS each (default 3); the load average is printed before and after.
 #
 # Everything is written to a temporary folder that is deleted at the end (also on error).
 # Usage: bash bench/long_recording.sh   (HOURS=6 for a shorter record)
@@ -15,7 +16,7 @@ HOURS=${HOURS:-24}
 RATE=${RATE:-1000}
 FIT_HOURS=${FIT_HOURS:-1}
 MEMORY=${MEMORY:-1GiB}
-RUNS=${RUNS:-2}
+RUNS=${RUNS:-3}
 cd "$(dirname "$0")/.."
 cargo build --release -q -p gyrolab-cli
 cargo build --release -q -p gyrolab-io --example long_record
@@ -61,17 +62,15 @@ rm -f "$WORK/long.csv"
 echo "== 2. ${FIT_HOURS} h at ${RATE} Hz: in memory against streamed, best of ${RUNS}" >&2
 "$GEN" "$FIT_HOURS" "$RATE" 2 >"$WORK/fit.csv"
 size=$(stat -c %s "$WORK/fit.csv")
-best() {
-    local name=$1 best_wall=999999 line=""
-    shift
-    for _ in $(seq "$RUNS"); do
-        read -r wall rss path stride < <(run "$name" "$WORK/fit.csv" "$@")
-        if (($(echo "$wall < $best_wall" | bc))); then best_wall=$wall line="$wall $rss $path $stride"; fi
-    done
-    echo "$line"
-}
-read -r mw mr mp _ < <(best in_memory)
-read -r sw sr sp ss < <(best streamed --memory 64MiB)
+echo "load before: $(cut -d' ' -f1-3 /proc/loadavg)"
+mw=999999 sw=999999
+for _ in $(seq "$RUNS"); do
+    read -r w r p _ < <(run in_memory "$WORK/fit.csv")
+    if (($(echo "$w < $mw" | bc))); then mw=$w mr=$r mp=$p; fi
+    read -r w r p s < <(run streamed "$WORK/fit.csv" --memory 64MiB)
+    if (($(echo "$w < $sw" | bc))); then sw=$w sr=$r sp=$p ss=$s; fi
+done
+echo "load after: $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "fit: $(echo "scale=2; $size / 10^9" | bc) GB of CSV"
 echo "fit: $mp: wall ${mw} s, peak RSS ${mr} MiB, $(echo "scale=0; $size / 10^6 / $mw" | bc) MB/s"
 echo "fit: $sp (stride $ss): wall ${sw} s, peak RSS ${sr} MiB, $(echo "scale=0; $size / 10^6 / $sw" | bc) MB/s"

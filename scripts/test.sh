@@ -47,6 +47,9 @@ else
     # again by pyulog + numpy: the committed JSON must equal a fresh independent reading.
     .venv/bin/python scripts/px4_clock_reference.py --check examples/recordings/px4_sample_log_small.ulg \
         crates/gyrolab-eval/tests/data/px4_clock_reference.json
+    # The filter exports (`allan --export`) read by each stack's reader or the closest one (PyYAML,
+    # OpenCV FileStorage, json, a PX4 parameter-file parser) against hand conversions and truth.
+    .venv/bin/python scripts/check_exports.py "$bin"
     # The Python package: built with maturin and installed into .venv, then its pytest suite
     # (equality with allantools and with the command line, simulated truth, malformed inputs).
     PATH="$PWD/.venv/bin:$PATH" .venv/bin/pip install --quiet --disable-pip-version-check --no-build-isolation ./python

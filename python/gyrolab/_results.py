@@ -5,8 +5,10 @@ from __future__ import annotations
 
 import html
 import json
+import os
+import tempfile
 from dataclasses import dataclass, field
-from typing import Any, Dict, Iterator, List, Mapping, Optional, Tuple
+from typing import Any, Dict, Iterator, List, Mapping, Optional, Tuple, Union
 
 import numpy as np
 
@@ -56,7 +58,8 @@ class AllanResult:
     ``accel_random_walk_m_s2_rt_h``, ...; ``None`` when absent); each is also an attribute
     (``r.arw_deg_rt_h``, ``r.vrw_m_s_rt_h``). ``readings`` says where each term was read (its
     basis and supported tau range), ``fit`` is the five-term fit (gyro), ``noise_note`` why
-    there are no terms. ``taus_rounded`` maps each requested tau (s) that was not a whole
+    there are no terms. ``stillness`` is the stillness check (``moved``, its episodes, levels in
+    ``rule["unit"]``; None when no rule applies). ``taus_rounded`` maps each requested tau (s) that was not a whole
     multiple of the sample interval to the tau used.
     """
 
@@ -79,11 +82,15 @@ class AllanResult:
     readings: List[Dict[str, Any]] = field(default_factory=list)
     fit: Optional[Dict[str, Any]] = None
     noise_note: Optional[str] = None
+    stillness: Optional[Dict[str, Any]] = None
     taus_rounded: Dict[float, float] = field(default_factory=dict)
     _doc: Dict[str, Any] = field(default_factory=dict)
+    _filter_terms: Optional[str] = None
 
     @classmethod
-    def _from_json(cls, ch: Dict[str, Any], arrays: List[np.ndarray], rounded: Dict[float, float]) -> "AllanResult":
+    def _from_json(
+        cls, ch: Dict[str, Any], arrays: List[np.ndarray], rounded: Dict[float, float], filter_terms: Optional[str] = None
+    ) -> "AllanResult":
         accel = ch.get("quantity") == "acceleration"
         terms = (ch.get("accel_noise") if accel else ch.get("noise")) or {}
         return cls(
@@ -106,8 +113,10 @@ class AllanResult:
             readings=terms.get("readings", []),
             fit=terms.get("fit"),
             noise_note=ch.get("noise_note"),
+            stillness=ch.get("stillness"),
             taus_rounded=dict(rounded),
             _doc=ch,
+            _filter_terms=filter_terms,
         )
 
     def __getattr__(self, name: str) -> Any:
@@ -129,7 +138,7 @@ class AllanResult:
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, AllanResult):
             return NotImplemented
-        names = [f for f in self.__dataclass_fields__ if f != "_doc"]
+        names = [f for f in self.__dataclass_fields__ if f not in ("_doc", "_filter_terms")]
         return all(_same(getattr(self, f), getattr(other, f)) for f in names)
 
     __hash__ = None  # type: ignore[assignment]
@@ -189,6 +198,24 @@ class AllanResult:
     def to_dict(self) -> Dict[str, Any]:
         """The channel's result with the keys of ``gyrolab allan --json``."""
         return json.loads(json.dumps(self._doc))
+
+    def export(
+        self,
+        stack: str,
+        path: Optional[Union[str, "os.PathLike[str]"]] = None,
+        *,
+        estimator: str = "slopes",
+        inflate: float = 1.0,
+        overbound: bool = False,
+    ) -> str:
+        """This channel's noise parameters as one filter stack's file (the text of ``gyrolab
+        allan --export STACK=FILE``; docs/EXPORTS.md): ``stack`` one of kalibr, openvins, vins,
+        orbslam3, basalt, px4, px4-qgc, ros-covariance. Returns the text; with ``path``, also
+        writes it (whole or not at all). ``estimator``: slopes (default), fit or gmwm;
+        ``inflate``: every value x this factor; ``overbound``: each value raised until its
+        model lies on or above the curve's upper confidence bounds. Warnings (bounds written,
+        terms not estimated) are issued as :class:`UserWarning`."""
+        return _export([self], self.record, self.tau0_s, stack, path, estimator, inflate, overbound)
 
     def to_dataframe(self) -> Any:
         """The curve as a tidy pandas DataFrame: ``channel``, ``tau_s``, ``m``, ``dev``,
@@ -260,6 +287,42 @@ def _noise_rows(r: AllanResult) -> List[Tuple[Any, ...]]:
     return rows
 
 
+def _export(
+    results: List[AllanResult],
+    record: str,
+    tau0_s: float,
+    stack: str,
+    path: Any,
+    estimator: str,
+    inflate: float,
+    overbound: bool,
+) -> str:
+    import warnings
+
+    from . import _gyrolab
+
+    terms = [r._filter_terms for r in results if r._filter_terms is not None]
+    motion = [r.stillness["motion"] for r in results if r.stillness and r.stillness.get("motion")]
+    text, notes = _gyrolab.render_export(
+        terms, record, 1.0 / tau0_s, stack, estimator, float(inflate), bool(overbound), motion
+    )
+    for n in notes:
+        warnings.warn(n, UserWarning, stacklevel=3)
+    if path is not None:
+        target = os.fspath(path)
+        folder = os.path.dirname(os.path.abspath(target))
+        fd, tmp = tempfile.mkstemp(prefix=".gyrolab-", suffix=".tmp", dir=folder)
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as f:
+                f.write(text)
+            os.replace(tmp, target)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+            raise
+    return text
+
+
 class AllanResults(Mapping[str, AllanResult]):
     """The channels of one record analysed in one call: a mapping channel name ->
     :class:`AllanResult` (in the record's order), with tidy tables of all of them."""
@@ -309,6 +372,21 @@ class AllanResults(Mapping[str, AllanResult]):
     def to_dict(self) -> Dict[str, Any]:
         """``{channel: to_dict()}``."""
         return {k: r.to_dict() for k, r in self._results.items()}
+
+    def export(
+        self,
+        stack: str,
+        path: Optional[Union[str, "os.PathLike[str]"]] = None,
+        *,
+        estimator: str = "slopes",
+        inflate: float = 1.0,
+        overbound: bool = False,
+    ) -> str:
+        """The record's noise parameters as one filter stack's file, gyro and accelerometer
+        channels combined by the largest value per entry, as ``gyrolab allan --export`` does
+        (see :meth:`AllanResult.export`)."""
+        first = next(iter(self._results.values()))
+        return _export(list(self._results.values()), self.record, first.tau0_s, stack, path, estimator, inflate, overbound)
 
     def plot(self, ax: Any = None, asymptotes: bool = False, terms: Optional["AllanResults"] = None) -> Any:
         """Every channel's curve on one axes (one colour each; a gyro and an accelerometer have

@@ -122,6 +122,11 @@ pub struct AnalysisArgs {
     /// `error`.
     #[arg(long, default_value = "fill", value_name = "POLICY")]
     pub gaps: String,
+    /// Analyse a record whose gyro or accelerometer channels moved (the stillness check: 1 s
+    /// windows against the still level, docs/METHODS.md): without it such a record is refused
+    /// (exit 2); with it every output (text, JSON, Kalibr and export files) is marked MOTION.
+    #[arg(long)]
+    pub allow_motion: bool,
 }
 
 impl AnalysisArgs {
@@ -141,6 +146,7 @@ impl AnalysisArgs {
             layout: record.layout.layout(),
             gaps: GapPolicy::parse(&self.gaps)?,
             topics: record.topics.clone(),
+            allow_motion: self.allow_motion,
         })
     }
 }

@@ -12,6 +12,7 @@ use gyrolab::allan::{
 };
 use gyrolab::noise::{fit_noise_model, slope_line_terms};
 use gyrolab::sampling::{estimate_interval, estimate_interval_of, ClockModel, Reset, SamplingError};
+use gyrolab::stillness::{check_channel, StillnessCheck};
 use gyrolab::units::{OutputUnit, Quantity, TimeUnit};
 use gyrolab::validate::{self, InvalidOption};
 use gyrolab_io::recording::{read_records, TopicMeta};
@@ -65,6 +66,9 @@ pub struct AllanRequest {
     pub gaps: GapPolicy,
     /// Topics of a recording (MCAP, ROS 1 bag, ULog) to analyse (default: every IMU topic).
     pub topics: Vec<String>,
+    /// Analyse a record whose gyro or accelerometer channels moved (the stillness check,
+    /// docs/METHODS.md): its outputs are marked; without it such a record is refused.
+    pub allow_motion: bool,
 }
 
 /// What the Allan analysis does with missing samples (docs/METHODS.md, "Gap policies").
@@ -123,6 +127,7 @@ impl AllanRequest {
             layout: LogLayout::default(),
             gaps: GapPolicy::default(),
             topics: Vec::new(),
+            allow_motion: false,
         }
     }
 }
@@ -714,6 +719,8 @@ pub struct ChannelSetup<'a> {
     pub fit_range_s: Option<(f64, f64)>,
     /// What to tell the user when the data cannot be turned into rates.
     pub uncalibrated_hint: &'a str,
+    /// The analysis of a channel that moved was asked for (marks the result).
+    pub allow_motion: bool,
 }
 
 /// Analyses one channel: converts it to deg/s, computes the curve and, for data in deg/s and an
@@ -725,9 +732,10 @@ pub fn analyse_channel(
 ) -> EvalResult<ChannelAnalysis> {
     let (quantity, conversion) = physical_conversion(setup, info)?;
     conversion.apply(&mut values);
+    let stillness = check_channel(&values, setup.tau0_s, quantity);
     values.reserve_exact(1);
     let curve = channel_curve(setup.path, info, values, setup.lines, setup.tau0_s, setup.options)?;
-    Ok(channel_analysis(setup, info, quantity, curve))
+    Ok(channel_analysis(setup, info, quantity, curve, stillness))
 }
 
 /// [`analyse_channel`] of borrowed samples: samples that need no unit conversion are read where
@@ -749,6 +757,7 @@ pub fn analyse_channel_borrowed(
         buffer.reserve_exact(values.len() + 1);
         buffer.extend_from_slice(values);
         conversion.apply(&mut buffer);
+        let stillness = check_channel(&buffer, setup.tau0_s, quantity);
         let curve = match missing {
             GapPolicy::Analyse | GapPolicy::Fill | GapPolicy::Contiguous => {
                 channel_curve(setup.path, info, buffer, setup.lines, setup.tau0_s, setup.options)?
@@ -756,15 +765,16 @@ pub fn analyse_channel_borrowed(
             GapPolicy::Error => deviation_from_rate(buffer, setup.tau0_s, setup.options)
                 .map_err(|e| curve_error(setup.path, info, setup.lines, e))?,
         };
-        return Ok(channel_analysis(setup, info, quantity, curve));
+        return Ok(channel_analysis(setup, info, quantity, curve, stillness));
     }
+    let stillness = check_channel(values, setup.tau0_s, quantity);
     match missing {
         GapPolicy::Analyse | GapPolicy::Fill | GapPolicy::Contiguous => {
             let curve = deviation_from_rate_with_gaps_into(values, buffer, setup.tau0_s, setup.options)
                 .map_err(|e| curve_error(setup.path, info, setup.lines, e))?;
-            Ok(channel_analysis(setup, info, quantity, curve))
+            Ok(channel_analysis(setup, info, quantity, curve, stillness))
         }
-        GapPolicy::Error => analyse_complete(setup, info, quantity, values, buffer),
+        GapPolicy::Error => analyse_complete(setup, info, quantity, values, buffer, stillness),
     }
 }
 
@@ -775,10 +785,11 @@ fn analyse_complete(
     quantity: Quantity,
     values: &[f64],
     buffer: Vec<f64>,
+    stillness: Option<StillnessCheck>,
 ) -> EvalResult<ChannelAnalysis> {
     let curve = deviation_from_rate_into(values, buffer, setup.tau0_s, setup.options)
         .map_err(|e| curve_error(setup.path, info, setup.lines, e))?;
-    Ok(channel_analysis(setup, info, quantity, curve))
+    Ok(channel_analysis(setup, info, quantity, curve, stillness))
 }
 
 /// What the channel's samples are in physical terms, and the conversion that makes them so.
@@ -798,6 +809,7 @@ pub(crate) fn channel_analysis(
     info: &ChannelInfo,
     quantity: Quantity,
     curve: AllanCurve,
+    stillness: Option<StillnessCheck>,
 ) -> ChannelAnalysis {
     let calibrated = matches!(quantity, Quantity::AngularRate | Quantity::Acceleration);
     let rate_unit = match quantity {
@@ -806,6 +818,11 @@ pub(crate) fn channel_analysis(
         _ => info.unit.symbol().to_string(),
     };
     let allan_kind = matches!(setup.options.kind, DeviationKind::Oadev | DeviationKind::Adev);
+    let gmwm = if calibrated && allan_kind {
+        gyrolab::gmwm::gmwm(&curve, curve.confidence.unwrap_or(DEFAULT_GMWM_CONFIDENCE)).ok()
+    } else {
+        None
+    };
     let (slope_lines, model_fit, noise_note) = if quantity == Quantity::Unitless {
         (
             None,
@@ -832,8 +849,14 @@ pub(crate) fn channel_analysis(
         slope_lines,
         model_fit,
         noise_note,
+        gmwm,
+        stillness,
+        allow_motion: setup.allow_motion,
     }
 }
+
+/// Confidence of the GMWM intervals when the curve has none (68.3 %, the curve's default).
+const DEFAULT_GMWM_CONFIDENCE: f64 = 0.683;
 
 /// Analyses every selected channel of a file, in parallel: a delimited text or Parquet file,
 /// or the single IMU topic of a recording (several topics: an error asking for one; see
@@ -898,7 +921,41 @@ pub fn analyse_records(request: &AllanRequest) -> EvalResult<Vec<AllanOutcome>> 
         outcome.topic = topic;
         outcomes.push(outcome);
     }
+    refuse_motion(outcomes.iter().flat_map(|o| &o.analyses), &request.file, request.allow_motion)?;
     Ok(outcomes)
+}
+
+/// Refuses records whose gyro or accelerometer channels moved (the stillness check), unless
+/// motion is allowed: the error names each channel that moved, its episodes and {allow_motion}.
+pub fn refuse_motion<'a>(
+    analyses: impl IntoIterator<Item = &'a ChannelAnalysis>,
+    file: &Path,
+    allow_motion: bool,
+) -> EvalResult<()> {
+    if allow_motion {
+        return Ok(());
+    }
+    let moved: Vec<String> = analyses
+        .into_iter()
+        .filter_map(|a| {
+            let summary = a.stillness.as_ref()?.motion_summary()?;
+            let topic =
+                a.topic.as_ref().map_or(String::new(), |t| format!("topic '{}' ", gyrolab_io::text::excerpt(t)));
+            Some(format!("{topic}channel '{}' {summary}", gyrolab_io::text::excerpt(&a.channel)))
+        })
+        .collect();
+    if moved.is_empty() {
+        return Ok(());
+    }
+    Err(EvalError::conflict_on(
+        &["allow_motion"],
+        format!(
+            "{}: the record is not static, so its noise terms would not be a still sensor's: {}; record the \
+             sensor at rest, or give {{allow_motion}} to analyse it anyway (every output is then marked)",
+            file.display(),
+            moved.join("; ")
+        ),
+    ))
 }
 
 /// An error of a record whose rows are not text lines (messages, table rows): the row is named
@@ -1037,6 +1094,7 @@ pub fn analyse_data(
         reference,
         fit_range_s: request.fit_range_s,
         uncalibrated_hint: "give a calibration or a scale factor for noise terms in deg units",
+        allow_motion: request.allow_motion,
     };
     let mut policy = request.gaps;
     if policy == GapPolicy::Fill {

@@ -19,7 +19,7 @@ use gyrolab::dropout::DropoutTally;
 use gyrolab::sampling::{estimate_interval_of, CompactStamps};
 use gyrolab::validate::InvalidOption;
 use gyrolab_io::recording::FileFormat;
-use gyrolab_io::series::{LineMap, SeriesData, SeriesOptions, SeriesReader, SkipReason};
+use gyrolab_io::series::{BatchReader, LineMap, SeriesData, SeriesOptions, SeriesReader, SkipReason};
 use gyrolab_io::DataError;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -32,8 +32,22 @@ pub const FALLBACK_MEMORY_BYTES: u64 = 2 << 30;
 /// Smallest ceiling accepted: 1 MiB.
 pub const MIN_MEMORY_BYTES: u64 = 1 << 20;
 
-/// Rows per block of the streamed read.
+/// Rows per block of the streamed read (the reader's header chunk).
 const BLOCK_ROWS: usize = 1 << 16;
+
+/// Bytes of each batch of the streamed read, parsed on every core: a 64th of the ceiling,
+/// between 16 KiB and 4 MiB.
+fn batch_bytes(memory_bytes: u64) -> usize {
+    usize::try_from((memory_bytes / 64).clamp(16 << 10, 4 << 20)).unwrap_or(4 << 20)
+}
+
+/// Bytes a batch of `batch` bytes takes while in flight, for a record of `rows` rows in
+/// `size` bytes with `slots` values a row: its bytes, their copy among the pieces, and its
+/// rows (the values and the line of each, 8 bytes apiece).
+fn batch_footprint(batch: usize, size: u64, rows: u64, slots: usize) -> u64 {
+    let rows_per_batch = batch as f64 * rows.max(1) as f64 / size.max(1) as f64;
+    2 * batch as u64 + (rows_per_batch * 8.0 * (slots as f64 + 1.0)).ceil() as u64
+}
 
 /// Bytes the in-memory path holds per row of a delimited text file: 8 per channel (the samples,
 /// turned into the angle series in place) and 8 for the stamps and line map (generous).
@@ -184,6 +198,8 @@ pub fn analyse_records_within(
     }
     // A file the reader refuses goes to the in-memory path, whose error the user gets as before.
     let Ok(options) = series_options(request) else { return Ok((analyse_records(request)?, in_memory(None))) };
+    // The header's chunk no larger than a streamed batch, so that every batch is of that size.
+    let options = SeriesOptions { chunk_bytes: batch_bytes(memory_bytes), ..options };
     let Ok(reader) = SeriesReader::open(path, &options) else {
         return Ok((analyse_records(request)?, in_memory(None)));
     };
@@ -206,7 +222,7 @@ pub fn analyse_records_within(
             ),
         ));
     }
-    let (outcome, summary) = analyse_streaming(request, reader, rows, memory_bytes, estimate)?;
+    let (outcome, summary) = analyse_streaming(request, reader, (rows, size), memory_bytes, estimate)?;
     Ok((vec![outcome], MemoryPath::Streaming(summary)))
 }
 
@@ -249,15 +265,17 @@ fn incomplete(path: &Path, what: &str, estimate: u64) -> DataError {
 }
 
 /// Streams one delimited text file through the estimators of its channels: the reader parses
-/// blocks on this thread, the estimators take them on another (channels in parallel).
+/// batches on every core, handed over in file order from this thread; the estimators take them
+/// on another (channels in parallel).
 fn analyse_streaming(
     request: &AllanRequest,
-    mut reader: SeriesReader<gyrolab_io::series::Source>,
-    rows: u64,
+    reader: SeriesReader<gyrolab_io::series::Source>,
+    (rows, size): (u64, u64),
     memory_bytes: u64,
     estimate: u64,
 ) -> EvalResult<(AllanOutcome, StreamingSummary)> {
     let path = request.file.as_path();
+    let mut reader = BatchReader::new(reader, rayon::current_num_threads(), batch_bytes(memory_bytes));
     let reference = request.reference.resolve()?;
     let header = reader.header().clone();
     let infos = header.channels.clone();
@@ -267,9 +285,10 @@ fn analyse_streaming(
         confidence: request.confidence,
         max_factor: None,
     };
-    // The stamps (about a byte a row), the blocks in flight and the reader's buffers come off
-    // the ceiling before the plan shares it among the channels.
-    let overhead = rows + 4 * (BLOCK_ROWS as u64) * 8 * (infos.len() as u64 + 2);
+    // The stamps (about a byte a row), the batches in flight (one read, two queued, one taken)
+    // come off the ceiling before the plan shares it among the channels.
+    let slots = infos.len() + 3;
+    let overhead = rows + 4 * batch_footprint(reader.batch_bytes(), size, rows, slots);
     let budget = memory_bytes.saturating_sub(overhead).max(MIN_MEMORY_BYTES / 2);
     let plan = StreamingPlan::for_memory(
         usize::try_from(rows).unwrap_or(usize::MAX),
@@ -287,6 +306,7 @@ fn analyse_streaming(
         reference: &reference,
         fit_range_s: request.fit_range_s,
         uncalibrated_hint: "",
+        allow_motion: request.allow_motion,
     };
     let conversions = infos.iter().map(|i| physical_conversion(&probe, i)).collect::<EvalResult<Vec<_>>>()?;
     let mut estimators = infos
@@ -325,16 +345,16 @@ fn analyse_streaming(
             Ok(())
         });
         let read = (|| -> Result<(), DataError> {
-            while let Some(block) = reader.next_block()? {
-                let refs: Vec<&[f64]> = block.channels.iter().map(|c| &c[..]).collect();
+            while let Some(batch) = reader.next_batch()? {
+                let refs: Vec<&[f64]> = batch.channels.iter().map(|c| &c[..]).collect();
                 tally.push_block(&refs);
                 if has_time {
-                    if let Some(t) = block.time {
+                    if let Some(t) = &batch.time {
                         stamps.extend_from_slice(t);
                     }
                 }
-                lines.extend_from_slice(block.lines);
-                if tx.send(block.channels.to_vec()).is_err() {
+                lines.extend_from_slice(&batch.lines);
+                if tx.send(batch.channels).is_err() {
                     break; // the estimators stopped on an error, reported below
                 }
             }
@@ -431,6 +451,7 @@ fn analyse_streaming(
         reference: &reference,
         fit_range_s: request.fit_range_s,
         uncalibrated_hint: "give a calibration or a scale factor for noise terms in deg units",
+        allow_motion: request.allow_motion,
     };
     let finished: Vec<EvalResult<_>> = estimators
         .into_par_iter()
@@ -445,7 +466,12 @@ fn analyse_streaming(
             })?;
             let streamed =
                 StreamedChannel { channel: info.name.clone(), taus: points.iter().map(StreamedTau::of).collect() };
-            Ok((channel_analysis(&setup, info, *quantity, curve), streamed))
+            // The stillness check needs the record's interval before its windows are cut, which
+            // the stream learns only at its end: not made on a streamed record (said so).
+            let stillness = gyrolab::stillness::StillnessRule::for_quantity(*quantity).map(|rule| {
+                gyrolab::stillness::StillnessCheck::not_evaluated(rule, "not made on a streamed record (--memory)")
+            });
+            Ok((channel_analysis(&setup, info, *quantity, curve, stillness), streamed))
         })
         .collect();
     let mut analyses = Vec::with_capacity(finished.len());

@@ -197,8 +197,15 @@ fn simulated_static_and_allan(
         });
     }
     let describe = |axis: &str| texts.get(axis).cloned().unwrap_or_default();
-    let ctx =
-        StaticContext { rate_axes: axes, calibration: None, limits: &[], base: &dir.0, simulated: Some(&describe) };
+    let ctx = StaticContext {
+        rate_axes: axes,
+        calibration: None,
+        limits: &[],
+        base: &dir.0,
+        simulated: Some(&describe),
+        exports: &[],
+        records_simulated: true,
+    };
     evaluate_static(&plans, &ctx, progress)
 }
 

@@ -32,6 +32,7 @@ pub mod apply;
 pub mod batch;
 pub mod demo;
 pub mod error;
+pub mod filter_export;
 pub mod layout;
 pub mod paper;
 pub mod program_sim;

@@ -122,6 +122,7 @@ fn borrowed_samples_give_the_curve_of_owned_ones() {
         reference: &reference,
         fit_range_s: None,
         uncalibrated_hint: "",
+        allow_motion: false,
     };
     let mut x = white(60_000, 0.05, 11);
     for unit in [OutputUnit::DegPerSec, OutputUnit::RadPerSec] {

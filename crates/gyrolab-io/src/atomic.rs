@@ -99,19 +99,7 @@ pub fn write_folder(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>,
         if Path::new(name).file_name() != Some(std::ffi::OsStr::new(name)) {
             return Err((path, std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a plain file name")));
         }
-        let stage = || -> std::io::Result<tempfile::NamedTempFile> {
-            let mut tmp = tempfile::Builder::new().prefix(".gyrolab-").suffix(".tmp").tempfile_in(dir)?;
-            register(tmp.path());
-            #[cfg(unix)]
-            {
-                use std::os::unix::fs::PermissionsExt;
-                tmp.as_file().set_permissions(std::fs::Permissions::from_mode(0o644))?;
-            }
-            tmp.write_all(bytes)?;
-            tmp.as_file().sync_all()?;
-            Ok(tmp)
-        };
-        match stage() {
+        match stage_in(dir, bytes) {
             Ok(tmp) => staged.push((tmp, path)),
             Err(e) => {
                 staged.iter().for_each(|(t, _)| unregister(t.path()));
@@ -169,6 +157,55 @@ pub fn write_folder(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>,
         unregister(keep);
     }
     unregister_all();
+    result.map(|()| written)
+}
+
+/// A temporary file in `dir` holding `bytes` (mode 0644, synced to disk), registered for
+/// removal on a signal until it is persisted or dropped.
+fn stage_in(dir: &Path, bytes: &[u8]) -> std::io::Result<tempfile::NamedTempFile> {
+    let mut tmp = tempfile::Builder::new().prefix(".gyrolab-").suffix(".tmp").tempfile_in(dir)?;
+    register(tmp.path());
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        tmp.as_file().set_permissions(std::fs::Permissions::from_mode(0o644))?;
+    }
+    tmp.write_all(bytes)?;
+    tmp.as_file().sync_all()?;
+    Ok(tmp)
+}
+
+/// Writes several files, each anywhere, all or nothing as far as a file system allows: every
+/// file is first written to a temporary file beside its target (fsynced); only when all are
+/// written are they renamed into place, in order. A failure before the renames leaves every
+/// target as it was; the error names the file it is about.
+pub fn write_files(files: &[(PathBuf, Vec<u8>)]) -> Result<Vec<PathBuf>, (PathBuf, std::io::Error)> {
+    let mut staged: Vec<(tempfile::NamedTempFile, PathBuf)> = Vec::with_capacity(files.len());
+    let release = |staged: &[(tempfile::NamedTempFile, PathBuf)]| staged.iter().for_each(|(t, _)| unregister(t.path()));
+    for (path, bytes) in files {
+        let dir = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        match stage_in(dir, bytes) {
+            Ok(tmp) => staged.push((tmp, path.clone())),
+            Err(e) => {
+                release(&staged);
+                return Err((path.clone(), e));
+            }
+        }
+    }
+    let temporaries: Vec<PathBuf> = staged.iter().map(|(t, _)| t.path().to_path_buf()).collect();
+    let mut written = Vec::with_capacity(staged.len());
+    let mut result = Ok(());
+    for (tmp, path) in staged {
+        if let Err(e) = tmp.persist(&path) {
+            result = Err((path.clone(), e.error));
+            break;
+        }
+        written.push(path);
+    }
+    temporaries.iter().for_each(|t| unregister(t));
     result.map(|()| written)
 }
 

@@ -23,6 +23,7 @@ pub mod contained;
 pub mod decimal;
 pub mod error;
 pub mod input_file;
+pub mod noise_export;
 pub mod pages;
 pub mod parquet_table;
 pub mod rate_table;

@@ -34,6 +34,8 @@ pub const FIRST_MISSING: usize = 100;
 
 mod ranges;
 pub use ranges::{read_series_in_ranges, RANGE_CHUNK_BYTES};
+mod batches;
+pub use batches::{BatchReader, SeriesBatch};
 
 pub use crate::decimal::plain_decimal;
 use crate::decimal::{read_rows, RowLayout, RowShapes, SKIP_COLUMN};
@@ -1618,13 +1620,7 @@ fn collect_series_parallel<R: Read>(
         }
         let batch = &r.buf[r.pos..r.complete];
         // Split at line ends into one piece per thread; count the lines of each piece.
-        let mut bounds = vec![0usize];
-        for k in 1..threads {
-            let at = (batch.len() * k / threads).max(*bounds.last().unwrap_or(&0));
-            let cut = memchr::memchr(b'\n', &batch[at..]).map_or(batch.len(), |i| at + i + 1);
-            bounds.push(cut.min(batch.len()));
-        }
-        bounds.push(batch.len());
+        let bounds = line_bounds(batch, threads);
         let mut line_no = r.line_no;
         let mut parsers = Vec::with_capacity(threads);
         for (k, w) in bounds.windows(2).enumerate() {
@@ -2071,4 +2067,17 @@ mod compact_time_tests {
             assert_eq!(d.quality.repeated_rows, expected.len() as u64);
         }
     }
+}
+
+/// The bounds of `threads` pieces of `batch` split at line ends (each piece but the last ends
+/// just after a `\n`; pieces may be empty): `threads + 1` offsets from 0 to `batch.len()`.
+pub(crate) fn line_bounds(batch: &[u8], threads: usize) -> Vec<usize> {
+    let mut bounds = vec![0usize];
+    for k in 1..threads {
+        let at = (batch.len() * k / threads).max(*bounds.last().unwrap_or(&0));
+        let cut = memchr::memchr(b'\n', &batch[at..]).map_or(batch.len(), |i| at + i + 1);
+        bounds.push(cut.min(batch.len()));
+    }
+    bounds.push(batch.len());
+    bounds
 }

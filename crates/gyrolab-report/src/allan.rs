@@ -38,6 +38,149 @@ pub struct ChannelAnalysis {
     pub model_fit: Option<ModelFitResult>,
     /// Why noise terms are missing, if they are.
     pub noise_note: Option<String>,
+    /// The GMWM fit (model chosen by its criterion), beside the slope lines and the five-term fit.
+    pub gmwm: Option<gyrolab::gmwm::GmwmFit>,
+    /// The stillness check of the channel (`None`: no rule for its quantity: not a gyro in
+    /// deg/s nor an accelerometer in m/s^2).
+    pub stillness: Option<gyrolab::stillness::StillnessCheck>,
+    /// The analysis of a channel that moved was asked for (`--allow-motion`, `allow_motion=True`).
+    pub allow_motion: bool,
+}
+
+impl ChannelAnalysis {
+    /// The line marking a channel that moved: `MOTION: the record is not static: FILE (CHANNEL)
+    /// moved in ...: noise terms are not a still sensor's`; `None` when it did not move.
+    pub fn motion_line(&self) -> Option<String> {
+        let summary = self.stillness.as_ref()?.motion_summary()?;
+        let topic = self.topic.as_ref().map_or(String::new(), |t| format!(" topic {t}"));
+        Some(format!(
+            "MOTION: the record is not static: {}{topic} ({}) {summary}: noise terms are not a still sensor's",
+            self.file, self.channel
+        ))
+    }
+}
+
+/// The stillness check in JSON: the check's keys (levels in `rule.unit`, times in s from the
+/// record start) and whether motion was allowed.
+#[derive(Debug, Clone, Serialize)]
+pub struct StillnessJson {
+    /// The check.
+    #[serde(flatten)]
+    pub check: gyrolab::stillness::StillnessCheck,
+    /// The analysis of a channel that moved was asked for.
+    pub allow_motion: bool,
+    /// The `MOTION: the record is not static: ...` line every output of a channel that moved
+    /// carries (absent when it did not move).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub motion: Option<String>,
+}
+
+/// One GMWM parameter in JSON.
+#[derive(Debug, Clone, Serialize)]
+pub struct GmwmParameterJson {
+    /// `quantization`, `white`, `flicker`, `random_walk` or `drift`.
+    pub process: &'static str,
+    /// The coefficient, in `unit`.
+    pub value: f64,
+    /// Lower end of the two-sided interval at the fit's confidence.
+    pub lower: f64,
+    /// Upper end of the two-sided interval.
+    pub upper: f64,
+    /// The coefficient's unit (Q deg, N deg/sqrt(s), B deg/s, K deg/s/sqrt(s), R deg/s^2 for a gyro
+    /// in deg/s; m/s, m/s/sqrt(s), m/s^2, m/s^2/sqrt(s), m/s^3 for an accelerometer).
+    pub unit: &'static str,
+}
+
+/// The GMWM fit in JSON.
+#[derive(Debug, Clone, Serialize)]
+pub struct GmwmJson {
+    /// Confidence level of the intervals.
+    pub confidence: f64,
+    /// Always `two-sided`.
+    pub sided: &'static str,
+    /// How the intervals are made and what they are worth (asymptotic, scales taken as
+    /// correlated as the fitted model makes them; their simulated coverage: docs/METHODS.md 3.1).
+    pub intervals: &'static str,
+    /// The parameters of the chosen model.
+    pub parameters: Vec<GmwmParameterJson>,
+    /// Scales (octave taus) used.
+    pub scales: usize,
+    /// The objective at the estimate.
+    pub objective: f64,
+    /// The model-choice criterion, objective + 2 x parameters.
+    pub criterion: f64,
+}
+
+/// What the GMWM intervals are (text and JSON).
+pub const GMWM_INTERVALS: &str =
+    "asymptotic: sandwich covariance with the wavelet variances correlated across scales as the fitted model makes them (Percival and Walden 2000, ch. 8); simulated coverage in docs/METHODS.md 3.1";
+
+/// The unit of a GMWM coefficient for the curve's quantity.
+pub fn gmwm_unit(process: gyrolab::gmwm::Process, quantity: Quantity) -> &'static str {
+    use gyrolab::gmwm::Process as P;
+    let accel = quantity == Quantity::Acceleration;
+    match (process, accel) {
+        (P::Quantization, false) => "deg",
+        (P::White, false) => "deg/sqrt(s)",
+        (P::Flicker, false) => "deg/s",
+        (P::RandomWalk, false) => "deg/s/sqrt(s)",
+        (P::Drift, false) => "deg/s^2",
+        (P::Quantization, true) => "m/s",
+        (P::White, true) => "m/s/sqrt(s)",
+        (P::Flicker, true) => "m/s^2",
+        (P::RandomWalk, true) => "m/s^2/sqrt(s)",
+        (P::Drift, true) => "m/s^3",
+    }
+}
+
+/// The GMWM fit of a channel in JSON.
+pub fn gmwm_json(a: &ChannelAnalysis) -> Option<GmwmJson> {
+    let g = a.gmwm.as_ref()?;
+    Some(GmwmJson {
+        confidence: g.confidence,
+        sided: "two-sided",
+        intervals: GMWM_INTERVALS,
+        parameters: g
+            .parameters
+            .iter()
+            .map(|p| GmwmParameterJson {
+                process: p.process.name(),
+                value: p.value,
+                lower: p.lower,
+                upper: p.upper,
+                unit: gmwm_unit(p.process, a.quantity),
+            })
+            .collect(),
+        scales: g.scales,
+        objective: g.objective,
+        criterion: g.criterion,
+    })
+}
+
+/// The GMWM line of the text report.
+pub fn gmwm_text(a: &ChannelAnalysis) -> Option<String> {
+    let g = a.gmwm.as_ref()?;
+    let parts: Vec<String> = g
+        .parameters
+        .iter()
+        .map(|p| {
+            format!(
+                "{} {} [{}, {}] {}",
+                p.process.name(),
+                sig(p.value, 4),
+                sig(p.lower, 3),
+                sig(p.upper, 3),
+                gmwm_unit(p.process, a.quantity)
+            )
+        })
+        .collect();
+    Some(format!(
+        "GMWM (Haar wavelet variance, model chosen by J + 2p over {} scales; {} % two-sided intervals, {}): {}\n",
+        g.scales,
+        short(100.0 * g.confidence, 4),
+        GMWM_INTERVALS,
+        parts.join("; ")
+    ))
 }
 
 /// Noise coefficients in JSON, each key naming its unit.
@@ -198,6 +341,11 @@ pub struct AllanJson {
     pub accel_noise: Option<AccelNoiseJson>,
     /// Why `noise` is null, if it is.
     pub noise_note: Option<String>,
+    /// The GMWM fit beside the slope lines and the five-term fit (null when not made).
+    pub gmwm: Option<GmwmJson>,
+    /// The stillness check (null when no rule applies: not a gyro in deg/s nor an
+    /// accelerometer in m/s^2).
+    pub stillness: Option<StillnessJson>,
 }
 
 /// The JSON document: the first channel's keys at the top level, every channel in `channels`.
@@ -350,6 +498,12 @@ pub fn allan_json(a: &ChannelAnalysis) -> AllanJson {
         noise,
         accel_noise,
         noise_note: a.noise_note.clone(),
+        gmwm: gmwm_json(a),
+        stillness: a.stillness.clone().map(|check| StillnessJson {
+            check,
+            allow_motion: a.allow_motion,
+            motion: a.motion_line(),
+        }),
     }
 }
 
@@ -494,11 +648,42 @@ pub fn allan_text(a: &ChannelAnalysis) -> String {
                 "\nEach term is a value only where the curve supports its slope at the bounds' confidence; '< x' is an upper bound (docs/METHODS.md section 3). \
                  B (IEEE 952) = Allan minimum / 0.6643; datasheets (ADI, Sensonor) quote the Allan minimum itself. N is read at the tau nearest 1 s on its -1/2 region.\n",
             );
+            if let Some(g) = gmwm_text(a) {
+                s.push_str(&g);
+            }
         }
         (None, Some(note)) => s.push_str(&format!("noise terms: {note}\n")),
         (None, None) => {}
     }
+    s.push_str(&stillness_text(a));
     s
+}
+
+/// The stillness lines of a channel's text: a `warning:` naming what moved and when, the rule
+/// of a still channel, or why the check was not made.
+pub fn stillness_text(a: &ChannelAnalysis) -> String {
+    let Some(c) = &a.stillness else { return String::new() };
+    let r = &c.rule;
+    if let Some(line) = a.motion_line() {
+        let allowed = if a.allow_motion { " (analysed because motion was allowed)" } else { "" };
+        return format!("warning: {line}{allowed}\n");
+    }
+    if !c.evaluated {
+        return format!(
+            "stillness: not evaluated ({}): nothing says the record is static\n",
+            c.not_evaluated_reason.as_deref().unwrap_or("no reason given")
+        );
+    }
+    format!(
+        "stillness: still: no window of {} s departed from the still level {} {u} by more than {} sigma and {} {u} \
+         ({} windows; docs/METHODS.md, stillness check)\n",
+        short(r.window_s, 4),
+        sig(c.still_level, 4),
+        short(r.k_sigma, 3),
+        sig(r.floor, 3),
+        c.windows,
+        u = r.unit
+    )
 }
 
 /// Kalibr's entries for the gyro and accelerometer channels, as written to imu.yaml.
@@ -692,6 +877,10 @@ fn filter_file(channels: &[ChannelAnalysis], update_rate_hz: f64, imu_utils: boo
         ));
     }
     let mut warnings = Vec::new();
+    for line in channels.iter().filter_map(ChannelAnalysis::motion_line) {
+        text.push_str(&format!("# {line}\n"));
+        warnings.push(format!("{} file: {line}", if imu_utils { "imu_utils" } else { "Kalibr" }));
+    }
     let mut body = String::new();
     for (key, value, basis, ch) in fe.list() {
         let out_key = if imu_utils {
@@ -806,8 +995,11 @@ mod tests {
             quantity: Quantity::AngularRate,
             slope_lines: slope_line_terms(&curve).ok(),
             model_fit: fit_noise_model(&curve, None).ok(),
+            gmwm: gyrolab::gmwm::gmwm(&curve, 0.683).ok(),
             curve,
             noise_note: None,
+            stillness: None,
+            allow_motion: false,
         }
     }
 

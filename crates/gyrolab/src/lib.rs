@@ -21,6 +21,7 @@
 //! - [`validate`]: validators of option values (errors name the request field);
 //! - [`thermal`]: temperature tests at soaked points: K(T), bias(T), sensitivities, compensation;
 //! - [`threshold`]: threshold and resolution from small-rate plateaus and rate steps;
+//! - [`stillness`]: whether a gyro or accelerometer channel moved during its record;
 //! - [`window_means`]: streaming means of consecutive windows (bias time series).
 //!
 //! Formulas and their sources are listed in `docs/METHODS.md`.
@@ -43,6 +44,7 @@ pub mod sampling;
 pub mod segment;
 pub mod sim;
 pub mod static_test;
+pub mod stillness;
 pub mod thermal;
 pub mod threshold;
 pub mod triad;

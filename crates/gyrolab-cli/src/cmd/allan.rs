@@ -8,6 +8,7 @@ use crate::progress::Bar;
 use clap::Args;
 use gyrolab_eval::allan::AllanRequest;
 use gyrolab_eval::allan_memory::{analyse_records_within, default_memory_bytes, parse_memory, size_text, MemoryPath};
+use gyrolab_eval::filter_export::{parse_target, write_exports, Estimator, ExportRequest};
 use gyrolab_eval::simulate::reference_from_headers;
 use gyrolab_eval::EvalError;
 use gyrolab_report::allan::{allan_csv, allan_document, allan_text, imu_utils_yaml, kalibr_yaml};
@@ -45,6 +46,24 @@ pub struct AllanArgs {
     /// long taus from every stride-th angle point, their EDF loss reported; docs/METHODS.md 3.2).
     #[arg(long, value_name = "SIZE")]
     pub memory: Option<String>,
+    /// Write noise parameters for a filter stack, repeatable (all files or none): kalibr,
+    /// openvins, vins, orbslam3, basalt, px4 (`param set` lines), px4-qgc (QGroundControl
+    /// .params), ros-covariance; each in the stack's keys, units and time convention, with a
+    /// header naming the record, rate, basis of each value and factors (docs/EXPORTS.md).
+    #[arg(long = "export", value_name = "STACK=FILE")]
+    pub exports: Vec<String>,
+    /// Multiply every exported value by X (variances by X^2); recorded in the files.
+    #[arg(long, default_value = "1", value_name = "X")]
+    pub inflate: f64,
+    /// Overbound each exported value: the smallest factor per parameter that puts the model's
+    /// Allan deviation on or above the curve's upper confidence bound at every tau (factors
+    /// recorded in the files and on stderr).
+    #[arg(long)]
+    pub overbound: bool,
+    /// Basis of the exported values: slopes (default: slope readings, else bounds, else the
+    /// five-term fit), fit (five-term fit) or gmwm.
+    #[arg(long, default_value = "slopes", value_name = "NAME")]
+    pub estimator: String,
 }
 
 impl AllanArgs {
@@ -101,6 +120,21 @@ pub fn run(args: &AllanArgs) -> CliResult {
             for w in &file.warnings {
                 eprintln!("warning: {w}");
             }
+        }
+    }
+    if !args.exports.is_empty() {
+        let request = ExportRequest {
+            targets: args.exports.iter().map(|t| parse_target(t)).collect::<Result<_, _>>()?,
+            estimator: Estimator::parse(&args.estimator)?,
+            inflate: args.inflate,
+            overbound: args.overbound,
+        };
+        let (written, warnings) = write_exports(&outcomes, &args.file, &request)?;
+        for w in &warnings {
+            eprintln!("warning: {w}");
+        }
+        if written.len() > 1 {
+            eprintln!("note: wrote {}", written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
         }
     }
     let analyses: Vec<_> = outcomes.into_iter().flat_map(|o| o.analyses).collect();

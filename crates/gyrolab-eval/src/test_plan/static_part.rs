@@ -57,6 +57,11 @@ pub struct StaticContext<'a> {
     pub base: &'a Path,
     /// Simulated data: the description shown with every section, table and JSON object.
     pub simulated: Option<&'a dyn Fn(&str) -> String>,
+    /// Filter stacks whose noise-parameter files are written from the axes' Allan analyses
+    /// (the plan's `[options] exports`).
+    pub exports: &'a [gyrolab_io::noise_export::Stack],
+    /// The plan says its records are simulated (`[device] simulated`): the exports say so.
+    pub records_simulated: bool,
 }
 
 pub(crate) fn shown(path: &Path, base: &Path) -> String {
@@ -343,6 +348,7 @@ fn allan_of(
         reference,
         fit_range_s: None,
         uncalibrated_hint: "give the axis a rate-table record or a calibration file",
+        allow_motion: false,
     };
     analyse_channel(&setup, &info, crate::allan::on_grid(values, &gaps, missing))
 }
@@ -350,6 +356,54 @@ fn allan_of(
 /// Number of progress steps of the static part.
 pub fn progress_steps(plans: &[StaticAxisPlan]) -> u64 {
     plans.iter().map(|s| s.files.len() as u64 + 1).sum()
+}
+
+/// The noise-parameter files of the plan's `[options] exports` (`noise_<stack>.<ext>`): every
+/// axis's Allan analysis combined as `gyrolab allan --export` combines channels (slope
+/// readings, the largest value per entry), SIMULATED when the plan's data are.
+fn filter_exports(reports: &[StaticAxisReport], ctx: &StaticContext<'_>) -> EvalResult<Vec<(String, Vec<u8>)>> {
+    use crate::filter_export::{channel_filter_terms, combine_terms, ExportRecord, ExportRequest};
+    if ctx.exports.is_empty() {
+        return Ok(Vec::new());
+    }
+    let analyses: Vec<&ChannelAnalysis> = reports.iter().filter_map(|r| r.allan.as_ref()).collect();
+    let Some(first) = analyses.first() else {
+        return Err(EvalError::conflict(
+            "options.exports: no [static.<axis>] table has an Allan analysis to export noise parameters from",
+        ));
+    };
+    let tau0 = first.curve.tau0_s;
+    if let Some(other) = analyses.iter().find(|a| (a.curve.tau0_s / tau0 - 1.0).abs() > 1e-9) {
+        return Err(EvalError::conflict(
+            format!(
+                "options.exports: the Allan records have different sample intervals ({} s in {}, {} s in {}): one filter file holds one rate",
+                tau0, first.file, other.curve.tau0_s, other.file
+            ),
+        ));
+    }
+    let channels: Vec<_> = analyses.iter().filter_map(|a| channel_filter_terms(a)).collect();
+    let mut files: Vec<&str> = analyses.iter().map(|a| a.file.as_str()).collect();
+    files.dedup();
+    let record = ExportRecord {
+        record: format!("test plan, static axes' Allan records: {}", files.join(", ")),
+        rate_hz: 1.0 / tau0,
+        simulated: ctx.simulated.is_some() || ctx.records_simulated,
+        rostopic: None,
+        motion: analyses.iter().filter_map(|a| a.motion_line()).collect(),
+    };
+    let request = ExportRequest {
+        targets: Vec::new(),
+        estimator: crate::filter_export::Estimator::Slopes,
+        inflate: 1.0,
+        overbound: false,
+    };
+    let (export, _warnings) = combine_terms(&record, &channels, &request)
+        .map_err(|e| EvalError::conflict(format!("options.exports: {e}")))?;
+    Ok(ctx
+        .exports
+        .iter()
+        .map(|s| (format!("noise_{}.{}", s.name(), s.file_extension()), export.render(*s).into_bytes()))
+        .collect())
 }
 
 /// Evaluates every `[static.<axis>]` table and builds the sections, figures, JSON and CSV files.
@@ -385,6 +439,7 @@ pub fn evaluate_static(
         }
     }
     parts.files.insert(0, ("bias_tests.csv".into(), bias_tests_csv(&reports).into_bytes()));
+    parts.files.extend(filter_exports(&reports, ctx)?);
     parts.json.insert("static".into(), serde_json::Value::Object(static_json));
     if !allan_json.is_empty() {
         parts.json.insert("allan".into(), serde_json::Value::Object(allan_json));

@@ -11,10 +11,13 @@
 //! factor m' (every term a term of the full estimator), so its EDF is that of N / b angle
 //! points at m' (computed and returned with the full-record EDF for comparison).
 //!
-//! Numerics: the angle of y - y_0 is accumulated in double-double (TwoSum), and each second
-//! difference is formed from double-double values, so the size of the angle (which grows with
-//! the record's mean rate times its length) does not enter the deviations; the kept angle is
-//! detrended by the record's mean in double-double before the long taus are computed.
+//! Numerics: a second difference of the angle is a difference of two adjacent sums of m rate
+//! samples, x_{j+2m} - 2 x_{j+m} + x_j = W_m(j+m) - W_m(j) with W_m(i) = sum of y_i .. y_{i+m-1};
+//! the full-resolution factors (octaves) take their window sums from a pyramid of the samples
+//! less the first one, W_2m(i) = W_m(i) + W_m(i+m) (pairwise sums of m small values: the size of
+//! the angle, which grows with the record's mean rate times its length, does not enter the
+//! deviations). The kept angle is accumulated in double-double (TwoSum) and detrended by the
+//! record's mean in double-double before the long taus are computed.
 
 use super::{
     averaging_factors, deviation_bounds, deviation_from_angle, equivalent_dof, two_sum, AllanCurve, AllanError,
@@ -99,12 +102,14 @@ pub struct StreamingOadev {
     /// The current angle (double-double, sample units).
     hi: f64,
     lo: f64,
-    /// Recent angle points, double-double (high and low parts apart): at least the last
-    /// 2 m_max before the next block, then the block's own.
-    hist_hi: Vec<f64>,
-    hist_lo: Vec<f64>,
-    /// Index in the record of the first point of `hist_hi`/`hist_lo`.
+    /// Recent rate samples less the offset: the last 2 m_max - 1 before the next block, then
+    /// the block's own.
+    hist: Vec<f64>,
+    /// Index in the record of the first sample of `hist`.
     base: usize,
+    /// The window sums of the current level of the pyramid, and the next level's.
+    level: Vec<f64>,
+    next_level: Vec<f64>,
     /// Angle points seen.
     points: usize,
     /// Neumaier sums (sum, carry) of squared second differences per exact factor.
@@ -140,15 +145,15 @@ impl StreamingOadev {
             offset: None,
             hi: 0.0,
             lo: 0.0,
-            hist_hi: vec![0.0],
-            hist_lo: vec![0.0],
+            hist: Vec::new(),
             base: 0,
+            level: Vec::new(),
+            next_level: Vec::new(),
             points: 1,
             kept: vec![(0.0, 0.0)],
             head: Vec::new(),
         };
-        s.hist_hi.reserve(1 << 16);
-        s.hist_lo.reserve(1 << 16);
+        s.hist.reserve(1 << 16);
         Ok(s)
     }
 
@@ -168,32 +173,41 @@ impl StreamingOadev {
         let room = self.plan.head_samples.saturating_sub(self.head.len()).min(rate.len());
         self.head.extend_from_slice(&rate[..room]);
         let offset = *self.offset.get_or_insert(rate[0]);
+        // Angle points start..end are new: point k is the sum of samples 0 .. k - 1.
         let start = self.points;
         let end = start + rate.len();
-        for &y in rate {
-            let (s, e) = two_sum(self.hi, y - offset);
+        let b = self.plan.stride;
+        for (k, &y) in (start..end).zip(rate) {
+            let v = y - offset;
+            let (s, e) = two_sum(self.hi, v);
             self.hi = s;
             self.lo += e;
-            self.hist_hi.push(self.hi);
-            self.hist_lo.push(self.lo);
+            if k % b == 0 {
+                self.kept.push((self.hi, self.lo));
+            }
+            self.hist.push(v);
         }
-        let (h, l, o) = (&self.hist_hi, &self.hist_lo, self.base);
-        let b = self.plan.stride;
-        for k in (start.next_multiple_of(b)..end).step_by(b) {
-            self.kept.push((h[k - o], l[k - o]));
-        }
+        // The term ending at point k (k - 2m >= 0) is W_m(k - m) - W_m(k - 2m): samples
+        // k - 2m .. k - 1, all in `hist` (which starts at sample `base`).
+        let o = self.base;
+        self.level.clear();
+        self.level.extend_from_slice(&self.hist);
         for (i, &m) in self.exact.iter().enumerate() {
+            if i > 0 {
+                // W_m(j) = W_{m/2}(j) + W_{m/2}(j + m/2), for every j whose window is in `hist`.
+                let half = m / 2;
+                let len = self.level.len().saturating_sub(half);
+                self.next_level.clear();
+                self.next_level.extend(self.level[..len].iter().zip(&self.level[half..]).map(|(a, c)| a + c));
+                std::mem::swap(&mut self.level, &mut self.next_level);
+            }
             let from = start.max(2 * m);
             if from >= end {
                 break;
             }
             let n = end - from;
-            let (a, bb, c) = (from - o, from - m - o, from - 2 * m - o);
-            let sub = sum_of_squared_differences(
-                (&h[a..a + n], &l[a..a + n]),
-                (&h[bb..bb + n], &l[bb..bb + n]),
-                (&h[c..c + n], &l[c..c + n]),
-            );
+            let (later, earlier) = (from - m - o, from - 2 * m - o);
+            let sub = sum_of_squared_differences(&self.level[later..later + n], &self.level[earlier..earlier + n]);
             let (sum, carry) = &mut self.sums[i];
             for v in sub {
                 let t = *sum + v;
@@ -202,12 +216,11 @@ impl StreamingOadev {
             }
         }
         self.points = end;
-        // Keep the last 2 m_max points for the next block.
-        let keep = 2 * self.exact.last().copied().unwrap_or(0);
-        if self.hist_hi.len() > keep {
-            let cut = self.hist_hi.len() - keep;
-            self.hist_hi.drain(..cut);
-            self.hist_lo.drain(..cut);
+        // Keep the last 2 m_max - 1 samples for the next block.
+        let keep = (2 * self.exact.last().copied().unwrap_or(0)).saturating_sub(1);
+        if self.hist.len() > keep {
+            let cut = self.hist.len() - keep;
+            self.hist.drain(..cut);
             self.base += cut;
         }
         Ok(())
@@ -324,43 +337,26 @@ impl StreamingOadev {
 /// rounding at most about 256 units, then joined by the caller's compensated sum).
 const SUB_SUM: usize = 1024;
 
-/// Sums of the squared second differences (a_j - b_j) - (b_j - c_j) of double-double points given
-/// as (high parts, low parts), one per run of [`SUB_SUM`] terms (independent terms, 4 lanes:
+/// Sums of the squared differences later_j - earlier_j (the second differences of the angle,
+/// from window sums), one per run of [`SUB_SUM`] terms (independent terms, 4 lanes:
 /// vectorisable).
-fn sum_of_squared_differences(a: (&[f64], &[f64]), b: (&[f64], &[f64]), c: (&[f64], &[f64])) -> Vec<f64> {
-    let n = a.0.len();
+fn sum_of_squared_differences(later: &[f64], earlier: &[f64]) -> Vec<f64> {
+    let n = later.len().min(earlier.len());
     let mut out = Vec::with_capacity(n / SUB_SUM + 1);
-    let mut from = 0;
-    while from < n {
-        let to = (from + SUB_SUM).min(n);
+    for (l, e) in later[..n].chunks(SUB_SUM).zip(earlier[..n].chunks(SUB_SUM)) {
         let mut lanes = [0.0f64; 4];
-        let mut j = from;
-        while j + 4 <= to {
+        let (lc, ec) = (l.chunks_exact(4), e.chunks_exact(4));
+        let (lr, er) = (lc.remainder(), ec.remainder());
+        for (x, y) in lc.zip(ec) {
             for (lane, acc) in lanes.iter_mut().enumerate() {
-                let k = j + lane;
-                let d = second_difference((a.0[k], a.1[k]), (b.0[k], b.1[k]), (c.0[k], c.1[k]));
+                let d = x[lane] - y[lane];
                 *acc += d * d;
             }
-            j += 4;
         }
-        let mut rest = 0.0;
-        for k in j..to {
-            let d = second_difference((a.0[k], a.1[k]), (b.0[k], b.1[k]), (c.0[k], c.1[k]));
-            rest += d * d;
-        }
+        let rest: f64 = lr.iter().zip(er).map(|(x, y)| (x - y) * (x - y)).sum();
         out.push((lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + rest);
-        from = to;
     }
     out
-}
-
-/// (a - b) - (b - c) of double-double values, rounded once.
-#[inline(always)]
-fn second_difference(a: (f64, f64), b: (f64, f64), c: (f64, f64)) -> f64 {
-    let (s1, e1) = two_sum(a.0, -b.0);
-    let (s2, e2) = two_sum(b.0, -c.0);
-    let (s, e) = two_sum(s1, -s2);
-    s + (e + (e1 - e2) + ((a.1 - b.1) - (b.1 - c.1)))
 }
 
 #[cfg(test)]
@@ -481,6 +477,35 @@ mod tests {
                 assert!(rel(p.upper.unwrap(), q.upper.unwrap()) < 1e-12, "m {}", p.m);
             }
         }
+    }
+
+    /// The full-resolution sums from the pyramid of window sums against brute force on a
+    /// record far from zero whose rate ramps away from its first sample (angle up to about 2e5
+    /// sample units): each term summed anew as the compensated sum of the m differences
+    /// y_{j+m+i} - y_{j+i} (no large value is ever formed), the squares summed compensated; every factor below the limit agrees to 1e-13, in blocks of odd sizes.
+    #[test]
+    fn full_resolution_sums_equal_brute_force_window_sums_on_a_ramping_rate() {
+        let n = 20_000;
+        let noise = record(n, 17, 0.0);
+        let rate: Vec<f64> = noise.iter().enumerate().map(|(k, y)| y + 1e-3 * (k as f64) - 1e5).collect();
+        let plan = StreamingPlan { stride: 4, full_resolution_below: 128, head_samples: 0 };
+        let mut s = StreamingOadev::new(&AllanOptions::default(), plan).unwrap();
+        for block in rate.chunks(997) {
+            s.push(block).unwrap();
+        }
+        for (i, &m) in s.exact.iter().enumerate() {
+            let terms: Vec<f64> = (0..=n - 2 * m)
+                .map(|j| {
+                    let pairs: Vec<f64> = (0..m).map(|i| rate[j + m + i] - rate[j + i]).collect();
+                    let d = crate::allan::compensated_sum(&pairs);
+                    d * d
+                })
+                .collect();
+            let brute = crate::allan::compensated_sum(&terms);
+            let streamed = s.sums[i].0 + s.sums[i].1;
+            assert!(rel(streamed, brute) < 1e-13, "m {m}: {streamed} vs {brute}");
+        }
+        assert_eq!(s.exact.len(), 7);
     }
 
     #[test]

@@ -15,11 +15,14 @@
 //! non-negative weighted least-squares problem solved exactly (every subset of processes, the
 //! best feasible one); Omega is the inverse of a diagonal estimate of the wavelet-variance
 //! covariance, var(nu_hat^2_j) = 2 nu^4_j / edf_j (the chi-squared approximation with the
-//! curve's equivalent degrees of freedom), re-evaluated at the fitted nu(theta) a few times.
-//! First-order Gauss-Markov processes are not included.
+//! curve's equivalent degrees of freedom), re-evaluated at the fitted nu(theta) a few times; the
+//! intervals use the full covariance across scales (module `covariance`, Percival and Walden
+//! 2000, ch. 8) in a sandwich. First-order Gauss-Markov processes are not included.
 
+mod covariance;
 mod overbound;
 
+pub use covariance::wavelet_variance_covariance;
 pub use overbound::{overbound_factors, OverboundFactors};
 
 use crate::allan::chi_squared_quantile;
@@ -82,6 +85,10 @@ pub struct WaveletVariance {
     pub nu2: f64,
     /// Equivalent degrees of freedom of the estimate (the curve's).
     pub edf: f64,
+    /// Averaging factor m (tau_s = m tau0).
+    pub m: u64,
+    /// Terms (wavelet coefficients) averaged in the estimate.
+    pub terms: u64,
 }
 
 /// Why a GMWM fit could not be made.
@@ -119,7 +126,13 @@ pub fn wavelet_variance(curve: &AllanCurve) -> Result<Vec<WaveletVariance>, Gmwm
             return Err(GmwmError::Curve(format!("no degrees of freedom at tau {} s", p.tau_s)));
         };
         if p.deviation.is_finite() && p.deviation > 0.0 {
-            out.push(WaveletVariance { tau_s: p.tau_s, nu2: 0.5 * p.deviation * p.deviation, edf });
+            out.push(WaveletVariance {
+                tau_s: p.tau_s,
+                nu2: 0.5 * p.deviation * p.deviation,
+                edf,
+                m: p.m as u64,
+                terms: p.terms as u64,
+            });
         }
     }
     Ok(out)
@@ -177,10 +190,22 @@ const ROUNDS: usize = 4;
 /// GMWM fit of a given set of processes (at least one) to the wavelet variance: non-negative
 /// weighted least squares in the squared coefficients with Omega = diag(edf_j / (2 nu_j^4)), nu_j
 /// the fitted wavelet variance (the estimate in the first round). Processes whose weight is zero
-/// at the optimum are left out of the result. Intervals: theta +- z sqrt(diag((X' Omega X)^-1))
-/// (the asymptotic covariance of the GMWM estimator with Omega the inverse of the estimate's
-/// covariance), clipped at zero, then square-rooted; two-sided at `confidence`.
+/// at the optimum are left out of the result. Intervals: theta +- z sqrt(var), var from the
+/// sandwich covariance with the wavelet variances' covariance across scales under the fitted
+/// model ([`wavelet_variance_covariance`]), clipped at zero, then square-rooted; two-sided at
+/// `confidence`.
 pub fn fit_processes(wv: &[WaveletVariance], processes: &[Process], confidence: f64) -> Result<GmwmFit, GmwmError> {
+    let (fit, sigma2) = fit_estimate(wv, processes, confidence)?;
+    Ok(with_intervals(fit, wv, &sigma2))
+}
+
+/// The estimate of [`fit_processes`] with its objective, intervals not yet made (NaN), and the
+/// final weights' variances sigma2.
+fn fit_estimate(
+    wv: &[WaveletVariance],
+    processes: &[Process],
+    confidence: f64,
+) -> Result<(GmwmFit, Vec<f64>), GmwmError> {
     if confidence.is_nan() || confidence <= 0.0 || confidence >= 1.0 {
         return Err(GmwmError::Confidence(confidence));
     }
@@ -204,23 +229,78 @@ pub fn fit_processes(wv: &[WaveletVariance], processes: &[Process], confidence: 
     let chosen: Vec<Process> = best.iter().map(|x| x.0).collect();
     let theta: Vec<f64> = best.iter().map(|x| x.1).collect();
     let objective = objective(wv, &chosen, &theta, &sigma2);
-    let cov = information(wv, &chosen, &sigma2).and_then(|m| invert(&m)).unwrap_or_default();
-    let z = chi_squared_quantile(confidence, 1.0).map_or(f64::NAN, f64::sqrt);
     let parameters = chosen
         .iter()
         .zip(&theta)
-        .enumerate()
-        .map(|(i, (&process, &t))| {
-            let se = cov.get(i).and_then(|r| r.get(i)).map_or(f64::NAN, |v| v.max(0.0).sqrt());
-            GmwmParameter {
-                process,
-                value: t.sqrt(),
-                lower: (t - z * se).max(0.0).sqrt(),
-                upper: (t + z * se).max(0.0).sqrt(),
-            }
-        })
+        .map(|(&process, &t)| GmwmParameter { process, value: t.sqrt(), lower: f64::NAN, upper: f64::NAN })
         .collect();
-    Ok(GmwmFit { parameters, confidence, scales: wv.len(), objective, criterion: objective + 2.0 * p as f64 })
+    let fit = GmwmFit { parameters, confidence, scales: wv.len(), objective, criterion: objective + 2.0 * p as f64 };
+    Ok((fit, sigma2))
+}
+
+/// The fit with its two-sided intervals: theta +- z sqrt(var) on the squared coefficients
+/// ([`estimate_covariance`]), clipped at 0, square-rooted.
+fn with_intervals(mut fit: GmwmFit, wv: &[WaveletVariance], sigma2: &[f64]) -> GmwmFit {
+    let chosen: Vec<Process> = fit.parameters.iter().map(|p| p.process).collect();
+    let theta: Vec<f64> = fit.parameters.iter().map(|p| p.value * p.value).collect();
+    let cov = estimate_covariance(wv, &chosen, &theta, sigma2);
+    let z = chi_squared_quantile(fit.confidence, 1.0).map_or(f64::NAN, f64::sqrt);
+    for (i, (par, &t)) in fit.parameters.iter_mut().zip(&theta).enumerate() {
+        let se = cov.get(i).and_then(|r| r.get(i)).map_or(f64::NAN, |v| v.max(0.0).sqrt());
+        par.lower = (t - z * se).max(0.0).sqrt();
+        par.upper = (t + z * se).max(0.0).sqrt();
+    }
+    fit
+}
+
+/// The covariance of the squared coefficients: the sandwich (X' W X)^-1 X' W Sigma W X (X' W
+/// X)^-1 of the weighted fit (W = diag(1 / sigma2)) with Sigma the covariance of the wavelet
+/// variances across scales under the fitted model ([`wavelet_variance_covariance`]); its
+/// diagonal is raised to the chi-squared variance 2 nu^4 / edf where that is larger (the
+/// large-sample formula understates the variance at scales with few independent terms), the
+/// correlations kept. Empty when the information matrix is singular.
+fn estimate_covariance(wv: &[WaveletVariance], set: &[Process], theta: &[f64], sigma2: &[f64]) -> Vec<Vec<f64>> {
+    let Some(bread) = information(wv, set, sigma2).and_then(|m| invert(&m)) else { return Vec::new() };
+    let model: Vec<(Process, f64)> = set.iter().copied().zip(theta.iter().copied()).collect();
+    let spectral = wavelet_variance_covariance(wv, &model);
+    let n = wv.len();
+    let diag: Vec<f64> = (0..n).map(|j| spectral[j][j].max(sigma2[j])).collect();
+    let p = set.len();
+    // A = W X (n x p); meat = A' Sigma A.
+    let a: Vec<Vec<f64>> = wv
+        .iter()
+        .zip(sigma2)
+        .map(|(w, s2)| set.iter().map(|pr| pr.unit_wavelet_variance(w.tau_s) / s2).collect())
+        .collect();
+    let sigma = |j: usize, k: usize| -> f64 {
+        if j == k {
+            return diag[j];
+        }
+        let (sj, sk) = (spectral[j][j], spectral[k][k]);
+        if sj > 0.0 && sk > 0.0 {
+            spectral[j][k] / (sj * sk).sqrt() * (diag[j] * diag[k]).sqrt()
+        } else {
+            0.0
+        }
+    };
+    let mut meat = vec![vec![0.0; p]; p];
+    for j in 0..n {
+        for k in 0..n {
+            let c = sigma(j, k);
+            if c == 0.0 {
+                continue;
+            }
+            for (r, row) in meat.iter_mut().enumerate() {
+                for (q, cell) in row.iter_mut().enumerate() {
+                    *cell += a[j][r] * c * a[k][q];
+                }
+            }
+        }
+    }
+    let mul = |x: &[Vec<f64>], y: &[Vec<f64>]| -> Vec<Vec<f64>> {
+        (0..p).map(|r| (0..p).map(|q| (0..p).map(|t| x[r][t] * y[t][q]).sum()).collect()).collect()
+    };
+    mul(&mul(&bread, &meat), &bread)
 }
 
 /// The GMWM fit with the model chosen by the criterion J + 2 p over every non-empty subset of
@@ -228,24 +308,25 @@ pub fn fit_processes(wv: &[WaveletVariance], processes: &[Process], confidence: 
 /// chi-squared with (scales - p) degrees of freedom when the model holds, so 2 p is the AIC
 /// penalty; Guerrier et al.'s WIC estimates the optimism instead).
 pub fn select_model(wv: &[WaveletVariance], candidates: &[Process], confidence: f64) -> Result<GmwmFit, GmwmError> {
-    let mut best: Option<GmwmFit> = None;
+    let mut best: Option<(GmwmFit, Vec<f64>)> = None;
     let mut last_err = None;
     for mask in 1u32..(1u32 << candidates.len()) {
         let set: Vec<Process> =
             candidates.iter().enumerate().filter(|(i, _)| mask & (1 << i) != 0).map(|(_, &p)| p).collect();
-        match fit_processes(wv, &set, confidence) {
-            Ok(mut f) => {
+        match fit_estimate(wv, &set, confidence) {
+            Ok((mut f, sigma2)) => {
                 // The penalty counts the processes the model keeps.
                 f.criterion = f.objective + 2.0 * f.parameters.len() as f64;
-                if best.as_ref().is_none_or(|b| f.criterion < b.criterion - 1e-12) {
-                    best = Some(f);
+                if best.as_ref().is_none_or(|b| f.criterion < b.0.criterion - 1e-12) {
+                    best = Some((f, sigma2));
                 }
             }
             Err(e) => last_err = Some(e),
         }
     }
     match (best, last_err) {
-        (Some(b), _) => Ok(b),
+        // Intervals for the chosen model only.
+        (Some((b, sigma2)), _) => Ok(with_intervals(b, wv, &sigma2)),
         (None, Some(e)) => Err(e),
         (None, None) => Err(GmwmError::TooFewScales { scales: wv.len(), parameters: 0 }),
     }

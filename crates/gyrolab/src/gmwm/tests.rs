@@ -31,7 +31,7 @@ fn exact_wavelet_variances_give_the_parameters_back() {
         .map(|j| {
             let tau = 0.01 * f64::from(1u32 << j);
             let avar = 3.0 * q * q / (tau * tau) + n * n / tau + k * k * tau / 3.0;
-            WaveletVariance { tau_s: tau, nu2: avar / 2.0, edf: 1000.0 }
+            WaveletVariance { tau_s: tau, nu2: avar / 2.0, edf: 1000.0, m: 1 << j, terms: 100_000 }
         })
         .collect();
     let fit = select_model(&wv, &PROCESSES, 0.95).unwrap();
@@ -90,10 +90,12 @@ fn white_plus_random_walk_against_simulated_truth() {
     let mean_k = sum_k / seeds as f64;
     assert!((mean_n / n - 1.0).abs() < 0.02, "mean N {mean_n}");
     assert!((mean_k / k - 1.0).abs() < 0.15, "mean K {mean_k}");
-    // The intervals take the scales as independent and are too narrow (docs/METHODS.md 3.1): their
-    // coverage is printed, not asserted, until the full wavelet-variance covariance is estimated.
+    // The intervals' coverage of the truth: 60 intervals at nominal 68.3 % (binomial sd about 6
+    // points); the intervals of the diagonal (independent-scales) covariance covered 37 %, so
+    // this band fails them. The 200-seed study by parameter and record length is
+    // `gmwm_coverage_study` below (ignored: run by hand, figures in docs/METHODS.md 3.1).
     let coverage = f64::from(covered) / f64::from(total);
-    eprintln!("GMWM 68.3 % interval coverage over {total} intervals: {coverage:.3} (independent scales assumed)");
+    assert!((0.5..=0.85).contains(&coverage), "GMWM 68.3 % interval coverage over {total} intervals: {coverage:.3}");
 }
 
 #[test]
@@ -113,7 +115,7 @@ fn model_choice_finds_white_and_random_walk() {
 
 #[test]
 fn bad_requests_are_errors() {
-    let wv = [WaveletVariance { tau_s: 1.0, nu2: 1.0, edf: 10.0 }];
+    let wv = [WaveletVariance { tau_s: 1.0, nu2: 1.0, edf: 10.0, m: 1, terms: 10 }];
     assert!(matches!(fit_processes(&wv, &[Process::White], 0.683), Err(GmwmError::TooFewScales { .. })));
     assert!(matches!(fit_processes(&wv, &[Process::White], 1.5), Err(GmwmError::Confidence(_))));
 }
@@ -159,4 +161,32 @@ fn overbound_factors_by_hand() {
     let g = overbound_factors(&c, Some(10.0), Some(10.0), None).unwrap();
     assert_eq!((g.white, g.random_walk), (Some(1.0), Some(1.0)));
     assert!(overbound_factors(&c, None, None, None).is_none());
+}
+
+/// Coverage of the GMWM intervals by parameter, `seeds` records of `len` samples (N, K as in
+/// the test above): (covered N, covered K, seeds).
+fn coverage_study(seeds: u64, len: usize, confidence: f64, processes: &[Process]) -> (u32, u32, u32) {
+    let (n, k, tau0) = (0.01, 0.001, 0.01);
+    let (mut cn, mut ck) = (0, 0);
+    for seed in 0..seeds {
+        let c = curve(record(1000 + seed, len, n, k, tau0), tau0);
+        let wv = wavelet_variance(&c).unwrap();
+        let fit = fit_processes(&wv, processes, confidence).unwrap();
+        let inside = |p: Process, truth: f64| fit.parameter(p).is_some_and(|x| x.lower <= truth && truth <= x.upper);
+        cn += u32::from(inside(Process::White, n));
+        ck += u32::from(inside(Process::RandomWalk, k));
+    }
+    (cn, ck, seeds as u32)
+}
+
+#[test]
+#[ignore = "study: cargo test -p gyrolab --release --lib gmwm_coverage_study -- --ignored --nocapture"]
+fn gmwm_coverage_study() {
+    for conf in [0.683, 0.95] {
+        for len in [1usize << 14, 1 << 16, 1 << 18] {
+            let (cn, ck, s) = coverage_study(200, len, conf, &[Process::White, Process::RandomWalk]);
+            let share = |c: u32| f64::from(c) / f64::from(s);
+            eprintln!("conf {conf} len {len}: N {:.3}  K {:.3} ({s} seeds)", share(cn), share(ck));
+        }
+    }
 }

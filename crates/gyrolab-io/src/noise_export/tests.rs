@@ -1,7 +1,12 @@
 use super::*;
 
 fn term(v: f64, basis: &'static str) -> ExportTerm {
-    ExportTerm { value: v, estimate: v, overbound_factor: None, source: TermSource { basis, detail: "test".into() } }
+    ExportTerm {
+        value: v,
+        estimate: v,
+        overbound_factor: None,
+        source: TermSource { basis: basis.into(), detail: "test".into() },
+    }
 }
 
 /// N = 1e-3 rad/s/sqrt(Hz), K = 2e-5 rad/s^2/sqrt(Hz), accel 4e-3, 6e-4 at 400 Hz.
@@ -17,6 +22,7 @@ pub(super) fn sample() -> NoiseExport {
         accel_noise: Some(term(4e-3, "value")),
         accel_walk: Some(term(6e-4, "fit_value")),
         rostopic: None,
+        motion: Vec::new(),
         writer: "test".into(),
     }
 }
@@ -82,16 +88,17 @@ fn continuous_stacks_write_the_densities_under_their_keys() {
 }
 
 #[test]
-fn px4_values_are_per_step_at_the_rate() {
+fn px4_values_are_per_step_at_the_ekf2_default_rate() {
     let n = sample();
     for stack in [Stack::Px4, Stack::Px4Qgc] {
         let text = n.render(stack);
-        // hand: 1e-3 x sqrt(400) = 0.02 rad/s; 2e-5 x 20 = 4e-4 rad/s^2; 4e-3 x 20 = 0.08; 6e-4 x 20 = 0.012
+        // hand, at EKF2's 100 Hz step (not the record's 400 Hz): 1e-3 x sqrt(100) = 0.01 rad/s;
+        // 2e-5 x 10 = 2e-4 rad/s^2; 4e-3 x 10 = 0.04 m/s^2; 6e-4 x 10 = 0.006 m/s^3
         for (k, want) in [
-            ("EKF2_GYR_NOISE", 0.02),
-            ("EKF2_GYR_B_NOISE", 4e-4),
-            ("EKF2_ACC_NOISE", 0.08),
-            ("EKF2_ACC_B_NOISE", 0.012),
+            ("EKF2_GYR_NOISE", 0.01),
+            ("EKF2_GYR_B_NOISE", 2e-4),
+            ("EKF2_ACC_NOISE", 0.04),
+            ("EKF2_ACC_B_NOISE", 0.006),
         ] {
             let got = value_of(&text, k).unwrap_or(f64::NAN);
             assert!((got / want - 1.0).abs() < 1e-12, "{stack:?} {k}: {got}\n{text}");

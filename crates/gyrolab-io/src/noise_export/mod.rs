@@ -14,7 +14,8 @@
 //!   `accel_bias_std` (continuous random-walk densities);
 //! - PX4 EKF2: `EKF2_GYR_NOISE` rad/s, `EKF2_ACC_NOISE` m/s^2 (the delta-angle variance is
 //!   (dt x EKF2_GYR_NOISE)^2), `EKF2_GYR_B_NOISE` rad/s^2, `EKF2_ACC_B_NOISE` m/s^3 (the bias
-//!   increment per step is dt x the parameter): per step, so from the densities at the step rate f:
+//!   increment per step is dt x the parameter; `Ekf::predictCovariance` in covariance.cpp, dt the
+//!   prediction step, EKF2_PREDICT_US): per step, so from the densities at the step rate f:
 //!   N sqrt(f) and K sqrt(f);
 //! - ROS `sensor_msgs/Imu`: row-major 3x3 covariances of one message (per-sample variances);
 //!   `orientation_covariance[0] = -1` when no orientation is given (the message's comment).
@@ -76,7 +77,19 @@ impl Stack {
         STACKS.iter().copied().find(|s| s.name() == t)
     }
 
-    /// Whether the stack's values are per sample (discrete time) rather than densities.
+    /// The usual extension of the stack's file: `json` (Basalt), `txt` (PX4 `param set`
+    /// lines), `params` (QGroundControl), else `yaml`.
+    pub fn file_extension(self) -> &'static str {
+        match self {
+            Stack::Basalt => "json",
+            Stack::Px4 => "txt",
+            Stack::Px4Qgc => "params",
+            _ => "yaml",
+        }
+    }
+
+    /// Whether the stack's values are per sample or per filter step (discrete time) rather than
+    /// densities.
     pub fn per_sample(self) -> bool {
         matches!(self, Stack::Px4 | Stack::Px4Qgc | Stack::RosCovariance)
     }
@@ -86,7 +99,7 @@ impl Stack {
 #[derive(Clone, Debug, PartialEq)]
 pub struct TermSource {
     /// `value`, `upper_bound`, `fit_value` or `gmwm`.
-    pub basis: &'static str,
+    pub basis: String,
     /// What the basis means for this term, for the file's header (confidence and sidedness of a
     /// bound or interval, the channel it comes from).
     pub detail: String,
@@ -130,6 +143,9 @@ pub struct NoiseExport {
     pub accel_walk: Option<ExportTerm>,
     /// The ROS topic, when the record is a topic of a recording.
     pub rostopic: Option<String>,
+    /// One `MOTION: the record is not static: ...` line per channel that moved (the stillness
+    /// check; analysed because motion was allowed): each goes into every file's header.
+    pub motion: Vec<String>,
     /// The writer's version, for the header.
     pub writer: String,
 }
@@ -232,12 +248,18 @@ impl NoiseExport {
         if self.simulated {
             h.push("SIMULATED: the record analysed is a simulated record, not a measured sensor".into());
         }
+        h.extend(self.motion.iter().map(|m| one_line(m)));
         h.push(format!("record: {}", one_line(&self.record)));
         h.push(format!("sample rate: {} Hz", rate_text(self.rate_hz)));
         h.push(format!("estimator: {}", self.estimator));
-        h.push(if stack.per_sample() {
+        h.push(if matches!(stack, Stack::Px4 | Stack::Px4Qgc) {
             format!(
-                "time convention: per sample at {} Hz (white noise: density x sqrt(rate); random walk: see each value)",
+                "time convention: per EKF2 prediction step at {} Hz (density x sqrt(step rate); see below)",
+                rate_text(PX4_DEFAULT_EKF_HZ)
+            )
+        } else if stack.per_sample() {
+            format!(
+                "time convention: per sample at {} Hz (variance of one message's value: (density x sqrt(rate))^2)",
                 rate_text(self.rate_hz)
             )
         } else {
@@ -415,9 +437,11 @@ impl NoiseExport {
         s
     }
 
-    /// PX4 values at the record's rate: white noise N sqrt(rate), random walk K sqrt(rate).
-    fn px4_values(&self) -> Vec<(&'static str, Option<f64>, &'static str)> {
-        let f = self.rate_hz.sqrt();
+    /// PX4 values per EKF2 prediction step at [`PX4_DEFAULT_EKF_HZ`]: white noise N sqrt(f),
+    /// random walk K sqrt(f), f the step rate (not the sensor's rate: EKF2 integrates the IMU
+    /// samples over each step).
+    fn px4_values(&self, step_hz: f64) -> Vec<(&'static str, Option<f64>, &'static str)> {
+        let f = step_hz.sqrt();
         let keys = [
             ("EKF2_GYR_NOISE", "rad/s"),
             ("EKF2_GYR_B_NOISE", "rad/s^2"),
@@ -430,23 +454,25 @@ impl NoiseExport {
     fn px4(&self, qgc: bool) -> String {
         let stack = if qgc { Stack::Px4Qgc } else { Stack::Px4 };
         let mut s = self.comment_header(stack, "# ");
-        let at100 = PX4_DEFAULT_EKF_HZ.sqrt();
         let _ = writeln!(
             s,
-            "# PX4 EKF2 applies these per prediction step dt: delta-angle sigma = dt x EKF2_GYR_NOISE, bias step = dt x EKF2_GYR_B_NOISE,\n\
-             # so each value is the continuous density x sqrt(step rate). Written at the record's rate, {} Hz; if EKF2 predicts at\n\
-             # another rate (EKF2_PREDICT_US, default 10000 us = 100 Hz) use density x sqrt(that rate): at 100 Hz:",
+            "# PX4 EKF2 applies these per prediction step dt (EKF2_PREDICT_US, default 10000 us = {} Hz): delta-angle\n\
+             # sigma = dt x EKF2_GYR_NOISE, bias step sigma = dt x EKF2_GYR_B_NOISE, so each value is the continuous density\n\
+             # x sqrt(step rate). Written for the default {} Hz step; for another EKF2_PREDICT_US use density x sqrt(1e6 /\n\
+             # EKF2_PREDICT_US). At the record's own rate, {} Hz, they would be:",
+            rate_text(PX4_DEFAULT_EKF_HZ),
+            rate_text(PX4_DEFAULT_EKF_HZ),
             rate_text(self.rate_hz)
         );
-        for ((k, _, u), slot) in self.px4_values().into_iter().zip(self.slots()) {
-            if let Some(t) = slot.term {
-                let _ = writeln!(s, "#   {k} = {} {u}", real_text(t.value * at100));
+        for (k, v, u) in self.px4_values(self.rate_hz) {
+            if let Some(v) = v {
+                let _ = writeln!(s, "#   {k} = {} {u}", real_text(v));
             }
         }
         if qgc {
             s.push_str("#\n# Vehicle-Id Component-Id Name Value Type\n");
         }
-        for (k, v, u) in self.px4_values() {
+        for (k, v, u) in self.px4_values(PX4_DEFAULT_EKF_HZ) {
             match (v, qgc) {
                 (Some(v), true) => {
                     // MAV_PARAM_TYPE_REAL32 = 9

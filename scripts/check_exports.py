@@ -27,7 +27,7 @@ import cv2
 import numpy as np
 import yaml
 
-RATE = 100.0
+RATE = 200.0  # not PX4's 100 Hz step rate, so the two conventions differ
 N_GYRO = 2.0e-3  # rad/s/sqrt(Hz)
 N_ACC = 3.0e-2  # m/s^2/sqrt(Hz)
 FAILURES = []
@@ -91,7 +91,7 @@ def main():
         with open(csv, "w", encoding="utf-8") as f:
             f.write("time_s,gyro_x [rad/s],accel_x [m/s^2]\n")
             for i in range(n):
-                f.write(f"{i / RATE:.2f},{gyro[i]!r},{acc[i]!r}\n")
+                f.write(f"{i / RATE:.3f},{gyro[i]:.17g},{acc[i]:.17g}\n")
         stacks = ["kalibr", "openvins", "vins", "orbslam3", "basalt", "px4", "px4-qgc", "ros-covariance"]
         ext = {"basalt": "json", "px4": "txt", "px4-qgc": "params"}
         paths = {s: os.path.join(d, f"{s}.{ext.get(s, 'yaml')}") for s in stacks}
@@ -145,9 +145,10 @@ def main():
             check(len(basalt[key]) == 3 and all(close(v, want) for v in basalt[key]), f"basalt {key}")
 
         root = math.sqrt(RATE)
+        step = math.sqrt(100.0)  # PX4 EKF2's default prediction step rate (EKF2_PREDICT_US = 10000)
         for name, params in [("px4", px4_param_file(paths["px4"])), ("px4-qgc", qgc_params(paths["px4-qgc"]))]:
-            for key, want in [("EKF2_GYR_NOISE", ng * root), ("EKF2_GYR_B_NOISE", kg * root),
-                              ("EKF2_ACC_NOISE", na * root), ("EKF2_ACC_B_NOISE", ka * root)]:
+            for key, want in [("EKF2_GYR_NOISE", ng * step), ("EKF2_GYR_B_NOISE", kg * step),
+                              ("EKF2_ACC_NOISE", na * step), ("EKF2_ACC_B_NOISE", ka * step)]:
                 check(close(params.get(key), want), f"{name} {key} = {params.get(key)} vs {want}")
 
         ros = yaml.safe_load(open(paths["ros-covariance"], encoding="utf-8"))

@@ -98,3 +98,78 @@ fn bad_exports_are_usage_errors_and_write_nothing() {
         .failure();
     assert!(!good.exists());
 }
+
+/// The values of `--export kalibr` and of `--kalibr-yaml` (two writers of the same rule) are the
+/// same numbers on a recording with gyro and accelerometer channels.
+#[test]
+fn export_kalibr_equals_kalibr_yaml() {
+    let dir = tempfile::tempdir().unwrap();
+    let mcap =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/recordings/simulated_imu_ros2.mcap");
+    let (a, b) = (dir.path().join("a.yaml"), dir.path().join("b.yaml"));
+    gyrolab()
+        .arg("allan")
+        .arg(&mcap)
+        .arg("--kalibr-yaml")
+        .arg(&a)
+        .arg("--export")
+        .arg(format!("kalibr={}", b.display()))
+        .assert()
+        .success();
+    let (a, b) = (std::fs::read_to_string(&a).unwrap(), std::fs::read_to_string(&b).unwrap());
+    for key in [
+        "gyroscope_noise_density",
+        "gyroscope_random_walk",
+        "accelerometer_noise_density",
+        "accelerometer_random_walk",
+        "update_rate",
+    ] {
+        let (x, y) = (value(&a, key), value(&b, key));
+        assert!(x > 0.0 && x == y, "{key}: {x} vs {y}");
+    }
+}
+
+/// The rate written into the filter files of real recordings, end to end (issue 30): the PX4 log's
+/// `sensor_combined` at the rate pyulog + numpy give (the committed reference that
+/// scripts/px4_clock_reference.py re-derives in the test script), and each topic of the ROS 1 bag
+/// at its simulated 100 Hz.
+#[test]
+fn update_rate_of_real_recordings_end_to_end() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let reference: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(root.join("crates/gyrolab-eval/tests/data/px4_clock_reference.json")).unwrap(),
+    )
+    .unwrap();
+    let want = reference["rate_hz"].as_f64().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let (k, ov) = (dir.path().join("k.yaml"), dir.path().join("ov.yaml"));
+    gyrolab()
+        .arg("allan")
+        .arg(root.join("examples/recordings/px4_sample_log_small.ulg"))
+        .args(["--topic", "sensor_combined", "--kalibr-yaml"])
+        .arg(&k)
+        .arg("--export")
+        .arg(format!("openvins={}", ov.display()))
+        .assert()
+        .success();
+    let kalibr = value(&std::fs::read_to_string(&k).unwrap(), "update_rate");
+    assert!((kalibr / want - 1.0).abs() < 1e-8, "Kalibr update_rate {kalibr} vs pyulog {want}");
+    let openvins = std::fs::read_to_string(&ov).unwrap();
+    let line = openvins.lines().find_map(|l| l.trim().strip_prefix("update_rate:")).unwrap();
+    let got: f64 = line.trim().parse().unwrap();
+    assert!((got / want - 1.0).abs() < 1e-12, "OpenVINS update_rate {got} vs pyulog {want}");
+
+    let bag = dir.path().join("bag.yaml");
+    gyrolab()
+        .arg("allan")
+        .arg(root.join("examples/recordings/simulated_imu_ros1.bag"))
+        .arg("--kalibr-yaml")
+        .arg(&bag)
+        .assert()
+        .success();
+    for topic in ["imu0", "imu1"] {
+        let text = std::fs::read_to_string(dir.path().join(format!("bag_{topic}.yaml"))).unwrap();
+        assert_eq!(value(&text, "update_rate"), 100.0, "{topic}\n{text}");
+        assert!(text.contains(&format!("rostopic: /{topic}")), "{text}");
+    }
+}

@@ -1,0 +1,149 @@
+//! The stillness check through `gyrolab allan` (issue 30, "records that move"): a record whose
+//! gyro moved is refused (exit 2, naming the channel, the episode and --allow-motion); with
+//! --allow-motion every output is marked. Truth: records written here from white noise with a
+//! rotation episode added at a known time; the bundled recordings (a simulated ROS 1 bag and
+//! ROS 2 MCAP at rest, and a PX4 excerpt logged armed on the ground) are not flagged.
+
+mod common;
+use common::{gyrolab, write};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Normal};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+/// 100 Hz, 120 s; gyro x and z in deg/s with white noise 0.05 deg/s per sample (N = 0.3
+/// deg/sqrt(h)) about biases 0.3 and -0.2 deg/s; a rate of `episode_dps` added to x from 50 s
+/// to 55 s.
+fn record(dir: &Path, name: &str, seed: u64, episode_dps: f64) -> PathBuf {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let noise = Normal::new(0.0, 0.05).unwrap();
+    let mut text = String::from("time_s,gyro_x [deg/s],gyro_z [deg/s]\n");
+    for i in 0..12_000 {
+        let t = i as f64 / 100.0;
+        let step = if (50.0..55.0).contains(&t) { episode_dps } else { 0.0 };
+        let x = 0.3 + step + noise.sample(&mut rng);
+        let z = -0.2 + noise.sample(&mut rng);
+        text.push_str(&format!("{t:.2},{x:.6},{z:.6}\n"));
+    }
+    write(dir, name, &text)
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn json(args: &[&str]) -> Value {
+    let out = gyrolab().args(args).arg("--json").output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn a_record_that_moved_is_refused_naming_the_channel_and_the_episode() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = record(dir.path(), "moved.csv", 1, 20.0);
+    let yaml = dir.path().join("imu.yaml");
+    let out = gyrolab()
+        .arg("allan")
+        .arg(&file)
+        .arg("--kalibr-yaml")
+        .arg(&yaml)
+        .arg("--export")
+        .arg(format!("openvins={}", dir.path().join("ov.yaml").display()))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("the record is not static"), "{err}");
+    assert!(err.contains("channel 'gyro_x [deg/s]' moved in 5 of 120 windows of 1 s"), "{err}");
+    assert!(err.contains("first episode 50.0 to 55.0 s (peak departure 20."), "{err}");
+    assert!(err.contains("--allow-motion"), "{err}");
+    assert!(!err.contains("channel 'gyro_z"), "{err}");
+    // nothing written
+    assert!(!yaml.exists() && !dir.path().join("ov.yaml").exists());
+}
+
+#[test]
+fn with_allow_motion_every_output_is_marked() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = record(dir.path(), "moved.csv", 2, -8.0);
+    let yaml = dir.path().join("imu.yaml");
+    let ov = dir.path().join("ov.yaml");
+    let f = file.to_str().unwrap();
+    let out = gyrolab()
+        .args(["allan", f, "--allow-motion", "--kalibr-yaml"])
+        .arg(&yaml)
+        .arg("--export")
+        .arg(format!("openvins={}", ov.display()))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("warning: MOTION: the record is not static:"), "{text}");
+    assert!(text.contains("(gyro_x [deg/s]) moved in 5 of 120 windows"), "{text}");
+    assert!(text.contains("analysed because motion was allowed"), "{text}");
+    let kalibr = std::fs::read_to_string(&yaml).unwrap();
+    assert!(kalibr.contains("# MOTION: the record is not static:") && kalibr.contains("(gyro_x [deg/s])"), "{kalibr}");
+    let export = std::fs::read_to_string(&ov).unwrap();
+    assert!(export.contains("MOTION: the record is not static:") && export.contains("still sensor's"), "{export}");
+    let j = json(&["allan", f, "--allow-motion"]);
+    let channels = j["channels"].as_array().unwrap();
+    let x = &channels[0]["stillness"];
+    assert_eq!((x["moved"].as_bool(), x["allow_motion"].as_bool()), (Some(true), Some(true)));
+    assert_eq!(x["rule"]["unit"], "deg/s");
+    assert_eq!(x["rule"]["floor"], 1.0);
+    assert_eq!(x["first_episode"]["start_s"], 50.0);
+    assert_eq!(x["first_episode"]["end_s"], 55.0);
+    let peak = x["first_episode"]["peak_departure"].as_f64().unwrap();
+    assert!((peak - 8.0).abs() < 0.1, "{peak}");
+    // the white noise from first differences is the simulated 0.05 deg/s
+    let sigma = x["white_noise_sigma"].as_f64().unwrap();
+    assert!((sigma / 0.05 - 1.0).abs() < 0.03, "{sigma}");
+    let z = &channels[1]["stillness"];
+    assert_eq!((z["evaluated"].as_bool(), z["moved"].as_bool()), (Some(true), Some(false)));
+}
+
+#[test]
+fn still_records_of_several_seeds_pass() {
+    let dir = tempfile::tempdir().unwrap();
+    for seed in 10..13 {
+        let file = record(dir.path(), &format!("still{seed}.csv"), seed, 0.0);
+        let out = gyrolab().arg("allan").arg(&file).output().unwrap();
+        assert!(out.status.success(), "seed {seed}: {}", String::from_utf8_lossy(&out.stderr));
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(text.matches("stillness: still:").count(), 2, "{text}");
+    }
+}
+
+#[test]
+fn bundled_recordings_at_rest_are_not_flagged() {
+    let dir = root().join("examples/recordings");
+    // The simulated bag and MCAP: records at rest. The PX4 excerpt (6.5 s of sensor_combined at
+    // 200 Hz) was logged armed on the ground: its window means stay within 0.04 deg/s and
+    // 0.01 m/s^2 (pyulog + numpy on the same messages), so it is not flagged either.
+    for (file, topic) in [
+        ("simulated_imu_ros1.bag", "/imu0"),
+        ("simulated_imu_ros2.mcap", "/imu0"),
+        ("px4_sample_log_small.ulg", "sensor_combined"),
+    ] {
+        let path = dir.join(file);
+        let j = json(&["allan", path.to_str().unwrap(), "--topic", topic]);
+        let channels = j["channels"].as_array().unwrap();
+        assert_eq!(channels.len(), 6, "{file}");
+        for c in channels {
+            let s = &c["stillness"];
+            assert_eq!((s["evaluated"].as_bool(), s["moved"].as_bool()), (Some(true), Some(false)), "{file}: {s}");
+        }
+    }
+}
+
+#[test]
+fn snapshot_topics_too_short_for_the_check_say_so() {
+    // PX4's sensor_gyro logged at 1 Hz: 6 samples, fewer than three windows of 10 samples.
+    let path = root().join("examples/recordings/px4_sample_log_small.ulg");
+    let out = gyrolab().args(["allan", path.to_str().unwrap(), "--topic", "sensor_gyro"]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("stillness: not evaluated (the record holds 1 window(s) of 10 samples"), "{text}");
+}

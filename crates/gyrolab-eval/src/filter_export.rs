@@ -1,0 +1,423 @@
+//! Filter noise-parameter exports of an Allan analysis (`gyrolab allan --export STACK=FILE`):
+//! the white-noise and random-walk terms of the gyro and accelerometer channels by the chosen
+//! estimator (slope readings, five-term fit or GMWM), optionally overbounded on each channel's
+//! curve and inflated, channels combined by the largest value (docs/EXPORTS.md, docs/METHODS.md
+//! "Filter exports").
+
+use crate::allan::AllanOutcome;
+use crate::error::{EvalError, EvalResult};
+use gyrolab::gmwm::{overbound_factors, Process};
+use gyrolab::noise::Reading;
+use gyrolab::units::{self, Quantity};
+use gyrolab_io::noise_export::{real_text, ExportTerm, NoiseExport, Stack, TermSource};
+use gyrolab_report::allan::ChannelAnalysis;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Which estimate the exported values are.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Estimator {
+    /// Slope readings: the value where resolved, else the upper bound, else the five-term fit.
+    #[default]
+    Slopes,
+    /// The weighted five-term fit.
+    Fit,
+    /// GMWM (the model chosen by the criterion).
+    Gmwm,
+}
+
+impl Estimator {
+    /// Parses `slopes`, `fit` or `gmwm`.
+    pub fn parse(text: &str) -> EvalResult<Estimator> {
+        match text.trim() {
+            "slopes" => Ok(Estimator::Slopes),
+            "fit" => Ok(Estimator::Fit),
+            "gmwm" => Ok(Estimator::Gmwm),
+            other => Err(EvalError::conflict_on(
+                &["estimator"],
+                format!("{{estimator}} '{}': expected slopes, fit or gmwm", gyrolab_io::text::excerpt(other)),
+            )),
+        }
+    }
+
+    /// `slopes`, `fit` or `gmwm`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Estimator::Slopes => "slopes",
+            Estimator::Fit => "fit",
+            Estimator::Gmwm => "gmwm",
+        }
+    }
+}
+
+/// How the exported values are made.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExportRequest {
+    /// (stack, file) pairs, written all or none.
+    pub targets: Vec<(Stack, PathBuf)>,
+    /// The estimator of the values.
+    pub estimator: Estimator,
+    /// Factor applied to every value (>= 1 is the usual use; 1: none).
+    pub inflate: f64,
+    /// Overbound each value on its channel's curve (the factors are recorded).
+    pub overbound: bool,
+}
+
+/// Parses a stack name.
+fn parse_stack(stack: &str) -> EvalResult<Stack> {
+    let names: Vec<&str> = gyrolab_io::noise_export::STACKS.iter().map(|s| s.name()).collect();
+    Stack::parse(stack).ok_or_else(|| {
+        EvalError::conflict_on(
+            &["export"],
+            format!(
+                "{{export}}: unknown stack '{}': expected one of {}",
+                gyrolab_io::text::excerpt(stack),
+                names.join(", ")
+            ),
+        )
+    })
+}
+
+/// Parses `STACK=FILE`.
+pub fn parse_target(text: &str) -> EvalResult<(Stack, PathBuf)> {
+    let names: Vec<&str> = gyrolab_io::noise_export::STACKS.iter().map(|s| s.name()).collect();
+    let (stack, file) = text.split_once('=').ok_or_else(|| {
+        EvalError::conflict_on(
+            &["export"],
+            format!(
+                "{{export}} '{}': expected STACK=FILE (STACK one of {})",
+                gyrolab_io::text::excerpt(text),
+                names.join(", ")
+            ),
+        )
+    })?;
+    let stack = parse_stack(stack)?;
+    if file.trim().is_empty() {
+        return Err(EvalError::conflict_on(&["export"], format!("{{export}} {}= names no file", stack.name())));
+    }
+    Ok((stack, PathBuf::from(file)))
+}
+
+/// One estimate of a channel's term, continuous time in the export's SI unit (gyro white noise
+/// rad/s/sqrt(Hz), gyro random walk rad/s^2/sqrt(Hz), accelerometer m/s^2/sqrt(Hz) and
+/// m/s^3/sqrt(Hz)), before any factor.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TermEstimate {
+    /// The value.
+    pub value: f64,
+    /// `value`, `upper_bound`, `fit_value` or `gmwm`.
+    pub basis: String,
+    /// What the basis means for this term (confidence and sidedness, the channel).
+    pub detail: String,
+    /// The factor that puts this estimator's model on or above the channel curve's upper
+    /// confidence bounds at every tau (applied only when overbounding is asked for).
+    pub overbound_factor: Option<f64>,
+}
+
+/// The white-noise and random-walk terms of one gyro or accelerometer channel by every
+/// estimator: what an export is made from (the CLI combines them at once; Python keeps them
+/// with its result, so `result.export(...)` needs no second analysis).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ChannelFilterTerms {
+    /// The channel's name.
+    pub channel: String,
+    /// An accelerometer channel (else a gyro).
+    pub accelerometer: bool,
+    /// Slope readings: the value where resolved, else the upper bound, else the five-term fit;
+    /// [white noise, random walk].
+    pub slopes: [Option<TermEstimate>; 2],
+    /// The weighted five-term fit; [white noise, random walk].
+    pub fit: [Option<TermEstimate>; 2],
+    /// GMWM; [white noise, random walk].
+    pub gmwm: [Option<TermEstimate>; 2],
+}
+
+impl ChannelFilterTerms {
+    fn of(&self, estimator: Estimator) -> &[Option<TermEstimate>; 2] {
+        match estimator {
+            Estimator::Slopes => &self.slopes,
+            Estimator::Fit => &self.fit,
+            Estimator::Gmwm => &self.gmwm,
+        }
+    }
+}
+
+/// The one-sided level of the upper end of a two-sided interval at `c`.
+fn one_sided(c: f64) -> f64 {
+    (1.0 + c) / 2.0
+}
+
+fn percent(c: f64) -> String {
+    let p = c * 100.0;
+    ((p * 10.0).round() / 10.0).to_string()
+}
+
+/// A channel's white-noise and random-walk terms by one estimator, in the curve's coefficient
+/// units (deg/sqrt(s), deg/s/sqrt(s) for a gyro in deg/s; m/s/sqrt(s), m/s^2/sqrt(s) for an
+/// accelerometer) with their sources (intervals written in SI units, `to_si` the factor).
+fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Option<(f64, String, String)>; 2] {
+    let name = match &a.topic {
+        Some(t) => format!("{} {} ({})", a.file, t, a.channel),
+        None => format!("{} ({})", a.file, a.channel),
+    };
+    let conf = a.curve.confidence.unwrap_or(0.683);
+    match estimator {
+        Estimator::Slopes => {
+            let Some(s) = &a.slope_lines else { return [None, None] };
+            let fit = a.model_fit.as_ref().map(|f| f.coefficients);
+            let pick = |r: &Reading, fit_value: Option<f64>| -> Option<(f64, String, String)> {
+                match r {
+                    Reading::Value { value, site } => Some((
+                        *value,
+                        "value".into(),
+                        format!("slope-line value read at tau {} s, {name}", site.tau_s),
+                    )),
+                    Reading::UpperBound { value, tau_s, .. } => Some((
+                        *value,
+                        "upper_bound".into(),
+                        format!(
+                            "UPPER BOUND, not a value: the upper end of the curve's {} % two-sided interval at tau {tau_s} s, i.e. a one-sided {} % bound; {name}",
+                            percent(conf),
+                            percent(one_sided(conf))
+                        ),
+                    )),
+                    Reading::Absent { .. } => fit_value.map(|v| {
+                        (v, "fit_value".into(), format!("five-term fit value (the slope lines neither read nor bound it); {name}"))
+                    }),
+                }
+            };
+            [pick(&s.arw, fit.and_then(|f| f.arw_deg_rt_s)), pick(&s.rrw, fit.and_then(|f| f.rrw_deg_s_rt_s))]
+        }
+        Estimator::Fit => {
+            let Some(f) = &a.model_fit else { return [None, None] };
+            let src = || {
+                format!(
+                    "weighted five-term fit over tau {} to {} s ({:?} fit); {name}",
+                    f.tau_range_s.0, f.tau_range_s.1, f.quality
+                )
+            };
+            [
+                f.coefficients.arw_deg_rt_s.map(|v| (v, "fit_value".into(), src())),
+                f.coefficients.rrw_deg_s_rt_s.map(|v| (v, "fit_value".into(), src())),
+            ]
+        }
+        Estimator::Gmwm => {
+            let Some(g) = &a.gmwm else { return [None, None] };
+            let model: Vec<&str> = g.parameters.iter().map(|p| p.process.name()).collect();
+            let term = |p: Process, unit: &str| {
+                g.parameter(p).map(|x| {
+                    (
+                        x.value,
+                        "gmwm".into(),
+                        format!(
+                            "GMWM estimate, {} % two-sided interval [{}, {}] {unit} (asymptotic sandwich covariance with the scales' covariance under the fitted model; coverage in simulation: docs/METHODS.md 3.1), model {}; {name}",
+                            percent(g.confidence),
+                            real_text(x.lower * to_si),
+                            real_text(x.upper * to_si),
+                            model.join(" + ")
+                        ),
+                    )
+                })
+            };
+            let accel = a.quantity == Quantity::Acceleration;
+            [
+                term(Process::White, if accel { "m/s^2/sqrt(Hz)" } else { "rad/s/sqrt(Hz)" }),
+                term(Process::RandomWalk, if accel { "m/s^3/sqrt(Hz)" } else { "rad/s^2/sqrt(Hz)" }),
+            ]
+        }
+    }
+}
+
+/// The filter terms of one analysed channel by every estimator, with their overbound factors
+/// on the channel's curve; `None` for a channel that is neither a gyro nor an accelerometer
+/// (in calibrated units).
+pub fn channel_filter_terms(a: &ChannelAnalysis) -> Option<ChannelFilterTerms> {
+    let (accelerometer, to_si) = match a.quantity {
+        Quantity::AngularRate => (false, units::deg_to_rad(1.0)),
+        Quantity::Acceleration => (true, 1.0),
+        _ => return None,
+    };
+    let terms = |estimator: Estimator| -> [Option<TermEstimate>; 2] {
+        let t = channel_terms(a, estimator, to_si);
+        let factors = overbound_factors(&a.curve, t[0].as_ref().map(|x| x.0), t[1].as_ref().map(|x| x.0), None);
+        let mut out: [Option<TermEstimate>; 2] = Default::default();
+        for (i, x) in t.into_iter().enumerate() {
+            out[i] = x.map(|(value, basis, detail)| TermEstimate {
+                value: value * to_si,
+                basis,
+                detail,
+                overbound_factor: factors.and_then(|f| if i == 0 { f.white } else { f.random_walk }),
+            });
+        }
+        out
+    };
+    Some(ChannelFilterTerms {
+        channel: a.channel.clone(),
+        accelerometer,
+        slopes: terms(Estimator::Slopes),
+        fit: terms(Estimator::Fit),
+        gmwm: terms(Estimator::Gmwm),
+    })
+}
+
+/// Checks `--inflate`.
+fn check_inflate(inflate: f64) -> EvalResult<()> {
+    if !(inflate.is_finite() && inflate > 0.0) {
+        return Err(EvalError::conflict_on(&["inflate"], format!("{{inflate}} {inflate} is not a positive number")));
+    }
+    Ok(())
+}
+
+/// The record an export is made for.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExportRecord {
+    /// The record's name (file, and topic of a recording).
+    pub record: String,
+    /// The sample rate, Hz.
+    pub rate_hz: f64,
+    /// The record was written by gyrolab's simulator.
+    pub simulated: bool,
+    /// The ROS topic, when the record is a topic of a recording.
+    pub rostopic: Option<String>,
+    /// The `MOTION: ...` line of each channel that moved (the stillness check), for every
+    /// file's header.
+    pub motion: Vec<String>,
+}
+
+/// The noise export of one record from its channels' terms: per quantity and term the largest
+/// value over the channels (after its overbound factor when overbounding), times the
+/// inflation; with the warnings to show (terms that are bounds or fit values, not estimated,
+/// overbound factors above 1).
+pub fn combine_terms(
+    record: &ExportRecord,
+    channels: &[ChannelFilterTerms],
+    request: &ExportRequest,
+) -> EvalResult<(NoiseExport, Vec<String>)> {
+    check_inflate(request.inflate)?;
+    let mut slots: [Vec<&TermEstimate>; 4] = Default::default();
+    for c in channels {
+        let base = if c.accelerometer { 2 } else { 0 };
+        for (i, t) in c.of(request.estimator).iter().enumerate() {
+            if let Some(t) = t {
+                slots[base + i].push(t);
+            }
+        }
+    }
+    if slots.iter().all(Vec::is_empty) {
+        return Err(EvalError::conflict(
+            "no noise terms for an export: give the gyro channels a unit such as --unit rad/s (accelerometers m/s^2), or calibrate outputs, and use --kind oadev with --taus octave",
+        ));
+    }
+    let factor = |t: &TermEstimate| if request.overbound { t.overbound_factor.unwrap_or(1.0) } else { 1.0 };
+    let mut warnings = Vec::new();
+    let what = ["gyro white noise", "gyro random walk", "accelerometer white noise", "accelerometer random walk"];
+    let mut combined: [Option<ExportTerm>; 4] = Default::default();
+    for (i, list) in slots.into_iter().enumerate() {
+        // The largest (after its overbound factor) over the channels, as allan_variance_ros.
+        let Some(t) = list.into_iter().max_by(|a, b| (a.value * factor(a)).total_cmp(&(b.value * factor(b)))) else {
+            warnings.push(format!("{} not estimated: not written to the exports", what[i]));
+            continue;
+        };
+        if t.basis == "upper_bound" || t.basis == "fit_value" {
+            let kind = if t.basis == "upper_bound" { "an upper bound, not a value," } else { "a five-term fit value" };
+            warnings.push(format!("{} is {kind} in the exports: {}", what[i], t.detail));
+        }
+        let f = request.overbound.then(|| factor(t));
+        if let Some(f) = f.filter(|f| *f > 1.0) {
+            warnings.push(format!("{} overbounded: x {f:.4} to lie above the curve's upper bounds", what[i]));
+        }
+        combined[i] = Some(ExportTerm {
+            value: t.value * f.unwrap_or(1.0) * request.inflate,
+            estimate: t.value,
+            overbound_factor: f,
+            source: TermSource { basis: t.basis.clone(), detail: t.detail.clone() },
+        });
+    }
+    let [gyro_noise, gyro_walk, accel_noise, accel_walk] = combined;
+    let export = NoiseExport {
+        record: record.record.clone(),
+        rate_hz: record.rate_hz,
+        simulated: record.simulated,
+        estimator: request.estimator.name().to_string(),
+        inflation: request.inflate,
+        gyro_noise,
+        gyro_walk,
+        accel_noise,
+        accel_walk,
+        rostopic: record.rostopic.clone(),
+        motion: record.motion.clone(),
+        writer: env!("CARGO_PKG_VERSION").to_string(),
+    };
+    Ok((export, warnings))
+}
+
+/// The text of one stack's file (by its name: kalibr, openvins, vins, orbslam3, basalt, px4,
+/// px4-qgc, ros-covariance) from the channels' terms, with the warnings (see
+/// [`combine_terms`]); the Python package's `result.export(...)`.
+pub fn render_export(
+    record: &ExportRecord,
+    channels: &[ChannelFilterTerms],
+    stack: &str,
+    request: &ExportRequest,
+) -> EvalResult<(String, Vec<String>)> {
+    let stack = parse_stack(stack)?;
+    let (export, warnings) = combine_terms(record, channels, request)?;
+    Ok((export.render(stack), warnings))
+}
+
+/// Whether a file was written by gyrolab's simulator (the SIMULATED mark of its exports).
+pub fn is_simulated_record(path: &Path) -> bool {
+    gyrolab_io::noise_export::is_gyrolab_simulation(path)
+}
+
+/// The noise export of one record (an outcome of [`crate::allan::analyse_records`]) and the
+/// warnings to show (terms that are bounds, not estimated, overbound factors).
+pub fn noise_export(
+    outcome: &AllanOutcome,
+    file: &Path,
+    request: &ExportRequest,
+) -> EvalResult<(NoiseExport, Vec<String>)> {
+    let channels: Vec<ChannelFilterTerms> = outcome.analyses.iter().filter_map(channel_filter_terms).collect();
+    let record = ExportRecord {
+        record: match &outcome.topic {
+            Some(t) => format!("{} topic {}", file.display(), t.topic),
+            None => file.display().to_string(),
+        },
+        rate_hz: 1.0 / outcome.sample_interval_s,
+        simulated: is_simulated_record(file),
+        rostopic: outcome.topic.as_ref().map(|t| t.topic.clone()),
+        motion: outcome.analyses.iter().filter_map(|a| a.motion_line()).collect(),
+    };
+    combine_terms(&record, &channels, request)
+}
+
+/// Writes the exports of every record of a run (one file per topic when there are several:
+/// imu.yaml -> imu_<topic>.yaml), all or none; returns the files written and the warnings.
+pub fn write_exports(
+    outcomes: &[AllanOutcome],
+    file: &Path,
+    request: &ExportRequest,
+) -> EvalResult<(Vec<PathBuf>, Vec<String>)> {
+    let several = outcomes.len() > 1;
+    let mut files = Vec::new();
+    let mut warnings = Vec::new();
+    for outcome in outcomes {
+        let (export, mut w) = noise_export(outcome, file, request)?;
+        if several {
+            if let Some(t) = &outcome.topic {
+                w.iter_mut().for_each(|x| *x = format!("topic {}: {x}", t.topic));
+            }
+        }
+        warnings.append(&mut w);
+        for (stack, path) in &request.targets {
+            let target = match (&outcome.topic, several) {
+                (Some(t), true) => crate::recording::per_topic_path(path, &t.topic),
+                _ => path.clone(),
+            };
+            files.push((target, export.render(*stack).into_bytes()));
+        }
+    }
+    let written = gyrolab_io::atomic::write_files(&files)
+        .map_err(|(path, e)| EvalError::Output(format!("{}: {e} (no export file was written)", path.display())))?;
+    Ok((written, warnings))
+}

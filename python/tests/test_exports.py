@@ -1,0 +1,96 @@
+"""result.export(stack): the filter stacks' files from Python, read back by PyYAML and OpenCV and
+checked against the simulated truth and the hand conversions (docs/EXPORTS.md), equal to the
+CLI's `--export` on the same record, and available after a pickle round trip."""
+import math
+import pickle
+import subprocess
+import warnings
+
+import cv2
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+import gyrolab
+
+RATE = 200.0
+N_GYRO = 2.0e-3  # rad/s/sqrt(Hz)
+N_ACC = 3.0e-2  # m/s^2/sqrt(Hz)
+
+
+@pytest.fixture(scope="module")
+def record():
+    rng = np.random.default_rng(3601)
+    n = 120_000
+    return pd.DataFrame(
+        {
+            "gyro_x": rng.standard_normal(n) * N_GYRO * math.sqrt(RATE),
+            "accel_x": 9.81 + rng.standard_normal(n) * N_ACC * math.sqrt(RATE),
+        }
+    )
+
+
+def analyse(frame):
+    return gyrolab.allan(frame, rate_hz=RATE, units={"gyro_x": "rad/s", "accel_x": "m/s^2"})
+
+
+def test_kalibr_and_ros_from_python_hold_the_truth_and_the_hand_conversion(record, tmp_path):
+    r = analyse(record)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        kalibr = yaml.safe_load(r.export("kalibr"))
+        target = tmp_path / "ros.yaml"
+        r.export("ros-covariance", target)
+    ng, na = kalibr["gyroscope_noise_density"], kalibr["accelerometer_noise_density"]
+    assert abs(ng / N_GYRO - 1) < 0.05 and abs(na / N_ACC - 1) < 0.05, (ng, na)
+    assert kalibr["update_rate"] == RATE
+    ros = yaml.safe_load(target.read_text())
+    # Per-sample variance = (density x sqrt(rate))^2, by hand.
+    assert ros["angular_velocity_covariance"][0] == pytest.approx((ng * math.sqrt(RATE)) ** 2, rel=1e-12)
+    assert ros["linear_acceleration_covariance"][8] == pytest.approx((na * math.sqrt(RATE)) ** 2, rel=1e-12)
+
+
+def test_orbslam3_reads_with_opencv_and_inflation_is_applied(record, tmp_path):
+    r = analyse(record)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plain = tmp_path / "orb.yaml"
+        r.export("orbslam3", plain)
+        tenfold = tmp_path / "orb10.yaml"
+        r.export("orbslam3", tenfold, inflate=10)
+    a = cv2.FileStorage(str(plain), cv2.FILE_STORAGE_READ)
+    b = cv2.FileStorage(str(tenfold), cv2.FILE_STORAGE_READ)
+    assert b.getNode("IMU.NoiseGyro").real() == pytest.approx(10 * a.getNode("IMU.NoiseGyro").real(), rel=1e-12)
+    assert a.getNode("IMU.Frequency").real() == RATE
+    assert "x 10 (--inflate)" in tenfold.read_text()
+
+
+def test_python_export_equals_the_cli_export(record, tmp_path, cli):
+    csv = tmp_path / "imu.csv"
+    frame = record.copy()
+    frame.insert(0, "time_s", np.arange(len(frame)) / RATE)
+    frame.columns = ["time_s", "gyro_x [rad/s]", "accel_x [m/s^2]"]
+    frame.to_csv(csv, index=False, float_format="%.17g")
+    out = tmp_path / "cli.yaml"
+    subprocess.run([cli, "allan", str(csv), "--sample-rate-hz", str(RATE), "--export", f"vins={out}"],
+                   check=True, capture_output=True)
+    r = gyrolab.allan(str(csv), rate_hz=RATE)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        text = r.export("vins")
+    body = lambda t: [l for l in t.splitlines() if not l.startswith("#")]  # noqa: E731
+    assert body(text) == body(out.read_text())
+
+
+def test_export_survives_pickling_and_bad_names_are_errors(record):
+    r = analyse(record)
+    again = pickle.loads(pickle.dumps(r))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert again.export("basalt") == r.export("basalt")
+        assert again["gyro_x"].export("px4") == r["gyro_x"].export("px4")
+    with pytest.raises(gyrolab.Error, match="unknown stack 'gtsam'"):
+        r.export("gtsam")
+    with pytest.raises(gyrolab.Error, match="estimator"):
+        r.export("kalibr", estimator="median")
