@@ -94,15 +94,13 @@ fn set_wal(c: &rusqlite::Connection, budget: Duration) -> Result<(), String> {
     let start = std::time::Instant::now();
     let mut pause = Duration::from_millis(5);
     loop {
-        let attempt = c
-            .query_row("PRAGMA journal_mode", [], |r| r.get::<_, String>(0))
-            .and_then(|mode| {
-                if mode.eq_ignore_ascii_case("wal") {
-                    Ok(mode)
-                } else {
-                    c.query_row("PRAGMA journal_mode = WAL", [], |r| r.get::<_, String>(0))
-                }
-            });
+        let attempt = c.query_row("PRAGMA journal_mode", [], |r| r.get::<_, String>(0)).and_then(|mode| {
+            if mode.eq_ignore_ascii_case("wal") {
+                Ok(mode)
+            } else {
+                c.query_row("PRAGMA journal_mode = WAL", [], |r| r.get::<_, String>(0))
+            }
+        });
         match attempt {
             Ok(mode) if mode.eq_ignore_ascii_case("wal") => return Ok(()),
             Ok(mode) => return Err(format!("cannot use write-ahead logging (journal mode stays '{mode}')")),

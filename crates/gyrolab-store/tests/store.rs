@@ -311,7 +311,10 @@ fn many_processes_opening_a_new_sqlite_store_at_once_all_open() {
             }
         }
         let mut s = Store::open(&loc, false).unwrap();
-        assert_eq!(count(&mut s), 40 - 5 * failures.iter().filter(|f| f.starts_with(&format!("round {round}:"))).count());
+        assert_eq!(
+            count(&mut s),
+            40 - 5 * failures.iter().filter(|f| f.starts_with(&format!("round {round}:"))).count()
+        );
     }
     assert!(failures.is_empty(), "{} of 96 opens failed:\n{}", failures.len(), failures.join("\n"));
 }
