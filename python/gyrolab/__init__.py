@@ -211,6 +211,7 @@ def allan(
     gaps: str = "error",
     names: Optional[Sequence[str]] = None,
     record: Optional[str] = None,
+    allow_motion: bool = False,
 ) -> Union[AllanResult, AllanResults]:
     """Allan-family deviation, confidence bounds and noise terms of rate samples.
 
@@ -240,6 +241,12 @@ def allan(
     ``gaps``: "error" (default: a NaN sample or a gap in the time stamps is refused, naming
     the first) or "analyse" (computed over, as ``gyrolab allan --gaps analyse``).
     ``record``: the name results and errors carry (default the path, or ``<array>``).
+
+    Stillness: a gyro (deg/s) or accelerometer (m/s^2) channel whose 1 s window means depart
+    from the record's still level (docs/METHODS.md, "Stillness check") moved: the call raises
+    :class:`Error` (keyword ``allow_motion``) naming the channel and the episode; with
+    ``allow_motion=True`` the results carry ``stillness["moved"] = True`` and every export
+    a ``MOTION:`` header line.
 
     Every channel is computed with the interpreter released, on gyrolab's own thread pool
     (safe in fork-based multiprocessing pools).
@@ -288,7 +295,7 @@ def allan(
             rate_hz = float(rate_hz)
         except (TypeError, ValueError):
             raise Error(f"rate_hz={rate_hz!r}: expected a number of hertz", keyword="rate_hz") from None
-    doc_json, per_channel = _gyrolab.allan_channels(
+    doc_json, per_channel, filter_terms = _gyrolab.allan_channels(
         arrays,
         cols,
         chan_units,
@@ -303,11 +310,12 @@ def allan(
         fit_range_s,
         "analyse" if gaps in ("analyse", "analyze") else "error",
         record or "<array>",
+        bool(allow_motion),
     )
     doc = json.loads(doc_json)
     results = {
-        ch["channel"]: AllanResult._from_json(ch, arrays_of, rounded)
-        for ch, arrays_of in zip(doc["channels"], per_channel)
+        ch["channel"]: AllanResult._from_json(ch, arrays_of, rounded, terms)
+        for ch, arrays_of, terms in zip(doc["channels"], per_channel, filter_terms)
     }
     if single:
         return next(iter(results.values()))
@@ -499,10 +507,18 @@ def read_with_units(
 
 def evaluate_plan(plan: PathLike, out: PathLike) -> Dict[str, Any]:
     """Evaluates a test plan (TOML, as ``gyrolab eval``) and writes its report folder to ``out``
-    (all files or none). Returns ``{"verdict": "PASS"|"FAIL"|"NOT_EVALUATED"|None, "files":
-    [...], "failures": [...]}``."""
-    verdict, files, failures = _gyrolab.evaluate_plan(str(plan), str(out))
-    return {"verdict": verdict, "files": [str(f) for f in files], "failures": list(failures)}
+    (all files or none). Returns ``{"verdict": "PASS"|"FAIL"|"INCOMPLETE"|"CONDITIONAL"|None,
+    "files": [...], "failures": [...], "undecided": [...]}``: the overall result of the plan's
+    limits (None without limits; INCOMPLETE when a check could not be evaluated, which never
+    counts as passed; CONDITIONAL inside a guard band), the files written, one line per failed
+    check, and one line per check CONDITIONAL or NOT EVALUATED with its reason."""
+    verdict, files, failures, undecided = _gyrolab.evaluate_plan(str(plan), str(out))
+    return {
+        "verdict": verdict,
+        "files": [str(f) for f in files],
+        "failures": list(failures),
+        "undecided": list(undecided),
+    }
 
 
 def apply(outputs: Any, calibration: PathLike, axis: Optional[str] = None) -> Dict[str, np.ndarray]:

@@ -55,10 +55,22 @@ class AllanResult:
     readings: List[Dict[str, Any]]
     fit: Optional[Dict[str, Any]]
     noise_note: Optional[str]
+    stillness: Optional[Dict[str, Any]]
     taus_rounded: Dict[float, float]
     def __getattr__(self, name: str) -> Any: ...
     def to_dict(self) -> Dict[str, Any]:
         """The result with the keys of `gyrolab allan --json`."""
+    def export(
+        self,
+        stack: str,
+        path: Optional[Union[str, "os.PathLike[str]"]] = ...,
+        *,
+        estimator: str = ...,
+        inflate: float = ...,
+        overbound: bool = ...,
+    ) -> str:
+        """This channel's noise parameters as one filter stack's file (kalibr, openvins, vins,
+        orbslam3, basalt, px4, px4-qgc, ros-covariance); written to `path` when given."""
     def to_dataframe(self) -> Any:
         """The curve as a tidy DataFrame."""
     def noise_table(self) -> Any:
@@ -80,6 +92,16 @@ class AllanResults(Mapping[str, AllanResult]):
     def to_dataframe(self) -> Any: ...
     def noise_table(self) -> Any: ...
     def to_dict(self) -> Dict[str, Any]: ...
+    def export(
+        self,
+        stack: str,
+        path: Optional[Union[str, "os.PathLike[str]"]] = ...,
+        *,
+        estimator: str = ...,
+        inflate: float = ...,
+        overbound: bool = ...,
+    ) -> str:
+        """The record's noise parameters as one filter stack's file (channels combined)."""
     def plot(self, ax: Any = ..., asymptotes: bool = ..., terms: Optional["AllanResults"] = ...) -> Any: ...
 
 def allan(
@@ -98,6 +120,7 @@ def allan(
     gaps: str = ...,
     names: Optional[Sequence[str]] = ...,
     record: Optional[str] = ...,
+    allow_motion: bool = ...,
 ) -> Any:
     """Allan-family deviation of rate samples: a 1-D array gives an AllanResult; a DataFrame,
     dict of arrays, 2-D array or file path gives AllanResults (see the docstring)."""
@@ -167,7 +190,7 @@ def read_with_units(
     """A time-series file: (column -> array, column -> unit symbol)."""
 
 def evaluate_plan(plan: PathLike, out: PathLike) -> Dict[str, Any]:
-    """Evaluates a test plan into a report folder: verdict, files, failures."""
+    """Evaluates a test plan into a report folder: verdict (PASS, FAIL, INCOMPLETE, CONDITIONAL), files, failures, undecided."""
 
 def apply(outputs: Any, calibration: PathLike, axis: Optional[str] = ...) -> Dict[str, np.ndarray]:
     """Applies a calibration file to outputs: rate_dps (or rate_x/y/z_dps) and status arrays."""

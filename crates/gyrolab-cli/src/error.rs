@@ -1,7 +1,10 @@
 //! Errors of the command-line program and their exit codes (documented in README):
 //! 0 success; 1 an internal or output failure; 2 bad usage or bad data (a plan error included);
 //! 3 a spec limit failed (`gyrolab eval`: every output was written, the report shows FAIL);
-//! 4 some inputs of a batch failed (`gyrolab batch`: the others were evaluated and written).
+//! 4 some inputs of a batch failed (`gyrolab batch`: the others were evaluated and written);
+//! 5 the result is INCOMPLETE (`gyrolab eval`: no limit failed, but a required check could not be
+//! evaluated: a check not evaluated never counts as passed); 6 the result is CONDITIONAL (no
+//! limit failed, every check evaluated, at least one inside the guard band of its decision rule).
 
 use gyrolab_eval::EvalError;
 use std::process::ExitCode;
@@ -19,6 +22,14 @@ pub enum CliError {
     /// The evaluation succeeded and its outputs were written, but a spec limit failed (exit 3).
     #[error("{0}")]
     LimitFailed(String),
+    /// The outputs were written; no limit failed but at least one required check was not
+    /// evaluated (exit 5).
+    #[error("{0}")]
+    Incomplete(String),
+    /// The outputs were written; no limit failed, every check was evaluated, and at least one is
+    /// CONDITIONAL (inside its guard band; exit 6).
+    #[error("{0}")]
+    Conditional(String),
     /// Some inputs of a batch failed; the others were evaluated and written (exit 4).
     #[error("{0}")]
     SomeFailed(String),
@@ -38,6 +49,8 @@ impl CliError {
             CliError::Eval(_) => ExitCode::from(2),
             CliError::LimitFailed(_) => ExitCode::from(3),
             CliError::SomeFailed(_) => ExitCode::from(4),
+            CliError::Incomplete(_) => ExitCode::from(5),
+            CliError::Conditional(_) => ExitCode::from(6),
             CliError::Store(e) if !e.is_bad_input() => ExitCode::from(1),
             CliError::Store(_) | CliError::Usage(_) => ExitCode::from(2),
         }

@@ -85,6 +85,10 @@ fn main() -> ExitCode {
             eprintln!("FAIL: {e}");
             e.exit_code()
         }
+        Err(e @ (error::CliError::Incomplete(_) | error::CliError::Conditional(_))) => {
+            eprintln!("{e}");
+            e.exit_code()
+        }
         Err(e) => {
             eprintln!("error: {e}");
             e.exit_code()

@@ -13,7 +13,9 @@ use std::time::{Duration, Instant};
 
 const CHROMIUM: &str = "/usr/bin/chromium";
 const WIDTH: u32 = 1200;
-const HEIGHT: u32 = 2400;
+/// Tall enough for the header, the summary (which lists the Allan terms known only as upper
+/// bounds, "at most ...", since issue 33) and the first axis's plots.
+const HEIGHT: u32 = 2800;
 
 /// Runs headless Chromium on `html`, writing a screenshot `height` pixels tall to `png`; at
 /// most 180 s.

@@ -41,7 +41,7 @@ fn paper_plan_writes_every_output_and_fails_its_limits_with_exit_3() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(stdout.contains("Spec limits: FAIL"), "{stdout}");
     assert!(stderr.starts_with("FAIL: 3 spec limit check(s) failed"), "{stderr}");
-    assert!(stderr.contains("axis x: linearity_pct = 5.543 % FS (limit ≤ 0.02)"), "{stderr}");
+    assert!(stderr.contains("axis x: linearity_pct = 5.543 % FS (limit ≤ 0.02; simple_acceptance)"), "{stderr}");
     assert!(!stderr.contains("panicked"));
     for f in [
         "report.html",
@@ -63,8 +63,13 @@ fn paper_plan_writes_every_output_and_fails_its_limits_with_exit_3() {
     assert!(html.contains("<span class=\"verdict NOT_EVALUATED\">NOT EVALUATED</span>"));
     assert_eq!(html.matches("<svg class=\"plot\"").count(), 9, "three plots per axis");
     let summary = read(&out.join("summary.csv"));
-    assert!(summary.contains("x,linearity_pct,% FS,5.5432247913663435,,0.02,FAIL"), "{summary}");
-    assert!(summary.contains("z,bias_stability_dph_10s,deg/h,,,20,NOT EVALUATED"), "{summary}");
+    assert!(!summary.contains("SIMULATED") && !read(&out.join("points_x.csv")).contains("SIMULATED"));
+    assert!(!html.contains("sim-page\">"), "measured data carry no SIMULATED mark");
+    assert!(
+        summary.contains("x,linearity_pct,% FS,5.5432247913663435,value,,0.02,simple_acceptance,FAIL,\n"),
+        "{summary}"
+    );
+    assert!(summary.contains("z,bias_stability_dph_10s,deg/h,,,,20,simple_acceptance,NOT EVALUATED,\n"), "{summary}");
 }
 
 #[test]
@@ -86,12 +91,94 @@ fn passing_limits_exit_0_and_quiet_prints_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let text = read(&example_plan())
         .replace("../data/paper/", &format!("{}/", common::paper("").display()))
-        .replace("linearity_pct = { max = 0.02 }", "linearity_pct = { max = 6 }");
+        .replace("linearity_pct = { max = 0.02 }", "linearity_pct = { max = 6 }")
+        .replace("bias_stability_dph_10s = { max = 20 }", "");
     let plan = write(dir.path(), "plan.toml", &text);
     let out = dir.path().join("out");
     gyrolab().arg("eval").arg(&plan).arg("--out").arg(&out).arg("-q").assert().code(0).stdout("").stderr("");
     let v: serde_json::Value = serde_json::from_str(&read(&out.join("results.json"))).unwrap();
     assert_eq!(v["verdict"], "PASS");
+}
+
+/// The paper's plan with an `[uncertainty]` table (k = 2, rate accuracy 50 ppm) and the given
+/// options and limits instead of its own.
+fn paper_plan_with(dir: &Path, options: &str, limits: &str) -> PathBuf {
+    let text = read(&example_plan()).replace("../data/paper/", &format!("{}/", common::paper("").display()));
+    let text = text[..text.find("[limits]").unwrap()].replace("[options]\n", &format!("[options]\n{options}\n"));
+    let text = format!("{text}\n[uncertainty]\ncoverage_factor = 2\nrate_accuracy_ppm = 50\n\n[limits]\n{limits}\n");
+    write(dir, "plan.toml", &text)
+}
+
+/// Runs `eval` on the plan; (exit code, stderr, results.json).
+fn eval_code(plan: &Path, out: &Path) -> (i32, String, serde_json::Value) {
+    let o = gyrolab().arg("eval").arg(plan).arg("--out").arg(out).arg("-q").output().unwrap();
+    let v = serde_json::from_str(&read(&out.join("results.json"))).unwrap();
+    (o.status.code().unwrap(), String::from_utf8_lossy(&o.stderr).into_owned(), v)
+}
+
+/// Issue 33: every verdict branch through the command line, with the exit codes: INCOMPLETE (5)
+/// when a required check is not evaluated, CONDITIONAL (6) inside a guard band of U(K), FAIL (3),
+/// PASS (0), the rule and the guard band in results.json, and bounds decided per axis.
+#[test]
+fn decision_rules_give_conditional_and_incomplete_their_own_exit_codes() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    // K and U(K) of axis x, from a passing run.
+    let plan = paper_plan_with(dir.path(), "", "scale_factor = { min = 0.007, max = 0.008 }");
+    let (code, err, v) = eval_code(&plan, &out);
+    assert_eq!((code, v["verdict"].as_str()), (0, Some("PASS")), "{err}");
+    let x = &v["rate_axes"][0];
+    let k = x["scale_factor"].as_f64().unwrap();
+    let check = &v["limit_checks"][0];
+    let u = check["expanded_uncertainty"].as_f64().expect("U(K) reaches the check");
+    // The paper's K has a standard error of about 2 % (issue 33): U (k = 2) about 4 %.
+    assert!(u > 0.0 && u < 0.1 * k, "U(K) = {u} for K = {k}");
+    assert_eq!((check["rule"].as_str(), check["guard_band"].as_f64()), (Some("simple_acceptance"), Some(0.0)));
+
+    // Guarded acceptance, the limit half a guard band above K: CONDITIONAL, exit 6.
+    let near_above = format!("scale_factor = {{ max = {}, axes = [\"x\"] }}", k + 0.5 * u);
+    let plan = paper_plan_with(dir.path(), "decision_rule = \"guarded_acceptance\"", &near_above);
+    let (code, err, v) = eval_code(&plan, &out);
+    assert_eq!((code, v["verdict"].as_str()), (6, Some("CONDITIONAL")), "{err}");
+    assert!(err.contains("CONDITIONAL") && err.contains("axis x: scale_factor"), "{err}");
+    let c = &v["limit_checks"];
+    assert_eq!(c.as_array().unwrap().len(), 1, "the limit applies to axis x only: {c}");
+    assert!((c[0]["guard_band"].as_f64().unwrap() - u).abs() <= 1e-12 * u);
+    assert!(c[0]["reason"].as_str().unwrap().starts_with("conditional pass"), "{c}");
+    assert_eq!(v["decision_rules"][0]["rule"], "guarded_acceptance");
+    let html = read(&out.join("report.html"));
+    assert!(html.contains("verdict overall CONDITIONAL") && html.contains("Decision rule: guarded acceptance"));
+    let csv = read(&out.join("summary.csv"));
+    assert!(csv.starts_with("axis,figure,unit,value,basis,limit_min,limit_max,rule,verdict,simulated\n"), "{csv}");
+    assert!(csv.contains(",guarded_acceptance,CONDITIONAL,"), "{csv}");
+    // The same limit under simple acceptance and guarded rejection: PASS.
+    for rule in ["simple_acceptance", "guarded_rejection"] {
+        let plan = paper_plan_with(dir.path(), &format!("decision_rule = \"{rule}\""), &near_above);
+        assert_eq!(eval_code(&plan, &out).0, 0, "{rule}");
+    }
+    // Half a guard band below K: FAIL (3) under simple acceptance, CONDITIONAL (conditional
+    // fail, 6) under guarded rejection, set on the limit itself.
+    let plan = paper_plan_with(dir.path(), "", &format!("scale_factor = {{ max = {}, axes = [\"x\"] }}", k - 0.5 * u));
+    assert_eq!(eval_code(&plan, &out).0, 3);
+    let below = format!("scale_factor = {{ max = {}, axes = [\"x\"], rule = \"guarded_rejection\" }}", k - 0.5 * u);
+    let (code, _, v) = eval_code(&paper_plan_with(dir.path(), "", &below), &out);
+    assert_eq!(code, 6);
+    assert!(v["limit_checks"][0]["reason"].as_str().unwrap().starts_with("conditional fail"));
+
+    // A required check not evaluated: INCOMPLETE, exit 5, never PASS; a guarded rule on a figure
+    // without an uncertainty likewise.
+    for limits in [
+        "linearity_pct = { max = 6 }\nbias_stability_dph_10s = { max = 20 }",
+        "hysteresis_pct = { max = 1.0, rule = \"guarded_acceptance\" }",
+    ] {
+        let (code, err, v) = eval_code(&paper_plan_with(dir.path(), "", limits), &out);
+        assert_eq!((code, v["verdict"].as_str()), (5, Some("INCOMPLETE")), "{limits}: {err}");
+        assert!(err.starts_with("INCOMPLETE: no spec limit failed"), "{err}");
+        assert!(
+            err.contains("the figure is not available") || err.contains("needs the figure's expanded uncertainty"),
+            "{err}"
+        );
+    }
 }
 
 fn plan_error(edit: impl Fn(&str) -> String) -> String {
@@ -175,6 +262,31 @@ fn demo_out_writes_the_papers_report() {
         "rate plots + bias, temperature, Allan per axis"
     );
     assert!(read(&out.join("bias_tests.csv")).contains("SIMULATED"));
+    // Issue 33: the folder says SIMULATED at the top of results.json, on every printed page, in
+    // every CSV (first line, or summary.csv's column for its simulated rows), and the measured
+    // rate-table files say that their own rows are not simulated.
+    assert_eq!(v["simulated"], true);
+    assert!(html.contains("<div class=\"sim-page\">SIMULATED DATA"));
+    let mut csvs = 0;
+    for e in std::fs::read_dir(&out).unwrap() {
+        let p = e.unwrap().path();
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        if !name.ends_with(".csv") {
+            continue;
+        }
+        csvs += 1;
+        let text = read(&p);
+        if name == "summary.csv" || name == "program_summary.csv" {
+            assert!(text.lines().next().unwrap().ends_with(",simulated"), "{name}");
+            assert!(text.lines().any(|l| l.ends_with(",SIMULATED")), "{name}: no simulated row");
+        } else {
+            assert!(text.starts_with("# SIMULATED"), "{name} has no SIMULATED mark: {}", &text[..text.len().min(120)]);
+        }
+        if name.starts_with("points_") {
+            assert!(text.starts_with("# SIMULATED INPUTS:"), "{name}: the paper's measured points");
+        }
+    }
+    assert!(csvs >= 10, "{csvs} CSV files");
     // Same inputs, same report apart from the time stamp.
     let out2 = dir.path().join("demo2");
     gyrolab().arg("demo").arg("--out").arg(&out2).args(short).arg("--quiet").assert().code(0);
@@ -333,6 +445,20 @@ fn static_plan_errors_name_the_key() {
     let a = gyrolab().arg("eval").arg(&plan).arg("--out").arg(dir.path().join("o")).assert().code(2);
     let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
     assert!(err.contains("static.x.temperature_channel") && !err.contains("panicked"), "{err}");
+    // A limit on the within-record temperature slope (confounded with drift) is refused, naming
+    // the line and the figure to limit instead (issue 33); nothing is written.
+    let plan = static_plan(dir.path(), "bias_dph = { max = 100 }\ntemp_sensitivity_dph_per_c = { max = 1 }");
+    let line = read(&plan).lines().position(|l| l.starts_with("temp_sensitivity_dph_per_c =")).unwrap() + 1;
+    let out = dir.path().join("refused");
+    let a = gyrolab().arg("eval").arg(&plan).arg("--out").arg(&out).assert().code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(err.contains(&format!("plan.toml:{line}")), "{err}");
+    assert!(
+        err.contains("limits.temp_sensitivity_dph_per_c: a within-record temperature slope is confounded"),
+        "{err}"
+    );
+    assert!(err.contains("bias_temp_sensitivity_dph_per_c"), "{err}");
+    assert!(!out.exists());
 }
 
 /// Rounds every number to 10 significant digits: snapshots compare figures, not the last bits
@@ -396,4 +522,42 @@ fn raw_log_plan_is_segmented_and_recovers_the_simulated_scale_factor() {
     let slope = lsq_slope(&rates, &means);
     assert!((slope / k - 1.0).abs() < 1e-6, "slope {slope} against K {k}");
     assert!(v["sections"]["segmentation"]["x"].is_object());
+}
+
+#[test]
+fn plan_exports_write_filter_files_from_the_static_allan_analysis() {
+    let dir = tempfile::tempdir().unwrap();
+    write_static_records(dir.path());
+    let text = read(&static_plan(dir.path(), ""))
+        .replace("[static.x]", "[options]\nexports = [\"kalibr\", \"px4\"]\n\n[static.x]");
+    let plan = write(dir.path(), "plan.toml", &text);
+    let out = dir.path().join("out");
+    gyrolab().arg("eval").arg(&plan).arg("--out").arg(&out).arg("-q").assert().code(0);
+    let v: serde_json::Value = serde_json::from_str(&read(&out.join("results.json"))).unwrap();
+    let arw = v["sections"]["allan"]["x"]["noise"]["arw_deg_rt_h"].as_f64().unwrap();
+    let kalibr = read(&out.join("noise_kalibr.yaml"));
+    let density = kalibr
+        .lines()
+        .find_map(|l| l.strip_prefix("gyroscope_noise_density:"))
+        .and_then(|r| r.split('#').next())
+        .map(|r| r.trim().parse::<f64>().unwrap())
+        .unwrap_or_else(|| panic!("{kalibr}"));
+    // By hand: N deg/sqrt(h) / 60 = deg/sqrt(s), x pi/180 = rad/s/sqrt(Hz).
+    let want = arw / 60.0 * std::f64::consts::PI / 180.0;
+    assert!((density / want - 1.0).abs() < 1e-9, "{density} vs {want}\n{kalibr}");
+    assert!(kalibr.contains("update_rate: 100.0") && kalibr.contains("long.csv"), "{kalibr}");
+    let px4 = read(&out.join("noise_px4.txt"));
+    let gyr = px4
+        .lines()
+        .find_map(|l| l.strip_prefix("param set EKF2_GYR_NOISE "))
+        .map(|r| r.trim().parse::<f64>().unwrap())
+        .unwrap_or_else(|| panic!("{px4}"));
+    assert!((gyr / (want * 10.0) - 1.0).abs() < 1e-9, "per EKF2 step at 100 Hz: density x 10: {gyr}");
+
+    let bad = text.replace("\"px4\"]", "\"gtsam\"]");
+    let plan = write(dir.path(), "plan.toml", &bad);
+    let a = gyrolab().arg("eval").arg(&plan).arg("--out").arg(dir.path().join("o2")).assert().code(2);
+    let err = String::from_utf8_lossy(&a.get_output().stderr).into_owned();
+    assert!(err.contains("plan.toml:7:") && err.contains("options.exports") && err.contains("gtsam"), "{err}");
+    assert!(!dir.path().join("o2").exists());
 }

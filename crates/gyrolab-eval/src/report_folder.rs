@@ -7,11 +7,10 @@ use crate::error::{EvalError, EvalResult};
 use crate::progress::Progress;
 use crate::rate::{calibration_file, EvaluatedAxis};
 use gyrolab_report::figures::{rate_figures, AxisFigures};
-use gyrolab_report::format::sig;
 use gyrolab_report::html::{rate_section, render_html, Report, ReportHeader, ReportSection, SummaryTable};
-use gyrolab_report::limits::{Limit, Verdict};
+use gyrolab_report::limits::{Limit, Overall, Verdict};
 use gyrolab_report::rate::{AxisJson, AxisReport};
-use gyrolab_report::results::{DeviceJson, LimitJson, ResultsJson};
+use gyrolab_report::results::{DecisionRuleJson, DeviceJson, LimitJson, ResultsJson};
 use gyrolab_report::tables_csv::{points_csv, runs_csv, summary_csv};
 use gyrolab_report::triad::TriadReport;
 use std::collections::BTreeMap;
@@ -30,10 +29,37 @@ pub struct NamedOutput {
 pub struct ReportFolder {
     /// The outputs, in writing order.
     pub outputs: Vec<NamedOutput>,
-    /// Overall verdict of the limits; `None` without limits.
-    pub verdict: Option<Verdict>,
+    /// Overall result of the limits; `None` without limits.
+    pub verdict: Option<Overall>,
     /// One line per failed check.
     pub failures: Vec<String>,
+    /// One line per check that is CONDITIONAL or NOT EVALUATED, with its reason.
+    pub undecided: Vec<String>,
+    /// Some results come from simulated records (results.json `simulated`).
+    pub simulated: bool,
+}
+
+/// The mark a CSV of a report folder with simulated inputs starts with, unless the file's own
+/// rows are simulated (it then starts with `# SIMULATED DATA: ...`).
+pub const SIMULATED_INPUTS_LINE: &str = "# SIMULATED INPUTS: some results of this report folder come from simulated \
+     records (results.json `simulated`; summary.csv column `simulated`); the rows of this file come from records not \
+     marked simulated\n";
+
+/// Marks every CSV of a folder with simulated inputs (summary.csv has its `simulated` column):
+/// files whose rows come from simulated records already start with `# SIMULATED`; when every
+/// record is simulated (`simulated_device`: the plan's `[device] simulated`, also the rate-table
+/// records) the others get `# SIMULATED DATA: <how>`, else [`SIMULATED_INPUTS_LINE`].
+fn mark_simulated_csvs(outputs: &mut [NamedOutput], simulated_device: Option<&str>) {
+    for o in outputs.iter_mut().filter(|o| o.name.ends_with(".csv") && o.name != "summary.csv") {
+        if o.bytes.starts_with(b"# SIMULATED") {
+            continue;
+        }
+        let line = match simulated_device {
+            Some(how) => format!("# SIMULATED DATA: {}\n", how.replace('\n', " ")),
+            None => SIMULATED_INPUTS_LINE.to_string(),
+        };
+        o.bytes.splice(0..0, line.into_bytes());
+    }
 }
 
 /// Everything a report folder is assembled from.
@@ -80,10 +106,7 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
     }
     for extra in inputs.extra_figures {
         match figures.iter_mut().find(|f| f.axis == extra.axis) {
-            Some(f) => {
-                extra.values.into_iter().for_each(|(k, v)| f.set(k, v));
-                f.simulated.extend(extra.simulated);
-            }
+            Some(f) => f.merge(extra),
             None => figures.push(extra),
         }
     }
@@ -101,23 +124,16 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
     }
     sections.extend(inputs.extra_sections);
     let verdict = if inputs.limits.is_empty() { None } else { Some(summary.overall()) };
-    let failures: Vec<String> = summary
-        .checks
-        .iter()
-        .filter(|c| c.verdict == Verdict::Fail)
-        .map(|c| {
-            let l = Limit { figure: c.figure.clone(), min: c.min, max: c.max };
-            format!(
-                "axis {}: {} = {} {} (limit {})",
-                c.axis,
-                c.figure,
-                sig(c.value.unwrap_or(f64::NAN), 4),
-                c.unit,
-                l.text()
-            )
-        })
-        .collect();
+    let lines = |keep: &dyn Fn(Verdict) -> bool| -> Vec<String> {
+        summary.checks.iter().filter(|c| keep(c.verdict)).map(|c| c.line()).collect()
+    };
+    let failures = lines(&|v| v == Verdict::Fail);
+    let undecided = lines(&|v| matches!(v, Verdict::Conditional | Verdict::NotEvaluated));
+    let simulated = inputs.simulated_rate.is_some()
+        || figures.iter().any(|f| !f.simulated.is_empty())
+        || sections.iter().any(|s| s.simulated);
     let results = ResultsJson {
+        simulated,
         gyrolab_version: inputs.header.gyrolab_version.clone(),
         created: inputs.header.date.clone(),
         plan_file: inputs.header.plan_file.clone(),
@@ -126,8 +142,9 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
         equipment: inputs.header.equipment.clone(),
         rate_axes: axis_json.clone(),
         sections: inputs.extra_json,
-        limits: inputs.limits.iter().map(|l| LimitJson { figure: l.figure.clone(), min: l.min, max: l.max }).collect(),
+        limits: inputs.limits.iter().map(LimitJson::new).collect(),
         limit_checks: summary.checks.clone(),
+        decision_rules: DecisionRuleJson::used(&inputs.limits),
         verdict,
     };
     let html = render_html(&Report { header: inputs.header, summary: summary.clone(), sections });
@@ -164,5 +181,8 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
         outputs.push(NamedOutput { name: "scale_factor_runs.csv".into(), bytes: runs_csv(&axis_json).into_bytes() });
     }
     outputs.extend(inputs.extra_files.into_iter().map(|(name, bytes)| NamedOutput { name, bytes }));
-    Ok(ReportFolder { outputs, verdict, failures })
+    if simulated {
+        mark_simulated_csvs(&mut outputs, inputs.simulated_rate.as_deref());
+    }
+    Ok(ReportFolder { outputs, verdict, failures, undecided, simulated })
 }

@@ -85,8 +85,11 @@ fn demo_folder_shows_the_test_program_simulated() {
     for title in ["Temperature tests, axis x", "Threshold and resolution", "g-sensitivity, axis x", "Warm-up"] {
         assert!(html.contains(title), "no section {title}");
     }
-    assert_eq!(html.matches("SIMULATED DATA").count(), 9, "every data section labelled");
+    assert_eq!(html.matches("<p class=\"simulated\">SIMULATED DATA").count(), 9, "every data section labelled");
+    assert!(html.contains("<div class=\"sim-page\">SIMULATED DATA"), "and every printed page");
     let json: serde_json::Value = serde_json::from_str(&get("program_results.json")).unwrap();
+    assert_eq!(json["simulated"], true, "program_results.json says SIMULATED at its top");
+    assert!(get("program_summary.csv").lines().skip(1).all(|l| l.ends_with(",SIMULATED")));
     assert!(json["sections"]["power_ups"]["x"].is_object() && json["sections"]["uncertainty"]["x"].is_object());
     assert!(get("program_plan.toml").contains("[temperature.x]"));
 }

@@ -12,7 +12,7 @@ use gyrolab_eval::progress::Silent;
 use gyrolab_eval::report_folder::ReportFolder;
 use gyrolab_eval::test_plan::{evaluate_test_plan, read_test_plan};
 use gyrolab_eval::EvalError;
-use gyrolab_report::limits::Verdict;
+use gyrolab_report::limits::Overall;
 use std::path::Path;
 
 fn output<'a>(folder: &'a ReportFolder, name: &str) -> &'a [u8] {
@@ -40,7 +40,7 @@ fn evaluate(dir: &Path, plan: &str) -> Result<serde_json::Value, EvalError> {
     v["html_has_section"] = serde_json::json!(html.contains("g-sensitivity, axis x"));
     v["html_unresolved_y"] =
         serde_json::json!(html.contains("not resolved: no record has a specific force along this axis"));
-    v["verdict"] = serde_json::json!(folder.verdict.map(|v| v == Verdict::Pass));
+    v["verdict"] = serde_json::json!(folder.verdict.map(|v| v == Overall::Pass));
     v["csv_lines"] =
         serde_json::json!(std::str::from_utf8(output(&folder, "g_sensitivity.csv")).unwrap().lines().count());
     Ok(v)

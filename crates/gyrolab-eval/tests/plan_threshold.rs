@@ -10,7 +10,7 @@ use gyrolab_eval::progress::Silent;
 use gyrolab_eval::report_folder::ReportFolder;
 use gyrolab_eval::test_plan::{evaluate_test_plan, read_test_plan};
 use gyrolab_eval::EvalError;
-use gyrolab_report::limits::Verdict;
+use gyrolab_report::limits::Overall;
 use std::path::{Path, PathBuf};
 
 fn repo_root() -> PathBuf {
@@ -96,13 +96,14 @@ fn threshold_is_recovered_between_the_tried_rates_that_bracket_the_dead_zone() {
         assert_eq!(r["base_rate_dps"].as_f64(), Some(BASE_RATE_DPS));
         assert_eq!(r["rates_tried"].as_array().unwrap().len(), 2 * RESOLUTION_STEPS_DPS.len());
         // Summary figures and limits: 0.12 <= 0.15 and 0.05 <= 0.1.
-        assert_eq!(f.verdict, Some(Verdict::Pass), "{:?}", f.failures);
+        assert_eq!(f.verdict, Some(Overall::Pass), "{:?}", f.failures);
         let html = String::from_utf8(output(&f, "report.html").to_vec()).unwrap();
         assert!(html.contains("Threshold and resolution"));
         assert!(html.contains("at most 0.05 deg/s"), "the resolution's bound is stated");
         assert!(html.contains("SIMULATED"));
         let csv = String::from_utf8(output(&f, "threshold_resolution.csv").to_vec()).unwrap();
-        assert_eq!(csv.lines().count(), 1 + 2 * (THRESHOLD_RATES_DPS.len() + RESOLUTION_STEPS_DPS.len()));
+        assert!(csv.starts_with("# SIMULATED DATA: "), "{csv}");
+        assert_eq!(csv.lines().count(), 2 + 2 * (THRESHOLD_RATES_DPS.len() + RESOLUTION_STEPS_DPS.len()));
     }
 }
 
@@ -110,7 +111,7 @@ fn threshold_is_recovered_between_the_tried_rates_that_bracket_the_dead_zone() {
 fn a_limit_below_the_threshold_fails() {
     let (_dir, p, _) = folder(&format!("{}{{SECTIONS}}", HEAD.replace("max = 0.15", "max = 0.1")), 3);
     let f = evaluate_test_plan(&read_test_plan(&p).unwrap(), "plan.toml", &Silent).unwrap();
-    assert_eq!(f.verdict, Some(Verdict::Fail));
+    assert_eq!(f.verdict, Some(Overall::Fail));
     assert!(f.failures.iter().any(|m| m.contains("threshold_dps")), "{:?}", f.failures);
 }
 

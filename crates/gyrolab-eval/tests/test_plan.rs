@@ -10,7 +10,7 @@ use gyrolab_eval::progress::Silent;
 use gyrolab_eval::report_folder::ReportFolder;
 use gyrolab_eval::test_plan::{evaluate_test_plan, read_test_plan};
 use gyrolab_io::sim_csv::{write_static_csv, SimCsvOptions};
-use gyrolab_report::limits::Verdict;
+use gyrolab_report::limits::Overall;
 use std::path::Path;
 
 const RATES: [f64; 7] = [-300.0, -100.0, -30.0, 0.0, 30.0, 100.0, 300.0];
@@ -174,7 +174,7 @@ fn paper_plan_verdict_is_fail() {
     let plan_path = repo_root().join("examples/paper_plan.toml");
     let plan = read_test_plan(&plan_path).unwrap();
     let folder = evaluate_test_plan(&plan, &plan_path.display().to_string(), &Silent).unwrap();
-    assert_eq!(folder.verdict, Some(Verdict::Fail));
+    assert_eq!(folder.verdict, Some(Overall::Fail));
     assert!(folder.failures.iter().any(|f| f.starts_with("axis x: linearity_pct")), "failures: {:?}", folder.failures);
     let v: serde_json::Value = serde_json::from_slice(output(&folder, "results.json")).unwrap();
     assert_eq!(v["verdict"], "FAIL");

@@ -6,7 +6,7 @@
 use gyrolab_eval::program_sim::write_test_program;
 use gyrolab_eval::progress::Silent;
 use gyrolab_eval::test_plan::{evaluate_test_plan, read_test_plan};
-use gyrolab_report::limits::Verdict;
+use gyrolab_report::limits::Overall;
 use serde_json::Value;
 use std::path::Path;
 
@@ -26,7 +26,7 @@ fn the_example_test_program_evaluates_every_section() {
     );
     let plan = read_test_plan(&dir.path().join("plan.toml")).unwrap();
     let folder = evaluate_test_plan(&plan, "plan.toml", &Silent).unwrap();
-    assert_eq!(folder.verdict, Some(Verdict::Pass), "{:?}", folder.failures);
+    assert_eq!(folder.verdict, Some(Overall::Pass), "{:?}", folder.failures);
     let get = |name: &str| &folder.outputs.iter().find(|o| o.name == name).unwrap().bytes;
     let json: Value = serde_json::from_slice(get("results.json")).unwrap();
     for section in [
@@ -45,7 +45,19 @@ fn the_example_test_program_evaluates_every_section() {
     let html = String::from_utf8(get("report.html").to_vec()).unwrap();
     // Every section carries the SIMULATED banner: count the sections and the banners.
     let sections = html.matches("<section").count();
-    let banners = html.matches("SIMULATED DATA").count();
+    let banners = html.matches("<p class=\"simulated\">SIMULATED DATA").count();
+    assert!(html.contains("<div class=\"sim-page\">SIMULATED DATA"), "SIMULATED on every printed page");
+    assert_eq!(json["simulated"], true);
+    // Every CSV of an all-simulated plan says SIMULATED DATA on its first line (summary.csv in
+    // its column).
+    for o in folder.outputs.iter().filter(|o| o.name.ends_with(".csv")) {
+        let text = String::from_utf8_lossy(&o.bytes);
+        if o.name == "summary.csv" {
+            assert!(text.lines().skip(1).all(|l| l.ends_with(",SIMULATED")), "{text}");
+        } else {
+            assert!(text.starts_with("# SIMULATED DATA"), "{}: {}", o.name, &text[..text.len().min(100)]);
+        }
+    }
     // Summary, sign-off and the methods appendix are not data sections; the nine others are.
     assert!(sections == 12 && banners == 9, "{sections} sections, {banners} SIMULATED banners");
     for title in [

@@ -177,11 +177,12 @@ enum Samples<'a> {
 
 /// Allan analysis of channels of one record in one native call, the channels in parallel on
 /// the package's pool: returns (JSON document as `gyrolab allan --json`, per channel the arrays
-/// taus_s, m, dev, ci_low, ci_high, n_terms, alpha; bounds NaN where none exists). `rate_hz`
+/// taus_s, m, dev, ci_low, ci_high, n_terms, alpha; bounds NaN where none exists, per channel
+/// the JSON of its filter terms or None: what `result.export(...)` renders). `rate_hz`
 /// or `time_s` (seconds, one per sample) gives the sampling; gaps in `time_s` and NaN samples
 /// follow `gaps` (`error` or `analyse`). `factors` replaces `taus` by averaging factors.
 #[pyfunction]
-#[pyo3(signature = (columns, names, units, rate_hz, time_s, kind, taus, factors, confidence, scale_factor=None, null=None, fit_range_s=None, gaps="error", record="<array>"))]
+#[pyo3(signature = (columns, names, units, rate_hz, time_s, kind, taus, factors, confidence, scale_factor=None, null=None, fit_range_s=None, gaps="error", record="<array>", allow_motion=false))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn allan_channels<'py>(
     py: Python<'py>,
@@ -199,7 +200,8 @@ fn allan_channels<'py>(
     fit_range_s: Option<Vec<f64>>,
     gaps: &str,
     record: &str,
-) -> PyResult<(String, Vec<Vec<Bound<'py, PyArray1<f64>>>>)> {
+    allow_motion: bool,
+) -> PyResult<(String, Vec<Vec<Bound<'py, PyArray1<f64>>>>, Vec<Option<String>>)> {
     let policy = GapPolicy::parse(gaps).map_err(|e| err(e.into()))?;
     if let Some(f) = rate_hz {
         gyrolab::validate::positive("sample_rate_hz", f).map_err(|e| err(e.into()))?;
@@ -346,6 +348,7 @@ fn allan_channels<'py>(
         reference: &reference,
         fit_range_s,
         uncalibrated_hint: "give scale_factor (and null), or a rate unit such as 'dps', for noise terms",
+        allow_motion,
     };
     // Missing samples in the record (NaN or gaps) are computed over only when asked for.
     let missing_policy = if policy == GapPolicy::Analyse { GapPolicy::Analyse } else { GapPolicy::Error };
@@ -365,6 +368,7 @@ fn allan_channels<'py>(
             .collect::<Result<Vec<_>, _>>()
     })?
     .map_err(err)?;
+    gyrolab_eval::allan::refuse_motion(&analyses, path, allow_motion).map_err(err)?;
     let doc = gyrolab_report::allan::allan_document(&analyses).ok_or_else(|| error("no channel"))?;
     let json = serde_json::to_string(&doc).map_err(json_err)?;
     let arrays = analyses
@@ -384,7 +388,51 @@ fn allan_channels<'py>(
             ]
         })
         .collect();
-    Ok((json, arrays))
+    let filter_terms = analyses
+        .iter()
+        .map(|a| {
+            gyrolab_eval::filter_export::channel_filter_terms(a)
+                .map(|t| serde_json::to_string(&t))
+                .transpose()
+                .map_err(json_err)
+        })
+        .collect::<PyResult<_>>()?;
+    Ok((json, arrays, filter_terms))
+}
+
+/// The text of one filter stack's noise-parameter file from the filter terms `allan_channels`
+/// returned (JSON, one per channel): returns (text, warnings). `stack`: kalibr, openvins,
+/// vins, orbslam3, basalt, px4, px4-qgc, ros-covariance; `estimator`: slopes, fit or gmwm.
+#[pyfunction]
+#[pyo3(signature = (terms, record, rate_hz, stack, estimator="slopes", inflate=1.0, overbound=false, motion=Vec::new()))]
+#[allow(clippy::too_many_arguments)]
+fn render_export(
+    terms: Vec<String>,
+    record: &str,
+    rate_hz: f64,
+    stack: &str,
+    estimator: &str,
+    inflate: f64,
+    overbound: bool,
+    motion: Vec<String>,
+) -> PyResult<(String, Vec<String>)> {
+    use gyrolab_eval::filter_export::{ChannelFilterTerms, Estimator, ExportRecord, ExportRequest};
+    let channels: Vec<ChannelFilterTerms> =
+        terms.iter().map(|t| serde_json::from_str(t)).collect::<Result<_, _>>().map_err(json_err)?;
+    let request = ExportRequest {
+        targets: Vec::new(),
+        estimator: Estimator::parse(estimator).map_err(|e| keyword_error("estimator", e.to_string()))?,
+        inflate,
+        overbound,
+    };
+    let export_record = ExportRecord {
+        record: record.to_string(),
+        rate_hz,
+        simulated: gyrolab_eval::filter_export::is_simulated_record(Path::new(record)),
+        rostopic: None,
+        motion,
+    };
+    gyrolab_eval::filter_export::render_export(&export_record, &channels, stack, &request).map_err(err)
 }
 
 /// Static test of one array: the JSON object of one `gyrolab bias --json` test.
@@ -620,9 +668,15 @@ fn read<'py>(
     Ok((arrays, units))
 }
 
-/// Evaluates a test plan and writes its report folder: (verdict or None, files written, failures).
+/// Evaluates a test plan and writes its report folder: (overall result or None, files written,
+/// failed checks, checks CONDITIONAL or NOT EVALUATED with their reasons).
 #[pyfunction]
-fn evaluate_plan(py: Python<'_>, plan: PathBuf, out: PathBuf) -> PyResult<(Option<String>, Vec<PathBuf>, Vec<String>)> {
+#[allow(clippy::type_complexity)]
+fn evaluate_plan(
+    py: Python<'_>,
+    plan: PathBuf,
+    out: PathBuf,
+) -> PyResult<(Option<String>, Vec<PathBuf>, Vec<String>, Vec<String>)> {
     let folder = run(py, || {
         let p = gyrolab_eval::test_plan::read_test_plan(&plan)?;
         gyrolab_eval::test_plan::evaluate_test_plan(&p, &plan.display().to_string(), &gyrolab_eval::Silent)
@@ -632,7 +686,7 @@ fn evaluate_plan(py: Python<'_>, plan: PathBuf, out: PathBuf) -> PyResult<(Optio
     let written = gyrolab_io::atomic::write_folder(&out, &files).map_err(|(p, e)| {
         pyo3::exceptions::PyOSError::new_err(format!("{}: cannot write the file: {e}", p.display()))
     })?;
-    Ok((folder.verdict.map(|v| v.text().to_string()), written, folder.failures))
+    Ok((folder.verdict.map(|v| v.text().to_string()), written, folder.failures, folder.undecided))
 }
 
 /// Applies a calibration file to outputs in memory: (rates per axis, status per sample:
@@ -666,6 +720,7 @@ fn apply<'py>(
 fn _gyrolab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(allan_channels, m)?)?;
+    m.add_function(wrap_pyfunction!(render_export, m)?)?;
     m.add_function(wrap_pyfunction!(bias, m)?)?;
     m.add_function(wrap_pyfunction!(rate_table, m)?)?;
     m.add_function(wrap_pyfunction!(rate_table_files, m)?)?;

@@ -4,6 +4,7 @@
 //! methods-notes sections 3 and 4).
 
 use crate::rate::AxisJson;
+use gyrolab::conformity::{Known, Support};
 
 /// Which part of a test a figure comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -92,7 +93,7 @@ pub const FIGURES: &[FigureDef] = &[
     def("bias_repeatability_power_up_dph", "bias repeatability across power-ups", "deg/h", Static, "std(B0_i, n − 1), B0_i = (mean output − null) / K of one static record per power-up", "[GJB], [IEEE 952]"),
     def("turn_on_bias_dph", "turn-on bias", "deg/h", Static, "mean bias of the first warm-up window after power-on", "[IEEE 952]"),
     def("warmup_settling_time_s", "warm-up settling time", "s", Static, "start of the first window from which every window mean stays within the band about the final bias", "[IEEE 952], [GJB]"),
-    def("temp_sensitivity_dph_per_c", "bias temperature sensitivity", "(deg/h)/degC", Static, "least-squares slope of 10-s window-mean bias against window-mean temperature; the test of largest magnitude", "[GJB], [GB/T 18459]"),
+    def("temp_sensitivity_dph_per_c", "bias temperature sensitivity (within-record; confounded with drift, no limit)", "(deg/h)/degC", Static, "least-squares slope of 10-s window-mean bias against window-mean temperature; the test of largest magnitude; confounded with the record's drift when temperature changes with time, so it cannot carry a limit", "[GJB], [GB/T 18459]"),
     def("arw_deg_rt_h", "angle random walk N", "deg/√h", Allan, "ADEV supported slope −1/2 region nearest τ = 1 s, line read at 1 s, × 60", "[IEEE 952], [SP1065]"),
     def("bias_instability_dph", "bias instability B", "deg/h", Allan, "IEEE 952 B = ADEV minimum of a supported flat region / 0.6643 (only when resolved)", "[IEEE 952]"),
     def("allan_minimum_dph", "Allan minimum", "deg/h", Allan, "ADEV minimum of a supported flat region (the ADI / Sensonor datasheet figure; 0.6643 B)", "[IEEE 952]"),
@@ -132,6 +133,21 @@ pub fn name_matches(pattern: &str, name: &str) -> bool {
     }
 }
 
+/// Why a figure cannot carry a spec limit, for the figures that cannot (issue 33): the
+/// within-record temperature slope of a static test is confounded with the record's drift when
+/// the temperature changes with time, so a limit on it would decide on drift as much as on
+/// temperature. It is reported with that caveat; the soaked-point figure carries limits.
+pub fn limit_refusal(name: &str) -> Option<&'static str> {
+    match name {
+        "temp_sensitivity_dph_per_c" => Some(
+            "a within-record temperature slope is confounded with the drift of the record (its temperature \
+             changes with time), so it is reported with that caveat but cannot carry a limit: limit \
+             bias_temp_sensitivity_dph_per_c, measured at soaked temperature points ([temperature.<axis>]), instead",
+        ),
+        _ => None,
+    }
+}
+
 /// The definition of a figure name, if it is known.
 pub fn known_figure(name: &str) -> Option<&'static FigureDef> {
     FIGURES.iter().find(|f| name_matches(f.key, name))
@@ -148,6 +164,26 @@ pub struct AxisFigures {
     pub values: Vec<(String, f64)>,
     /// Keys whose values come from simulated data (marked SIMULATED in the summary).
     pub simulated: Vec<String>,
+    /// Keys whose entry in `values` is a bound, not an estimate (an Allan term the curve does not
+    /// resolve: at most; a threshold above the largest rate tried: above), with its kind.
+    pub bounds: Vec<(String, Support)>,
+    /// Expanded uncertainties U (same unit as the figure) given for a figure directly; figures
+    /// with a catalogue uncertainty key ([`uncertainty_key`]) take theirs from `values`.
+    pub uncertainties: Vec<(String, f64)>,
+}
+
+/// The catalogue key of a figure's expanded uncertainty (that of K is relative, in ppm:
+/// [`AxisFigures::known`] multiplies it by |K| × 1e-6).
+pub fn uncertainty_key(figure: &str) -> Option<&'static str> {
+    match figure {
+        "scale_factor" => Some("scale_factor_expanded_uncertainty_ppm"),
+        "zero_offset" => Some("zero_offset_expanded_uncertainty"),
+        "bias_dph" => Some("bias_expanded_uncertainty_dph"),
+        "arw_deg_rt_h" => Some("arw_expanded_uncertainty_deg_rt_h"),
+        "bias_instability_dph" => Some("bias_instability_expanded_uncertainty_dph"),
+        "rrw_deg_h_rt_h" => Some("rrw_expanded_uncertainty_deg_h_rt_h"),
+        _ => None,
+    }
 }
 
 impl AxisFigures {
@@ -156,13 +192,60 @@ impl AxisFigures {
         self.values.iter().find(|(k, _)| k == key).map(|(_, v)| *v)
     }
 
-    /// Adds or replaces a figure value (non-finite values are left out).
+    /// Adds or replaces a figure value, an estimate (non-finite values are left out).
     pub fn set(&mut self, key: impl Into<String>, value: f64) {
         let key = key.into();
         self.values.retain(|(k, _)| *k != key);
+        self.bounds.retain(|(k, _)| *k != key);
         if value.is_finite() {
             self.values.push((key, value));
         }
+    }
+
+    /// Adds or replaces a figure known only as a bound: `support` says which side
+    /// ([`Support::Value`] is the same as [`AxisFigures::set`]).
+    pub fn set_bound(&mut self, key: impl Into<String>, bound: f64, support: Support) {
+        let key = key.into();
+        self.set(key.clone(), bound);
+        if support != Support::Value && bound.is_finite() {
+            self.bounds.push((key, support));
+        }
+    }
+
+    /// Takes every figure of `other` (same axis), with its bound and uncertainty, replacing
+    /// figures of the same key.
+    pub fn merge(&mut self, other: AxisFigures) {
+        for (k, v) in other.values {
+            let support = other.bounds.iter().find(|(b, _)| *b == k).map_or(Support::Value, |(_, s)| *s);
+            self.set_bound(k, v, support);
+        }
+        for (k, u) in other.uncertainties {
+            self.set_uncertainty(k, u);
+        }
+        self.simulated.extend(other.simulated);
+    }
+
+    /// Gives a figure's expanded uncertainty U (same unit as the figure).
+    pub fn set_uncertainty(&mut self, key: impl Into<String>, u: f64) {
+        let key = key.into();
+        self.uncertainties.retain(|(k, _)| *k != key);
+        if u.is_finite() && u >= 0.0 {
+            self.uncertainties.push((key, u));
+        }
+    }
+
+    /// The figure as the conformity decision sees it: value or bound, and its expanded
+    /// uncertainty (given directly, or from the catalogue's uncertainty figure of this axis).
+    pub fn known(&self, key: &str) -> Option<Known> {
+        let value = self.get(key)?;
+        let support = self.bounds.iter().find(|(k, _)| k == key).map_or(Support::Value, |(_, s)| *s);
+        let direct = self.uncertainties.iter().find(|(k, _)| k == key).map(|(_, u)| *u);
+        let catalogue = || {
+            let u = self.get(uncertainty_key(key)?)?;
+            Some(if key == "scale_factor" { u * value.abs() * 1e-6 } else { u })
+        };
+        let expanded_uncertainty = if support == Support::Value { direct.or_else(catalogue) } else { None };
+        Some(Known { value, support, expanded_uncertainty })
     }
 
     /// The unit of a figure for this axis.

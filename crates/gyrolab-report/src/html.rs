@@ -9,7 +9,7 @@
 
 use crate::figures::{known_figure, AxisFigures, FigureGroup, FIGURES};
 use crate::format::{sig, sig_opt};
-use crate::limits::{check_limits, overall, Limit, LimitCheck, Verdict};
+use crate::limits::{check_limits, overall, DecisionRule, Limit, LimitCheck, Overall, Support, Verdict};
 use crate::plot::PlotError;
 use crate::rate::AxisReport;
 use crate::rate_plots::{calibration_plot, hysteresis_plot, scale_factor_plot};
@@ -120,6 +120,31 @@ pub struct FigureRow {
     pub verdict: Option<Verdict>,
 }
 
+impl FigureRow {
+    /// The row of figure `key` of one axis, checked against the limits that apply to the axis:
+    /// the value (or bound, "at most"/"above") to four significant digits or as many more as keep
+    /// it from contradicting the verdict; `None` when the axis has no such figure.
+    pub fn checked(figs: &AxisFigures, limits: &[Limit], key: &str, label: &str) -> Option<FigureRow> {
+        let k = figs.known(key)?;
+        let limit = limits.iter().find(|l| l.figure == key && l.applies_to(&figs.axis));
+        let check = limit.and_then(|l| check_limits(std::slice::from_ref(l), std::slice::from_ref(figs)).pop());
+        let value = match (&check, k.support) {
+            (Some(c), _) => c.value_text(4),
+            (None, Support::Value) => sig(k.value, 4),
+            (None, Support::UpperBound) => format!("at most {}", sig(k.value, 4)),
+            (None, Support::LowerBound) => format!("above {}", sig(k.value, 4)),
+        };
+        Some(FigureRow {
+            label: label.to_string(),
+            key: key.to_string(),
+            value,
+            unit: figs.unit_of(key),
+            limit: limit.map_or_else(String::new, Limit::text),
+            verdict: check.map(|c| c.verdict),
+        })
+    }
+}
+
 /// A table of data (points, runs...).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct DataTable {
@@ -211,21 +236,25 @@ impl SummaryTable {
             .map(|key| {
                 let def = known_figure(&key);
                 let limit = limits.iter().find(|l| l.figure == key);
+                let digits = if key == "scale_factor" || key == "zero_offset" { 6 } else { 4 };
                 let cells = axes
                     .iter()
                     .map(|a| {
-                        let v = a.get(&key);
-                        let text = match v {
-                            Some(v) if key == "scale_factor" || key == "zero_offset" => sig(v, 6),
-                            Some(v) => sig(v, 4),
-                            None => "n/a".into(),
+                        let check = checks.iter().find(|c| c.axis == a.axis && c.figure == key);
+                        // With a limit, as many digits as keep value and limit from contradicting
+                        // the verdict; a bound says which side it is.
+                        let text = match (a.known(&key), check) {
+                            (Some(_), Some(c)) => c.value_text(digits),
+                            (Some(k), None) => match k.support {
+                                Support::Value => sig(k.value, digits),
+                                Support::UpperBound => format!("at most {}", sig(k.value, digits)),
+                                Support::LowerBound => format!("above {}", sig(k.value, digits)),
+                            },
+                            (None, _) => "n/a".into(),
                         };
-                        let verdict = limit.map(|_| {
-                            checks
-                                .iter()
-                                .find(|c| c.axis == a.axis && c.figure == key)
-                                .map_or(Verdict::NotEvaluated, |c| c.verdict)
-                        });
+                        let verdict = limit
+                            .filter(|l| l.applies_to(&a.axis))
+                            .map(|_| check.map_or(Verdict::NotEvaluated, |c| c.verdict));
                         (text, verdict)
                     })
                     .collect();
@@ -242,9 +271,14 @@ impl SummaryTable {
         SummaryTable { axes: axes.iter().map(|a| a.axis.clone()).collect(), rows, checks }
     }
 
-    /// The overall verdict of the limits.
-    pub fn overall(&self) -> Verdict {
+    /// The overall result of the limits.
+    pub fn overall(&self) -> Overall {
         overall(&self.checks)
+    }
+
+    /// The decision rules the checks used, each once.
+    pub fn rules(&self) -> Vec<DecisionRule> {
+        DecisionRule::ALL.into_iter().filter(|r| self.checks.iter().any(|c| c.rule == *r)).collect()
     }
 }
 
@@ -259,8 +293,16 @@ pub struct Report {
     pub sections: Vec<ReportSection>,
 }
 
+impl Report {
+    /// Whether any section or summary figure comes from simulated records: the report then
+    /// carries a SIMULATED mark on every printed page and beside its overall result.
+    pub fn simulated(&self) -> bool {
+        self.sections.iter().any(|s| s.simulated) || self.summary.rows.iter().any(|r| r.simulated)
+    }
+}
+
 const CSS: &str = r#"
-:root { --pass: #1b7f3a; --pass-bg: #dff3e4; --fail: #b00020; --fail-bg: #fde2e4; --ne: #6b6b6b; --ne-bg: #eeeeee; }
+:root { --pass: #1b7f3a; --pass-bg: #dff3e4; --fail: #b00020; --fail-bg: #fde2e4; --ne: #6b6b6b; --ne-bg: #eeeeee; --cond: #8a5a00; --cond-bg: #fff0cc; }
 * { box-sizing: border-box; }
 body { font-family: sans-serif; font-size: 11pt; color: #111; margin: 0 auto; padding: 16px 24px; max-width: 1100px; line-height: 1.35; }
 h1 { font-size: 20pt; margin: 0 0 8px; }
@@ -275,9 +317,11 @@ table.header td { text-align: left; border: none; padding: 1px 10px 1px 0; }
 .verdict { font-weight: bold; white-space: nowrap; padding: 0 4px; border-radius: 3px; }
 .PASS { color: var(--pass); background: var(--pass-bg); }
 .FAIL { color: var(--fail); background: var(--fail-bg); }
-.NOT_EVALUATED { color: var(--ne); background: var(--ne-bg); }
+.NOT_EVALUATED, .INCOMPLETE { color: var(--ne); background: var(--ne-bg); }
+.CONDITIONAL { color: var(--cond); background: var(--cond-bg); }
 .overall { font-size: 13pt; padding: 4px 10px; display: inline-block; margin: 4px 0; }
 .simulated { display: inline-block; background: #fff3cd; color: #7a5a00; border: 2px solid #e0b000; font-weight: bold; padding: 2px 10px; margin: 4px 0; }
+.sim-page { display: block; background: #fff3cd; color: #7a5a00; border: 2px solid #e0b000; font-weight: bold; padding: 2px 10px; margin: 4px 0; }
 .sim-tag { font-size: 8.5pt; font-weight: bold; color: #7a5a00; background: #fff3cd; border: 1px solid #e0b000; padding: 0 4px; }
 figure.plot { margin: 10px 0 16px; break-inside: avoid; page-break-inside: avoid; }
 figure.plot svg { display: block; width: 100%; max-width: 760px; height: auto; border: 1px solid #ddd; }
@@ -296,17 +340,13 @@ tr { break-inside: avoid; page-break-inside: avoid; }
   body { max-width: none; padding: 0; font-size: 10pt; }
   * { -webkit-print-color-adjust: exact; print-color-adjust: exact; }
   figure.plot svg { max-width: 165mm; max-height: 240mm; }
+  .sim-page { position: fixed; bottom: 0; right: 0; margin: 0; padding: 0 6px; font-size: 8pt; }
   h2, h3 { break-after: avoid; page-break-after: avoid; }
 }
 "#;
 
 fn verdict_span(v: Verdict) -> String {
-    let class = match v {
-        Verdict::Pass => "PASS",
-        Verdict::Fail => "FAIL",
-        Verdict::NotEvaluated => "NOT_EVALUATED",
-    };
-    format!("<span class=\"verdict {class}\">{}</span>", v.text())
+    format!("<span class=\"verdict {}\">{}</span>", v.class(), v.text())
 }
 
 fn anchor(key: &str) -> String {
@@ -380,25 +420,55 @@ fn write_section(h: &mut String, s: &ReportSection) {
     h.push_str("</section>\n");
 }
 
-fn write_summary(h: &mut String, s: &SummaryTable) {
+fn write_summary(h: &mut String, s: &SummaryTable, simulated: bool) {
     h.push_str("<section>\n<h2>Summary</h2>\n");
     if !s.checks.is_empty() {
         let o = s.overall();
-        let failed = s.checks.iter().filter(|c| c.verdict == Verdict::Fail).count();
-        let not_eval = s.checks.iter().filter(|c| c.verdict == Verdict::NotEvaluated).count();
+        let count = |v: Verdict| s.checks.iter().filter(|c| c.verdict == v).count();
         let _ = writeln!(
             h,
-            "<p>Overall: <span class=\"verdict overall {}\">{}</span> ({} limit check(s): {} failed, {} not evaluated)</p>",
-            match o {
-                Verdict::Pass => "PASS",
-                Verdict::Fail => "FAIL",
-                Verdict::NotEvaluated => "NOT_EVALUATED",
-            },
+            "<p>Overall: <span class=\"verdict overall {}\">{}</span>{} ({} limit check(s): {} passed, {} failed, {} \
+             conditional, {} not evaluated)</p>",
             o.text(),
+            o.text(),
+            if simulated { " <span class=\"sim-tag\">ON SIMULATED DATA</span>" } else { "" },
             s.checks.len(),
-            failed,
-            not_eval
+            count(Verdict::Pass),
+            count(Verdict::Fail),
+            count(Verdict::Conditional),
+            count(Verdict::NotEvaluated)
         );
+        if o == Overall::Incomplete {
+            h.push_str(
+                "<p class=\"note\">INCOMPLETE: no check failed, but at least one required check could not be \
+                 evaluated (reasons below); a check not evaluated never counts as passed.</p>\n",
+            );
+        }
+        for r in s.rules() {
+            let _ = writeln!(h, "<p class=\"note\">Decision rule: {}.</p>", escape(r.statement()));
+        }
+        let undecided: Vec<&LimitCheck> = s
+            .checks
+            .iter()
+            .filter(|c| {
+                matches!(c.verdict, Verdict::NotEvaluated | Verdict::Conditional)
+                    || c.support.is_some_and(|x| x != Support::Value)
+            })
+            .collect();
+        if !undecided.is_empty() {
+            h.push_str("<ul class=\"note\">\n");
+            for c in undecided {
+                let _ = writeln!(
+                    h,
+                    "<li>axis {}, {}: {} ({})</li>",
+                    escape(&c.axis),
+                    escape(&c.figure),
+                    c.verdict.text(),
+                    escape(c.reason.as_deref().unwrap_or(""))
+                );
+            }
+            h.push_str("</ul>\n");
+        }
     } else {
         h.push_str("<p class=\"note\">The plan sets no spec limits: figures are reported without verdicts.</p>\n");
     }
@@ -529,10 +599,18 @@ pub fn render_html(r: &Report) -> String {
         h,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-         <title>{}</title>\n<style>{CSS}</style>\n</head>\n<body>\n<header>\n<h1>{}</h1>\n<table class=\"header\">\n",
-        escape(&hd.title),
+         <title>{}</title>\n<style>{CSS}</style>\n</head>\n<body>\n",
         escape(&hd.title)
     );
+    let simulated = r.simulated();
+    if simulated {
+        // Fixed in print: Chromium repeats it at the foot of every printed page.
+        h.push_str(
+            "<div class=\"sim-page\">SIMULATED DATA: some results of this report come from simulated records, \
+             not measurements (sections and summary rows marked SIMULATED)</div>\n",
+        );
+    }
+    let _ = write!(h, "<header>\n<h1>{}</h1>\n<table class=\"header\">\n", escape(&hd.title));
     let rows = [
         ("model", &hd.model),
         ("serial", &hd.serial),
@@ -550,7 +628,7 @@ pub fn render_html(r: &Report) -> String {
         let _ = writeln!(h, "<p class=\"note\">{}</p>", escape(n));
     }
     h.push_str("</header>\n");
-    write_summary(&mut h, &r.summary);
+    write_summary(&mut h, &r.summary, simulated);
     for s in &r.sections {
         write_section(&mut h, s);
     }
@@ -605,10 +683,25 @@ pub fn rate_section(a: &AxisReport<'_>, limits: &[Limit]) -> Result<ReportSectio
             "ppm".into(),
         ),
     ];
+    // A value printed beside a limit gets the digits that keep the two from contradicting the
+    // verdict (the comparison is on the unrounded value).
+    for f in figures.iter_mut() {
+        let Some(c) = checks.iter().find(|c| c.figure == f.key) else { continue };
+        let (Some(v), Some(Support::Value)) = (c.value, c.support) else { continue };
+        let (base, factor) = match f.key.as_str() {
+            "scale_factor" => (6, df),
+            "zero_offset" => (7, 1.0),
+            _ => (4, 1.0),
+        };
+        let n = c.limit().digits_for(v, base);
+        if n > base {
+            f.value = sig(v * factor, n);
+        }
+    }
     // A limit on scale_factor is given in output units per deg/s (the JSON key's unit): shown
     // in the row's display unit (mV/(deg/s) for volt outputs), so value and limit share a unit.
     if let Some(l) = limits.iter().find(|l| l.figure == "scale_factor") {
-        let shown = Limit { figure: l.figure.clone(), min: l.min.map(|x| x * df), max: l.max.map(|x| x * df) };
+        let shown = Limit { min: l.min.map(|x| x * df), max: l.max.map(|x| x * df), ..l.clone() };
         if let Some(f) = figures.iter_mut().find(|f| f.key == "scale_factor") {
             f.limit = shown.text();
         }

@@ -6,7 +6,7 @@ use crate::bias::{warmup_text, WarmupJson, WarmupReport};
 use crate::figures::{known_figure, AxisFigures};
 use crate::format::{short, sig};
 use crate::html::{DataTable, FigureRow, PlotBlock, ReportSection};
-use crate::limits::{check_limits, Limit};
+use crate::limits::Limit;
 use crate::plot::{Axis, Figure, LegendCorner, Panel, PlotError, Series, SeriesStyle};
 use crate::static_report::ReferenceJson;
 use gyrolab::power_ups::PowerUpSpread;
@@ -159,18 +159,10 @@ fn reason(f: &PowerUpFigure, missing: bool) -> Option<String> {
 }
 
 fn figure_rows(figs: &AxisFigures, limits: &[Limit], keys: &[&str]) -> Vec<FigureRow> {
-    let checks = check_limits(limits, std::slice::from_ref(figs));
     keys.iter()
         .filter_map(|key| {
-            let v = figs.get(key)?;
-            Some(FigureRow {
-                label: known_figure(key).map_or_else(|| key.to_string(), |d| d.label.to_string()),
-                key: key.to_string(),
-                value: sig(v, 4),
-                unit: figs.unit_of(key),
-                limit: limits.iter().find(|l| l.figure == *key).map_or_else(String::new, Limit::text),
-                verdict: checks.iter().find(|c| c.figure == *key).map(|c| c.verdict),
-            })
+            let label = known_figure(key).map_or_else(|| key.to_string(), |d| d.label.to_string());
+            FigureRow::checked(figs, limits, key, &label)
         })
         .collect()
 }

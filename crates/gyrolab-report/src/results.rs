@@ -2,7 +2,7 @@
 //! rate-table figure per axis (the `gyrolab rate --json` axis objects), the limits and their
 //! verdicts. The static (bias) and Allan sections (and the demo's `paper`) go under their own key in `sections`.
 
-use crate::limits::{LimitCheck, Verdict};
+use crate::limits::{DecisionRule, Limit, LimitCheck, Overall};
 use crate::rate::AxisJson;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -29,11 +29,46 @@ pub struct LimitJson {
     pub min: Option<f64>,
     /// Upper bound.
     pub max: Option<f64>,
+    /// Its decision rule (`simple_acceptance`, `guarded_acceptance`, `guarded_rejection`).
+    pub rule: DecisionRule,
+    /// The axes it applies to; null: every axis.
+    pub axes: Option<Vec<String>>,
+}
+
+impl LimitJson {
+    /// The plan's limit as written to results.json.
+    pub fn new(l: &Limit) -> LimitJson {
+        LimitJson { figure: l.figure.clone(), min: l.min, max: l.max, rule: l.rule, axes: l.axes.clone() }
+    }
+}
+
+/// A decision rule used by the limits, with the statement the report prints (ISO/IEC
+/// 17025:2017 7.8.6.1: the rule is reported with the statement of conformity).
+#[derive(Debug, Clone, Serialize)]
+pub struct DecisionRuleJson {
+    /// The rule's key.
+    pub rule: DecisionRule,
+    /// What it means, with its source.
+    pub statement: &'static str,
+}
+
+impl DecisionRuleJson {
+    /// The rules the limits use, each once, in [`DecisionRule::ALL`] order.
+    pub fn used(limits: &[Limit]) -> Vec<DecisionRuleJson> {
+        DecisionRule::ALL
+            .into_iter()
+            .filter(|r| limits.iter().any(|l| l.rule == *r))
+            .map(|rule| DecisionRuleJson { rule, statement: rule.statement() })
+            .collect()
+    }
 }
 
 /// The whole results.json document.
 #[derive(Debug, Clone, Serialize)]
 pub struct ResultsJson {
+    /// True when any input of the report is simulated (a section, a summary figure): the
+    /// verdict is then one on SIMULATED data (each section and `summary.csv` row says which).
+    pub simulated: bool,
     /// Program version.
     pub gyrolab_version: String,
     /// Time of evaluation (RFC 3339, UTC).
@@ -55,6 +90,9 @@ pub struct ResultsJson {
     pub limits: Vec<LimitJson>,
     /// Every limit checked on every axis.
     pub limit_checks: Vec<LimitCheck>,
-    /// FAIL if any check failed, PASS if any passed, NOT_EVALUATED otherwise; null without limits.
-    pub verdict: Option<Verdict>,
+    /// The decision rules of the limits, with their statements.
+    pub decision_rules: Vec<DecisionRuleJson>,
+    /// Overall: FAIL if any check failed, else INCOMPLETE if any is NOT_EVALUATED, else
+    /// CONDITIONAL if any is, else PASS; null without limits.
+    pub verdict: Option<Overall>,
 }

@@ -7,7 +7,7 @@ use crate::bias::TestReport;
 use crate::figures::AxisFigures;
 use crate::format::{short, sig, sig_opt};
 use crate::html::{DataTable, FigureRow, PlotBlock, ReportSection};
-use crate::limits::{check_limits, Limit};
+use crate::limits::Limit;
 use crate::plot::{
     scatter_fit_plot, Annotation, Axis, Figure, LegendCorner, Orientation, Panel, PlotError, RefLine, Series,
     SeriesStyle,
@@ -147,6 +147,27 @@ impl StaticAxisReport {
             ] {
                 if let Some(v) = v {
                     f.set(k, v);
+                }
+            }
+            // Terms the curve does not resolve but bounds from above: "at most" figures, which a
+            // limit can still decide (an upper bound under an upper limit passes).
+            let b = gyrolab::noise::NoiseCoefficients::from_base_units(
+                s.quantization.bound(),
+                s.arw.bound(),
+                s.bias_instability.bound(),
+                s.rrw.bound(),
+                s.rate_ramp.bound(),
+            );
+            for (k, v) in [
+                ("arw_deg_rt_h", b.arw_deg_rt_h),
+                ("bias_instability_dph", b.bias_instability_dph),
+                ("rrw_deg_h_rt_h", b.rrw_deg_h_rt_h),
+                ("quantization_deg", b.quantization_deg),
+                ("rate_ramp_dph_per_h", b.rate_ramp_dph_per_h),
+                ("allan_minimum_dph", s.allan_minimum.bound().map(gyrolab::units::bias_dps_to_dph)),
+            ] {
+                if let (Some(v), None) = (v, f.get(k)) {
+                    f.set_bound(k, v, gyrolab::conformity::Support::UpperBound);
                 }
             }
         }
@@ -432,20 +453,7 @@ pub fn allan_plot(a: &StaticAxisReport) -> Option<Result<String, PlotError>> {
 /// The figure rows of a section: each key's value with its unit, limit and verdict (keys without a
 /// value are left out).
 pub fn figure_rows(figs: &AxisFigures, limits: &[Limit], keys: &[(String, String)]) -> Vec<FigureRow> {
-    let checks = check_limits(limits, std::slice::from_ref(figs));
-    keys.iter()
-        .filter_map(|(key, label)| {
-            let v = figs.get(key)?;
-            Some(FigureRow {
-                label: label.clone(),
-                key: key.clone(),
-                value: sig(v, 4),
-                unit: figs.unit_of(key),
-                limit: limits.iter().find(|l| l.figure == *key).map_or_else(String::new, Limit::text),
-                verdict: checks.iter().find(|c| c.figure == *key).map(|c| c.verdict),
-            })
-        })
-        .collect()
+    keys.iter().filter_map(|(key, label)| FigureRow::checked(figs, limits, key, label)).collect()
 }
 
 fn simulated_paragraph(a: &StaticAxisReport) -> Vec<String> {

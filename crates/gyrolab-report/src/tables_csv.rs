@@ -63,9 +63,11 @@ pub fn runs_csv(axes: &[AxisJson]) -> String {
     s
 }
 
-/// The summary CSV: every figure of every axis with its unit, limit and verdict.
+/// The summary CSV: every figure of every axis with its unit, what the value is (`basis`:
+/// `value`, `upper_bound` or `lower_bound`), its limit, decision rule and verdict, and whether it
+/// comes from SIMULATED records (`simulated`: `SIMULATED` or empty). docs/PLAN.md.
 pub fn summary_csv(summary: &SummaryTable, figures: &[AxisFigures], limits: &[Limit]) -> String {
-    let mut s = String::from("axis,figure,unit,value,limit_min,limit_max,verdict\n");
+    let mut s = String::from("axis,figure,unit,value,basis,limit_min,limit_max,rule,verdict,simulated\n");
     for a in figures {
         for row in &summary.rows {
             let l = limits.iter().find(|l| l.figure == row.key);
@@ -74,15 +76,19 @@ pub fn summary_csv(summary: &SummaryTable, figures: &[AxisFigures], limits: &[Li
                 .iter()
                 .find(|c| c.axis == a.axis && c.figure == row.key)
                 .map_or("", |c| c.verdict.text());
+            let known = a.known(&row.key);
             s.push_str(&format!(
-                "{},{},{},{},{},{},{}\n",
+                "{},{},{},{},{},{},{},{},{},{}\n",
                 csv_field(&a.axis),
                 row.key,
                 csv_field(&a.unit_of(&row.key)),
-                opt(a.get(&row.key)),
+                opt(known.map(|k| k.value)),
+                known.map_or("", |k| k.support.key()),
                 opt(l.and_then(|l| l.min)),
                 opt(l.and_then(|l| l.max)),
-                verdict
+                l.map_or("", |l| l.rule.key()),
+                verdict,
+                if a.simulated.contains(&row.key) { "SIMULATED" } else { "" }
             ));
         }
     }

@@ -184,8 +184,15 @@ pub fn step_figures(reports: &[StepReport]) -> Vec<AxisFigures> {
         .iter()
         .map(|r| {
             let mut f = AxisFigures { axis: r.axis.clone(), output_unit: r.output_unit.clone(), ..Default::default() };
-            if let Some(v) = r.figure_value() {
-                f.set(r.kind.figure(), v);
+            // The value, or the bound on its side: "at most the smallest tried" or "above the
+            // largest tried" (a limit decides on the bound where it can).
+            let e = &r.estimate;
+            let known = match e.support {
+                Support::Value | Support::UpperBound => e.value_dps,
+                Support::LowerBound => e.above_dps,
+            };
+            if let Some(v) = known {
+                f.set_bound(r.kind.figure(), v, e.support);
                 if r.simulated.is_some() {
                     f.simulated.push(r.kind.figure().into());
                 }
@@ -204,8 +211,8 @@ pub fn step_section(reports: &[StepReport], limits: &[Limit]) -> ReportSection {
          rate step whose output change is at least {} % of K × step, for both signs. Each tried magnitude passes \
          when both directions pass; the figure is the smallest tried magnitude from which on every larger tried \
          magnitude passes. When the smallest tried passes the figure is an upper bound (at most the smallest \
-         tried); when the largest tried fails it is a lower bound with no value (above the largest tried; a limit \
-         on it is then NOT EVALUATED). A decision within {} standard errors of the {} % line is marked marginal. \
+         tried; it passes an upper limit at or above it); when the largest tried fails it is a lower bound with no \
+         value (above the largest tried; it fails an upper limit at or below it). A decision within {} standard errors of the {} % line is marked marginal. \
          docs/METHODS.md, threshold and resolution.",
         PASS_FRACTION * 100.0,
         PASS_FRACTION * 100.0,
@@ -236,7 +243,7 @@ pub fn step_section(reports: &[StepReport], limits: &[Limit]) -> ReportSection {
         let key = r.kind.figure();
         let figs = step_figures(std::slice::from_ref(r));
         let checks = check_limits(limits, &figs);
-        let limit = limits.iter().find(|l| l.figure == key);
+        let limit = limits.iter().find(|l| l.figure == key && l.applies_to(&r.axis));
         figures.push(FigureRow {
             label: format!("{} {}", r.axis, r.kind.word()),
             key: key.into(),
@@ -282,16 +289,20 @@ mod tests {
     fn lower_bound_has_no_figure_and_says_so() {
         let r = report(vec![g(0.0, 0.0), g(0.1, 0.0), g(-0.1, 0.0)]);
         assert_eq!(r.figure_value(), None);
-        assert!(step_figures(std::slice::from_ref(&r))[0].values.is_empty());
+        let f = &step_figures(std::slice::from_ref(&r))[0];
+        assert_eq!(f.known("threshold_dps").map(|k| (k.value, k.support)), Some((0.1, Support::LowerBound)));
         assert!(r.value_text().starts_with("above the largest tried, 0.1"), "{}", r.value_text());
         let j = r.json();
         assert_eq!(j["threshold_dps"], serde_json::Value::Null);
         assert_eq!(j["threshold_support"], "lower_bound");
         assert_eq!(j["above_dps"], 0.1);
-        let limits = [Limit { figure: "threshold_dps".into(), min: None, max: Some(0.05) }];
-        let s = step_section(std::slice::from_ref(&r), &limits);
-        assert_eq!(s.figures[0].verdict, Some(crate::limits::Verdict::NotEvaluated));
+        // Above 0.1 against <= 0.05: FAIL (the issue's "no response even at 0.5 against <= 0.2");
+        // against <= 0.5 the bound cannot decide.
+        let s = step_section(std::slice::from_ref(&r), &[Limit::new("threshold_dps", None, Some(0.05))]);
+        assert_eq!(s.figures[0].verdict, Some(crate::limits::Verdict::Fail));
         assert_eq!(s.tables[0].rows.len(), 3);
+        let s = step_section(std::slice::from_ref(&r), &[Limit::new("threshold_dps", None, Some(0.5))]);
+        assert_eq!(s.figures[0].verdict, Some(crate::limits::Verdict::NotEvaluated));
     }
 
     #[test]
@@ -302,9 +313,11 @@ mod tests {
         assert_eq!(j["threshold_support"], "upper_bound");
         assert_eq!(j["rates_tried"][0]["rate_dps"], -0.1);
         assert_eq!(j["rates_tried"][0]["pass"], true);
-        let limits = [Limit { figure: "threshold_dps".into(), min: None, max: Some(0.05) }];
-        let s = step_section(std::slice::from_ref(&r), &limits);
-        assert_eq!(s.figures[0].verdict, Some(crate::limits::Verdict::Fail));
+        // At most 0.1 against <= 0.05 cannot be decided; against <= 0.2 it passes.
+        let s = step_section(std::slice::from_ref(&r), &[Limit::new("threshold_dps", None, Some(0.05))]);
+        assert_eq!(s.figures[0].verdict, Some(crate::limits::Verdict::NotEvaluated));
         assert!(s.figures[0].value.starts_with("at most 0.1"));
+        let s = step_section(std::slice::from_ref(&r), &[Limit::new("threshold_dps", None, Some(0.2))]);
+        assert_eq!(s.figures[0].verdict, Some(crate::limits::Verdict::Pass));
     }
 }

@@ -52,7 +52,7 @@ pub struct FigureRecord {
     pub limit_min: Option<f64>,
     /// Upper limit.
     pub limit_max: Option<f64>,
-    /// PASS, FAIL, NOT_EVALUATED (`None`: no limit).
+    /// PASS, FAIL, CONDITIONAL, NOT EVALUATED (`None`: no limit on this figure).
     pub verdict: Option<String>,
     /// The figure comes from SIMULATED records.
     pub simulated: bool,
@@ -274,9 +274,11 @@ fn number(text: &str, path: &Path, line: usize, column: &str) -> StoreResult<Opt
     })
 }
 
-/// The figures of summary.csv (axis, figure, unit, value, limit_min, limit_max, verdict), with
-/// each `*_expanded_uncertainty*` figure's value attached as U to the figure of the same name
-/// without `_expanded_uncertainty` and the same unit, k = `coverage`.
+/// The figures of summary.csv, with each `*_expanded_uncertainty*` figure's value attached as U
+/// to the figure of the same name without `_expanded_uncertainty` and the same unit, k =
+/// `coverage`. Two layouts are read: gyrolab 0.2 and later (axis, figure, unit, value, basis,
+/// limit_min, limit_max, rule, verdict, simulated) and the earlier seven columns (axis, figure,
+/// unit, value, limit_min, limit_max, verdict), so report folders written before stay storable.
 pub fn figures_from_summary(text: &str, path: &Path, coverage: f64, simulated: bool) -> StoreResult<Vec<FigureRecord>> {
     let records = csv_records(text);
     let bad = |line: usize, m: String| StoreError::Input {
@@ -287,29 +289,42 @@ pub fn figures_from_summary(text: &str, path: &Path, coverage: f64, simulated: b
         return Err(bad(1, "empty file".into()));
     };
     let cols = csv_fields(header);
-    let want = ["axis", "figure", "unit", "value", "limit_min", "limit_max", "verdict"];
-    if cols != want {
-        return Err(bad(1, format!("header {cols:?}, expected {want:?}")));
-    }
+    let old = ["axis", "figure", "unit", "value", "limit_min", "limit_max", "verdict"];
+    let new = ["axis", "figure", "unit", "value", "basis", "limit_min", "limit_max", "rule", "verdict", "simulated"];
+    // Positions of value, basis, limit_min, limit_max, verdict, simulated.
+    let (width, at): (usize, [Option<usize>; 6]) = if cols == new {
+        (new.len(), [Some(3), Some(4), Some(5), Some(6), Some(8), Some(9)])
+    } else if cols == old {
+        (old.len(), [Some(3), None, Some(4), Some(5), Some(6), None])
+    } else {
+        return Err(bad(1, format!("header {cols:?}, expected {new:?} (or the earlier {old:?})")));
+    };
     let mut out = Vec::new();
     for (i, rec) in records.iter().enumerate().skip(1) {
         let line = i + 1;
         let f = csv_fields(rec);
-        if f.len() != 7 {
-            return Err(bad(line, format!("{} fields, expected 7", f.len())));
+        if f.len() != width {
+            return Err(bad(line, format!("{} fields, expected {width}", f.len())));
         }
+        let field = |j: Option<usize>| j.map_or("", |j| f[j].as_str());
+        let basis = match field(at[1]) {
+            "" | "value" => "value",
+            "upper_bound" => "upper_bound",
+            "lower_bound" => "lower_bound",
+            other => return Err(bad(line, format!("basis {other:?}: expected value, upper_bound or lower_bound"))),
+        };
         out.push(FigureRecord {
             axis: f[0].clone(),
             figure: f[1].clone(),
             unit: f[2].clone(),
-            value: number(&f[3], path, line, "value")?,
-            basis: "value".into(),
+            value: number(field(at[0]), path, line, "value")?,
+            basis: basis.into(),
             expanded_uncertainty: None,
             coverage_factor: None,
-            limit_min: number(&f[4], path, line, "limit_min")?,
-            limit_max: number(&f[5], path, line, "limit_max")?,
-            verdict: Some(f[6].clone()).filter(|v| !v.is_empty()),
-            simulated,
+            limit_min: number(field(at[2]), path, line, "limit_min")?,
+            limit_max: number(field(at[3]), path, line, "limit_max")?,
+            verdict: Some(field(at[4]).to_string()).filter(|v| !v.is_empty()),
+            simulated: simulated || field(at[5]) == "SIMULATED",
         });
     }
     let uncertainties: Vec<(String, String, String, Option<f64>)> = out
@@ -509,6 +524,19 @@ mod tests {
         assert_eq!(f[1].coverage_factor, Some(2.0));
         let e = figures_from_summary("axis,figure\n", Path::new("s.csv"), 2.0, false).unwrap_err();
         assert!(e.to_string().contains("s.csv: line 1"), "{e}");
+    }
+
+    #[test]
+    fn the_current_summary_layout_carries_basis_rule_and_simulated() {
+        let text = "axis,figure,unit,value,basis,limit_min,limit_max,rule,verdict,simulated\n\
+                    x,threshold_dps,deg/s,0.5,lower_bound,,0.2,simple_acceptance,FAIL,SIMULATED\n\
+                    x,bias_dph,deg/h,1.5,value,,2,guarded_acceptance,CONDITIONAL,\n";
+        let f = figures_from_summary(text, Path::new("s.csv"), 2.0, false).unwrap();
+        assert_eq!((f[0].basis.as_str(), f[0].verdict.as_deref(), f[0].simulated), ("lower_bound", Some("FAIL"), true));
+        assert_eq!((f[1].basis.as_str(), f[1].limit_max, f[1].simulated), ("value", Some(2.0), false));
+        let bad = text.replace("lower_bound", "sideways");
+        let e = figures_from_summary(&bad, Path::new("s.csv"), 2.0, false).unwrap_err();
+        assert!(e.to_string().contains("s.csv: line 2: basis \"sideways\""), "{e}");
     }
 
     #[test]

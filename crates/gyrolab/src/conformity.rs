@@ -32,6 +32,17 @@ pub enum Support {
     LowerBound,
 }
 
+impl Support {
+    /// The JSON spelling (`value`, `upper_bound`, `lower_bound`).
+    pub fn key(self) -> &'static str {
+        match self {
+            Support::Value => "value",
+            Support::UpperBound => "upper_bound",
+            Support::LowerBound => "lower_bound",
+        }
+    }
+}
+
 /// A decision rule (ILAC-G8:09/2019 4.2, JCGM 106:2012 8).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
 #[serde(rename_all = "snake_case")]

@@ -90,28 +90,10 @@ pub enum ThresholdError {
     NotFinite,
 }
 
-/// What the data support about the figure.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Support {
-    /// The figure lies between the largest failing tried magnitude and this value; the value is
-    /// the smallest tried magnitude from which on every tried magnitude passes.
-    Value,
-    /// Even the smallest tried magnitude passes: the figure is at most the smallest tried.
-    UpperBound,
-    /// Even the largest tried magnitude fails: the figure is above the largest tried (no value).
-    LowerBound,
-}
-
-impl Support {
-    /// The JSON spelling (`value`, `upper_bound`, `lower_bound`).
-    pub fn key(self) -> &'static str {
-        match self {
-            Support::Value => "value",
-            Support::UpperBound => "upper_bound",
-            Support::LowerBound => "lower_bound",
-        }
-    }
-}
+/// What the data support about the figure (the conformity module's [`Support`]: a value, "at
+/// most" the smallest tried magnitude when even that one passes, or "above" the largest tried
+/// when even that one fails, with no value).
+pub use crate::conformity::Support;
 
 /// One tried rate (or step) against its reference.
 #[derive(Debug, Clone, PartialEq)]

@@ -71,7 +71,9 @@ pub fn run(args: &EvalArgs) -> CliResult {
         Some(Err(_)) => return Err(CliError::Output("the thread opening the store failed".into())),
     };
     let result = write_and_finish(&args.out, &folder?, args.quiet, args.pdf);
-    if let (Some(l), Ok(()) | Err(CliError::LimitFailed(_))) = (&location, &result) {
+    let verdict_only =
+        matches!(result, Err(CliError::LimitFailed(_) | CliError::Incomplete(_) | CliError::Conditional(_)));
+    if let (Some(l), true) = (&location, result.is_ok() || verdict_only) {
         let inputs = match inputs {
             Some(hashed) => Some(hashed?),
             None => None,

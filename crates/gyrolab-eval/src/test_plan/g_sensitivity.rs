@@ -205,7 +205,10 @@ fn section(a: &AxisResult<'_>, figures: &AxisFigures, limits: &[Limit], base: &P
                 None => sig(m.value, 4),
             },
             unit: "(deg/h)/g".into(),
-            limit: limits.iter().find(|l| l.figure == FIGURE_KEY).map_or_else(String::new, Limit::text),
+            limit: limits
+                .iter()
+                .find(|l| l.figure == FIGURE_KEY && l.applies_to(&figures.axis))
+                .map_or_else(String::new, Limit::text),
             verdict: checks.iter().find(|c| c.figure == FIGURE_KEY).map(|c| c.verdict),
         });
     }

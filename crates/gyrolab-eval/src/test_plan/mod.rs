@@ -30,9 +30,16 @@ use gyrolab_report::segments::SegmentationJson;
 use gyrolab_report::triad::triad_json;
 use std::path::{Path, PathBuf};
 
-/// Reads and checks a plan file (limit names are checked against the figure catalogue).
+/// Reads and checks a plan file (limit names are checked against the figure catalogue; a limit
+/// on a figure that cannot carry one is refused with the reason, naming the plan's line).
 pub fn read_test_plan(path: &Path) -> EvalResult<TestPlan> {
-    Ok(read_plan(path, &|n| known_figure(n).is_some())?)
+    let plan = read_plan(path, &|n| known_figure(n).is_some())?;
+    for l in &plan.limits {
+        if let Some(why) = gyrolab_report::figures::limit_refusal(&l.figure) {
+            return Err(gyrolab_io::DataError::new(path, format!("limits.{}: {why}", l.figure)).at_line(l.line).into());
+        }
+    }
+    Ok(plan)
 }
 
 /// Rate-test settings of a plan.
@@ -148,7 +155,7 @@ fn triad_section(t: &gyrolab_report::triad::TriadReport<'_>) -> ReportSection {
 /// let plan = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper_plan.toml");
 /// let folder = evaluate_test_plan(&read_test_plan(&plan)?, &plan.display().to_string(), &Silent)?;
 /// assert!(folder.outputs.iter().any(|o| o.name == "results.json"));
-/// assert_eq!(folder.verdict, Some(gyrolab_report::limits::Verdict::Fail)); // the paper's own claims fail
+/// assert_eq!(folder.verdict, Some(gyrolab_report::limits::Overall::Fail)); // the paper's own claims fail
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progress) -> EvalResult<ReportFolder> {
@@ -175,8 +182,11 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
     if let Some(l) = plan.options.nonlinearity_limit_pct {
         notes.push(format!("Linear input range searched with a nonlinearity limit of {} %.", sig(l, 4)));
     }
-    let limits: Vec<Limit> =
-        plan.limits.iter().map(|l| Limit { figure: l.figure.clone(), min: l.min, max: l.max }).collect();
+    let limits: Vec<Limit> = plan
+        .limits
+        .iter()
+        .map(|l| Limit { figure: l.figure.clone(), min: l.min, max: l.max, rule: l.rule, axes: l.axes.clone() })
+        .collect();
     let base = match plan.file.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
@@ -187,6 +197,8 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         limits: &limits,
         base: &base,
         simulated: None,
+        exports: &plan.options.exports,
+        records_simulated: plan.device.simulated.is_some(),
     };
     let mut parts = static_part::evaluate_static(&plan.static_tests, &ctx, progress)?;
     let more = power_ups::evaluate_power_ups(plan, &ctx, progress)?;

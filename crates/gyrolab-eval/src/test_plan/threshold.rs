@@ -162,7 +162,12 @@ fn evaluate_one(
 
 /// The CSV of every rate tried (one row per rate and test).
 fn rates_csv(reports: &[StepReport]) -> String {
-    let mut s = String::from(
+    // Rows from simulated records say so on the first line (issue 33), as the other CSVs do.
+    let mut s = match reports.iter().find_map(|r| r.simulated.as_deref()) {
+        Some(how) => format!("# SIMULATED DATA: {}\n", how.replace('\n', " ")),
+        None => String::new(),
+    };
+    s.push_str(
         "axis,test,rate_dps,step_dps,samples,mean_output,mean_output_std_error,output_change,expected_change,ratio,ratio_std_error,pass,marginal,output_unit\n",
     );
     for r in reports {

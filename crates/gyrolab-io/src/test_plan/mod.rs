@@ -8,6 +8,7 @@
 use crate::calibration::line_col;
 use crate::rate_table::RateColumns;
 use crate::DataError;
+use gyrolab::conformity::DecisionRule;
 use gyrolab::triad::TableAxis;
 use gyrolab::units::{OutputUnit, RateUnit};
 use gyrolab::validate::{self, InvalidOption};
@@ -138,6 +139,8 @@ struct RawOptions {
     order: Option<Spanned<i64>>,
     nonlinearity_limit_pct: Option<Spanned<f64>>,
     calibration: Option<Spanned<String>>,
+    exports: Option<Spanned<Vec<String>>>,
+    decision_rule: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -176,6 +179,8 @@ struct RawStatic {
 struct RawLimit {
     min: Option<f64>,
     max: Option<f64>,
+    rule: Option<Spanned<String>>,
+    axes: Option<Spanned<Vec<String>>>,
 }
 
 /// The device under test.
@@ -263,6 +268,12 @@ pub struct PlanOptions {
     pub nonlinearity_limit_pct: Option<f64>,
     /// An existing calibration file for the static sections (resolved path).
     pub calibration: Option<PathBuf>,
+    /// Filter stacks whose noise-parameter files the report folder gets from the static axes'
+    /// Allan analyses (`exports = ["kalibr", "px4"]`; docs/EXPORTS.md).
+    pub exports: Vec<crate::noise_export::Stack>,
+    /// The decision rule of every limit that names none (`decision_rule = "guarded_acceptance"`;
+    /// default simple acceptance; docs/PLAN.md, METHODS "Decision rules").
+    pub decision_rule: DecisionRule,
 }
 
 /// The rate-table record of one axis (`[rate.<axis>]`).
@@ -343,6 +354,12 @@ pub struct PlanLimit {
     pub min: Option<f64>,
     /// Upper bound, inclusive.
     pub max: Option<f64>,
+    /// The decision rule of this limit (`rule = ".."`), else the plan's
+    /// [`PlanOptions::decision_rule`].
+    pub rule: DecisionRule,
+    /// The axes the limit applies to (`axes = ["x"]`); `None`: every axis of the device (each
+    /// is then a required check).
+    pub axes: Option<Vec<String>>,
     /// 1-based line in the plan.
     pub line: u64,
 }
@@ -568,12 +585,42 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         )?;
     }
     let calibration = o.calibration.as_ref().map(|c| cx.existing_file("options.calibration", c)).transpose()?;
+    let mut exports = Vec::new();
+    if let Some(list) = &o.exports {
+        for name in list.get_ref() {
+            let stack = crate::noise_export::Stack::parse(name).ok_or_else(|| {
+                let names: Vec<&str> = crate::noise_export::STACKS.iter().map(|s| s.name()).collect();
+                cx.err(
+                    list.span(),
+                    "options.exports",
+                    format!("unknown filter stack '{}': expected {}", crate::text::excerpt(name), names.join(", ")),
+                )
+            })?;
+            if !exports.contains(&stack) {
+                exports.push(stack);
+            }
+        }
+    }
+    let rule_of = |v: &Spanned<String>, key: &str| {
+        DecisionRule::parse(v.get_ref()).ok_or_else(|| {
+            let names: Vec<&str> = DecisionRule::ALL.iter().map(|r| r.key()).collect();
+            cx.err(
+                v.span(),
+                key,
+                format!("unknown decision rule '{}': expected {}", crate::text::excerpt(v.get_ref()), names.join(", ")),
+            )
+        })
+    };
+    let decision_rule =
+        o.decision_rule.as_ref().map(|r| rule_of(r, "options.decision_rule")).transpose()?.unwrap_or_default();
     let options = PlanOptions {
         coverage,
         half_hysteresis: o.half_hysteresis.unwrap_or(false),
         order,
         nonlinearity_limit_pct: o.nonlinearity_limit_pct.as_ref().map(|l| *l.get_ref()),
         calibration,
+        exports,
+        decision_rule,
     };
 
     let mut rate = Vec::new();
@@ -675,7 +722,35 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
                 return Err(cx.err(l.span(), &key, format!("min {lo} is above max {hi}")));
             }
         }
-        limits.push(PlanLimit { figure: name.clone(), min: v.min, max: v.max, line: line_col(text, l.span().start).0 });
+        let rule = v.rule.as_ref().map(|r| rule_of(r, &format!("{key}.rule"))).transpose()?.unwrap_or(decision_rule);
+        if let Some(list) = &v.axes {
+            if list.get_ref().is_empty() {
+                return Err(cx.err(
+                    list.span(),
+                    &format!("{key}.axes"),
+                    "an empty list: name at least one axis, or leave `axes` out for every axis",
+                ));
+            }
+            if let Some(a) = list.get_ref().iter().find(|a| !raw.device.axes.get_ref().contains(a)) {
+                return Err(cx.err(
+                    list.span(),
+                    &format!("{key}.axes"),
+                    format!(
+                        "axis '{}' is not one of the device's axes ({})",
+                        crate::text::excerpt(a),
+                        raw.device.axes.get_ref().join(", ")
+                    ),
+                ));
+            }
+        }
+        limits.push(PlanLimit {
+            figure: name.clone(),
+            min: v.min,
+            max: v.max,
+            rule,
+            axes: v.axes.as_ref().map(|a| a.get_ref().clone()),
+            line: line_col(text, l.span().start).0,
+        });
     }
     limits.sort_by_key(|l| l.line);
 
@@ -852,6 +927,43 @@ sample_rate_hz = 1.0
 nonlinearity_pct = { max = 0.1 }
 bias_stability_dph_10s = { max = 20 }
 "#;
+
+    #[test]
+    fn decision_rules_and_limit_axes() {
+        // The plan's rule applies to every limit that names none; a limit's own rule wins.
+        let text = GOOD.replace("order = 3", "order = 3\ndecision_rule = \"guarded_acceptance\"").replace(
+            "bias_stability_dph_10s = { max = 20 }",
+            "bias_stability_dph_10s = { max = 20, rule = \"simple_acceptance\", axes = [\"x\"] }",
+        );
+        let (_dir, r) = setup(&text);
+        let p = r.unwrap();
+        assert_eq!(p.options.decision_rule, DecisionRule::GuardedAcceptance);
+        assert_eq!((p.limits[0].rule, p.limits[0].axes.clone()), (DecisionRule::GuardedAcceptance, None));
+        assert_eq!(
+            (p.limits[1].rule, p.limits[1].axes.clone()),
+            (DecisionRule::SimpleAcceptance, Some(vec!["x".into()]))
+        );
+        // Without a key: simple acceptance.
+        assert_eq!(setup(GOOD).1.unwrap().limits[0].rule, DecisionRule::SimpleAcceptance);
+        // Errors name the key and the line.
+        let bad = GOOD.replace("order = 3", "order = 3\ndecision_rule = \"lenient\"");
+        let e = setup(&bad).1.unwrap_err().to_string();
+        assert!(e.contains("options.decision_rule") && e.contains("unknown decision rule 'lenient'"), "{e}");
+        assert!(e.contains("guarded_acceptance"), "{e}");
+        let bad = GOOD.replace("{ max = 20 }", "{ max = 20, axes = [\"q\"] }");
+        let e = setup(&bad).1.unwrap_err().to_string();
+        assert!(
+            e.contains("limits.bias_stability_dph_10s.axes")
+                && e.contains("axis 'q' is not one of the device's axes (x)"),
+            "{e}"
+        );
+        let bad = GOOD.replace("{ max = 20 }", "{ max = 20, axes = [] }");
+        assert!(setup(&bad).1.unwrap_err().to_string().contains("an empty list"));
+        let bad = GOOD.replace("{ max = 20 }", "{ max = 20, rule = \"guarded\" }");
+        let e = setup(&bad).1.unwrap_err();
+        assert_eq!(e.line, Some(21), "{e}");
+        assert!(e.to_string().contains("limits.bias_stability_dph_10s.rule"), "{e}");
+    }
 
     #[test]
     fn good_plan() {
