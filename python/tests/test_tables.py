@@ -62,6 +62,11 @@ def test_evaluate_plan_writes_the_report(root, tmp_path):
     r = gyrolab.evaluate_plan(root / "examples" / "paper_plan.toml", out)
     assert r["verdict"] == "FAIL" and r["failures"]
     assert (out / "report.html").exists() and (out / "results.json").exists()
+    # The checks not evaluated (no static records in the paper's plan) come back with their reason.
+    assert any("bias_stability_dph_10s" in u and "not available" in u for u in r["undecided"]), r["undecided"]
+    results = json.loads((out / "results.json").read_text())
+    assert results["simulated"] is False and len(results["integrity"]["inputs"]) == 3
+    assert (out / "plan_copy.toml").read_bytes() == (root / "examples" / "paper_plan.toml").read_bytes()
 
 
 def test_apply_inverts_the_calibration(cli, root, tmp_path):

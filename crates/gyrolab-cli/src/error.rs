@@ -1,6 +1,7 @@
 //! Errors of the command-line program and their exit codes (documented in README):
 //! 0 success; 1 an internal or output failure; 2 bad usage or bad data (a plan error included);
-//! 3 a spec limit failed (`gyrolab eval`: every output was written, the report shows FAIL);
+//! 3 a spec limit failed (`gyrolab eval`: every output was written, the report shows FAIL), or
+//! `gyrolab verify` found a plan or input changed or missing since the report was made;
 //! 4 some inputs of a batch failed (`gyrolab batch`: the others were evaluated and written);
 //! 5 the result is INCOMPLETE (`gyrolab eval`: no limit failed, but a required check could not be
 //! evaluated: a check not evaluated never counts as passed); 6 the result is CONDITIONAL (no
@@ -22,6 +23,9 @@ pub enum CliError {
     /// The evaluation succeeded and its outputs were written, but a spec limit failed (exit 3).
     #[error("{0}")]
     LimitFailed(String),
+    /// `gyrolab verify`: a file of the report changed or is missing (exit 3).
+    #[error("{0}")]
+    Changed(String),
     /// The outputs were written; no limit failed but at least one required check was not
     /// evaluated (exit 5).
     #[error("{0}")]
@@ -47,7 +51,7 @@ impl CliError {
         match self {
             CliError::Eval(EvalError::Output(_)) | CliError::Output(_) => ExitCode::from(1),
             CliError::Eval(_) => ExitCode::from(2),
-            CliError::LimitFailed(_) => ExitCode::from(3),
+            CliError::LimitFailed(_) | CliError::Changed(_) => ExitCode::from(3),
             CliError::SomeFailed(_) => ExitCode::from(4),
             CliError::Incomplete(_) => ExitCode::from(5),
             CliError::Conditional(_) => ExitCode::from(6),

@@ -54,6 +54,8 @@ enum Command {
     /// The records store: add report folders; history, lot statistics, comparison, control charts, revisions.
     #[command(subcommand)]
     Store(cmd::store::StoreCommand),
+    /// Check a report folder's plan and inputs against the SHA-256 recorded when it was made.
+    Verify(cmd::verify::VerifyArgs),
 }
 
 fn main() -> ExitCode {
@@ -78,10 +80,11 @@ fn main() -> ExitCode {
         Command::Simulate(c) => cmd::simulate::run(c),
         Command::Plan(c) => cmd::record_length::run(c),
         Command::Store(c) => cmd::store::run(c),
+        Command::Verify(a) => cmd::verify::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e @ error::CliError::LimitFailed(_)) => {
+        Err(e @ (error::CliError::LimitFailed(_) | error::CliError::Changed(_))) => {
             eprintln!("FAIL: {e}");
             e.exit_code()
         }

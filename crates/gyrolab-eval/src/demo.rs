@@ -223,6 +223,8 @@ pub fn paper_report_folder(request: &PaperReportRequest, progress: &dyn Progress
     let created = humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string();
     let names: Vec<String> = axes.iter().map(|a| a.name.clone()).collect();
     let header = ReportHeader {
+        report_number: crate::report_folder::generated_report_number(&created, "demo"),
+        issue_date: created.get(..10).unwrap_or_default().to_string(),
         title: "Gyro test report: the paper's worked example".into(),
         model: "MEMS rate gyro, ADXRS family (Cheng et al. 2014)".into(),
         serial: "the paper's three units (axes x, y, z)".into(),

@@ -47,6 +47,7 @@ pub mod simulate;
 pub mod static_test;
 pub mod test_plan;
 pub mod triad;
+pub mod verify;
 
 pub use error::{EvalError, EvalResult};
 pub use progress::{Progress, Silent};

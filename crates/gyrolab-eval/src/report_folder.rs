@@ -94,6 +94,20 @@ fn json<T: serde::Serialize>(value: &T) -> EvalResult<String> {
         .map_err(|e| EvalError::Output(format!("cannot serialise JSON: {e}")))
 }
 
+/// A report number for a plan that gives none: `GYR-<YYYYMMDD>-<8 hex digits>`, the digits from
+/// the SHA-256 of the evaluation time and `seed` (the plan's SHA-256), so two evaluations never
+/// share one in practice.
+///
+/// ```
+/// let n = gyrolab_eval::report_folder::generated_report_number("2026-11-29T03:10:00Z", "ab");
+/// assert!(n.starts_with("GYR-20261129-") && n.len() == 21, "{n}");
+/// ```
+pub fn generated_report_number(created: &str, seed: &str) -> String {
+    let day: String = created.chars().take(10).filter(char::is_ascii_digit).collect();
+    let h = gyrolab_io::input_file::sha256_hex(format!("{created}\n{seed}").as_bytes());
+    format!("GYR-{day}-{}", &h[..8])
+}
+
 /// Assembles the report folder from evaluated inputs.
 pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> EvalResult<ReportFolder> {
     let reports: Vec<AxisReport<'_>> = inputs.axes.iter().map(EvaluatedAxis::report).collect();
@@ -134,6 +148,9 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
         || sections.iter().any(|s| s.simulated);
     let results = ResultsJson {
         simulated,
+        report_number: inputs.header.report_number.clone(),
+        issue_date: inputs.header.issue_date.clone(),
+        integrity: inputs.header.integrity.clone(),
         gyrolab_version: inputs.header.gyrolab_version.clone(),
         created: inputs.header.date.clone(),
         plan_file: inputs.header.plan_file.clone(),

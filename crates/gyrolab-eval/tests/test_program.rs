@@ -58,8 +58,9 @@ fn the_example_test_program_evaluates_every_section() {
             assert!(text.starts_with("# SIMULATED DATA"), "{}: {}", o.name, &text[..text.len().min(100)]);
         }
     }
-    // Summary, sign-off and the methods appendix are not data sections; the nine others are.
-    assert!(sections == 12 && banners == 9, "{sections} sections, {banners} SIMULATED banners");
+    // Summary, sign-off, the inputs with their SHA-256 and the methods appendix are not data
+    // sections; the nine others are.
+    assert!(sections == 13 && banners == 9, "{sections} sections, {banners} SIMULATED banners");
     for title in [
         "Temperature tests, axis x",
         "Threshold and resolution",

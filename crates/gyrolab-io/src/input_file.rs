@@ -61,9 +61,58 @@ pub fn open_regular(path: &Path) -> Result<(File, u64), DataError> {
     Ok((f, meta.len()))
 }
 
+/// SHA-256 (lower-case hex, FIPS 180-4) and size in bytes of a regular file, read in 64 KiB
+/// blocks (the integrity record of a report folder's inputs; `gyrolab verify`).
+pub fn sha256_file(path: &Path) -> Result<(String, u64), DataError> {
+    use sha2::Digest;
+    use std::io::Read;
+    let (mut f, _) = open_regular(path)?;
+    let mut h = sha2::Sha256::new();
+    let mut buf = vec![0u8; 1 << 16];
+    let mut size = 0u64;
+    loop {
+        let n = f.read(&mut buf).map_err(|e| DataError::io(path, &e))?;
+        if n == 0 {
+            break;
+        }
+        size += n as u64;
+        h.update(&buf[..n]);
+    }
+    Ok((hex(&h.finalize()), size))
+}
+
+/// SHA-256 (lower-case hex) of bytes.
+///
+/// ```
+/// // FIPS 180-4 example "abc".
+/// assert_eq!(
+///     gyrolab_io::input_file::sha256_hex(b"abc"),
+///     "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+/// );
+/// ```
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    use sha2::Digest;
+    hex(&sha2::Sha256::digest(bytes))
+}
+
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sha256_of_a_file_equals_that_of_its_bytes_across_blocks() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("big.bin");
+        let bytes: Vec<u8> = (0..200_000u32).map(|i| (i * 7 % 251) as u8).collect();
+        std::fs::write(&p, &bytes).unwrap();
+        assert_eq!(sha256_file(&p).unwrap(), (sha256_hex(&bytes), 200_000));
+        // FIPS 180-4: the empty message.
+        assert_eq!(sha256_hex(b""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+    }
 
     #[test]
     fn regular_files_open_and_others_are_named() {

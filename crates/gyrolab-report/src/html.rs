@@ -55,6 +55,12 @@ pub struct ReportHeader {
     pub test: TestConditions,
     /// The equipment used, with its calibration status on the test date.
     pub equipment: Vec<EquipmentRow>,
+    /// The report's number (ISO/IEC 17025:2017 7.8.2.1 b): on the header and every printed page.
+    pub report_number: String,
+    /// The issue date, `YYYY-MM-DD`.
+    pub issue_date: String,
+    /// The plan and the inputs with their SHA-256 (empty for built-in data).
+    pub integrity: crate::results::IntegrityJson,
 }
 
 /// The conditions of a test, for the header and the sign-off block.
@@ -74,6 +80,14 @@ pub struct TestConditions {
     pub ambient_temperature_c: Option<f64>,
     /// Ambient relative humidity, %.
     pub ambient_humidity_pct: Option<f64>,
+    /// The customer.
+    pub customer: Option<String>,
+    /// The item's condition when received.
+    pub item_condition: Option<String>,
+    /// The date the item was received, `YYYY-MM-DD`.
+    pub receipt_date: Option<String>,
+    /// Deviations from, additions to or exclusions from the method.
+    pub deviations: Option<String>,
 }
 
 /// Whether a piece of equipment was within its calibration on the test date.
@@ -327,6 +341,7 @@ figure.plot { margin: 10px 0 16px; break-inside: avoid; page-break-inside: avoid
 figure.plot svg { display: block; width: 100%; max-width: 760px; height: auto; border: 1px solid #ddd; }
 figcaption { font-size: 9.5pt; color: #333; margin-top: 3px; }
 .note { font-size: 9.5pt; color: #333; }
+p.end { text-align: center; font-weight: bold; margin-top: 24px; }
 section.page-break { break-before: page; page-break-before: always; }
 table.conditions, table.equipment { margin-top: 8px; }
 table.sign-off td.sign { min-width: 180px; height: 40px; }
@@ -543,6 +558,9 @@ fn write_conditions(h: &mut String, t: &TestConditions, equipment: &[EquipmentRo
         |v: Option<f64>, unit: &str| v.map_or(String::new(), |x| format!("{} {unit}", crate::format::short(x, 4)));
     h.push_str("<table class=\"conditions\"><caption>Test conditions</caption><tbody>\n");
     let rows = [
+        ("customer", text(&t.customer)),
+        ("item condition on receipt", text(&t.item_condition)),
+        ("receipt date", text(&t.receipt_date)),
         ("test date", text(&t.test_date)),
         ("site", text(&t.site)),
         ("procedure", text(&t.procedure)),
@@ -554,6 +572,11 @@ fn write_conditions(h: &mut String, t: &TestConditions, equipment: &[EquipmentRo
         let _ = writeln!(h, "<tr><th class=\"name\">{k}</th><td class=\"name\">{v}</td></tr>");
     }
     h.push_str("</tbody></table>\n");
+    let _ = writeln!(
+        h,
+        "<p class=\"note\"><b>Deviations from the method:</b> {}</p>",
+        t.deviations.as_deref().map_or_else(|| "none stated in the plan ([test] deviations).".to_string(), escape)
+    );
     h.push_str("<table class=\"equipment\"><caption>Equipment</caption><thead><tr><th class=\"name\">equipment</th><th class=\"name\">model</th><th class=\"name\">identifier</th><th class=\"name\">calibration due</th><th class=\"name\">status on the test date</th></tr></thead><tbody>\n");
     if equipment.is_empty() {
         h.push_str("<tr><td class=\"name\" colspan=\"5\">none listed in the plan ([[equipment]])</td></tr>\n");
@@ -591,6 +614,54 @@ fn write_sign_off(h: &mut String, t: &TestConditions) {
     h.push_str("</tbody></table>\n</section>\n");
 }
 
+/// The printed page's margin boxes: the report number at the foot of every page and "page x of
+/// y" beside it (CSS Paged Media margin boxes, printed by Chromium 131 and later).
+fn page_style(report_number: &str) -> String {
+    // A CSS string: only printable characters, quotes and backslashes escaped.
+    let number: String = report_number
+        .chars()
+        .filter(|c| !c.is_control())
+        .flat_map(|c| match c {
+            '"' | '\\' | '<' | '>' => format!("\\{:x} ", c as u32).chars().collect::<Vec<_>>(),
+            c => vec![c],
+        })
+        .collect();
+    format!(
+        "\n@page {{ @bottom-left {{ content: \"Report {number}\"; font-size: 8pt; color: #333; }} \
+         @bottom-right {{ content: \"page \" counter(page) \" of \" counter(pages); font-size: 8pt; color: #333; }} }}\n"
+    )
+}
+
+/// The inputs of the report with their SHA-256 (`gyrolab verify DIR` recomputes them).
+fn write_inputs(h: &mut String, integrity: &crate::results::IntegrityJson) {
+    if integrity.inputs.is_empty() && integrity.plan_sha256.is_none() {
+        return;
+    }
+    h.push_str(
+        "<section class=\"inputs\">\n<h2>Inputs and their SHA-256</h2>\n<p class=\"note\">Each input as hashed when it \
+         was evaluated; <code>gyrolab verify</code> on this folder recomputes the hashes and names any input that changed.</p>\n\
+         <table><thead><tr><th class=\"name\">file</th><th>bytes</th><th class=\"name\">SHA-256</th></tr></thead><tbody>\n",
+    );
+    if let (Some(sha), Some(copy)) = (&integrity.plan_sha256, &integrity.plan_copy) {
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"name\">plan (copy: {})</td><td></td><td class=\"name\"><code>{}</code></td></tr>",
+            escape(copy),
+            escape(sha)
+        );
+    }
+    for i in &integrity.inputs {
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"name\">{}</td><td>{}</td><td class=\"name\"><code>{}</code></td></tr>",
+            escape(&i.file),
+            i.size_bytes,
+            escape(&i.sha256)
+        );
+    }
+    h.push_str("</tbody></table>\n</section>\n");
+}
+
 /// Renders the whole report as one self-contained HTML document.
 pub fn render_html(r: &Report) -> String {
     let hd = &r.header;
@@ -599,8 +670,9 @@ pub fn render_html(r: &Report) -> String {
         h,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-         <title>{}</title>\n<style>{CSS}</style>\n</head>\n<body>\n",
-        escape(&hd.title)
+         <title>{}</title>\n<style>{CSS}{}</style>\n</head>\n<body>\n",
+        escape(&hd.title),
+        page_style(&hd.report_number)
     );
     let simulated = r.simulated();
     if simulated {
@@ -612,6 +684,8 @@ pub fn render_html(r: &Report) -> String {
     }
     let _ = write!(h, "<header>\n<h1>{}</h1>\n<table class=\"header\">\n", escape(&hd.title));
     let rows = [
+        ("report number", &hd.report_number),
+        ("issued", &hd.issue_date),
         ("model", &hd.model),
         ("serial", &hd.serial),
         ("axes", &hd.axes.join(", ")),
@@ -623,6 +697,10 @@ pub fn render_html(r: &Report) -> String {
         let _ = writeln!(h, "<tr><td><b>{k}</b></td><td>{}</td></tr>", escape(v));
     }
     h.push_str("</table>\n");
+    h.push_str(
+        "<p class=\"note\">The results relate only to the items tested, as received. This report shall not be \
+         reproduced except in full.</p>\n",
+    );
     write_conditions(&mut h, &hd.test, &hd.equipment);
     for n in &hd.notes {
         let _ = writeln!(h, "<p class=\"note\">{}</p>", escape(n));
@@ -633,7 +711,9 @@ pub fn render_html(r: &Report) -> String {
         write_section(&mut h, s);
     }
     write_sign_off(&mut h, &hd.test);
+    write_inputs(&mut h, &hd.integrity);
     write_methods(&mut h);
+    let _ = writeln!(h, "<p class=\"end\">End of report {}</p>", escape(&hd.report_number));
     h.push_str("</body>\n</html>\n");
     h
 }

@@ -42,6 +42,30 @@ impl LimitJson {
     }
 }
 
+/// One input file of a report, hashed when it was evaluated.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, serde::Deserialize)]
+pub struct InputJson {
+    /// The path, relative to the plan's folder when the file lies inside it (else absolute).
+    pub file: String,
+    /// SHA-256 of its bytes, lower-case hex.
+    pub sha256: String,
+    /// Its size in bytes.
+    pub size_bytes: u64,
+}
+
+/// What a report folder was made from: the plan (its SHA-256 and the name of its copy in the
+/// folder) and every input file with its SHA-256 (ISO/IEC 17025:2017 7.5, 7.11; `gyrolab
+/// verify`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, serde::Deserialize)]
+pub struct IntegrityJson {
+    /// SHA-256 of the plan file's bytes.
+    pub plan_sha256: Option<String>,
+    /// The plan's copy in the folder (`plan_copy.toml`).
+    pub plan_copy: Option<String>,
+    /// The inputs, in plan order.
+    pub inputs: Vec<InputJson>,
+}
+
 /// A decision rule used by the limits, with the statement the report prints (ISO/IEC
 /// 17025:2017 7.8.6.1: the rule is reported with the statement of conformity).
 #[derive(Debug, Clone, Serialize)]
@@ -69,6 +93,10 @@ pub struct ResultsJson {
     /// True when any input of the report is simulated (a section, a summary figure): the
     /// verdict is then one on SIMULATED data (each section and `summary.csv` row says which).
     pub simulated: bool,
+    /// The report's number.
+    pub report_number: String,
+    /// The issue date, `YYYY-MM-DD`.
+    pub issue_date: String,
     /// Program version.
     pub gyrolab_version: String,
     /// Time of evaluation (RFC 3339, UTC).
@@ -86,6 +114,8 @@ pub struct ResultsJson {
     /// Further sections by name (`static`, `allan`, `paper`), keys in docs/JSON.md.
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub sections: BTreeMap<String, serde_json::Value>,
+    /// The plan and the inputs with their SHA-256.
+    pub integrity: IntegrityJson,
     /// The plan's limits.
     pub limits: Vec<LimitJson>,
     /// Every limit checked on every axis.

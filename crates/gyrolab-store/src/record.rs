@@ -5,8 +5,6 @@
 use crate::{StoreError, StoreResult};
 use gyrolab_eval::test_plan::read_test_plan;
 use serde::Serialize;
-use sha2::{Digest, Sha256};
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// Longest text accepted in one field (a plan, a serial...): 16 MiB.
@@ -143,79 +141,21 @@ impl EvaluationRecord {
     }
 }
 
-/// SHA-256 (hex) and size of a file, read in blocks.
+/// SHA-256 (hex) and size of a file, read in blocks ([`gyrolab_io::input_file::sha256_file`]).
 pub fn hash_file(path: &Path) -> StoreResult<(String, u64)> {
-    let err = |e: std::io::Error| StoreError::Input {
-        path: path.display().to_string(),
-        message: format!("cannot read: {e}"),
-    };
-    let mut f = std::fs::File::open(path).map_err(err)?;
-    let mut h = Sha256::new();
-    let mut buf = vec![0u8; 1 << 16];
-    let mut size = 0u64;
-    loop {
-        let n = f.read(&mut buf).map_err(err)?;
-        if n == 0 {
-            break;
-        }
-        size += n as u64;
-        h.update(&buf[..n]);
-    }
-    Ok((hex(&h.finalize()), size))
+    gyrolab_io::input_file::sha256_file(path)
+        .map_err(|e| StoreError::Input { path: path.display().to_string(), message: e.message })
 }
 
 /// SHA-256 (hex) of bytes.
 pub fn hash_bytes(bytes: &[u8]) -> String {
-    hex(&Sha256::digest(bytes))
+    gyrolab_io::input_file::sha256_hex(bytes)
 }
 
-fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
-}
-
-/// Every input file a plan names, resolved against its folder, in plan order, without repeats.
+/// Every input file a plan names, resolved against its folder, in plan order, without repeats
+/// ([`gyrolab_io::test_plan::TestPlan::input_files`]).
 pub fn plan_inputs(plan: &gyrolab_io_plan::TestPlan) -> Vec<PathBuf> {
-    let mut out: Vec<PathBuf> = Vec::new();
-    let mut add = |p: &PathBuf| {
-        if !out.iter().any(|q| q == p) {
-            out.push(p.clone());
-        }
-    };
-    if let Some(c) = &plan.options.calibration {
-        add(c);
-    }
-    for r in &plan.rate {
-        add(&r.file);
-        if let Some(s) = &r.segmentation.segments {
-            add(s);
-        }
-    }
-    if let Some(t) = &plan.triad {
-        t.files.iter().for_each(&mut add);
-        if let Some(s) = &t.segmentation.segments {
-            add(s);
-        }
-    }
-    for s in &plan.static_tests {
-        s.files.iter().for_each(&mut add);
-        if let Some(a) = &s.allan_file {
-            add(a);
-        }
-    }
-    for t in &plan.temperature {
-        for p in &t.points {
-            p.rate_file.iter().chain(&p.static_file).for_each(&mut add);
-        }
-    }
-    plan.threshold.iter().chain(&plan.resolution).for_each(|s| add(&s.file));
-    for p in &plan.power_ups {
-        p.rate_files.iter().chain(&p.static_files).for_each(|(f, _)| add(f));
-    }
-    plan.warmup.iter().for_each(|w| add(&w.file));
-    for g in &plan.g_sensitivity {
-        g.records.iter().for_each(|r| add(&r.file));
-    }
-    out
+    plan.input_files()
 }
 
 /// The plan types (re-exported by gyrolab-eval's plan reader).

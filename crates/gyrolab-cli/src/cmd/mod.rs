@@ -12,3 +12,4 @@ pub mod rate;
 pub mod record_length;
 pub mod simulate;
 pub mod store;
+pub mod verify;

@@ -25,10 +25,13 @@ use gyrolab_report::figures::known_figure;
 use gyrolab_report::format::sig;
 use gyrolab_report::html::{DataTable, ReportHeader, ReportSection};
 use gyrolab_report::limits::Limit;
-use gyrolab_report::results::DeviceJson;
+use gyrolab_report::results::{DeviceJson, InputJson, IntegrityJson};
 use gyrolab_report::segments::SegmentationJson;
 use gyrolab_report::triad::triad_json;
 use std::path::{Path, PathBuf};
+
+/// The name of the plan's copy in a report folder.
+pub const PLAN_COPY: &str = "plan_copy.toml";
 
 /// Reads and checks a plan file (limit names are checked against the figure catalogue; a limit
 /// on a figure that cannot carry one is refused with the reason, naming the plan's line).
@@ -272,7 +275,34 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
     }
     let created = humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string();
     let (test, equipment) = conditions(&plan.test, &plan.equipment, &created);
+    // The integrity record: the plan (hashed, and copied into the folder) and every input with
+    // its SHA-256 (docs/PLAN.md, `gyrolab verify`).
+    progress.message("hashing the inputs");
+    let plan_bytes = std::fs::read(&plan.file).map_err(|e| gyrolab_io::DataError::io(&plan.file, &e))?;
+    let plan_sha256 = gyrolab_io::input_file::sha256_hex(&plan_bytes);
+    let plan_dir = plan.file.parent().unwrap_or(Path::new("."));
+    let mut inputs_json = Vec::new();
+    for f in plan.input_files() {
+        let (sha256, size_bytes) = gyrolab_io::input_file::sha256_file(&f)?;
+        let file = f.strip_prefix(plan_dir).unwrap_or(&f).display().to_string();
+        inputs_json.push(InputJson { file, sha256, size_bytes });
+    }
+    parts.files.push((PLAN_COPY.into(), plan_bytes));
+    let integrity = IntegrityJson {
+        plan_sha256: Some(plan_sha256.clone()),
+        plan_copy: Some(PLAN_COPY.into()),
+        inputs: inputs_json,
+    };
+    let report_number = plan
+        .test
+        .report_number
+        .clone()
+        .unwrap_or_else(|| crate::report_folder::generated_report_number(&created, &plan_sha256));
+    let issue_date = plan.test.issue_date.clone().unwrap_or_else(|| created.get(..10).unwrap_or_default().to_string());
     let header = ReportHeader {
+        report_number,
+        issue_date,
+        integrity,
         title: "Gyro test report".into(),
         test,
         equipment,
@@ -341,6 +371,10 @@ fn conditions(
         procedure: test.procedure.clone(),
         ambient_temperature_c: test.ambient_temperature_c,
         ambient_humidity_pct: test.ambient_humidity_pct,
+        customer: test.customer.clone(),
+        item_condition: test.item_condition.clone(),
+        receipt_date: test.receipt_date.clone(),
+        deviations: test.deviations.clone(),
     };
     (conditions, rows)
 }

@@ -69,6 +69,12 @@ struct RawTest {
     procedure: Option<String>,
     ambient_temperature_c: Option<Spanned<f64>>,
     ambient_humidity_pct: Option<Spanned<f64>>,
+    report_number: Option<Spanned<String>>,
+    issue_date: Option<Spanned<String>>,
+    customer: Option<String>,
+    item_condition: Option<String>,
+    receipt_date: Option<Spanned<String>>,
+    deviations: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -219,6 +225,18 @@ pub struct TestInfo {
     pub ambient_temperature_c: Option<f64>,
     /// Ambient relative humidity, %.
     pub ambient_humidity_pct: Option<f64>,
+    /// The report's number (ISO/IEC 17025:2017 7.8.2.1 b); `None`: gyrolab generates one.
+    pub report_number: Option<String>,
+    /// The report's issue date, `YYYY-MM-DD`; `None`: the evaluation date.
+    pub issue_date: Option<String>,
+    /// The customer (7.8.2.1 e).
+    pub customer: Option<String>,
+    /// The condition of the item when received (7.8.2.1 g).
+    pub item_condition: Option<String>,
+    /// The date the item was received, `YYYY-MM-DD` (7.8.2.1 h).
+    pub receipt_date: Option<String>,
+    /// Deviations from, additions to or exclusions from the method (7.8.2.1 l; 7.8.3.1 a).
+    pub deviations: Option<String>,
 }
 
 /// One piece of test equipment (`[[equipment]]`): rate table, chamber, data acquisition.
@@ -399,6 +417,54 @@ pub struct TestPlan {
     pub warmup: Vec<WarmupPlan>,
     /// g-sensitivity records (`[g_sensitivity.<axis>]`) in device axis order.
     pub g_sensitivity: Vec<GSensitivityAxisPlan>,
+}
+
+impl TestPlan {
+    /// Every input file the plan names, resolved against its folder, in plan order, without
+    /// repeats (the files a report's integrity record hashes).
+    pub fn input_files(&self) -> Vec<PathBuf> {
+        let mut out: Vec<PathBuf> = Vec::new();
+        let mut add = |p: &PathBuf| {
+            if !out.iter().any(|q| q == p) {
+                out.push(p.clone());
+            }
+        };
+        if let Some(c) = &self.options.calibration {
+            add(c);
+        }
+        for r in &self.rate {
+            add(&r.file);
+            if let Some(s) = &r.segmentation.segments {
+                add(s);
+            }
+        }
+        if let Some(t) = &self.triad {
+            t.files.iter().for_each(&mut add);
+            if let Some(s) = &t.segmentation.segments {
+                add(s);
+            }
+        }
+        for s in &self.static_tests {
+            s.files.iter().for_each(&mut add);
+            if let Some(a) = &s.allan_file {
+                add(a);
+            }
+        }
+        for t in &self.temperature {
+            for p in &t.points {
+                p.rate_file.iter().chain(&p.static_file).for_each(&mut add);
+            }
+        }
+        self.threshold.iter().chain(&self.resolution).for_each(|s| add(&s.file));
+        for p in &self.power_ups {
+            p.rate_files.iter().chain(&p.static_files).for_each(|(f, _)| add(f));
+        }
+        self.warmup.iter().for_each(|w| add(&w.file));
+        for g in &self.g_sensitivity {
+            g.records.iter().for_each(|r| add(&r.file));
+        }
+        out
+    }
 }
 
 /// Reads and checks a plan file; `known_figure` tells which `[limits]` names exist.
@@ -780,6 +846,23 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         procedure: t.procedure.clone(),
         ambient_temperature_c: t.ambient_temperature_c.as_ref().map(|v| *v.get_ref()),
         ambient_humidity_pct: t.ambient_humidity_pct.as_ref().map(|v| *v.get_ref()),
+        report_number: t
+            .report_number
+            .as_ref()
+            .map(|n| {
+                let v = n.get_ref().trim();
+                if v.is_empty() || v.len() > 64 || v.chars().any(|c| c.is_control()) {
+                    Err(cx.err(n.span(), "test.report_number", "expected 1 to 64 printable characters"))
+                } else {
+                    Ok(v.to_string())
+                }
+            })
+            .transpose()?,
+        issue_date: t.issue_date.as_ref().map(|d| date(d, "test.issue_date")).transpose()?,
+        customer: t.customer.clone(),
+        item_condition: t.item_condition.clone(),
+        receipt_date: t.receipt_date.as_ref().map(|d| date(d, "test.receipt_date")).transpose()?,
+        deviations: t.deviations.clone(),
     };
     let mut equipment = Vec::with_capacity(raw.equipment.len());
     for (i, e) in raw.equipment.iter().enumerate() {
