@@ -246,6 +246,8 @@ fn demo_out_writes_the_papers_report() {
         assert!(s["simulated"].as_str().unwrap().contains("adxrs646"), "{s}");
         assert_eq!(s["tests"].as_array().unwrap().len(), 4);
         assert_eq!(s["reference"]["source"], "rate_table");
+        // Issue 33: with the rate test's rest output as null, B0 is named a bias shift.
+        assert!(s["reference"]["text"].as_str().unwrap().contains("is a bias shift"), "{}", s["reference"]);
         assert!(v["sections"]["allan"][axis]["simulated"].is_string());
         let arw = v["sections"]["allan"][axis]["noise"]["arw_deg_rt_h"].as_f64().unwrap();
         assert!((arw / 0.6 - 1.0).abs() < 0.05, "axis {axis}: ARW {arw}");

@@ -86,7 +86,7 @@ pub const FIGURES: &[FigureDef] = &[
     def("scale_factor_repeatability_ppm", "scale-factor repeatability K_r", "ppm", RateTable, "std(K_i, n − 1) / |mean(K_i)|, K_i fitted per run on both strokes (runs within one record: within-run)", "[GJB]"),
     def("scale_factor_repeatability_pct", "scale-factor repeatability K_r", "%", RateTable, "as scale_factor_repeatability_ppm, in percent", "[GJB]"),
     def("scale_factor_repeatability_power_up_ppm", "scale-factor repeatability across power-ups", "ppm", RateTable, "std(K_i, n − 1) / |mean(K_i)|, K_i of one rate-table record per power-up", "[GJB], [IEEE 952]"),
-    def("bias_dph", "bias B_0", "deg/h", Static, "(mean output − F_null) / K per test; the summary quotes the mean over the Q tests", "[P] eq. 10"),
+    def("bias_dph", "bias B_0 (shift against the rest output)", "deg/h", Static, "(mean output − F_null) / K per test, F_null the rate test's rest output, which holds the gyro's bias then: a bias shift, not the absolute bias against a nominal null; the summary quotes the mean over the Q tests", "[P] eq. 10"),
     def("bias_stability_dph_<T>s", "bias stability B_s(T)", "deg/h", Static, "std(means of consecutive T-second windows, n − 1) / K; the summary quotes the worst test", "[P] eq. 11, [GJB]"),
     def("bias_repeatability_dph", "bias repeatability B_r", "deg/h", Static, "std(B_0i, n − 1) over the Q tests", "[P] eq. 12, [GJB]"),
     def("drift_dph_per_h", "drift", "deg/h per h", Static, "least-squares slope of bias against time; the summary quotes the test of largest magnitude", "[GJB]"),

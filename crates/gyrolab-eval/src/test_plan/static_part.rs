@@ -174,7 +174,9 @@ pub(crate) fn reference_of(axis: &str, ctx: &StaticContext<'_>) -> EvalResult<(R
             text: format!(
                 "K = {} {u}/(deg/s) and null = {} {u} ({words}; F0 = {} {u}) from {from}. The null was measured at \
                  rest on the rate table, so it already contains the earth-rate component of a vertical input axis: \
-                 a latitude does not subtract it again.",
+                 a latitude does not subtract it again. It also contains the gyro's own bias at that time, so B0 = \
+                 (static mean - null) / K is a bias shift (the change of the zero-rate output between the rate-table \
+                 and the static tests), not the absolute bias against a nominal null.",
                 sig(c.scale_factor, 6),
                 sig(null, 7),
                 sig(c.zero_offset, 7),
