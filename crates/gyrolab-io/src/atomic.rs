@@ -134,15 +134,7 @@ pub fn write_folder(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>,
             kept.push((keep, path.clone()));
         }
     }
-    let mut written = Vec::with_capacity(staged.len());
-    let mut result = Ok(());
-    for (tmp, path) in staged {
-        if let Err(e) = tmp.persist(&path) {
-            result = Err((path.clone(), e.error));
-            break;
-        }
-        written.push(path);
-    }
+    let (written, result) = persist_in_order(staged);
     if result.is_err() {
         // Put the folder back as it was: the new files out, the old ones in.
         for path in &written {
@@ -158,6 +150,22 @@ pub fn write_folder(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>,
     }
     unregister_all();
     result.map(|()| written)
+}
+
+/// Renames each staged file onto its target, in order, stopping at the first failure: (the
+/// targets written, the failure naming its file).
+#[allow(clippy::type_complexity)]
+fn persist_in_order(
+    staged: Vec<(tempfile::NamedTempFile, PathBuf)>,
+) -> (Vec<PathBuf>, Result<(), (PathBuf, std::io::Error)>) {
+    let mut written = Vec::with_capacity(staged.len());
+    for (tmp, path) in staged {
+        if let Err(e) = tmp.persist(&path) {
+            return (written, Err((path, e.error)));
+        }
+        written.push(path);
+    }
+    (written, Ok(()))
 }
 
 /// A temporary file in `dir` holding `bytes` (mode 0644, synced to disk), registered for
@@ -196,15 +204,7 @@ pub fn write_files(files: &[(PathBuf, Vec<u8>)]) -> Result<Vec<PathBuf>, (PathBu
         }
     }
     let temporaries: Vec<PathBuf> = staged.iter().map(|(t, _)| t.path().to_path_buf()).collect();
-    let mut written = Vec::with_capacity(staged.len());
-    let mut result = Ok(());
-    for (tmp, path) in staged {
-        if let Err(e) = tmp.persist(&path) {
-            result = Err((path.clone(), e.error));
-            break;
-        }
-        written.push(path);
-    }
+    let (written, result) = persist_in_order(staged);
     temporaries.iter().for_each(|t| unregister(t));
     result.map(|()| written)
 }
