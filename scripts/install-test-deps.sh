@@ -29,14 +29,14 @@ fi
 
 if [ "${GYROLAB_SKIP_PYTHON:-}" = "1" ]; then
     echo "install-test-deps: GYROLAB_SKIP_PYTHON=1, not creating .venv (the Python checks will be SKIPPED)" >&2
-elif ! .venv/bin/python -c "import allantools, scipy, pytest, matplotlib, maturin, rosbags, mcap, pyarrow, pandas, dask, distributed, pyulog, yaml, cv2" 2>/dev/null; then
-    echo "install-test-deps: installing allantools, scipy, pytest, matplotlib, maturin, rosbags, mcap, pyarrow, pandas, dask, pyulog, pyyaml, opencv-python-headless" >&2
+elif ! .venv/bin/python -c "import allantools, scipy, pytest, matplotlib, maturin, rosbags, mcap, pyarrow, pandas, dask, distributed, pyulog, yaml, cv2, pypdf" 2>/dev/null; then
+    echo "install-test-deps: installing allantools, scipy, pytest, matplotlib, maturin, rosbags, mcap, pyarrow, pandas, dask, pyulog, pyyaml, opencv-python-headless, pypdf" >&2
     echo "install-test-deps: (PyPI, into $PWD/.venv, about 750 MB; GYROLAB_SKIP_PYTHON=1 skips the checks that need them instead)" >&2
     python3 -m venv .venv
     .venv/bin/pip install --quiet --disable-pip-version-check "allantools==2024.6" "numpy<3" "scipy" \
         "pytest>=7" "matplotlib>=3.5" "maturin>=1.7,<2" "rosbags==0.11.9" "mcap==1.6.0" "pyarrow==26.0.1" \
         "pandas==3.1.1" "dask==2026.8.0" "distributed==2026.8.0" "pyulog==1.2.0" \
-        "pyyaml==6.0.3" "opencv-python-headless==4.12.0.88"
+        "pyyaml==6.0.3" "opencv-python-headless==4.12.0.88" "pypdf==7.1.1"
 fi
 
 if have_browser; then

@@ -171,7 +171,7 @@ fn decision_rules_give_conditional_and_incomplete_their_own_exit_codes() {
     // without an uncertainty likewise.
     for limits in [
         "linearity_pct = { max = 6 }\nbias_stability_dph_10s = { max = 20 }",
-        "hysteresis_pct = { max = 1.0, rule = \"guarded_acceptance\" }",
+        "asymmetry_pct = { max = 100, rule = \"guarded_acceptance\" }",
     ] {
         let (code, err, v) = eval_code(&paper_plan_with(dir.path(), "", limits), &out);
         assert_eq!((code, v["verdict"].as_str()), (5, Some("INCOMPLETE")), "{limits}: {err}");
@@ -181,6 +181,14 @@ fn decision_rules_give_conditional_and_incomplete_their_own_exit_codes() {
             "{err}"
         );
     }
+    // Hysteresis has its own budget (the stroke means' scatter across the paper's four runs), so
+    // a guarded rule decides on it: 0.66 % FS with U = 0.73 against <= 1 is inside the guard band.
+    let (code, err, v) = eval_code(
+        &paper_plan_with(dir.path(), "", "hysteresis_pct = { max = 1.0, rule = \"guarded_acceptance\" }"),
+        &out,
+    );
+    assert_eq!((code, v["verdict"].as_str()), (6, Some("CONDITIONAL")), "{err}");
+    assert!(v["limit_checks"][0]["expanded_uncertainty"].as_f64().unwrap() > 0.0);
 }
 
 fn plan_error(edit: impl Fn(&str) -> String) -> String {

@@ -24,6 +24,28 @@ fn page_count_counts_pages_not_the_page_tree() {
     assert_eq!(page_count(pdf), 2);
 }
 
+/// The text of each page of a PDF, extracted by pypdf in the test venv; `None` (said loudly) only
+/// with GYROLAB_SKIP_PYTHON=1 when the venv lacks it.
+fn page_texts(pdf: &Path) -> Option<Vec<String>> {
+    let py = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../.venv/bin/python");
+    let script = "import json, sys, pypdf\nr = pypdf.PdfReader(sys.argv[1])\n\
+                  print(json.dumps([p.extract_text() for p in r.pages]))\n";
+    let out = std::process::Command::new(&py).args(["-c", script]).arg(pdf).output();
+    match out {
+        Ok(o) if o.status.success() => Some(serde_json::from_slice(&o.stdout).unwrap()),
+        _ if std::env::var("GYROLAB_SKIP_PYTHON").as_deref() == Ok("1") => {
+            eprintln!(
+                "\n*** SKIPPED: the PDF page texts were not checked: .venv has no pypdf (GYROLAB_SKIP_PYTHON=1) ***\n"
+            );
+            None
+        }
+        other => panic!(
+            "the PDF test reads the pages with pypdf from .venv: run scripts/install-test-deps.sh (or set \
+             GYROLAB_SKIP_PYTHON=1 to skip that check loudly): {other:?}"
+        ),
+    }
+}
+
 /// The files of a folder, sorted.
 fn names(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> =
@@ -79,6 +101,20 @@ fn demo_report_prints_to_a_paginated_pdf() {
     assert!(!boxes.is_empty(), "no /MediaBox");
     for b in &boxes {
         assert!(b.len() == 4 && (b[2] - b[0] - a4_w).abs() < 1.0 && (b[3] - b[1] - a4_h).abs() < 1.0, "not A4: {b:?}");
+    }
+    // Every printed page has the report number and "page i of N" in its margin (CSS @page margin
+    // boxes), read back from the PDF's text by pypdf, an independent PDF reader.
+    let results: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("results.json")).unwrap()).unwrap();
+    let number = results["report_number"].as_str().unwrap().to_string();
+    if let Some(texts) = page_texts(&out.join("report.pdf")) {
+        assert_eq!(texts.len(), pages, "pypdf and the page count disagree");
+        for (i, t) in texts.iter().enumerate() {
+            let want = format!("page {} of {pages}", i + 1);
+            assert!(t.contains(&want), "page {}: no {want:?} in {:?}", i + 1, &t[..t.len().min(200)]);
+            assert!(t.contains(&format!("Report {number}")), "page {}: no report number {number}", i + 1);
+            assert!(t.contains("SIMULATED DATA"), "page {}: no SIMULATED mark", i + 1);
+        }
+        assert!(texts.last().unwrap().contains(&format!("End of report {number}")), "no end-of-report mark");
     }
     // Nothing temporary is left beside the outputs.
     let files = names(&out);

@@ -205,6 +205,7 @@ fn simulated_static_and_allan(
         simulated: Some(&describe),
         exports: &[],
         records_simulated: true,
+        nominal_nulls: &std::collections::BTreeMap::new(),
     };
     evaluate_static(&plans, &ctx, progress)
 }

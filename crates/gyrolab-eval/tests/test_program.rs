@@ -74,3 +74,105 @@ fn the_example_test_program_evaluates_every_section() {
     let cal = String::from_utf8(get("calibration.toml").to_vec()).unwrap();
     assert!(cal.contains("[axis.temperature]"), "{cal}");
 }
+
+fn num(v: &Value) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
+}
+
+fn close(got: f64, want: f64, rel: f64, what: &str) {
+    assert!((got - want).abs() <= rel * want.abs(), "{what}: got {got}, want {want}");
+}
+
+/// Sample standard deviation (n − 1), written out here.
+fn std_dev(x: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    let m = x.iter().sum::<f64>() / n;
+    (x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+}
+
+/// The budgets of the figures beyond K, F0 and the static ones, recomputed here from the
+/// numbers of results.json by their textbook formulas (docs/METHODS.md, section 11, "Further
+/// figures"), k = 2, and each figure's U handed to its limit check.
+#[test]
+fn figure_budgets_of_the_test_program_equal_a_recomputation() {
+    let dir = tempfile::tempdir().unwrap();
+    write_test_program(dir.path(), SEED).unwrap();
+    let plan = read_test_plan(&dir.path().join("plan.toml")).unwrap();
+    let folder = evaluate_test_plan(&plan, "plan.toml", &Silent).unwrap();
+    let json: Value =
+        serde_json::from_slice(&folder.outputs.iter().find(|o| o.name == "results.json").unwrap().bytes).unwrap();
+    let s = &json["sections"];
+    let u = &s["uncertainty"]["x"];
+    let expanded = |figure: &str| num(&u[format!("{figure}_expanded_uncertainty")]);
+    let check_u = |figure: &str| {
+        let c = json["limit_checks"].as_array().unwrap().iter().find(|c| c["figure"] == figure).unwrap().clone();
+        num(&c["expanded_uncertainty"])
+    };
+    let (out_acc, rate_ppm, temp_acc) = (2e-4, 50.0, 0.5);
+    // Threshold 0.12 deg/s above the failing 0.08: rectangular over (0.08, 0.12], plus 50 ppm
+    // rectangular of the rate.
+    let t = &s["threshold"]["x"];
+    let (v, below) = (num(&t["threshold_dps"]), num(&t["above_dps"]));
+    let want = 2.0 * (((v - below) / 12f64.sqrt()).powi(2) + (v * rate_ppm * 1e-6 / 3f64.sqrt()).powi(2)).sqrt();
+    close(expanded("threshold_dps"), want, 1e-12, "threshold");
+    close(check_u("threshold_dps"), want, 1e-12, "threshold check");
+    // Warm-up: one 10 s window, rectangular.
+    let w = num(&s["warmup"]["x"]["window_s"]);
+    close(expanded("warmup_settling_time_s"), 2.0 * w / 12f64.sqrt(), 1e-12, "settling time");
+    // Power-ups: s of the six biases, u = s/√(2(n − 1)).
+    let biases: Vec<f64> =
+        s["power_ups"]["x"]["bias"]["power_ups"].as_array().unwrap().iter().map(|p| num(&p["value"])).collect();
+    let sd = std_dev(&biases);
+    close(num(&s["power_ups"]["x"]["bias"]["bias_repeatability_power_up_dph"]), sd, 1e-12, "power-up s");
+    close(
+        expanded("bias_repeatability_power_up_dph"),
+        2.0 * sd / (2.0 * (biases.len() as f64 - 1.0)).sqrt(),
+        1e-12,
+        "power-up bias repeatability",
+    );
+    // Bias temperature sensitivity: the slope's textbook standard error over the soaked points
+    // and the chamber's 0.5 degC rectangular through |slope| / √S_TT.
+    let pts: Vec<(f64, f64)> = s["temperature"]["x"]["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|p| p["bias_dph"].is_number())
+        .map(|p| (num(&p["temperature_c"]), num(&p["bias_dph"])))
+        .collect();
+    let n = pts.len() as f64;
+    let mt = pts.iter().map(|p| p.0).sum::<f64>() / n;
+    let mb = pts.iter().map(|p| p.1).sum::<f64>() / n;
+    let stt: f64 = pts.iter().map(|p| (p.0 - mt).powi(2)).sum();
+    let slope = pts.iter().map(|p| (p.0 - mt) * (p.1 - mb)).sum::<f64>() / stt;
+    let ss: f64 = pts.iter().map(|p| (p.1 - mb - slope * (p.0 - mt)).powi(2)).sum();
+    let se = (ss / (n - 2.0) / stt).sqrt();
+    let tb = slope.abs() * temp_acc / 3f64.sqrt() / stt.sqrt();
+    close(expanded("bias_temp_sensitivity_dph_per_c"), 2.0 * (se * se + tb * tb).sqrt(), 1e-9, "bias temp slope");
+    // Nonlinearity: the point of the largest |a_j|, its two stroke means' scatter across the
+    // runs (s/√R, weight 1/2) and the output accuracy, all over F_m, in %.
+    let a = &json["rate_axes"][0];
+    let r = num(&a["runs"]);
+    let p = a["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .max_by(|x, y| num(&x["nonlinearity_pct"]).abs().total_cmp(&num(&y["nonlinearity_pct"]).abs()))
+        .unwrap();
+    let (sf, sr) = (num(&p["fwd_std"]) / r.sqrt(), num(&p["rev_std"]) / r.sqrt());
+    let u_point = (0.25 * sf * sf + 0.25 * sr * sr + (out_acc / 3f64.sqrt()).powi(2)).sqrt();
+    let want = 2.0 * u_point * 100.0 / num(&a["output_amplitude"]);
+    close(expanded("nonlinearity_pct"), want, 1e-9, "nonlinearity");
+    close(check_u("nonlinearity_pct"), want, 1e-9, "nonlinearity check");
+    // K for the device: the power-up scatter of K and the test temperature through its
+    // coefficient join the slope and rate-accuracy lines.
+    let k = num(&a["scale_factor"]);
+    let kb = &u["budgets"]["scale_factor"]["components"];
+    let s_k = num(&s["power_ups"]["x"]["scale_factor"]["scale_factor_repeatability_power_up_ppm"]);
+    close(num(&kb[2]["contribution"]), s_k * k * 1e-6, 1e-9, "K power-up line");
+    let alpha = num(&s["temperature"]["x"]["scale_factor_temp_sensitivity_ppm_per_c"]["value"]);
+    close(num(&kb[3]["contribution"]), alpha.abs() * k * 1e-6 * temp_acc / 3f64.sqrt(), 1e-9, "K temperature line");
+    let parts: f64 = kb.as_array().unwrap().iter().map(|c| num(&c["contribution"]).powi(2)).sum();
+    close(num(&u["scale_factor_expanded_ppm"]), 2.0 * parts.sqrt() / k * 1e6, 1e-9, "U(K) ppm");
+    // The bias stability's U reaches its check.
+    close(check_u("bias_stability_dph_10s"), num(&u["bias_stability_expanded_dph"]), 1e-12, "bias stability check");
+}

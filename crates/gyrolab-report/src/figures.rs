@@ -170,6 +170,9 @@ pub struct AxisFigures {
     /// Expanded uncertainties U (same unit as the figure) given for a figure directly; figures
     /// with a catalogue uncertainty key ([`uncertainty_key`]) take theirs from `values`.
     pub uncertainties: Vec<(String, f64)>,
+    /// Labels that replace the catalogue's for this axis (the bias is absolute against a nominal
+    /// null on some axes and a bias shift on others).
+    pub labels: Vec<(String, String)>,
 }
 
 /// The catalogue key of a figure's expanded uncertainty (that of K is relative, in ppm:
@@ -222,7 +225,27 @@ impl AxisFigures {
         for (k, u) in other.uncertainties {
             self.set_uncertainty(k, u);
         }
+        for (k, l) in other.labels {
+            self.set_label(k, l);
+        }
         self.simulated.extend(other.simulated);
+    }
+
+    /// Replaces the catalogue's label of a figure on this axis.
+    pub fn set_label(&mut self, key: impl Into<String>, label: impl Into<String>) {
+        let key = key.into();
+        self.labels.retain(|(k, _)| *k != key);
+        self.labels.push((key, label.into()));
+    }
+
+    /// The label of a figure on this axis: its own, else the catalogue's, else the key.
+    pub fn label_of(&self, key: &str) -> String {
+        self.labels
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, l)| l.clone())
+            .or_else(|| known_figure(key).map(|d| d.label.to_string()))
+            .unwrap_or_else(|| key.to_string())
     }
 
     /// Gives a figure's expanded uncertainty U (same unit as the figure).

@@ -16,6 +16,55 @@ pub fn sig(v: f64, digits: usize) -> String {
     format!("{v:.decimals$}")
 }
 
+/// The significant digits of `v` that end at the decimal of the second significant digit of its
+/// expanded uncertainty `u` (U stated to two significant digits and the value rounded to match,
+/// GUM 7.2.6); at least 1. `None` without a positive finite U or for a zero value.
+///
+/// ```
+/// use gyrolab_report::format::{digits_to_uncertainty, sig};
+/// // 7.21834 with U = 3.2: to 0.1 -> "7.2"; 0.0012345 with U = 0.000051 -> "0.001234" (4 digits).
+/// assert_eq!(sig(7.21834, digits_to_uncertainty(7.21834, 3.2).unwrap()), "7.2");
+/// assert_eq!(digits_to_uncertainty(0.0012345, 0.000051), Some(4));
+/// assert_eq!(digits_to_uncertainty(5.0, 0.0), None);
+/// ```
+pub fn digits_to_uncertainty(v: f64, u: f64) -> Option<usize> {
+    if !(v.is_finite() && u.is_finite() && u > 0.0) || v == 0.0 {
+        return None;
+    }
+    let mv = v.abs().log10().floor() as i32;
+    let mu = u.log10().floor() as i32;
+    Some((mv - mu + 2).max(1) as usize)
+}
+
+/// A value and its expanded uncertainty as printed: U rounded to two significant digits and the
+/// value rounded to the same decimal, tens and hundreds included (GUM 7.2.6); `None` without a
+/// positive finite U or a finite value. Very large or small magnitudes use [`sig`]'s exponent form.
+///
+/// ```
+/// use gyrolab_report::format::rounded_to_uncertainty;
+/// assert_eq!(rounded_to_uncertainty(581.29, 367.6), Some(("580".into(), "370".into())));
+/// assert_eq!(rounded_to_uncertainty(7.21834, 3.2), Some(("7.2".into(), "3.2".into())));
+/// assert_eq!(rounded_to_uncertainty(0.0075000198, 8.754e-6), Some(("0.0075000".into(), "0.0000088".into())));
+/// assert_eq!(rounded_to_uncertainty(1.0, 0.0), None);
+/// ```
+pub fn rounded_to_uncertainty(v: f64, u: f64) -> Option<(String, String)> {
+    if !(v.is_finite() && u.is_finite() && u > 0.0) {
+        return None;
+    }
+    let mag = u.log10().floor() as i32;
+    // Rounding U may carry into the next decade (9.96 -> 10): take the exponent after rounding.
+    let step = 10f64.powi(mag - 1);
+    let u_r = (u / step).round() * step;
+    let mag = u_r.log10().floor() as i32;
+    let step = 10f64.powi(mag - 1);
+    if !(-6..=8).contains(&mag) {
+        return Some((sig(v, digits_to_uncertainty(v, u_r).unwrap_or(2)), sig(u_r, 2)));
+    }
+    let decimals = (1 - mag).max(0) as usize;
+    let v_r = (v / step).round() * step;
+    Some((format!("{v_r:.decimals$}"), format!("{u_r:.decimals$}")))
+}
+
 /// Formats a value with up to `digits` significant digits, trailing zeros removed.
 pub fn short(v: f64, digits: usize) -> String {
     let s = sig(v, digits);

@@ -257,14 +257,23 @@ impl SummaryTable {
                         let check = checks.iter().find(|c| c.axis == a.axis && c.figure == key);
                         // With a limit, as many digits as keep value and limit from contradicting
                         // the verdict; a bound says which side it is.
-                        let text = match (a.known(&key), check) {
+                        let known = a.known(&key);
+                        let u = known.as_ref().and_then(|k| k.expanded_uncertainty).filter(|u| *u > 0.0);
+                        let text = match (&known, check) {
                             (Some(_), Some(c)) => c.value_text(digits),
                             (Some(k), None) => match k.support {
-                                Support::Value => sig(k.value, digits),
+                                Support::Value => u
+                                    .and_then(|u| crate::format::rounded_to_uncertainty(k.value, u))
+                                    .map_or_else(|| sig(k.value, digits), |(v, _)| v),
                                 Support::UpperBound => format!("at most {}", sig(k.value, digits)),
                                 Support::LowerBound => format!("above {}", sig(k.value, digits)),
                             },
                             (None, _) => "n/a".into(),
+                        };
+                        // The expanded uncertainty beside the value, to two significant digits.
+                        let text = match u.and_then(|u| crate::format::rounded_to_uncertainty(1.0, u)) {
+                            Some((_, u_text)) => format!("{text} ± {u_text}"),
+                            None => text,
                         };
                         let verdict = limit
                             .filter(|l| l.applies_to(&a.axis))
@@ -274,7 +283,15 @@ impl SummaryTable {
                     .collect();
                 SummaryRow {
                     simulated: axes.iter().any(|a| a.simulated.contains(&key)),
-                    label: def.map_or_else(|| key.clone(), |d| d.label.to_string()),
+                    label: {
+                        let mut labels: Vec<String> = axes.iter().map(|a| a.label_of(&key)).collect();
+                        labels.dedup();
+                        if labels.is_empty() {
+                            def.map_or_else(|| key.clone(), |d| d.label.to_string())
+                        } else {
+                            labels.join(" / ")
+                        }
+                    },
                     unit: axes.first().map_or_else(String::new, |a| a.unit_of(&key)),
                     limit: limit.map_or_else(String::new, Limit::text),
                     key,

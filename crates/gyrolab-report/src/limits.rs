@@ -101,12 +101,23 @@ pub struct LimitCheck {
 }
 
 impl LimitCheck {
-    /// The value as printed beside its limit: at least `min_digits` significant digits and as
-    /// many more as keep the printed value and limit from contradicting the verdict; a bound
-    /// printed `at most ..` or `above ..`; `n/a` without a value.
+    /// The value as printed beside its limit: rounded to its expanded uncertainty (the decimal of
+    /// U's second significant digit) when it has one, else at least `min_digits` significant
+    /// digits, and as many more as keep the printed value and limit from contradicting the
+    /// verdict; a bound printed `at most ..` or `above ..`; `n/a` without a value.
     pub fn value_text(&self, min_digits: usize) -> String {
         let Some(v) = self.value else { return "n/a".into() };
-        let n = self.limit().digits_for(v, min_digits);
+        let to_u = self.expanded_uncertainty.and_then(|u| crate::format::digits_to_uncertainty(v, u));
+        let n = self.limit().digits_for(v, to_u.unwrap_or(min_digits));
+        // Rounded to U (tens included) where that many digits already agree with the verdict.
+        let estimate = !matches!(self.support, Some(Support::UpperBound | Support::LowerBound));
+        if let (Some(d), Some(u), true) = (to_u, self.expanded_uncertainty, estimate) {
+            if n == d {
+                if let Some((text, _)) = crate::format::rounded_to_uncertainty(v, u) {
+                    return text;
+                }
+            }
+        }
         match self.support {
             Some(Support::UpperBound) => format!("at most {}", sig(v, n)),
             Some(Support::LowerBound) => format!("above {}", sig(v, n)),

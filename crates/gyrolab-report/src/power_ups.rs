@@ -285,6 +285,9 @@ impl WarmupAxisReport {
         let r = &self.report.result;
         let mut f = AxisFigures { axis: self.axis.clone(), ..Default::default() };
         f.set("turn_on_bias_dph", r.turn_on);
+        if self.reference.null_source.as_deref() == Some(crate::static_report::NOMINAL_NULL) {
+            f.set_label("turn_on_bias_dph", "turn-on bias (absolute, against the nominal null)");
+        }
         if let Some(t) = r.settling_time_s {
             f.set("warmup_settling_time_s", t);
         }

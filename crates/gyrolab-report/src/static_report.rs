@@ -49,6 +49,12 @@ pub struct TestWindows {
     pub windows: Vec<WindowMean>,
 }
 
+/// The `null_source` of a reference whose null is the plan's nominal null (absolute bias).
+pub const NOMINAL_NULL: &str = "nominal_null";
+
+/// The summary label of B0 when it is the absolute bias against the nominal null.
+pub const ABSOLUTE_BIAS_LABEL: &str = "bias B_0 (absolute, against the nominal null)";
+
 /// Everything evaluated for one axis's static records.
 #[derive(Debug, Clone)]
 pub struct StaticAxisReport {
@@ -117,6 +123,9 @@ impl StaticAxisReport {
         let biases: Option<Vec<f64>> = self.tests.iter().map(|t| t.result.bias_dph).collect();
         if let Some(m) = biases.as_deref().and_then(gyrolab::fit::mean) {
             f.set("bias_dph", m);
+        }
+        if self.reference.null_source.as_deref() == Some(NOMINAL_NULL) {
+            f.set_label("bias_dph", ABSOLUTE_BIAS_LABEL);
         }
         for t in self.smoothing_times() {
             let worst =

@@ -3,7 +3,9 @@
 //!
 //! Sources: JCGM 100:2008 (GUM) = JJF 1059.1-2012: clause 4.2 (type A evaluation), 4.3 (type B
 //! evaluation; 4.3.7 rectangular distribution u = a/√3), 5.1.2 (law of propagation of
-//! uncertainty for uncorrelated input quantities), 6.2-6.3 (expanded uncertainty U = k u_c),
+//! uncertainty for uncorrelated input quantities), 5.2.2 (correlated input quantities, eq. 16),
+//! 6.2-6.3 (expanded uncertainty U = k u_c), Annex G.4 (effective degrees of freedom by the
+//! Welch-Satterthwaite formula, eq. G.2b, and k_p = t_p(ν_eff), ν_eff truncated to an integer),
 //! Annex E.4.3 (the standard deviation of an experimental standard deviation ≈ s/√(2(n-1)),
 //! normal theory); JJF 1535 for the gyro figures. The standard errors of a least-squares line
 //! are the textbook ones (Draper & Smith, Applied Regression Analysis, 3rd ed., section 1.4;
@@ -70,6 +72,11 @@ pub struct Component {
     pub sensitivity: f64,
     /// Contribution u_i(y) = |c_i| u(x_i), in the budget's unit.
     pub contribution: f64,
+    /// Degrees of freedom ν_i of u(x_i) (GUM G.3, G.4.2): n − 1 for a mean or standard deviation
+    /// of n values, m − 2 for a straight line through m points, the equivalent degrees of freedom
+    /// of an Allan deviation; `None` is infinite (a type-B accuracy taken as exactly known).
+    #[serde(default)]
+    pub dof: Option<f64>,
 }
 
 impl Component {
@@ -82,8 +89,45 @@ impl Component {
             unit: unit.into(),
             sensitivity: c,
             contribution: (c * u).abs(),
+            dof: None,
         }
     }
+
+    /// The same component with ν_i degrees of freedom (non-finite or non-positive: infinite).
+    pub fn with_dof(mut self, dof: f64) -> Self {
+        self.dof = (dof.is_finite() && dof > 0.0).then_some(dof);
+        self
+    }
+
+    /// The signed contribution c_i u(x_i) (the correlated law of propagation needs the sign).
+    pub fn signed_contribution(&self) -> f64 {
+        self.sensitivity * self.standard_uncertainty
+    }
+}
+
+/// How a budget's expanded uncertainty is obtained (GUM 6.2-6.3, Annex G).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Coverage {
+    /// One coverage factor k for every budget (the report's k); the coverage probability it
+    /// gives at each budget's ν_eff is stated beside it.
+    Factor(f64),
+    /// A coverage probability p: each budget's k_p = t_p(ν_eff) (GUM G.4.1, G.3.4).
+    Probability(f64),
+}
+
+/// A correlation coefficient r(x_i, x_j) between two components of a budget, with the reason it
+/// is stated (GUM 5.2.2, 5.2.4: e.g. both read with the same instrument).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Correlation {
+    /// Index of the first component.
+    pub first: usize,
+    /// Index of the second component.
+    pub second: usize,
+    /// r(x_i, x_j), in [-1, 1].
+    pub coefficient: f64,
+    /// Why the two inputs are correlated, as the report states it.
+    pub reason: String,
 }
 
 /// An uncertainty budget of one figure: components, combined standard uncertainty and expanded
@@ -98,10 +142,22 @@ pub struct Budget {
     pub unit: String,
     /// The components.
     pub components: Vec<Component>,
-    /// Combined standard uncertainty u_c = √(Σ u_i²) (uncorrelated inputs, GUM 5.1.2).
+    /// Correlations between components (none: uncorrelated inputs).
+    #[serde(default)]
+    pub correlations: Vec<Correlation>,
+    /// Combined standard uncertainty u_c: √(Σ u_i²) for uncorrelated inputs (GUM 5.1.2), with
+    /// the terms 2 Σ c_i c_j u_i u_j r_ij of the correlated ones (GUM 5.2.2, eq. 16).
     pub combined: f64,
+    /// Effective degrees of freedom ν_eff = u_c⁴ / Σ (u_i⁴ / ν_i) (Welch-Satterthwaite, GUM
+    /// G.4.1 eq. G.2b); `None` is infinite (every component has infinite ν).
+    #[serde(default)]
+    pub effective_dof: Option<f64>,
     /// Coverage factor k (GUM 6.2.1).
     pub coverage_factor: f64,
+    /// Coverage probability p of U = k u_c at ν_eff (Student's t; the normal distribution for
+    /// infinite ν_eff).
+    #[serde(default)]
+    pub coverage_probability: f64,
     /// Expanded uncertainty U = k u_c (GUM 6.2.1).
     pub expanded: f64,
 }
@@ -115,15 +171,42 @@ impl Budget {
         components: Vec<Component>,
         k: f64,
     ) -> Self {
-        let combined = combine(&components);
+        Budget::correlated(quantity, value, unit, components, Vec::new(), Coverage::Factor(k))
+    }
+
+    /// Combines the components with their correlations (GUM 5.2.2) and expands them as
+    /// `coverage` says: with one k, or with k_p = t_p(ν_eff) (GUM G.4). Correlations naming a
+    /// component that does not exist are ignored; coefficients are clamped to [-1, 1].
+    pub fn correlated(
+        quantity: impl Into<String>,
+        value: f64,
+        unit: impl Into<String>,
+        components: Vec<Component>,
+        correlations: Vec<Correlation>,
+        coverage: Coverage,
+    ) -> Self {
+        let correlations: Vec<Correlation> = correlations
+            .into_iter()
+            .filter(|c| c.first < components.len() && c.second < components.len() && c.first != c.second)
+            .map(|c| Correlation { coefficient: c.coefficient.clamp(-1.0, 1.0), ..c })
+            .collect();
+        let combined = combine_correlated(&components, &correlations);
+        let effective_dof = welch_satterthwaite(combined, &components);
+        let (coverage_factor, coverage_probability) = match coverage {
+            Coverage::Factor(k) => (k, coverage_probability_of(k, effective_dof)),
+            Coverage::Probability(p) => (coverage_factor_for(p, effective_dof), p),
+        };
         Budget {
             quantity: quantity.into(),
             value,
             unit: unit.into(),
             components,
+            correlations,
             combined,
-            coverage_factor: k,
-            expanded: k * combined,
+            effective_dof,
+            coverage_factor,
+            coverage_probability,
+            expanded: coverage_factor * combined,
         }
     }
 
@@ -141,6 +224,77 @@ impl Budget {
 /// Combined standard uncertainty of uncorrelated components: √(Σ (c_i u_i)²) (GUM eq. 10).
 pub fn combine(components: &[Component]) -> f64 {
     components.iter().map(|c| c.contribution * c.contribution).sum::<f64>().sqrt()
+}
+
+/// Combined standard uncertainty with correlations: u_c² = Σ (c_i u_i)² + 2 Σ_{i<j} c_i u_i c_j
+/// u_j r_ij (GUM 5.2.2, eq. 16). A fully correlated pair read with opposite sensitivities cancels.
+pub fn combine_correlated(components: &[Component], correlations: &[Correlation]) -> f64 {
+    let mut v: f64 = components.iter().map(|c| c.contribution * c.contribution).sum();
+    for r in correlations {
+        if let (Some(a), Some(b)) = (components.get(r.first), components.get(r.second)) {
+            v += 2.0 * a.signed_contribution() * b.signed_contribution() * r.coefficient;
+        }
+    }
+    v.max(0.0).sqrt()
+}
+
+/// Effective degrees of freedom ν_eff = u_c⁴ / Σ (u_i⁴ / ν_i) (Welch-Satterthwaite, GUM G.4.1,
+/// eq. G.2b); components of infinite ν add nothing to the denominator. `None` (infinite) when
+/// every component has infinite ν or u_c is 0.
+///
+/// ```
+/// use gyrolab::uncertainty::{welch_satterthwaite, Component, EvaluationType::A};
+/// // GUM G.4.1, example 1: relative uncertainties 0.25 %, 0.57 %, 0.82 % from 10, 5 and 15
+/// // observations (ν = 9, 4, 14) combine to 1.03 % with ν_eff = 19.0.
+/// let c = [
+///     Component::new("x1", A, 0.25, "%", 1.0).with_dof(9.0),
+///     Component::new("x2", A, 0.57, "%", 1.0).with_dof(4.0),
+///     Component::new("x3", A, 0.82, "%", 1.0).with_dof(14.0),
+/// ];
+/// let uc = gyrolab::uncertainty::combine(&c);
+/// assert!((uc - 1.03).abs() < 0.005);
+/// assert!((welch_satterthwaite(uc, &c).unwrap() - 19.0).abs() < 0.05);
+/// ```
+pub fn welch_satterthwaite(combined: f64, components: &[Component]) -> Option<f64> {
+    let denominator: f64 = components.iter().filter_map(|c| c.dof.map(|nu| c.contribution.powi(4) / nu)).sum();
+    (denominator > 0.0 && combined > 0.0).then(|| combined.powi(4) / denominator)
+}
+
+/// ν_eff truncated to the next lower integer, at least 1 (GUM G.4.1 b: the conservative choice
+/// for a table of t_p).
+fn truncated_dof(nu: f64) -> f64 {
+    nu.floor().max(1.0)
+}
+
+/// Coverage factor k_p = t_p(ν) of a two-sided interval of coverage probability p (Student's t
+/// with ν truncated to an integer, GUM G.3.2-G.4.1; the normal quantile for infinite ν).
+///
+/// ```
+/// use gyrolab::uncertainty::coverage_factor_for;
+/// // GUM Table G.2: t_95(19) = 2.09 (2.093), t_95.45(∞) = 2.00, t_95(∞) = 1.96.
+/// assert!((coverage_factor_for(0.95, Some(19.0)) - 2.093).abs() < 5e-4);
+/// assert!((coverage_factor_for(0.9545, None) - 2.0).abs() < 1e-3);
+/// assert!((coverage_factor_for(0.95, None) - 1.95996).abs() < 1e-4);
+/// ```
+pub fn coverage_factor_for(p: f64, effective_dof: Option<f64>) -> f64 {
+    use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
+    let q = (1.0 + p.clamp(0.0, 1.0 - 1e-15)) / 2.0;
+    let t = effective_dof.and_then(|nu| StudentsT::new(0.0, 1.0, truncated_dof(nu)).ok());
+    match t {
+        Some(t) => t.inverse_cdf(q),
+        None => Normal::new(0.0, 1.0).map(|n| n.inverse_cdf(q)).unwrap_or(f64::NAN),
+    }
+}
+
+/// The coverage probability of U = k u_c at ν_eff: 2 F_t(k; ν) − 1 (the normal distribution for
+/// infinite ν). k = 2 gives 95.45 % at infinite ν and 91.95 % at ν = 8.
+pub fn coverage_probability_of(k: f64, effective_dof: Option<f64>) -> f64 {
+    use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
+    let cdf = match effective_dof.and_then(|nu| StudentsT::new(0.0, 1.0, truncated_dof(nu)).ok()) {
+        Some(t) => t.cdf(k),
+        None => Normal::new(0.0, 1.0).map(|n| n.cdf(k)).unwrap_or(f64::NAN),
+    };
+    2.0 * cdf - 1.0
 }
 
 /// Why an uncertainty cannot be stated.
@@ -294,6 +448,63 @@ mod tests {
         assert_relative_eq!(b.combined, 5.0);
         assert_relative_eq!(b.expanded, 10.0);
         assert_relative_eq!(b.relative_expanded().unwrap(), 0.5);
+    }
+
+    #[test]
+    fn welch_satterthwaite_on_the_gum_example() {
+        // JCGM 100:2008 G.4.1, example 1: u_i/x_i = 0.25, 0.57, 0.82 % from n = 10, 5, 15
+        // observations: u_c/y = 1.03 %, ν_eff = 1.03⁴ / (0.25⁴/9 + 0.57⁴/4 + 0.82⁴/14) = 19.0,
+        // t_95(19) = 2.09, U_95 = 2.2 %. scipy: ν_eff = 18.99874, t.ppf(0.975, 19) = 2.0930240.
+        let c = vec![
+            Component::new("x1", EvaluationType::A, 0.25, "%", 1.0).with_dof(9.0),
+            Component::new("x2", EvaluationType::A, 0.57, "%", 1.0).with_dof(4.0),
+            Component::new("x3", EvaluationType::A, 0.82, "%", 1.0).with_dof(14.0),
+        ];
+        let b = Budget::correlated("y", 100.0, "%", c, Vec::new(), Coverage::Probability(0.95));
+        assert_relative_eq!(b.combined, 1.0294658809304948, max_relative = 1e-12);
+        assert_relative_eq!(b.effective_dof.unwrap(), 18.998742314267954, max_relative = 1e-9);
+        // ν_eff truncated to 18 (GUM G.4.1 b): t_95(18) = 2.100922 (scipy), U = 2.16 %.
+        assert_relative_eq!(b.coverage_factor, 2.1009220402410382, max_relative = 1e-7);
+        assert!((b.expanded - 2.2).abs() < 0.05);
+        // With one k = 2 for the report the stated probability follows ν_eff: scipy
+        // 2 t.cdf(2, 18) − 1 = 0.9391785.
+        let fixed = Budget::new("y", 100.0, "%", b.components.clone(), 2.0);
+        assert_relative_eq!(fixed.coverage_probability, 0.9391785343306676, max_relative = 1e-7);
+        // Infinite ν everywhere: the normal distribution (95.45 % for k = 2).
+        let b = Budget::new("y", 1.0, "u", vec![Component::new("b", EvaluationType::B, 1.0, "u", 1.0)], 2.0);
+        assert_eq!(b.effective_dof, None);
+        assert_relative_eq!(b.coverage_probability, 0.9544997361036416, max_relative = 1e-9);
+        // t_p(ν) against scipy: t.ppf(0.975, 4) = 2.7764451; 2 t.cdf(2, 8) − 1 = 0.9194838.
+        assert_relative_eq!(coverage_factor_for(0.95, Some(4.7)), 2.7764451051977934, max_relative = 1e-7);
+        assert_relative_eq!(coverage_probability_of(2.0, Some(8.0)), 0.9194837620427374, max_relative = 1e-7);
+    }
+
+    #[test]
+    fn correlated_readings_of_one_instrument_cancel_to_the_stated_degree() {
+        // y = x1 − x2, both read by one instrument with u = 3 (the same offset error): r = 1
+        // cancels it; r = 0 adds in quadrature (3√2); r = 0.5 gives √(9 + 9 − 9) = 3.
+        let c = || {
+            vec![
+                Component::new("reading 1", EvaluationType::B, 3.0, "V", 1.0),
+                Component::new("reading 2", EvaluationType::B, 3.0, "V", -1.0),
+                Component::new("scatter", EvaluationType::A, 4.0, "V", 1.0).with_dof(10.0),
+            ]
+        };
+        let r =
+            |coefficient: f64| vec![Correlation { first: 0, second: 1, coefficient, reason: "same instrument".into() }];
+        let full = Budget::correlated("y", 0.0, "V", c(), r(1.0), Coverage::Factor(2.0));
+        assert_relative_eq!(full.combined, 4.0, max_relative = 1e-12);
+        let none = Budget::correlated("y", 0.0, "V", c(), r(0.0), Coverage::Factor(2.0));
+        assert_relative_eq!(none.combined, (16.0f64 + 18.0).sqrt(), max_relative = 1e-12);
+        let half = Budget::correlated("y", 0.0, "V", c(), r(0.5), Coverage::Factor(2.0));
+        assert_relative_eq!(half.combined, 5.0, max_relative = 1e-12);
+        // Same sign: a correlated pair adds linearly (3 + 3 = 6 with r = 1).
+        let mut same = c();
+        same[1].sensitivity = 1.0;
+        let b = Budget::correlated("y", 0.0, "V", same, r(1.0), Coverage::Factor(2.0));
+        assert_relative_eq!(b.combined, (36.0f64 + 16.0).sqrt(), max_relative = 1e-12);
+        // ν_eff only from the type-A scatter: u_c⁴ / (4⁴/10) with u_c = 4 gives 10.
+        assert_relative_eq!(full.effective_dof.unwrap(), 10.0, max_relative = 1e-12);
     }
 
     #[test]

@@ -84,6 +84,7 @@ pub fn write_test_program(dir: &Path, seed: u64) -> EvalResult<String> {
     plan.push_str(&power_ups::write_warmup_records_of(dir, axis, seed.wrapping_add(500), &model)?);
     plan.push('\n');
     plan.push_str(&uncertainty::write_uncertainty_section(2.0, Some(50.0), Some(2e-4)));
+    plan.push_str("temperature_accuracy_c = 0.5               # chamber and room temperature, degC; u = a/sqrt(3)\n");
     plan.push_str(
         "\n# Spec limits (JSON keys with their units; docs/PLAN.md lists them).\n[limits]\n\
          scale_factor = { min = 0.0074, max = 0.0077 }\nnonlinearity_pct = { max = 0.1 }\n\
@@ -91,7 +92,9 @@ pub fn write_test_program(dir: &Path, seed: u64) -> EvalResult<String> {
          bias_temp_sensitivity_dph_per_c = { max = 1 }\nbias_thermal_hysteresis_dph = { max = 10 }\n\
          scale_factor_repeatability_power_up_ppm = { max = 1000 }\nbias_repeatability_power_up_dph = { max = 100 }\n\
          warmup_settling_time_s = { max = 600 }\nthreshold_dps = { max = 0.2 }\nresolution_dps = { max = 0.1 }\n\
-         g_sensitivity_dph_per_g = { max = 100 }\nscale_factor_expanded_uncertainty_ppm = { max = 500 }\n",
+         g_sensitivity_dph_per_g = { max = 100 }\n\
+         # U(K) holds the scatter of K across power-ups and the test temperature (docs/METHODS.md).\n\
+         scale_factor_expanded_uncertainty_ppm = { max = 1500 }\n",
     );
     std::fs::write(dir.join("plan.toml"), &plan)
         .map_err(|e| EvalError::Output(format!("{}: {e}", dir.join("plan.toml").display())))?;

@@ -37,6 +37,8 @@ pub struct GSensitivityParts {
     pub json: Option<Value>,
     /// CSV files (name, content).
     pub files: Vec<(String, Vec<u8>)>,
+    /// Uncertainty inputs of the figure for the `[uncertainty]` part.
+    pub uncertainty_inputs: Vec<super::uncertainty::FigureInput>,
 }
 
 /// One evaluated axis.
@@ -201,7 +203,7 @@ fn section(a: &AxisResult<'_>, figures: &AxisFigures, limits: &[Limit], base: &P
             label: format!("g-sensitivity: {}", magnitude_words(&m.kind)),
             key: FIGURE_KEY.into(),
             value: match m.std_error {
-                Some(se) => format!("{} ± {}", sig(m.value, 4), sig(se, 2)),
+                Some(se) => format!("{} ± {} (standard error, k = 1)", sig(m.value, 4), sig(se, 2)),
                 None => sig(m.value, 4),
             },
             unit: "(deg/h)/g".into(),
@@ -422,6 +424,12 @@ pub fn evaluate_g_sensitivity(
         };
         if let Some(m) = &a.fit.magnitude {
             figs.set(FIGURE_KEY, m.value);
+            parts.uncertainty_inputs.push(super::uncertainty::g_sensitivity_input(
+                &a.plan.axis,
+                m.value,
+                m.std_error,
+                a.fit.residual_dof,
+            ));
         }
         if a.simulated.is_some() {
             figs.simulated = figs.values.iter().map(|(k, _)| k.clone()).collect();

@@ -202,6 +202,7 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         simulated: None,
         exports: &plan.options.exports,
         records_simulated: plan.device.simulated.is_some(),
+        nominal_nulls: &plan.options.nominal_null,
     };
     let mut parts = static_part::evaluate_static(&plan.static_tests, &ctx, progress)?;
     let more = power_ups::evaluate_power_ups(plan, &ctx, progress)?;
@@ -209,11 +210,13 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
     parts.figures.extend(more.figures);
     parts.json.extend(more.json);
     parts.files.extend(more.files);
+    parts.uncertainty_inputs.extend(more.uncertainty_inputs);
     let steps = threshold::evaluate_threshold(&plan.file, &plan.threshold, &plan.resolution, &axes, &limits, progress)?;
     parts.sections.extend(steps.sections);
     parts.figures.extend(steps.figures);
     parts.json.extend(steps.json);
     parts.files.extend(steps.files);
+    parts.uncertainty_inputs.extend(steps.uncertainty_inputs);
     let thermal =
         temperature::evaluate_temperature(&plan.temperature, &plan_settings(plan).options()?, &ctx, progress)?;
     if !thermal.reports.is_empty() {
@@ -222,6 +225,7 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         for r in &thermal.reports {
             parts.sections.push(gyrolab_report::thermal::temperature_section(r, &limits).map_err(plot_err)?);
             parts.figures.push(r.figures());
+            parts.uncertainty_inputs.extend(uncertainty::temperature_inputs(r));
             json.insert(r.axis.clone(), r.json());
         }
         parts.json.insert("temperature".into(), serde_json::Value::Object(json));
@@ -234,11 +238,12 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
     parts.sections.extend(g.sections);
     parts.figures.extend(g.figures);
     parts.files.extend(g.files);
+    parts.uncertainty_inputs.extend(g.uncertainty_inputs);
     if let Some(j) = g.json {
         parts.json.insert("g_sensitivity".into(), j);
     }
     if let Some(u) = &plan.uncertainty {
-        let un = uncertainty::evaluate_uncertainty(u, &axes, &parts.reports);
+        let un = uncertainty::evaluate_uncertainty(u, &axes, &parts.reports, &parts.uncertainty_inputs);
         parts.sections.extend(un.sections);
         parts.figures.extend(un.figures);
         parts.json.insert("uncertainty".into(), un.json);

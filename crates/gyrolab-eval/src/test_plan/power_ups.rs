@@ -251,6 +251,7 @@ pub fn evaluate_power_ups(
         let r = evaluate_power_ups_axis(plan, p, ctx, progress)?;
         parts.sections.push(power_ups_section(&r, ctx.limits));
         parts.figures.push(r.figures());
+        parts.uncertainty_inputs.extend(super::uncertainty::power_up_inputs(&r));
         json.insert(r.axis.clone(), r.json());
     }
     if !json.is_empty() {
@@ -262,6 +263,7 @@ pub fn evaluate_power_ups(
         let r = evaluate_warmup_axis(plan, w, ctx)?;
         parts.sections.push(warmup_section(&r, ctx.limits).map_err(|e| EvalError::Output(e.to_string()))?);
         parts.figures.push(r.figures());
+        parts.uncertainty_inputs.extend(super::uncertainty::warmup_inputs(&r));
         json.insert(r.axis.clone(), r.json());
         parts.files.push((format!("warmup_windows_{}.csv", r.axis), warmup_csv(&r).into_bytes()));
         progress.advance(1);

@@ -43,6 +43,8 @@ pub struct StaticParts {
     pub files: Vec<(String, Vec<u8>)>,
     /// The evaluated axes (their numbers feed the measurement-uncertainty budgets).
     pub reports: Vec<StaticAxisReport>,
+    /// Uncertainty inputs of further figures (power-ups, warm-up) for the `[uncertainty]` part.
+    pub uncertainty_inputs: Vec<super::uncertainty::FigureInput>,
 }
 
 /// Inputs of the static part besides the plan's `[static.*]` tables.
@@ -62,6 +64,9 @@ pub struct StaticContext<'a> {
     pub exports: &'a [gyrolab_io::noise_export::Stack],
     /// The plan says its records are simulated (`[device] simulated`): the exports say so.
     pub records_simulated: bool,
+    /// The plan's nominal nulls by axis (`[options] nominal_null`): those axes' bias is the
+    /// absolute bias against it; the others' the bias shift against the rest output.
+    pub nominal_nulls: &'a BTreeMap<String, f64>,
 }
 
 pub(crate) fn shown(path: &Path, base: &Path) -> String {
@@ -144,7 +149,7 @@ pub(crate) fn reference_of(axis: &str, ctx: &StaticContext<'_>) -> EvalResult<(R
             None => None,
         },
     };
-    let Some((c, null, key, words, source, from)) = found else {
+    let Some((c, measured_null, key, words, source, from)) = found else {
         return Ok((
             Reference::None,
             ReferenceJson {
@@ -162,6 +167,29 @@ pub(crate) fn reference_of(axis: &str, ctx: &StaticContext<'_>) -> EvalResult<(R
         ));
     };
     let u = c.output_unit.symbol();
+    if let Some(&nominal) = ctx.nominal_nulls.get(axis) {
+        return Ok((
+            Reference::Calibrated { scale_factor: c.scale_factor, null: nominal, unit: c.output_unit },
+            ReferenceJson {
+                source: source.into(),
+                scale_factor: Some(c.scale_factor),
+                null_output: Some(nominal),
+                null_source: Some(gyrolab_report::static_report::NOMINAL_NULL.into()),
+                null_contains_earth_rate: false,
+                output_unit: Some(u.into()),
+                text: format!(
+                    "K = {} {u}/(deg/s) from {from}; null = the plan's nominal null {} {u} (options.nominal_null). \
+                     B0 = (static mean - nominal null) / K is the absolute bias: the gyro's zero-rate output against \
+                     its nominal null, with the earth-rate component of the input axis removed only where a \
+                     latitude is given. (The rate test's {words}, {} {u}, is not used as the null.)",
+                    sig(c.scale_factor, 6),
+                    sig(nominal, 7),
+                    sig(measured_null, 7),
+                ),
+            },
+        ));
+    }
+    let null = measured_null;
     Ok((
         Reference::Calibrated { scale_factor: c.scale_factor, null, unit: c.output_unit },
         ReferenceJson {
@@ -176,7 +204,8 @@ pub(crate) fn reference_of(axis: &str, ctx: &StaticContext<'_>) -> EvalResult<(R
                  rest on the rate table, so it already contains the earth-rate component of a vertical input axis: \
                  a latitude does not subtract it again. It also contains the gyro's own bias at that time, so B0 = \
                  (static mean - null) / K is a bias shift (the change of the zero-rate output between the rate-table \
-                 and the static tests), not the absolute bias against a nominal null.",
+                 and the static tests), not the absolute bias against a nominal null (options.nominal_null gives \
+                 that).",
                 sig(c.scale_factor, 6),
                 sig(null, 7),
                 sig(c.zero_offset, 7),

@@ -29,6 +29,8 @@ pub struct ThresholdParts {
     pub json: BTreeMap<String, serde_json::Value>,
     /// CSV files (name, content).
     pub files: Vec<(String, Vec<u8>)>,
+    /// Uncertainty inputs of the figures for the `[uncertainty]` part.
+    pub uncertainty_inputs: Vec<super::uncertainty::FigureInput>,
 }
 
 /// An error about the plan's table `plan_key` (`threshold.x.base_rate_dps`), at its line.
@@ -223,6 +225,7 @@ pub fn evaluate_threshold(
     }
     parts.sections.push(step_section(&reports, limits));
     parts.figures = step_figures(&reports);
+    parts.uncertainty_inputs = reports.iter().filter_map(super::uncertainty::step_inputs).collect();
     for kind in [StepKind::Threshold, StepKind::Resolution] {
         let mut m = serde_json::Map::new();
         for r in reports.iter().filter(|r| r.kind == kind) {

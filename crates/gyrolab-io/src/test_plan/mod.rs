@@ -147,6 +147,7 @@ struct RawOptions {
     calibration: Option<Spanned<String>>,
     exports: Option<Spanned<Vec<String>>>,
     decision_rule: Option<Spanned<String>>,
+    nominal_null: Option<Spanned<toml::Value>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -292,6 +293,11 @@ pub struct PlanOptions {
     /// The decision rule of every limit that names none (`decision_rule = "guarded_acceptance"`;
     /// default simple acceptance; docs/PLAN.md, METHODS "Decision rules").
     pub decision_rule: DecisionRule,
+    /// The nominal null of each axis, in its output unit (`nominal_null = 2.5` for every axis or
+    /// `nominal_null = { x = 2.5, y = 0 }`; 0 for a digital output's zero code): the bias of those
+    /// axes is the absolute bias against it. Axes without one keep the bias shift against the
+    /// rate test's rest output (docs/PLAN.md, METHODS "Bias").
+    pub nominal_null: BTreeMap<String, f64>,
 }
 
 /// The rate-table record of one axis (`[rate.<axis>]`).
@@ -679,7 +685,44 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
     };
     let decision_rule =
         o.decision_rule.as_ref().map(|r| rule_of(r, "options.decision_rule")).transpose()?.unwrap_or_default();
+    let mut nominal_null = BTreeMap::new();
+    if let Some(v) = &o.nominal_null {
+        let number = |x: &toml::Value, key: &str| -> Result<f64, DataError> {
+            let f = x.as_float().or_else(|| x.as_integer().map(|i| i as f64));
+            match f {
+                Some(f) if f.is_finite() => Ok(f),
+                _ => Err(cx.err(
+                    v.span(),
+                    key,
+                    format!(
+                        "must be a number in the axis's output unit (the datasheet null voltage, 0 for a digital                          output's zero code), got {}",
+                        crate::text::excerpt(&x.to_string())
+                    ),
+                )),
+            }
+        };
+        match v.get_ref() {
+            toml::Value::Table(t) => {
+                for (axis, x) in t {
+                    let key = format!("options.nominal_null.{axis}");
+                    if !axes.contains(axis) {
+                        return Err(cx.err(
+                            v.span(),
+                            &key,
+                            format!("axis '{axis}' is not in device.axes ({})", axes.join(", ")),
+                        ));
+                    }
+                    nominal_null.insert(axis.clone(), number(x, &key)?);
+                }
+            }
+            x => {
+                let f = number(x, "options.nominal_null")?;
+                nominal_null.extend(axes.iter().map(|a| (a.clone(), f)));
+            }
+        }
+    }
     let options = PlanOptions {
+        nominal_null,
         coverage,
         half_hysteresis: o.half_hysteresis.unwrap_or(false),
         order,

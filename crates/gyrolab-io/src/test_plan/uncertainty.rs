@@ -16,6 +16,9 @@ pub(crate) struct RawUncertainty {
     rate_accuracy_distribution: Option<Spanned<String>>,
     output_accuracy: Option<Spanned<f64>>,
     output_accuracy_distribution: Option<Spanned<String>>,
+    coverage_probability: Option<Spanned<f64>>,
+    output_accuracy_correlation: Option<Spanned<f64>>,
+    temperature_accuracy_c: Option<Spanned<f64>>,
 }
 
 /// The checked `[uncertainty]` table.
@@ -31,9 +34,28 @@ pub struct UncertaintyPlan {
     pub output_accuracy: Option<f64>,
     /// How `output_accuracy` is stated (default rectangular half-width).
     pub output_accuracy_distribution: Distribution,
+    /// A coverage probability instead of one k: each budget's k_p = t_p(ν_eff) (GUM G.4); `None`
+    /// uses `coverage_factor` for every budget of the report.
+    pub coverage_probability: Option<f64>,
+    /// Correlation coefficient r of the output-accuracy errors of two readings of one axis by the
+    /// same data acquisition at nearly the same level (the static mean and the rate test's zero-rate
+    /// output; default 1: the same instrument's offset error, which cancels in their difference).
+    pub output_accuracy_correlation: f64,
+    /// The chamber's temperature accuracy, degC (rectangular half-width, u = a/√3): a type-B term
+    /// of the temperature sensitivities, taken as independent between the soaked points (u of a
+    /// slope = |slope| u_T / √S_TT; an offset common to every point does not change a slope).
+    pub temperature_accuracy_c: Option<f64>,
 }
 
 impl UncertaintyPlan {
+    /// How every budget of the report is expanded: one k, or k_p from each ν_eff.
+    pub fn coverage(&self) -> gyrolab::uncertainty::Coverage {
+        match self.coverage_probability {
+            Some(p) => gyrolab::uncertainty::Coverage::Probability(p),
+            None => gyrolab::uncertainty::Coverage::Factor(self.coverage_factor),
+        }
+    }
+
     /// Standard uncertainty of the table rate, relative (ratio), when stated.
     pub fn rate_standard_uncertainty_rel(&self) -> Option<f64> {
         self.rate_accuracy_ppm
@@ -64,6 +86,43 @@ pub(crate) fn parse_uncertainty(
             v
         }
         None => 2.0,
+    };
+    let coverage_probability = match &raw.coverage_probability {
+        Some(p) => {
+            let v = *p.get_ref();
+            if raw.coverage_factor.is_some() {
+                return Err(err(
+                    p.span(),
+                    "uncertainty.coverage_probability",
+                    "give coverage_factor (one k for the whole report) or coverage_probability (k_p = t_p(ν_eff) \
+                     per budget), not both"
+                        .into(),
+                ));
+            }
+            if !(v.is_finite() && v > 0.5 && v < 1.0) {
+                return Err(err(
+                    p.span(),
+                    "uncertainty.coverage_probability",
+                    format!("must be a probability between 0.5 and 1 (0.95 for 95 %), got {v}"),
+                ));
+            }
+            Some(v)
+        }
+        None => None,
+    };
+    let output_accuracy_correlation = match &raw.output_accuracy_correlation {
+        Some(r) => {
+            let v = *r.get_ref();
+            if !(v.is_finite() && (-1.0..=1.0).contains(&v)) {
+                return Err(err(
+                    r.span(),
+                    "uncertainty.output_accuracy_correlation",
+                    format!("must be a correlation coefficient between -1 and 1, got {v}"),
+                ));
+            }
+            v
+        }
+        None => 1.0,
     };
     let non_negative = |v: &Option<Spanned<f64>>, key: &str| -> Result<Option<f64>, DataError> {
         match v {
@@ -102,5 +161,8 @@ pub(crate) fn parse_uncertainty(
             &raw.output_accuracy_distribution,
             "uncertainty.output_accuracy_distribution",
         )?,
+        coverage_probability,
+        output_accuracy_correlation,
+        temperature_accuracy_c: non_negative(&raw.temperature_accuracy_c, "uncertainty.temperature_accuracy_c")?,
     })
 }
