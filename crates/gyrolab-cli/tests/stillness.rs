@@ -147,3 +147,40 @@ fn snapshot_topics_too_short_for_the_check_say_so() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("stillness: not evaluated (the record holds 1 window(s) of 10 samples"), "{text}");
 }
+
+/// A test plan's static record that moved is refused like `allan`'s, naming the plan key that
+/// allows it; with `allow_motion = true` it is evaluated and its analysis says it moved.
+#[test]
+fn a_plan_refuses_a_static_record_that_moved_unless_the_plan_allows_it() {
+    let dir = tempfile::tempdir().unwrap();
+    record(dir.path(), "moved.csv", 3, 20.0);
+    let plan = |allow: &str| {
+        write(
+            dir.path(),
+            "plan.toml",
+            &format!(
+                "[device]\nmodel = \"m\"\nserial = \"s\"\naxes = [\"x\"]\n[static.x]\nfiles = [\"moved.csv\"]\n\
+                 sample_rate_hz = 100.0\nchannel = \"gyro_x [deg/s]\"\n{allow}"
+            ),
+        )
+    };
+    let out = gyrolab().arg("eval").arg(plan("")).arg("--out").arg(dir.path().join("r")).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("static.x: the Allan record is not static"), "{err}");
+    assert!(err.contains("first episode 50.0 to 55.0 s"), "{err}");
+    assert!(err.contains("static.x.allow_motion = true"), "{err}");
+    assert!(!dir.path().join("r").exists(), "nothing written");
+    let out = gyrolab()
+        .arg("eval")
+        .arg(plan("allow_motion = true\n"))
+        .arg("--out")
+        .arg(dir.path().join("r"))
+        .arg("-q")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: Value = serde_json::from_slice(&std::fs::read(dir.path().join("r/results.json")).unwrap()).unwrap();
+    let text = v["sections"]["allan"]["x"].to_string();
+    assert!(text.contains("moved"), "the analysis says the record moved: {}", &text[..text.len().min(400)]);
+}

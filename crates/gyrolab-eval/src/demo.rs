@@ -194,6 +194,7 @@ fn simulated_static_and_allan(
             temperature_channel: Some("temp_c".into()),
             latitude_deg: None,
             allan_file: Some(allan_path),
+            allow_motion: false,
         });
     }
     let describe = |axis: &str| texts.get(axis).cloned().unwrap_or_default();

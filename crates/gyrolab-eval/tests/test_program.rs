@@ -173,6 +173,14 @@ fn figure_budgets_of_the_test_program_equal_a_recomputation() {
     close(num(&kb[3]["contribution"]), alpha.abs() * k * 1e-6 * temp_acc / 3f64.sqrt(), 1e-9, "K temperature line");
     let parts: f64 = kb.as_array().unwrap().iter().map(|c| num(&c["contribution"]).powi(2)).sum();
     close(num(&u["scale_factor_expanded_ppm"]), 2.0 * parts.sqrt() / k * 1e6, 1e-9, "U(K) ppm");
+    // The summary prints value ± U, U to two significant digits and the value to its decimal:
+    // the power-up scale-factor repeatability 581.29 ppm with U = 367.6 ppm reads 580 ± 370.
+    let html =
+        String::from_utf8(folder.outputs.iter().find(|o| o.name == "report.html").unwrap().bytes.clone()).unwrap();
+    let v = num(&s["power_ups"]["x"]["scale_factor"]["scale_factor_repeatability_power_up_ppm"]);
+    let big_u = expanded("scale_factor_repeatability_power_up_ppm");
+    assert!((v - 581.29).abs() < 0.01 && (big_u - 367.64).abs() < 0.01, "seeded values changed: {v}, {big_u}");
+    assert!(html.contains("<td>580 ± 370 <span class=\"verdict PASS\">"), "no '580 ± 370' in the summary");
     // The bias stability's U reaches its check.
     close(check_u("bias_stability_dph_10s"), num(&u["bias_stability_expanded_dph"]), 1e-12, "bias stability check");
 }

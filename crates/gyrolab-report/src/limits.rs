@@ -300,6 +300,26 @@ mod tests {
     }
 
     #[test]
+    fn values_with_an_uncertainty_are_rounded_to_it_unless_that_contradicts_the_verdict() {
+        let with_u = |v: f64, u: f64| {
+            let mut a = axis("x", &[("nonlinearity_pct", v)]);
+            a.set_uncertainty("nonlinearity_pct", u);
+            a
+        };
+        // 0.09751 ± 0.015 against <= 0.1: U to two digits is 0.015, the value to 0.001: 0.098.
+        let c = check_limits(&[limit("nonlinearity_pct", None, Some(0.1))], &[with_u(0.09751, 0.015)]);
+        assert_eq!((c[0].verdict, c[0].value_text(4)), (Verdict::Pass, "0.098".to_string()));
+        // 0.09994 ± 0.015 against <= 0.09995 passes, but 0.100 would print above the limit: the
+        // digits that keep value and limit apart instead.
+        let c = check_limits(&[limit("nonlinearity_pct", None, Some(0.09995))], &[with_u(0.09994, 0.015)]);
+        assert_eq!(c[0].verdict, Verdict::Pass);
+        assert_eq!(c[0].value_text(4), "0.09994");
+        // Tens: 581.29 ± 367.6 prints 580 (U 370).
+        let c = check_limits(&[limit("nonlinearity_pct", None, Some(1000.0))], &[with_u(581.29, 367.6)]);
+        assert_eq!(c[0].value_text(4), "580");
+    }
+
+    #[test]
     fn bounds_are_inclusive_and_texts() {
         let l = limit("linearity_pct", Some(1.0), Some(2.0));
         assert!(l.admits(1.0) && l.admits(2.0) && l.admits(1.5));

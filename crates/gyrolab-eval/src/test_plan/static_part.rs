@@ -310,7 +310,7 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, progress: &dyn Pro
         }
     };
     progress.message(&format!("axis {axis}: Allan deviation of {}", shown(&allan_path, ctx.base)));
-    let allan = allan_of(axis, &allan_path, &options, &reference, s.sample_rate_hz, ctx.base)?;
+    let allan = allan_of(axis, &allan_path, &options, &reference, s, ctx.base)?;
     progress.advance(1);
     let simulated = ctx.simulated.map(|f| f(axis));
     Ok(StaticAxisReport {
@@ -333,9 +333,10 @@ fn allan_of(
     path: &Path,
     options: &SeriesOptions,
     reference: &Reference,
-    sample_rate_hz: f64,
+    plan: &StaticAxisPlan,
     base: &Path,
 ) -> EvalResult<ChannelAnalysis> {
+    let sample_rate_hz = plan.sample_rate_hz;
     let mut data = read_series_all(path, options)?;
     if let Some(t) = &data.time {
         let key = format!("static.{axis}.sample_rate_hz");
@@ -379,9 +380,21 @@ fn allan_of(
         reference,
         fit_range_s: None,
         uncalibrated_hint: "give the axis a rate-table record or a calibration file",
-        allow_motion: false,
+        allow_motion: plan.allow_motion,
     };
-    analyse_channel(&setup, &info, crate::allan::on_grid(values, &gaps, missing))
+    let analysis = analyse_channel(&setup, &info, crate::allan::on_grid(values, &gaps, missing))?;
+    // A static record that moved is not a still sensor's: refused, naming the plan key that
+    // allows it (then every output of the analysis is marked).
+    if let Some(summary) = analysis.stillness.as_ref().and_then(|c| c.motion_summary()).filter(|_| !plan.allow_motion) {
+        return Err(EvalError::conflict(format!(
+            "{}: static.{axis}: the Allan record is not static, so its noise terms and bias figures would not be \
+             a still sensor's: channel '{}' {summary}; record the sensor at rest, or set \
+             static.{axis}.allow_motion = true to analyse it anyway (its outputs are then marked)",
+            path.display(),
+            gyrolab_io::text::excerpt(&analysis.channel)
+        )));
+    }
+    Ok(analysis)
 }
 
 /// Number of progress steps of the static part.

@@ -179,6 +179,7 @@ struct RawStatic {
     temperature_channel: Option<String>,
     latitude_deg: Option<Spanned<f64>>,
     allan_file: Option<Spanned<String>>,
+    allow_motion: Option<bool>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -367,6 +368,9 @@ pub struct StaticAxisPlan {
     pub latitude_deg: Option<f64>,
     /// Record for the Allan analysis (resolved); `None`: the longest of `files`.
     pub allan_file: Option<PathBuf>,
+    /// Analyse the Allan record even when the stillness check finds motion (`allow_motion =
+    /// true`; its noise terms are then marked); by default such a record is refused.
+    pub allow_motion: bool,
 }
 
 /// One spec limit (`[limits] figure = { min = .., max = .. }`).
@@ -807,6 +811,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
                 temperature_channel: s.temperature_channel.clone(),
                 latitude_deg: s.latitude_deg.as_ref().map(|l| *l.get_ref()),
                 allan_file: s.allan_file.as_ref().map(|f| cx.existing_file(&key("allan_file"), f)).transpose()?,
+                allow_motion: s.allow_motion.unwrap_or(false),
             });
         }
     }
