@@ -137,6 +137,7 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
         progress.advance(1);
     }
     sections.extend(inputs.extra_sections);
+    gyrolab_report::html::round_rows_to_uncertainty(&mut sections, &figures, &inputs.limits);
     let verdict = if inputs.limits.is_empty() { None } else { Some(summary.overall()) };
     let lines = |keep: &dyn Fn(Verdict) -> bool| -> Vec<String> {
         summary.checks.iter().filter(|c| keep(c.verdict)).map(|c| c.line()).collect()

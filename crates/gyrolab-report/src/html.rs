@@ -132,6 +132,9 @@ pub struct FigureRow {
     pub limit: String,
     /// Verdict when a limit applies.
     pub verdict: Option<Verdict>,
+    /// The axis whose figure the row shows, when its value is in the figure's catalogue unit
+    /// (the report then prints it rounded to its expanded uncertainty).
+    pub axis: Option<String>,
 }
 
 impl FigureRow {
@@ -155,7 +158,49 @@ impl FigureRow {
             unit: figs.unit_of(key),
             limit: limit.map_or_else(String::new, Limit::text),
             verdict: check.map(|c| c.verdict),
+            axis: Some(figs.axis.clone()),
         })
+    }
+}
+
+/// The text of figure `key` of an axis as the report prints it: with a limit check, as many
+/// digits as keep value and limit from contradicting the verdict; a bound says which side it is
+/// ("at most", "above"); with an expanded uncertainty U the value rounded to U's second
+/// significant digit followed by "± U" (GUM 7.2.6); `None` when the axis has no such figure.
+pub fn value_cell(a: &AxisFigures, key: &str, check: Option<&LimitCheck>, digits: usize) -> Option<String> {
+    let k = a.known(key)?;
+    let u = k.expanded_uncertainty.filter(|u| *u > 0.0);
+    let text = match (check, k.support) {
+        (Some(c), _) => c.value_text(digits),
+        (None, Support::Value) => u
+            .and_then(|u| crate::format::rounded_to_uncertainty(k.value, u))
+            .map_or_else(|| sig(k.value, digits), |(v, _)| v),
+        (None, Support::UpperBound) => format!("at most {}", sig(k.value, digits)),
+        (None, Support::LowerBound) => format!("above {}", sig(k.value, digits)),
+    };
+    Some(match u.and_then(|u| crate::format::rounded_to_uncertainty(1.0, u)) {
+        Some((_, u_text)) => format!("{text} ± {u_text}"),
+        None => text,
+    })
+}
+
+/// Prints the per-axis figure rows of every section as the summary prints them wherever the
+/// figure has an expanded uncertainty (the sections are drawn before the uncertainty part has
+/// run): value rounded to U and "± U", the digits a limit needs kept. Rows without an axis, or
+/// whose figure has no U, keep their own digits.
+pub fn round_rows_to_uncertainty(sections: &mut [ReportSection], figures: &[AxisFigures], limits: &[Limit]) {
+    for row in sections.iter_mut().flat_map(|s| s.figures.iter_mut()) {
+        let (Some(axis), false) = (row.axis.as_deref(), row.key.is_empty()) else { continue };
+        let Some(a) = figures.iter().find(|f| f.axis == axis) else { continue };
+        if a.known(&row.key).and_then(|k| k.expanded_uncertainty).is_none_or(|u| u <= 0.0) {
+            continue;
+        }
+        let applicable: Vec<Limit> =
+            limits.iter().filter(|l| l.figure == row.key && l.applies_to(axis)).cloned().collect();
+        let check = check_limits(&applicable, std::slice::from_ref(a)).pop();
+        if let Some(text) = value_cell(a, &row.key, check.as_ref(), 4) {
+            row.value = text;
+        }
     }
 }
 
@@ -255,26 +300,7 @@ impl SummaryTable {
                     .iter()
                     .map(|a| {
                         let check = checks.iter().find(|c| c.axis == a.axis && c.figure == key);
-                        // With a limit, as many digits as keep value and limit from contradicting
-                        // the verdict; a bound says which side it is.
-                        let known = a.known(&key);
-                        let u = known.as_ref().and_then(|k| k.expanded_uncertainty).filter(|u| *u > 0.0);
-                        let text = match (&known, check) {
-                            (Some(_), Some(c)) => c.value_text(digits),
-                            (Some(k), None) => match k.support {
-                                Support::Value => u
-                                    .and_then(|u| crate::format::rounded_to_uncertainty(k.value, u))
-                                    .map_or_else(|| sig(k.value, digits), |(v, _)| v),
-                                Support::UpperBound => format!("at most {}", sig(k.value, digits)),
-                                Support::LowerBound => format!("above {}", sig(k.value, digits)),
-                            },
-                            (None, _) => "n/a".into(),
-                        };
-                        // The expanded uncertainty beside the value, to two significant digits.
-                        let text = match u.and_then(|u| crate::format::rounded_to_uncertainty(1.0, u)) {
-                            Some((_, u_text)) => format!("{text} ± {u_text}"),
-                            None => text,
-                        };
+                        let text = value_cell(a, &key, check, digits).unwrap_or_else(|| "n/a".into());
                         let verdict = limit
                             .filter(|l| l.applies_to(&a.axis))
                             .map(|_| check.map_or(Verdict::NotEvaluated, |c| c.verdict));
@@ -752,6 +778,8 @@ pub fn rate_section(a: &AxisReport<'_>, limits: &[Limit]) -> Result<ReportSectio
             unit,
             limit: limits.iter().find(|l| l.figure == key).map_or_else(String::new, Limit::text),
             verdict: c.map(|c| c.verdict),
+            // K is shown in a display unit (mV/(deg/s)) of its own.
+            axis: (key != "scale_factor").then(|| figs.axis.clone()),
         }
     };
     let hyst = if e.options.half_hysteresis { "hysteresis δ_H (half)" } else { "hysteresis δ_H" };
@@ -909,6 +937,7 @@ mod tests {
                 unit: "deg/h".into(),
                 limit: "≤ 20".into(),
                 verdict: Some(Verdict::Pass),
+                axis: None,
             }],
             ..Default::default()
         };

@@ -196,6 +196,7 @@ fn section(a: &AxisResult<'_>, figures: &AxisFigures, limits: &[Limit], base: &P
             unit: "(deg/h)/g".into(),
             limit: String::new(),
             verdict: None,
+            axis: None,
         });
     }
     if let Some(m) = &f.magnitude {
@@ -212,6 +213,7 @@ fn section(a: &AxisResult<'_>, figures: &AxisFigures, limits: &[Limit], base: &P
                 .find(|l| l.figure == FIGURE_KEY && l.applies_to(&figures.axis))
                 .map_or_else(String::new, Limit::text),
             verdict: checks.iter().find(|c| c.figure == FIGURE_KEY).map(|c| c.verdict),
+            axis: None,
         });
     }
     rows.push(FigureRow {
@@ -221,6 +223,7 @@ fn section(a: &AxisResult<'_>, figures: &AxisFigures, limits: &[Limit], base: &P
         unit: "deg/h".into(),
         limit: String::new(),
         verdict: None,
+        axis: None,
     });
     let se_words = match (f.std_error_absent, f.residual_std_dph) {
         (Some(NoStdError::NoResidualDegreesOfFreedom), _) => format!(

@@ -1150,8 +1150,8 @@ pub fn evaluate_uncertainty(
         "Standard uncertainties evaluated per JCGM 100:2008 (GUM) = JJF 1059.1-2012: type A from the data (GUM 4.2), \
          type B from the plan's [uncertainty] accuracies (GUM 4.3: rate accuracy {}, output accuracy {}, chamber \
          temperature accuracy {}), combined by the law of propagation (GUM 5.1.2; correlated inputs by GUM 5.2.2) and \
-         {}. Contributions are |c_i| u(x_i) in the figure's unit; ν = ∞ for a type-B accuracy. Summary values are \
-         rounded to the decimal of U's second significant digit. Budgets and their limits: docs/METHODS.md, \
+         {}. Contributions are |c_i| u(x_i) in the figure's unit; ν = ∞ for a type-B accuracy. Values with a U are \
+         printed rounded to the decimal of U's second significant digit, \"value ± U\". Budgets and their limits: docs/METHODS.md, \
          \"Measurement uncertainty\".",
         plan.rate_accuracy_ppm.map_or("not stated".to_string(), |a| format!("{} ppm", sig(a, 4))),
         plan.output_accuracy.map_or("not stated".to_string(), |a| format!("{} (axis output unit)", sig(a, 4))),
