@@ -184,3 +184,34 @@ fn a_plan_refuses_a_static_record_that_moved_unless_the_plan_allows_it() {
     let text = v["sections"]["allan"]["x"].to_string();
     assert!(text.contains("moved"), "the analysis says the record moved: {}", &text[..text.len().min(400)]);
 }
+
+/// The gravity check of a three-axis accelerometer: the bundled ROS 1 bag's /imu0 holds gravity
+/// (9.80665 m/s^2 on z) and is within 0.1 g in every 1 s window; its /imu1 carries every value
+/// times 2 (recordings README), so its magnitude is 2 g: a warning naming the unit or scale, and
+/// the check in each accelerometer channel's JSON (never in a gyro's).
+#[test]
+fn the_gravity_check_finds_an_accelerometer_that_is_not_1_g() {
+    let bag = root().join("examples/recordings/simulated_imu_ros1.bag");
+    let run = |topic: &str| {
+        let out = gyrolab().arg("allan").arg(&bag).args(["--topic", topic, "--json"]).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+        (v, String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (v, err) = run("/imu0");
+    assert!(err.contains("note: gravity: the accelerometer's magnitude is 9.80"), "{err}");
+    assert!(err.contains("in every window"), "{err}");
+    for c in v["channels"].as_array().unwrap() {
+        let name = c["channel"].as_str().unwrap();
+        assert_eq!(c.get("gravity").is_some(), name.starts_with("accel"), "{name}");
+    }
+    let g = &v["channels"][3]["gravity"];
+    assert_eq!(g["outside_windows"], 0);
+    assert!((g["median_magnitude_m_s2"].as_f64().unwrap() - 9.80665).abs() < 0.01, "{g}");
+    let (v, err) = run("/imu1");
+    assert!(err.contains("warning: gravity: the accelerometer's magnitude is not 1 g"), "{err}");
+    assert!(err.contains("unit or scale is wrong") && err.contains("--unit"), "{err}");
+    let g = &v["channels"][3]["gravity"];
+    assert_eq!(g["outside_windows"], g["windows"]);
+    assert!((g["median_magnitude_m_s2"].as_f64().unwrap() - 2.0 * 9.80665).abs() < 0.02, "{g}");
+}

@@ -197,6 +197,9 @@ pub enum ReadNote {
     },
     /// The clock model of the time stamps and the evidence it was decided on.
     Clock(ClockModel),
+    /// The gravity check of a three-axis accelerometer (a warning when a window's magnitude is
+    /// not 1 g within the tolerance).
+    Gravity(gyrolab::stillness::GravityCheck),
     /// A time stamp going back to or before the first one (a clock reset, a trailer of zeros)
     /// ended the record: the rows before it are analysed. Shown as a warning.
     Reset {
@@ -318,6 +321,25 @@ impl std::fmt::Display for ReadNote {
                 )
             }
             ReadNote::Clock(c) => write!(f, "clock: {c}"),
+            ReadNote::Gravity(g) if g.outside_windows == 0 => write!(
+                f,
+                "gravity: the accelerometer's magnitude is {:.4} m/s^2 (median of {} windows), within {:.3} m/s^2 \
+                 of 1 g (9.80665 m/s^2) in every window",
+                g.median_magnitude_m_s2, g.windows, g.tolerance_m_s2
+            ),
+            ReadNote::Gravity(g) => write!(
+                f,
+                "gravity: the accelerometer's magnitude is not 1 g (9.80665 m/s^2) within {:.3} m/s^2 in {} of {} \
+                 windows (first at {:.1} s; median {:.4} m/s^2, largest departure {:.4} m/s^2): the sensor \
+                 accelerated, or the accelerometer's unit or scale is wrong (m/s^2 against g: give {{units}}), or \
+                 gravity was removed from the samples",
+                g.tolerance_m_s2,
+                g.outside_windows,
+                g.windows,
+                g.first_outside_s.unwrap_or(f64::NAN),
+                g.median_magnitude_m_s2,
+                g.largest_departure_m_s2
+            ),
             ReadNote::Reset { reset, row, rows } => write!(
                 f,
                 "the time stamps go back at {} {row} (from {} s to {} s: a clock reset or a trailer of zeros): the record ends before it, {} row(s) from there left out",
@@ -409,6 +431,7 @@ impl ReadNote {
             _ => matches!(
                 self,
                 ReadNote::Truncated(_)
+                    | ReadNote::Gravity(gyrolab::stillness::GravityCheck { outside_windows: 1.., .. })
                     | ReadNote::TimeUnitDoubt { .. }
                     | ReadNote::Reset { .. }
                     | ReadNote::LongTausLost { .. }
@@ -852,6 +875,7 @@ pub(crate) fn channel_analysis(
         gmwm,
         stillness,
         allow_motion: setup.allow_motion,
+        gravity: None,
     }
 }
 
@@ -917,12 +941,32 @@ pub fn analyse_records(request: &AllanRequest) -> EvalResult<Vec<AllanOutcome>> 
             notes.push(ReadNote::Truncated(what.clone()));
         }
         notes.append(&mut outcome.notes);
+        if let Some(g) = gravity_of(&mut outcome.analyses) {
+            notes.push(ReadNote::Gravity(g));
+        }
         outcome.notes = notes;
         outcome.topic = topic;
         outcomes.push(outcome);
     }
     refuse_motion(outcomes.iter().flat_map(|o| &o.analyses), &request.file, request.allow_motion)?;
     Ok(outcomes)
+}
+
+/// The gravity check of a record with exactly three accelerometer channels (in m/s^2, each with
+/// an evaluated stillness check), attached to each of them; `None` for other records.
+fn gravity_of(analyses: &mut [ChannelAnalysis]) -> Option<gyrolab::stillness::GravityCheck> {
+    use gyrolab::units::Quantity;
+    let accel: Vec<usize> = (0..analyses.len()).filter(|&i| analyses[i].quantity == Quantity::Acceleration).collect();
+    let [a, b, c] = accel[..] else { return None };
+    let g = {
+        let checks =
+            [analyses[a].stillness.as_ref()?, analyses[b].stillness.as_ref()?, analyses[c].stillness.as_ref()?];
+        gyrolab::stillness::gravity_check(checks, gyrolab::stillness::GRAVITY_TOLERANCE_M_S2)?
+    };
+    for i in [a, b, c] {
+        analyses[i].gravity = Some(g.clone());
+    }
+    Some(g)
 }
 
 /// Refuses records whose gyro or accelerometer channels moved (the stillness check), unless

@@ -45,6 +45,9 @@ pub struct ChannelAnalysis {
     pub stillness: Option<gyrolab::stillness::StillnessCheck>,
     /// The analysis of a channel that moved was asked for (`--allow-motion`, `allow_motion=True`).
     pub allow_motion: bool,
+    /// The gravity check of the three accelerometer axes this channel is one of (the same on
+    /// each of them; `None` unless a record has exactly three accelerometer channels in m/s^2).
+    pub gravity: Option<gyrolab::stillness::GravityCheck>,
 }
 
 impl ChannelAnalysis {
@@ -346,6 +349,10 @@ pub struct AllanJson {
     /// The stillness check (null when no rule applies: not a gyro in deg/s nor an
     /// accelerometer in m/s^2).
     pub stillness: Option<StillnessJson>,
+    /// The gravity check of a three-axis accelerometer (the magnitude of each window's mean
+    /// vector against 1 g; absent for other channels).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<gyrolab::stillness::GravityCheck>,
 }
 
 /// The JSON document: the first channel's keys at the top level, every channel in `channels`.
@@ -504,6 +511,7 @@ pub fn allan_json(a: &ChannelAnalysis) -> AllanJson {
             allow_motion: a.allow_motion,
             motion: a.motion_line(),
         }),
+        gravity: a.gravity.clone(),
     }
 }
 
@@ -1000,6 +1008,7 @@ mod tests {
             noise_note: None,
             stillness: None,
             allow_motion: false,
+            gravity: None,
         }
     }
 
