@@ -181,8 +181,9 @@ fn a_plan_refuses_a_static_record_that_moved_unless_the_plan_allows_it() {
         .unwrap();
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     let v: Value = serde_json::from_slice(&std::fs::read(dir.path().join("r/results.json")).unwrap()).unwrap();
-    let text = v["sections"]["allan"]["x"].to_string();
-    assert!(text.contains("moved"), "the analysis says the record moved: {}", &text[..text.len().min(400)]);
+    let still = &v["sections"]["allan"]["x"]["stillness"];
+    assert_eq!((still["moved"].as_bool(), still["allow_motion"].as_bool()), (Some(true), Some(true)), "{still}");
+    assert!(still["motion"].as_str().is_some_and(|m| m.starts_with("MOTION:")), "{still}");
 }
 
 /// The gravity check of a three-axis accelerometer: the bundled ROS 1 bag's /imu0 holds gravity

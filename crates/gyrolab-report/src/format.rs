@@ -46,6 +46,9 @@ pub fn digits_to_uncertainty(v: f64, u: f64) -> Option<usize> {
 /// assert_eq!(rounded_to_uncertainty(7.21834, 3.2), Some(("7.2".into(), "3.2".into())));
 /// assert_eq!(rounded_to_uncertainty(0.0075000198, 8.754e-6), Some(("0.0075000".into(), "0.0000088".into())));
 /// assert_eq!(rounded_to_uncertainty(1.0, 0.0), None);
+/// // U = 0.0996 rounds up to 0.10; a negative value that rounds to zero prints 0.
+/// assert_eq!(rounded_to_uncertainty(1.046, 0.0996), Some(("1.05".into(), "0.10".into())));
+/// assert_eq!(rounded_to_uncertainty(-0.03, 3.2), Some(("0.0".into(), "3.2".into())));
 /// ```
 pub fn rounded_to_uncertainty(v: f64, u: f64) -> Option<(String, String)> {
     if !(v.is_finite() && u.is_finite() && u > 0.0) {
@@ -61,7 +64,9 @@ pub fn rounded_to_uncertainty(v: f64, u: f64) -> Option<(String, String)> {
         return Some((sig(v, digits_to_uncertainty(v, u_r).unwrap_or(2)), sig(u_r, 2)));
     }
     let decimals = (1 - mag).max(0) as usize;
-    let v_r = (v / step).round() * step;
+    // A value that rounds to zero prints 0, not -0.
+    let v_r = (v / step).round() * step + 0.0;
+    let v_r = if v_r == 0.0 { 0.0 } else { v_r };
     Some((format!("{v_r:.decimals$}"), format!("{u_r:.decimals$}")))
 }
 

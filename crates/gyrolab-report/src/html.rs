@@ -310,8 +310,12 @@ impl SummaryTable {
                 SummaryRow {
                     simulated: axes.iter().any(|a| a.simulated.contains(&key)),
                     label: {
-                        let mut labels: Vec<String> = axes.iter().map(|a| a.label_of(&key)).collect();
-                        labels.dedup();
+                        let mut labels: Vec<String> = Vec::new();
+                        for l in axes.iter().map(|a| a.label_of(&key)) {
+                            if !labels.contains(&l) {
+                                labels.push(l);
+                            }
+                        }
                         if labels.is_empty() {
                             def.map_or_else(|| key.clone(), |d| d.label.to_string())
                         } else {

@@ -107,13 +107,14 @@ impl LimitCheck {
     /// verdict; a bound printed `at most ..` or `above ..`; `n/a` without a value.
     pub fn value_text(&self, min_digits: usize) -> String {
         let Some(v) = self.value else { return "n/a".into() };
-        let to_u = self.expanded_uncertainty.and_then(|u| crate::format::digits_to_uncertainty(v, u));
-        let n = self.limit().digits_for(v, to_u.unwrap_or(min_digits));
-        // Rounded to U (tens included) where that many digits already agree with the verdict.
+        let n = self.limit().digits_for(v, min_digits);
+        // Rounded to U (tens included) where the printed number falls on the same side of the
+        // limit as the value; else the digits that keep them apart.
         let estimate = !matches!(self.support, Some(Support::UpperBound | Support::LowerBound));
-        if let (Some(d), Some(u), true) = (to_u, self.expanded_uncertainty, estimate) {
-            if n == d {
-                if let Some((text, _)) = crate::format::rounded_to_uncertainty(v, u) {
+        if let (Some(u), true) = (self.expanded_uncertainty, estimate) {
+            if let Some((text, _)) = crate::format::rounded_to_uncertainty(v, u) {
+                let limit = self.limit();
+                if text.parse::<f64>().is_ok_and(|p| limit.admits(p) == limit.admits(v)) {
                     return text;
                 }
             }
@@ -317,6 +318,14 @@ mod tests {
         // Tens: 581.29 ± 367.6 prints 580 (U 370).
         let c = check_limits(&[limit("nonlinearity_pct", None, Some(1000.0))], &[with_u(581.29, 367.6)]);
         assert_eq!(c[0].value_text(4), "580");
+        // U = 0.0996 rounds up a decade to 0.10: 1.046 prints 1.05, above a limit <= 1.049 it
+        // passes, so the digits that keep it below instead.
+        let c = check_limits(&[limit("nonlinearity_pct", None, Some(1.049))], &[with_u(1.046, 0.0996)]);
+        assert_eq!((c[0].verdict, c[0].value_text(4)), (Verdict::Pass, "1.046".to_string()));
+        // |v| far below U: 0.04 ± 1.2 fails [-0.02, 0.02]; "0.0" would sit inside, so not that.
+        let c = check_limits(&[limit("nonlinearity_pct", Some(-0.02), Some(0.02))], &[with_u(0.04, 1.2)]);
+        assert_eq!(c[0].verdict, Verdict::Fail);
+        assert_eq!(c[0].value_text(4), "0.04000");
     }
 
     #[test]

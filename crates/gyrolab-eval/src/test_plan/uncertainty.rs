@@ -759,8 +759,9 @@ fn bias_budget(
     let u_mean = u_means.iter().map(|(u, _)| u * u).sum::<f64>().sqrt() / qf;
     // ν of the mean of Q record means (Welch-Satterthwaite over the tests, each ν = the EDF of the
     // Allan point used).
-    let ws: Option<f64> = u_means.iter().map(|(u, edf)| edf.map(|nu| (u / qf).powi(4) / nu)).sum();
-    let mean_dof = ws.filter(|d| *d > 0.0).map_or(f64::INFINITY, |d| u_mean.powi(4) / d);
+    // A test whose Allan point has no EDF counts as infinite ν (adds nothing).
+    let ws: f64 = u_means.iter().filter_map(|(u, edf)| edf.map(|nu| (u / qf).powi(4) / nu)).sum();
+    let mean_dof = if ws > 0.0 { u_mean.powi(4) / ws } else { f64::INFINITY };
     let k = kb.value;
     let per_output = units::bias_dps_to_dph(1.0 / k);
     let taus_text = used.iter().map(|t| sig(*t, 4)).collect::<Vec<_>>().join(", ");

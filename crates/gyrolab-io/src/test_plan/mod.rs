@@ -699,7 +699,8 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
                     v.span(),
                     key,
                     format!(
-                        "must be a number in the axis's output unit (the datasheet null voltage, 0 for a digital                          output's zero code), got {}",
+                        "must be a number in the axis's output unit (the datasheet null voltage, 0 for a digital \
+                         output's zero code), got {}",
                         crate::text::excerpt(&x.to_string())
                     ),
                 )),
