@@ -23,7 +23,7 @@ pub fn sig(v: f64, digits: usize) -> String {
 /// ```
 /// use gyrolab_report::format::{digits_to_uncertainty, sig};
 /// // 7.21834 with U = 3.2: to 0.1 -> "7.2"; 0.0012345 with U = 0.000051 -> "0.001234" (4 digits).
-/// assert_eq!(sig(7.21834, digits_to_uncertainty(7.21834, 3.2).unwrap()), "7.2");
+/// assert_eq!(sig(7.21834, digits_to_uncertainty(7.21834, 3.2).unwrap()), "7.2"); // ok: doctest, valid inputs
 /// assert_eq!(digits_to_uncertainty(0.0012345, 0.000051), Some(4));
 /// assert_eq!(digits_to_uncertainty(5.0, 0.0), None);
 /// ```

@@ -253,7 +253,7 @@ pub fn combine_correlated(components: &[Component], correlations: &[Correlation]
 /// ];
 /// let uc = gyrolab::uncertainty::combine(&c);
 /// assert!((uc - 1.03).abs() < 0.005);
-/// assert!((welch_satterthwaite(uc, &c).unwrap() - 19.0).abs() < 0.05);
+/// assert!((welch_satterthwaite(uc, &c).unwrap() - 19.0).abs() < 0.05); // ok: doctest, valid inputs
 /// ```
 pub fn welch_satterthwaite(combined: f64, components: &[Component]) -> Option<f64> {
     let denominator: f64 = components.iter().filter_map(|c| c.dof.map(|nu| c.contribution.powi(4) / nu)).sum();
