@@ -47,6 +47,10 @@ else
     # again by pyulog + numpy: the committed JSON must equal a fresh independent reading.
     .venv/bin/python scripts/px4_clock_reference.py --check examples/recordings/px4_sample_log_small.ulg \
         crates/gyrolab-eval/tests/data/px4_clock_reference.json
+    # The stillness check's reference for the real PX4 flight (crates/gyrolab-cli/tests/stillness.rs),
+    # read again by pyulog + numpy the same way.
+    .venv/bin/python scripts/px4_motion_reference.py --check examples/recordings/px4_sample_flight.ulg \
+        crates/gyrolab-cli/tests/data/px4_motion_reference.json
     # The filter exports (`allan --export`) read by each stack's reader or the closest one (PyYAML,
     # OpenCV FileStorage, json, a PX4 parameter-file parser) against hand conversions and truth.
     .venv/bin/python scripts/check_exports.py "$bin"

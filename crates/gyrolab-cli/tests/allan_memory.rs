@@ -140,6 +140,19 @@ fn an_incomplete_record_or_another_estimator_is_refused_when_streamed() {
     let e = gyrolab().arg("allan").arg(&p).args(["--memory", "1MiB"]).assert().code(2).get_output().stderr.clone();
     let e = String::from_utf8(e).unwrap();
     assert!(e.contains(":70001:") && e.contains("--memory"), "{e}");
+    // A reset: the stamps of the last 10,000 rows start again from 0 (in memory the record
+    // ends before them, with a note; streamed, the estimators took them: refused).
+    let mut rows: Vec<String> = text.lines().map(String::from).collect();
+    for (k, row) in rows[90_001..].iter_mut().enumerate() {
+        let rest = row.split_once(',').unwrap().1.to_string();
+        *row = format!("{:.3},{rest}", k as f64 * 0.005);
+    }
+    let p = write(dir.path(), "reset.csv", &(rows.join("\n") + "\n"));
+    let (in_memory, _) = json(&p, &[]);
+    assert_eq!(in_memory["samples"], 90_000, "the in-memory record ends before the reset");
+    let e = gyrolab().arg("allan").arg(&p).args(["--memory", "1MiB"]).assert().code(2).get_output().stderr.clone();
+    let e = String::from_utf8(e).unwrap();
+    assert!(e.contains("time stamps go back") && e.contains(":90002:") && e.contains("--memory"), "{e}");
     // MDEV beyond the ceiling; a ceiling that is no size.
     let p = write(dir.path(), "ok.csv", &text);
     let e = gyrolab().arg("allan").arg(&p).args(["--memory", "1MiB", "--kind", "mdev"]).assert().code(2);

@@ -16,10 +16,15 @@ use std::path::{Path, PathBuf};
 /// deg/sqrt(h)) about biases 0.3 and -0.2 deg/s; a rate of `episode_dps` added to x from 50 s
 /// to 55 s.
 fn record(dir: &Path, name: &str, seed: u64, episode_dps: f64) -> PathBuf {
+    record_of(dir, name, seed, episode_dps, 12_000)
+}
+
+/// [`record`] of `rows` rows.
+fn record_of(dir: &Path, name: &str, seed: u64, episode_dps: f64, rows: usize) -> PathBuf {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let noise = Normal::new(0.0, 0.05).unwrap();
     let mut text = String::from("time_s,gyro_x [deg/s],gyro_z [deg/s]\n");
-    for i in 0..12_000 {
+    for i in 0..rows {
         let t = i as f64 / 100.0;
         let step = if (50.0..55.0).contains(&t) { episode_dps } else { 0.0 };
         let x = 0.3 + step + noise.sample(&mut rng);
@@ -148,42 +153,61 @@ fn snapshot_topics_too_short_for_the_check_say_so() {
     assert!(text.contains("stillness: not evaluated (the record holds 1 window(s) of 10 samples"), "{text}");
 }
 
-/// A test plan's static record that moved is refused like `allan`'s, naming the plan key that
-/// allows it; with `allow_motion = true` it is evaluated and its analysis says it moved.
+/// A test plan's static records that moved are refused like `allan`'s, naming the plan key that
+/// allows it: a bias record (evaluated for bias, not for the Allan curve) and the Allan record;
+/// with `allow_motion = true` they are evaluated and the section and the analysis say they moved.
 #[test]
 fn a_plan_refuses_a_static_record_that_moved_unless_the_plan_allows_it() {
     let dir = tempfile::tempdir().unwrap();
     record(dir.path(), "moved.csv", 3, 20.0);
-    let plan = |allow: &str| {
+    record(dir.path(), "still.csv", 6, 0.0);
+    let plan = |files: &str, allan: &str, allow: &str| {
         write(
             dir.path(),
             "plan.toml",
             &format!(
-                "[device]\nmodel = \"m\"\nserial = \"s\"\naxes = [\"x\"]\n[static.x]\nfiles = [\"moved.csv\"]\n\
-                 sample_rate_hz = 100.0\nchannel = \"gyro_x [deg/s]\"\n{allow}"
+                "[device]\nmodel = \"m\"\nserial = \"s\"\naxes = [\"x\"]\n[static.x]\nfiles = [{files}]\n\
+                 allan_file = \"{allan}\"\nsample_rate_hz = 100.0\nchannel = \"gyro_x [deg/s]\"\n{allow}"
             ),
         )
     };
-    let out = gyrolab().arg("eval").arg(plan("")).arg("--out").arg(dir.path().join("r")).output().unwrap();
+    let eval = |plan: PathBuf| {
+        let _ = std::fs::remove_dir_all(dir.path().join("r"));
+        gyrolab().arg("eval").arg(plan).arg("--out").arg(dir.path().join("r")).arg("-q").output().unwrap()
+    };
+    // a bias record that moved (the Allan record is still), with a gap of 0.5 s in its stamps
+    // before the episode: the samples are placed on the grid, so the episode is where it was
+    let moved = std::fs::read_to_string(dir.path().join("moved.csv")).unwrap();
+    let kept: Vec<&str> =
+        moved.lines().enumerate().filter(|(i, _)| !(2001..2051).contains(i)).map(|(_, l)| l).collect();
+    write(dir.path(), "moved_gap.csv", &(kept.join("\n") + "\n"));
+    let out = eval(plan("\"still.csv\", \"moved_gap.csv\"", "still.csv", ""));
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("moved_gap.csv: static.x.files[1]: the record is not static"), "{err}");
+    assert!(err.contains("first episode 50.0 to 55.0 s"), "{err}");
+    assert!(err.contains("static.x.allow_motion = true"), "{err}");
+    assert!(!dir.path().join("r").exists(), "nothing written");
+    // the Allan record that moved (the bias record is still)
+    let out = eval(plan("\"still.csv\"", "moved.csv", ""));
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("static.x: the Allan record is not static"), "{err}");
     assert!(err.contains("first episode 50.0 to 55.0 s"), "{err}");
     assert!(err.contains("static.x.allow_motion = true"), "{err}");
     assert!(!dir.path().join("r").exists(), "nothing written");
-    let out = gyrolab()
-        .arg("eval")
-        .arg(plan("allow_motion = true\n"))
-        .arg("--out")
-        .arg(dir.path().join("r"))
-        .arg("-q")
-        .output()
-        .unwrap();
+    // allowed: both evaluated, both marked
+    let out = eval(plan("\"still.csv\", \"moved.csv\"", "moved.csv", "allow_motion = true\n"));
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     let v: Value = serde_json::from_slice(&std::fs::read(dir.path().join("r/results.json")).unwrap()).unwrap();
     let still = &v["sections"]["allan"]["x"]["stillness"];
     assert_eq!((still["moved"].as_bool(), still["allow_motion"].as_bool()), (Some(true), Some(true)), "{still}");
     assert!(still["motion"].as_str().is_some_and(|m| m.starts_with("MOTION:")), "{still}");
+    let notes = v["sections"]["static"]["x"]["notes"].as_array().unwrap();
+    let moved: Vec<&str> = notes.iter().filter_map(|n| n.as_str()).filter(|n| n.starts_with("MOTION: ")).collect();
+    assert_eq!(moved.len(), 1, "{notes:?}");
+    assert!(moved[0].contains("moved.csv: channel 'gyro_x [deg/s]' moved in 5 of 120 windows"), "{moved:?}");
+    assert!(moved[0].contains("static.x.allow_motion = true"), "{moved:?}");
 }
 
 /// The gravity check of a three-axis accelerometer: the bundled ROS 1 bag's /imu0 holds gravity
@@ -215,4 +239,130 @@ fn the_gravity_check_finds_an_accelerometer_that_is_not_1_g() {
     let g = &v["channels"][3]["gravity"];
     assert_eq!(g["outside_windows"], g["windows"]);
     assert!((g["median_magnitude_m_s2"].as_f64().unwrap() - 2.0 * 9.80665).abs() < 0.02, "{g}");
+}
+
+/// A record streamed within a memory ceiling (`--memory`) gets the same check as in memory:
+/// refused when it moved, naming the episode; with --allow-motion the streamed check equals the
+/// in-memory one (same windows, episodes and white-noise sigma).
+#[test]
+fn a_streamed_record_is_checked_as_in_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    // 600 s at 100 Hz, two channels: about 1.4 MB in memory, above a 1 MiB ceiling
+    let file = record_of(dir.path(), "long.csv", 4, 20.0, 60_000);
+    let f = file.to_str().unwrap();
+    let out = gyrolab().args(["allan", f, "--memory", "1MiB"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("channel 'gyro_x [deg/s]' moved in 5 of 600 windows of 1 s"), "{err}");
+    assert!(err.contains("first episode 50.0 to 55.0 s"), "{err}");
+    let streamed = json(&["allan", f, "--memory", "1MiB", "--allow-motion"]);
+    assert_eq!(streamed["memory"]["path"], "streaming");
+    let in_memory = json(&["allan", f, "--allow-motion"]);
+    assert_eq!(in_memory["memory"]["path"], "in_memory");
+    for c in 0..2 {
+        let (a, b) = (&streamed["channels"][c]["stillness"], &in_memory["channels"][c]["stillness"]);
+        assert_eq!(a["evaluated"], true, "{a}");
+        for key in ["moved", "windows", "moved_windows", "window_samples", "first_episode", "largest_episode"] {
+            assert_eq!(a[key], b[key], "channel {c}, {key}");
+        }
+        let (sa, sb) = (a["white_noise_sigma"].as_f64().unwrap(), b["white_noise_sigma"].as_f64().unwrap());
+        assert!((sa / sb - 1.0).abs() < 1e-9, "{sa} vs {sb}");
+    }
+    assert_eq!(streamed["channels"][0]["stillness"]["moved"], true);
+    assert_eq!(streamed["channels"][1]["stillness"]["moved"], false);
+    // a still record streamed passes
+    let still = record_of(dir.path(), "still.csv", 5, 0.0, 60_000);
+    let j = json(&["allan", still.to_str().unwrap(), "--memory", "1MiB"]);
+    assert_eq!(j["memory"]["path"], "streaming");
+    for c in j["channels"].as_array().unwrap() {
+        let s = &c["stillness"];
+        assert_eq!((s["evaluated"].as_bool(), s["moved"].as_bool()), (Some(true), Some(false)), "{s}");
+    }
+}
+
+/// A REAL moving record: PX4/pyulog's `test/sample.ulg` (BSD-3-Clause; bundled as
+/// examples/recordings/px4_sample_flight.ulg) is a flight: its gyro turns at up to 12 deg/s in
+/// 1 s window means. `allan` refuses it naming each gyro channel; with --allow-motion the
+/// check's windows, still level and first episode agree with an independent reading by pyulog +
+/// numpy (scripts/px4_motion_reference.py: 1 s windows by time stamp, which the test script
+/// checks against the committed JSON), allowing for gyrolab's own window grid.
+#[test]
+fn a_real_px4_flight_is_found_moving() {
+    let ulg = root().join("examples/recordings/px4_sample_flight.ulg");
+    let reference: Value = serde_json::from_slice(
+        &std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/px4_motion_reference.json")).unwrap(),
+    )
+    .unwrap();
+    let f = ulg.to_str().unwrap();
+    let out = gyrolab().args(["allan", f, "--topic", "sensor_combined"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("the record is not static"), "{err}");
+    for axis in ["x", "y", "z"] {
+        assert!(err.contains(&format!("channel 'gyro_{axis}_rad_s' moved in ")), "{axis}: {err}");
+    }
+    assert!(err.contains("--allow-motion"), "{err}");
+    let j = json(&["allan", f, "--topic", "sensor_combined", "--allow-motion"]);
+    let channels = j["channels"].as_array().unwrap();
+    for axis in ["x", "y", "z"] {
+        let c = channels.iter().find(|c| c["channel"] == format!("gyro_{axis}_rad_s")).unwrap();
+        let s = &c["stillness"];
+        let r = &reference["channels"][format!("gyro_{axis}")];
+        assert_eq!((s["evaluated"].as_bool(), s["moved"].as_bool()), (Some(true), Some(true)), "{axis}: {s}");
+        assert_eq!(s["windows"], r["windows"], "{axis}");
+        let level = s["still_level"].as_f64().unwrap();
+        let want = r["still_level_dps"].as_f64().unwrap();
+        assert!((level - want).abs() < 0.01, "{axis}: still level {level} vs numpy {want}");
+        // every window whose mean departs by more than the floor is moved in gyrolab too (its
+        // spread test may add windows that shook without moving their mean)
+        let moved = s["moved_windows"].as_u64().unwrap();
+        let mean_moved = r["mean_moved_windows"].as_u64().unwrap();
+        assert!(moved >= mean_moved && moved <= mean_moved + 2, "{axis}: {moved} vs numpy {mean_moved}");
+        let start = s["first_episode"]["start_s"].as_f64().unwrap();
+        let want = r["first_mean_moved_start_s"].as_f64().unwrap();
+        assert!((start - want).abs() <= 1.0, "{axis}: first episode at {start} s, numpy's first moved window {want} s");
+        let peak = s["first_episode"]["peak_departure"].as_f64().unwrap();
+        let largest = s["largest_episode"]["peak_departure"].as_f64().unwrap_or(peak);
+        assert!(peak.max(largest) >= r["largest_mean_departure_dps"].as_f64().unwrap() * 0.9, "{axis}");
+        assert!(c["stillness"]["motion"].as_str().is_some_and(|m| m.starts_with("MOTION:")), "{axis}");
+    }
+}
+
+/// The static records of `[power_ups.<axis>]` are checked too: refused naming the file and
+/// `power_ups.<axis>.allow_motion`; allowed, evaluated with a MOTION note in the section's JSON.
+#[test]
+fn a_plan_refuses_a_power_up_record_that_moved_unless_the_plan_allows_it() {
+    let dir = tempfile::tempdir().unwrap();
+    record(dir.path(), "up1.csv", 7, 0.0);
+    record(dir.path(), "up2.csv", 8, 15.0);
+    record(dir.path(), "up3.csv", 9, 0.0);
+    let plan = |allow: &str| {
+        write(
+            dir.path(),
+            "plan.toml",
+            &format!(
+                "[device]\nmodel = \"m\"\nserial = \"s\"\naxes = [\"x\"]\n[power_ups.x]\n\
+                 static_files = [\"up1.csv\", \"up2.csv\", \"up3.csv\"]\nsample_rate_hz = 100.0\n\
+                 channel = \"gyro_x [deg/s]\"\n{allow}"
+            ),
+        )
+    };
+    let r = dir.path().join("r");
+    let out = gyrolab().arg("eval").arg(plan("")).arg("--out").arg(&r).arg("-q").output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("up2.csv: power_ups.x.static_files[1]: the record is not static"), "{err}");
+    assert!(err.contains("channel 'gyro_x [deg/s]' moved in 5 of 120 windows"), "{err}");
+    assert!(err.contains("power_ups.x.allow_motion = true"), "{err}");
+    assert!(!r.exists(), "nothing written");
+    let out = gyrolab().arg("eval").arg(plan("allow_motion = true\n")).arg("--out").arg(&r).arg("-q").output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: Value = serde_json::from_slice(&std::fs::read(r.join("results.json")).unwrap()).unwrap();
+    let notes = v["sections"]["power_ups"]["x"]["notes"].as_array().unwrap();
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    let note = notes[0].as_str().unwrap();
+    assert!(note.starts_with("MOTION: up2.csv: channel 'gyro_x [deg/s]' moved in 5 of 120 windows"), "{note}");
+    assert!(note.contains("power_ups.x.allow_motion = true"), "{note}");
+    let html = std::fs::read_to_string(r.join("report.html")).unwrap();
+    assert!(html.contains("MOTION: up2.csv"), "the section prints the note");
 }

@@ -954,7 +954,7 @@ pub fn analyse_records(request: &AllanRequest) -> EvalResult<Vec<AllanOutcome>> 
 
 /// The gravity check of a record with exactly three accelerometer channels (in m/s^2, each with
 /// an evaluated stillness check), attached to each of them; `None` for other records.
-fn gravity_of(analyses: &mut [ChannelAnalysis]) -> Option<gyrolab::stillness::GravityCheck> {
+pub(crate) fn gravity_of(analyses: &mut [ChannelAnalysis]) -> Option<gyrolab::stillness::GravityCheck> {
     use gyrolab::units::Quantity;
     let accel: Vec<usize> = (0..analyses.len()).filter(|&i| analyses[i].quantity == Quantity::Acceleration).collect();
     let [a, b, c] = accel[..] else { return None };

@@ -9,14 +9,15 @@
 //! ceiling that would let the in-memory path analyse them; never a different number in silence.
 
 use crate::allan::{
-    analyse_records, channel_analysis, physical_conversion, read_notes, record_timing, AllanOutcome, AllanRequest,
-    ChannelSetup, ReadNote,
+    analyse_records, channel_analysis, gravity_of, physical_conversion, read_notes, record_timing, refuse_motion,
+    AllanOutcome, AllanRequest, ChannelSetup, ReadNote,
 };
 use crate::error::{EvalError, EvalResult};
 use gyrolab::allan::streaming::{StreamedPoint, StreamingOadev, StreamingPlan};
 use gyrolab::allan::{AllanError, AllanOptions, DeviationKind, TauList};
 use gyrolab::dropout::DropoutTally;
 use gyrolab::sampling::{estimate_interval_of, CompactStamps};
+use gyrolab::stillness::{StillnessAccumulator, StillnessCheck, StillnessRule};
 use gyrolab::validate::InvalidOption;
 use gyrolab_io::recording::FileFormat;
 use gyrolab_io::series::{BatchReader, LineMap, SeriesData, SeriesOptions, SeriesReader, SkipReason};
@@ -222,7 +223,8 @@ pub fn analyse_records_within(
             ),
         ));
     }
-    let (outcome, summary) = analyse_streaming(request, reader, (rows, size), memory_bytes, estimate)?;
+    let start = start_interval(path, &options, request.sample_rate_hz)?;
+    let (outcome, summary) = analyse_streaming(request, reader, (rows, size), memory_bytes, estimate, start)?;
     Ok((vec![outcome], MemoryPath::Streaming(summary)))
 }
 
@@ -253,6 +255,34 @@ fn estimated_rows(path: &Path, size: u64) -> EvalResult<u64> {
     Ok((size as f64 * lines.max(1) as f64 / head.len() as f64).ceil() as u64)
 }
 
+/// Rows of the record's start whose stamps give the stillness check's interval.
+const START_ROWS: usize = 10_000;
+
+/// The sample interval at a streamed record's start, s, by which the stillness check cuts its
+/// windows before the record's interval is known: the sample rate given, else the interval the
+/// clock model reads from the first [`START_ROWS`] stamps (the in-memory path reads it from
+/// all of them: the two agree on a complete record, the only kind streamed); `None` when
+/// neither gives a positive finite number.
+fn start_interval(path: &Path, options: &SeriesOptions, sample_rate_hz: Option<f64>) -> EvalResult<Option<f64>> {
+    let interval = match sample_rate_hz {
+        Some(r) => Some(1.0 / r),
+        None => crate::allan::first_times(path, options, START_ROWS)?
+            .and_then(|t| gyrolab::sampling::estimate_interval(&t).ok())
+            .map(|e| e.interval_s),
+    };
+    Ok(interval.filter(|x| x.is_finite() && *x > 0.0))
+}
+
+/// Bytes the stillness checks of a streamed record hold: per channel and window (at most
+/// `rows` / the window's samples + 1), its sums (72 bytes, doubled for the vector's growth)
+/// and what the verdict copies (judged sums, means, variances, window means: 104 bytes).
+fn stillness_footprint(rows: u64, channels: usize, tau0_s: f64) -> u64 {
+    let Some(rule) = StillnessRule::for_quantity(gyrolab::units::Quantity::AngularRate) else { return 0 };
+    let window = (rule.window_s / tau0_s).round().max(gyrolab::stillness::MIN_WINDOW_SAMPLES as f64);
+    let windows = (rows as f64 / window).ceil() as u64 + 1;
+    windows.saturating_mul(channels as u64).saturating_mul(2 * 72 + 104)
+}
+
 /// Why a streamed record is refused: it is incomplete, which only the in-memory path analyses.
 fn incomplete(path: &Path, what: &str, estimate: u64) -> DataError {
     DataError::new(
@@ -273,6 +303,7 @@ fn analyse_streaming(
     (rows, size): (u64, u64),
     memory_bytes: u64,
     estimate: u64,
+    start_interval: Option<f64>,
 ) -> EvalResult<(AllanOutcome, StreamingSummary)> {
     let path = request.file.as_path();
     let mut reader = BatchReader::new(reader, rayon::current_num_threads(), batch_bytes(memory_bytes));
@@ -288,7 +319,8 @@ fn analyse_streaming(
     // The stamps (about a byte a row), the batches in flight (one read, two queued, one taken)
     // come off the ceiling before the plan shares it among the channels.
     let slots = infos.len() + 3;
-    let overhead = rows + 4 * batch_footprint(reader.batch_bytes(), size, rows, slots);
+    let stillness_bytes = start_interval.map_or(0, |tau0| stillness_footprint(rows, infos.len(), tau0));
+    let overhead = rows + 4 * batch_footprint(reader.batch_bytes(), size, rows, slots) + stillness_bytes;
     let budget = memory_bytes.saturating_sub(overhead).max(MIN_MEMORY_BYTES / 2);
     let plan = StreamingPlan::for_memory(
         usize::try_from(rows).unwrap_or(usize::MAX),
@@ -319,19 +351,33 @@ fn analyse_streaming(
     let mut lines = LineMap::default();
     let mut tally = DropoutTally::new(infos.len());
     let has_time = header.time_column.is_some();
+    // The stillness check cuts its windows as the samples arrive, at the interval of the
+    // record's start; its times are reported at the record's interval, learnt at the end.
+    let mut stillness: Vec<Option<StillnessAccumulator>> = conversions
+        .iter()
+        .map(|(q, _)| {
+            let tau0 = start_interval?;
+            StillnessRule::for_quantity(*q).and_then(|r| StillnessAccumulator::new(r, tau0))
+        })
+        .collect();
     let (read, pushed) = std::thread::scope(|scope| {
         let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Vec<f64>>>(2);
         let conversions = &conversions;
         let estimators = &mut estimators;
+        let stillness = &mut stillness;
         let consumer = scope.spawn(move || -> Result<(), (usize, AllanError)> {
             for mut block in rx {
                 let failed = estimators
                     .par_iter_mut()
+                    .zip(stillness.par_iter_mut())
                     .zip(block.par_iter_mut())
                     .zip(conversions.par_iter())
                     .enumerate()
-                    .map(|(c, ((est, values), (_, conversion)))| {
+                    .map(|(c, (((est, still), values), (_, conversion)))| {
                         conversion.apply(values);
+                        if let Some(acc) = still {
+                            acc.push(values);
+                        }
                         est.push(values).err().map(|e| (c, e))
                     })
                     .collect::<Vec<_>>()
@@ -431,6 +477,15 @@ fn analyse_streaming(
         quality,
     };
     let timing = record_timing(&stub, path, request.sample_rate_hz, request.gaps)?;
+    // A stamp going back (a reset, a trailer of zeros) ends the record in memory; the streamed
+    // estimators have taken the samples after it: refused.
+    if let Some(r) = timing.reset {
+        let what = format!(
+            "the time stamps go back (from {} s to {} s: a clock reset or a trailer), which ends the record before it",
+            r.from_s, r.to_s
+        );
+        return Err(incomplete(path, &what, estimate).at_line(stub.lines.get(r.index).unwrap_or(0)).into());
+    }
     let lines = std::mem::take(&mut stub.lines);
     drop(stub);
     let tau0 = timing.tau0_s;
@@ -455,9 +510,10 @@ fn analyse_streaming(
     };
     let finished: Vec<EvalResult<_>> = estimators
         .into_par_iter()
+        .zip(stillness.into_par_iter())
         .zip(infos.par_iter())
         .zip(conversions.par_iter())
-        .map(|((est, info), (quantity, _))| {
+        .map(|(((est, still), info), (quantity, _))| {
             let (curve, points) = est.finish(tau0).map_err(|e| {
                 EvalError::Data(DataError::new(
                     path,
@@ -466,11 +522,15 @@ fn analyse_streaming(
             })?;
             let streamed =
                 StreamedChannel { channel: info.name.clone(), taus: points.iter().map(StreamedTau::of).collect() };
-            // The stillness check needs the record's interval before its windows are cut, which
-            // the stream learns only at its end: not made on a streamed record (said so).
-            let stillness = gyrolab::stillness::StillnessRule::for_quantity(*quantity).map(|rule| {
-                gyrolab::stillness::StillnessCheck::not_evaluated(rule, "not made on a streamed record (--memory)")
-            });
+            let stillness = match still {
+                Some(acc) => Some(acc.finish_at_interval(tau0)),
+                None => StillnessRule::for_quantity(*quantity).map(|rule| {
+                    StillnessCheck::not_evaluated(
+                        rule,
+                        "the interval of the streamed record's start could not be read from its first time stamps",
+                    )
+                }),
+            };
             Ok((channel_analysis(&setup, info, *quantity, curve, stillness), streamed))
         })
         .collect();
@@ -481,6 +541,10 @@ fn analyse_streaming(
         analyses.push(a);
         streamed.push(s);
     }
+    if let Some(g) = gravity_of(&mut analyses) {
+        notes.push(ReadNote::Gravity(g));
+    }
+    refuse_motion(&analyses, path, request.allow_motion)?;
     let max_edf_loss = streamed.iter().flat_map(|c| c.taus.iter().filter_map(|t| t.edf_loss)).reduce(f64::max);
     let summary = StreamingSummary {
         memory_ceiling_bytes: memory_bytes,

@@ -321,6 +321,63 @@ pub fn evaluate_record(
     })
 }
 
+/// The stillness check ([`gyrolab::stillness`]) of a static record's first selected channel,
+/// converted to deg/s (or m/s^2) with `reference`, streaming the file once (memory per window).
+/// The samples are placed on the grid of `sample_rate_hz` as the Allan record's are: a gap in the
+/// time stamps is that many missing samples (rounded), dropout rows (found as [`evaluate_file`]
+/// finds them) are missing samples, and a stamp that does not increase adds none. The channel's
+/// name and its check;
+/// `None` when no rule applies (a channel the reference leaves in volts or counts) or the
+/// record has no channel.
+pub fn stillness_of_file(
+    path: &Path,
+    options: &SeriesOptions,
+    reference: &Reference,
+    sample_rate_hz: f64,
+) -> EvalResult<Option<(String, gyrolab::stillness::StillnessCheck)>> {
+    use gyrolab::stillness::{StillnessAccumulator, StillnessRule};
+    let mut options = options.clone();
+    let verdict = dropout_verdict(path, &options)?;
+    options.zero_rows_missing = verdict.all_zero;
+    options.repeated_rows_missing = verdict.repeated;
+    let mut r = gyrolab_io::series::SeriesReader::open(path, &options)?;
+    let Some(info) = r.header().channels.first().cloned() else { return Ok(None) };
+    let (quantity, conversion) = reference.physical_conversion(info.unit).map_err(|m| {
+        EvalError::conflict(format!("{}: channel '{}': {m}", path.display(), gyrolab_io::text::excerpt(&info.name)))
+    })?;
+    let Some(mut acc) =
+        StillnessRule::for_quantity(quantity).and_then(|rule| StillnessAccumulator::new(rule, 1.0 / sample_rate_hz))
+    else {
+        return Ok(None);
+    };
+    let tau0 = 1.0 / sample_rate_hz;
+    let mut buffer = Vec::new();
+    let mut last_stamp: Option<f64> = None;
+    while let Some(block) = r.next_block()? {
+        buffer.clear();
+        buffer.extend_from_slice(block.channels.first().map_or(&[][..], |c| &c[..]));
+        conversion.apply(&mut buffer);
+        let Some(time) = block.time else {
+            acc.push(&buffer);
+            continue;
+        };
+        let mut run_start = 0;
+        for (i, &t) in time.iter().enumerate() {
+            let missing = last_stamp.map_or(0.0, |last| ((t - last) / tau0).round() - 1.0);
+            if missing >= 1.0 && missing.is_finite() {
+                acc.push(&buffer[run_start..i]);
+                acc.skip(missing as u64);
+                run_start = i;
+            }
+            if t.is_finite() {
+                last_stamp = Some(last_stamp.map_or(t, |l: f64| l.max(t)));
+            }
+        }
+        acc.push(&buffer[run_start..]);
+    }
+    Ok(Some((info.name, acc.finish())))
+}
+
 /// Which dropout rows `path` has (all zero, repeated), by the rule of [`gyrolab::dropout`]
 /// (far more of them than independent channels would give): a streaming pass over the file
 /// that tallies zeros and repeats, only for files of two channels or more.

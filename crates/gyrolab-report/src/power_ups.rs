@@ -36,6 +36,9 @@ pub struct PowerUpsReport {
     pub reference: Option<ReferenceJson>,
     /// Simulated data: what was simulated.
     pub simulated: Option<String>,
+    /// Notes shown in the section and in JSON (`notes`): static records that moved, evaluated
+    /// because the plan allowed motion.
+    pub notes: Vec<String>,
 }
 
 /// One power-up in JSON.
@@ -146,7 +149,7 @@ impl PowerUpsReport {
             reference: self.reference.clone(),
             power_ups: values_json(f),
         });
-        serde_json::json!({ "scale_factor": sf, "bias": bias, "simulated": self.simulated })
+        serde_json::json!({ "scale_factor": sf, "bias": bias, "notes": self.notes, "simulated": self.simulated })
     }
 }
 
@@ -244,6 +247,7 @@ pub fn power_ups_section(r: &PowerUpsReport, limits: &[Limit]) -> ReportSection 
         }
         tables.push(table(format!("Bias B0_i per power-up, axis {} (deg/h)", r.axis), "deg/h", "deg/h", f, &|d, _| d));
     }
+    paragraphs.extend(r.notes.iter().cloned());
     let figs = r.figures();
     ReportSection {
         title: format!("Repeatability across power-ups — axis {}", r.axis),

@@ -256,10 +256,52 @@ impl StillnessAccumulator {
             self.current.push(x);
             self.index += 1;
             if self.current.samples == self.window_samples {
-                let next = WindowStats { start_index: self.index, ..WindowStats::default() };
-                self.windows.push(std::mem::replace(&mut self.current, next));
+                self.close_window();
             }
         }
+    }
+
+    /// Passes over `missing` missing samples (a gap in the time stamps) as `missing` NaN
+    /// samples would, in time proportional to the windows it ends, not to `missing`: windows
+    /// left without a sample are not kept (they are never judged).
+    pub fn skip(&mut self, missing: u64) {
+        let mut left = missing;
+        while left > 0 {
+            let take = left.min(self.window_samples - self.current.samples);
+            self.current.samples += take;
+            self.current.prev = None;
+            self.index += take;
+            left -= take;
+            if self.current.samples == self.window_samples {
+                self.close_window();
+            }
+            if self.current.samples == 0 && left >= self.window_samples {
+                let whole = left / self.window_samples * self.window_samples;
+                self.index += whole;
+                left -= whole;
+                self.current.start_index = self.index;
+            }
+        }
+    }
+
+    /// Keeps the full current window (unless it holds no sample) and starts the next.
+    fn close_window(&mut self) {
+        let next = WindowStats { start_index: self.index, ..WindowStats::default() };
+        let full = std::mem::replace(&mut self.current, next);
+        if full.n > 0 {
+            self.windows.push(full);
+        }
+    }
+
+    /// The verdict with the record's interval learnt after the windows were cut (a streamed
+    /// record: its windows hold the samples of `window_s` at the interval estimated from its
+    /// start; their times are reported at `tau0_s`). A `tau0_s` that is not a positive finite
+    /// number keeps the estimate.
+    pub fn finish_at_interval(mut self, tau0_s: f64) -> StillnessCheck {
+        if tau0_s.is_finite() && tau0_s > 0.0 {
+            self.tau0_s = tau0_s;
+        }
+        self.finish()
     }
 
     /// The verdict.
@@ -573,5 +615,30 @@ mod tests {
         let g = gravity_check([&gx, &gy, &gz], GRAVITY_TOLERANCE_M_S2).unwrap();
         assert_eq!(g.outside_windows, 120);
         assert_eq!(g.first_outside_s, Some(0.0));
+    }
+
+    #[test]
+    fn skipping_missing_samples_equals_pushing_nans() {
+        // a still gyro with a rotation episode, gaps of 0 to 5000 samples at several offsets
+        // (inside a window, across windows, over many whole windows); the check (windows,
+        // episodes and their times, sigma, level) is the same as with the NaNs pushed
+        let mut x = still_gyro(3, 300.0);
+        for v in &mut x[40_000..41_000] {
+            *v += 20.0;
+        }
+        let rule = StillnessRule::for_quantity(Quantity::AngularRate).unwrap();
+        for (at, gap) in [(0usize, 0u64), (150, 1), (10_000, 37), (20_000, 200), (33_333, 1_999), (45_000, 5_000)] {
+            let mut pushed = StillnessAccumulator::new(rule, 1.0 / 200.0).unwrap();
+            let mut skipped = pushed.clone();
+            pushed.push(&x[..at]);
+            skipped.push(&x[..at]);
+            pushed.push(&vec![f64::NAN; gap as usize]);
+            skipped.skip(gap);
+            pushed.push(&x[at..]);
+            skipped.push(&x[at..]);
+            let (a, b) = (pushed.finish(), skipped.finish());
+            assert_eq!(a, b, "gap of {gap} at {at}");
+            assert!(a.moved, "gap of {gap} at {at}");
+        }
     }
 }

@@ -3,7 +3,7 @@
 //! and the warm-up of a record from power-on ([`gyrolab::warmup`]); report sections, summary
 //! figures, `sections.power_ups` and `sections.warmup` of results.json.
 
-use super::static_part::{reference_of, shown, StaticContext, StaticParts};
+use super::static_part::{motion_of_static_record, reference_of, shown, StaticContext, StaticParts};
 use super::{evaluate_plan_rates, PlanRates};
 use crate::error::{EvalError, EvalResult};
 use crate::progress::{Progress, Silent};
@@ -89,11 +89,13 @@ fn locate(e: EvalError, key: &str) -> EvalError {
     }
 }
 
-/// The bias B0_i of each static record, deg/h, with the reference used.
+/// The bias B0_i of each static record, deg/h, with the reference used; a record that moved is
+/// refused unless the plan allows motion (then a note in `notes`).
 fn biases(
     p: &PowerUpsPlan,
     ctx: &StaticContext<'_>,
     progress: &dyn Progress,
+    notes: &mut Vec<String>,
 ) -> EvalResult<(Vec<(String, f64)>, gyrolab_report::static_report::ReferenceJson)> {
     let axis = &p.axis;
     let (reference, reference_json) = reference_of(axis, ctx)?;
@@ -118,6 +120,9 @@ fn biases(
         let Some(r) = results.into_iter().next() else {
             return Err(EvalError::Data(DataError::new(path, format!("{key}: no output channel to evaluate"))));
         };
+        let record_key = format!("static_files[{i}]");
+        let motion = ("power_ups", record_key.as_str(), fs, p.allow_motion);
+        notes.extend(motion_of_static_record(path, &options, &reference, axis, motion, ctx.base)?);
         let Some(b) = r.bias_dph else {
             return Err(EvalError::Data(DataError::new(
                 path,
@@ -146,10 +151,11 @@ pub fn evaluate_power_ups_axis(
         let (v, u) = scale_factors(plan, p, progress)?;
         (Some(spread_of(v)), u)
     };
+    let mut notes = Vec::new();
     let (bias, reference) = if p.static_files.is_empty() {
         (None, None)
     } else {
-        let (v, r) = biases(p, ctx, progress)?;
+        let (v, r) = biases(p, ctx, progress, &mut notes)?;
         (Some(spread_of(v)), Some(r))
     };
     Ok(PowerUpsReport {
@@ -159,6 +165,7 @@ pub fn evaluate_power_ups_axis(
         bias,
         reference,
         simulated: ctx.simulated.map(|f| f(&p.axis)),
+        notes,
     })
 }
 

@@ -7,7 +7,7 @@ use crate::error::{EvalError, EvalResult};
 use crate::progress::Progress;
 use crate::rate::EvaluatedAxis;
 use crate::reference::Reference;
-use crate::static_test::evaluate_file;
+use crate::static_test::{evaluate_file, stillness_of_file};
 use gyrolab::allan::{AllanOptions, DeviationKind};
 use gyrolab::rate_test::RestReferenceSource;
 use gyrolab::static_test::{bias_repeatability, smoothing_key, StaticTestConfig};
@@ -242,7 +242,7 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, progress: &dyn Pro
     let mut tests = Vec::new();
     let mut notes = Vec::new();
     let mut samples = Vec::new();
-    for path in &s.files {
+    for (i, path) in s.files.iter().enumerate() {
         progress.message(&format!("axis {axis}: static test {}", shown(path, ctx.base)));
         let config = StaticTestConfig {
             latitude_deg: s.latitude_deg,
@@ -285,6 +285,10 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, progress: &dyn Pro
         let Some(result) = results.into_iter().next() else {
             return Err(EvalError::Data(DataError::new(path, "no output channel to evaluate")));
         };
+        // The Allan record is checked again with its curve.
+        let record_key = format!("files[{i}]");
+        let motion = ("static", record_key.as_str(), s.sample_rate_hz, s.allow_motion);
+        notes.extend(motion_of_static_record(path, &options, &reference, axis, motion, ctx.base)?);
         samples.push(summary.rows);
         tests.push(TestReport { file: shown(path, ctx.base), result });
         progress.advance(1);
@@ -324,6 +328,36 @@ fn evaluate_axis(s: &StaticAxisPlan, ctx: &StaticContext<'_>, progress: &dyn Pro
         simulated,
         notes,
     })
+}
+
+/// The stillness check of a static record (its first selected channel, [`stillness_of_file`]):
+/// a record that moved gives no still sensor's bias, so it is refused naming the plan key that
+/// allows it, `<table>.<axis>.allow_motion`; when allowed, the note its section prints
+/// (`MOTION: ...`). `motion`: the plan table's name, the key of the record in it (such as
+/// `files[1]`), the sample rate and `allow_motion`.
+pub(crate) fn motion_of_static_record(
+    path: &Path,
+    options: &SeriesOptions,
+    reference: &Reference,
+    axis: &str,
+    (table, record_key, sample_rate_hz, allow_motion): (&str, &str, f64, bool),
+    base: &Path,
+) -> EvalResult<Option<String>> {
+    let Some((channel, check)) = stillness_of_file(path, options, reference, sample_rate_hz)? else {
+        return Ok(None);
+    };
+    let Some(summary) = check.motion_summary() else { return Ok(None) };
+    let summary = format!("channel '{}' {summary}", gyrolab_io::text::excerpt(&channel));
+    let key = format!("{table}.{axis}.allow_motion");
+    if !allow_motion {
+        return Err(EvalError::conflict(format!(
+            "{}: {table}.{axis}.{record_key}: the record is not static, so its bias figures would not be a still \
+             sensor's: {summary}; record the sensor at rest, or set {key} = true to evaluate it anyway \
+             (the report then says it moved)",
+            path.display()
+        )));
+    }
+    Ok(Some(format!("MOTION: {}: {summary}; evaluated because {key} = true.", shown(path, base))))
 }
 
 /// OADEV (octave taus, 68.3 % bounds) of one record's first selected channel, converted to deg/s

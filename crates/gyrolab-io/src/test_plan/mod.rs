@@ -368,8 +368,9 @@ pub struct StaticAxisPlan {
     pub latitude_deg: Option<f64>,
     /// Record for the Allan analysis (resolved); `None`: the longest of `files`.
     pub allan_file: Option<PathBuf>,
-    /// Analyse the Allan record even when the stillness check finds motion (`allow_motion =
-    /// true`; its noise terms are then marked); by default such a record is refused.
+    /// Evaluate a record of `files` or the Allan record even when the stillness check finds
+    /// motion (`allow_motion = true`; the section then says it moved and the Allan analysis is
+    /// marked); by default such a record is refused.
     pub allow_motion: bool,
 }
 

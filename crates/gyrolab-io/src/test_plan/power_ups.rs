@@ -29,6 +29,7 @@ pub(super) struct RawPowerUps {
     sample_rate_hz: Option<Spanned<f64>>,
     channel: Option<String>,
     output_unit: Option<Spanned<String>>,
+    allow_motion: Option<bool>,
 }
 
 /// `[warmup.<axis>]` as written.
@@ -62,6 +63,9 @@ pub struct PowerUpsPlan {
     pub channel: Option<String>,
     /// Output unit of `channel`, overriding its suffix.
     pub output_unit: Option<OutputUnit>,
+    /// Evaluate static records whose stillness check finds motion (`allow_motion = true`; they
+    /// are refused otherwise).
+    pub allow_motion: bool,
     /// 1-based line of the section in the plan.
     pub line: u64,
 }
@@ -218,6 +222,7 @@ pub(super) fn power_ups(
             sample_rate_hz,
             channel: s.channel.clone(),
             output_unit: cx.channel_unit(&key, &s.channel, &s.output_unit)?,
+            allow_motion: s.allow_motion.unwrap_or(false),
             line: line_col(cx.text, span.start).0,
         });
     }
