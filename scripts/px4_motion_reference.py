@@ -78,6 +78,7 @@ def main():
     if json.dumps(fresh, sort_keys=True) != json.dumps(stored, sort_keys=True):
         print("px4_motion_reference: %s differs from a fresh reading of %s" % (path, ulg), file=sys.stderr)
         return 1
+    print("px4_motion_reference: matches " + path)
     return 0
 
 

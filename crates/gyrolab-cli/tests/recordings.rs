@@ -423,3 +423,109 @@ fn apply_calibrates_a_recording_topic_as_it_does_the_csv() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("2 IMU topics (/imu0, /imu1): choose one with --topic"), "{err}");
 }
+
+/// Recordings beyond the memory ceiling are streamed (issue 37): every format, under 1 MiB
+/// (the 1200 s records need about 6.4 MiB a topic in memory), against the same file in memory:
+/// the same channels, samples and taus; every tau at full resolution equal to 1e-12 relative
+/// (deviation, terms), every longer one inside the in-memory 68.3 % interval with
+/// ceil(terms / stride) terms; the stillness check the same. Under 1 MiB a topic's messages
+/// come in blocks of 1024, so the 120,000 cross many blocks; out-of-order messages (the bags
+/// hold 2400) are put in order as in memory; a ULog's two IMU topics streamed at once come in
+/// the in-memory order. The Parquet table of the same numbers likewise.
+#[test]
+fn recordings_beyond_the_ceiling_are_streamed_and_agree_with_memory() {
+    let Some(f) = fixture() else { return };
+    let rec = f.dir.join("rec");
+    let nums =
+        |v: &Value, key: &str| -> Vec<f64> { v[key].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect() };
+    let cases = [
+        ("plain_zstd.mcap", "/imu0"),
+        ("plain_lz4.mcap", "/imu0"),
+        ("imu_bz2.bag", "/imu0"),
+        ("imu_lz4.bag", "/imu0"),
+        ("imu.bag", "/imu0"),
+        ("imu.ulg", "sensor_combined"),
+        // every IMU topic at once (sensor_combined and sensor_gyro), and a table
+        ("imu.ulg", ""),
+        ("imu.parquet", ""),
+    ];
+    let ros2 = f.ros2_mcap.to_str().unwrap().to_string();
+    let files: Vec<(String, &str)> = cases
+        .iter()
+        .map(|(file, topic)| (rec.join(file).to_str().unwrap().to_string(), *topic))
+        .chain(std::iter::once((ros2, "/imu0")))
+        .collect();
+    for (file, topic) in &files {
+        // a table has no topic
+        let (args, topic): (Vec<&str>, Option<&str>) =
+            if topic.is_empty() { (vec![file], None) } else { (vec![file, "--topic", topic], Some(*topic)) };
+        let (memory, _) = allan_json(&args);
+        assert_eq!(memory["memory"]["path"], "in_memory", "{file}");
+        let streamed_args: Vec<&str> = args.iter().copied().chain(["--memory", "1MiB"]).collect();
+        let (streamed, err) = allan_json(&streamed_args);
+        let info = &streamed["memory"];
+        assert_eq!(info["path"], "streaming", "{file}: {info}");
+        assert!(err.contains("streamed"), "{file}: {err}");
+        assert!(info["stride"].as_u64().unwrap() > 1, "{file}: {info}");
+        let (a, b) = (channels(&memory, topic), channels(&streamed, topic));
+        assert_eq!(a.len(), if file.ends_with(".ulg") && topic.is_none() { 9 } else { 6 }, "{file}");
+        assert_eq!(a.len(), b.len(), "{file}");
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!((&x["topic"], &x["channel"]), (&y["topic"], &y["channel"]), "{file}: the same order");
+            assert_eq!(x["samples"], y["samples"], "{file}");
+            let (mx, my) = (nums(x, "m"), nums(y, "m"));
+            assert_eq!(mx, my, "{file}: the same taus");
+            let (dx, dy) = (nums(x, "dev"), nums(y, "dev"));
+            let (lo, hi) = (nums(x, "ci_low"), nums(x, "ci_high"));
+            let (tx, ty) = (nums(x, "n_terms"), nums(y, "n_terms"));
+            // each topic has its own plan: the stride of each tau from the summary
+            let taus = info["channels"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|c| c["topic"] == y["topic"] && c["channel"] == y["channel"])
+                .unwrap_or_else(|| panic!("{file}: {} in the summary", y["channel"]))["taus"]
+                .as_array()
+                .unwrap()
+                .clone();
+            assert_eq!(taus.len(), mx.len(), "{file}");
+            for i in 0..mx.len() {
+                let m = mx[i] as usize;
+                let stride = taus[i]["stride"].as_u64().unwrap() as usize;
+                assert_eq!(taus[i]["m"].as_u64().unwrap() as usize, m, "{file}");
+                if stride == 1 {
+                    assert!(
+                        (dy[i] / dx[i] - 1.0).abs() < 1e-12,
+                        "{file} {} m {m}: {} vs {}",
+                        x["channel"],
+                        dy[i],
+                        dx[i]
+                    );
+                    assert_eq!(tx[i], ty[i], "{file} m {m}");
+                } else {
+                    assert!(
+                        dy[i] > lo[i] && dy[i] < hi[i],
+                        "{file} {} m {m}: {} outside [{}, {}]",
+                        x["channel"],
+                        dy[i],
+                        lo[i],
+                        hi[i]
+                    );
+                    assert_eq!(ty[i] as usize, (tx[i] as usize).div_ceil(stride), "{file} m {m}");
+                }
+            }
+            let (sx, sy) = (&x["stillness"], &y["stillness"]);
+            for key in ["evaluated", "moved", "windows", "window_samples", "moved_windows"] {
+                assert_eq!(sx[key], sy[key], "{file} {}: stillness {key}", x["channel"]);
+            }
+        }
+    }
+    // Another estimator beyond the ceiling is refused, naming the options.
+    let out = gyrolab()
+        .args(["allan", rec.join("imu.ulg").to_str().unwrap(), "--memory", "1MiB", "--kind", "mdev"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("octave OADEV only") && err.contains("--memory"), "{err}");
+}

@@ -903,10 +903,9 @@ pub fn analyse_file(request: &AllanRequest) -> EvalResult<AllanOutcome> {
     ))
 }
 
-/// Analyses every record of any file gyrolab reads (by content): the table of a delimited
-/// text or Parquet file, or each IMU topic of an MCAP file, ROS 1 bag or ULog file (read in
-/// one pass; `request.topics` selects), each record's channels in parallel.
-pub fn analyse_records(request: &AllanRequest) -> EvalResult<Vec<AllanOutcome>> {
+/// The request's numbers: a positive sample rate, a confidence in (0, 1), an increasing fit
+/// range.
+pub(crate) fn validate_request(request: &AllanRequest) -> EvalResult<()> {
     if let Some(f) = request.sample_rate_hz {
         validate::positive("sample_rate_hz", f)?;
     }
@@ -916,6 +915,14 @@ pub fn analyse_records(request: &AllanRequest) -> EvalResult<Vec<AllanOutcome>> 
     if let Some((a, b)) = request.fit_range_s {
         validate::increasing_pair("fit_range_s", &[a, b])?;
     }
+    Ok(())
+}
+
+/// Analyses every record of any file gyrolab reads (by content): the table of a delimited
+/// text or Parquet file, or each IMU topic of an MCAP file, ROS 1 bag or ULog file (read in
+/// one pass; `request.topics` selects), each record's channels in parallel.
+pub fn analyse_records(request: &AllanRequest) -> EvalResult<Vec<AllanOutcome>> {
+    validate_request(request)?;
     let reference = request.reference.resolve()?;
     let path = &request.file;
     let options = request.layout.apply(SeriesOptions {

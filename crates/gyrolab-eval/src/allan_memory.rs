@@ -1,29 +1,39 @@
 //! The Allan analysis of a record of any length within a memory ceiling (issue 37 part 2;
-//! docs/METHODS.md section 3.2): a delimited text file whose estimated in-memory size exceeds the
-//! ceiling is read block by block into [`gyrolab::allan::streaming::StreamingOadev`] (octave
-//! OADEV, full resolution for the short taus, every `stride`-th angle point for the long ones);
-//! every other record takes the in-memory path of [`crate::allan::analyse_records`] unchanged.
+//! docs/METHODS.md section 3.2): a delimited text file, a recording (MCAP, ROS 1 bag, ULog:
+//! [`recording`]) or a Parquet table ([`parquet`]) whose estimated in-memory size exceeds the
+//! ceiling is read block by block into
+//! [`gyrolab::allan::streaming::StreamingOadev`] (octave OADEV, full resolution for the short
+//! taus, every `stride`-th angle point for the long ones), with the stillness check; every other
+//! record takes the in-memory path of [`crate::allan::analyse_records`] unchanged.
 //!
-//! The streamed record must be complete: a gap in the time stamps, a NaN or empty cell, or
-//! dropout rows (found by the same tally as the in-memory path) are refused, naming the memory
-//! ceiling that would let the in-memory path analyse them; never a different number in silence.
+//! The streamed record must be complete: a gap in the time stamps, a NaN or empty cell, dropout
+//! rows (found by the same tally as the in-memory path) or a stamp going back are refused, naming
+//! the memory ceiling that would let the in-memory path analyse them; never a different number
+//! in silence.
 
 use crate::allan::{
     analyse_records, channel_analysis, gravity_of, physical_conversion, read_notes, record_timing, refuse_motion,
     AllanOutcome, AllanRequest, ChannelSetup, ReadNote,
 };
 use crate::error::{EvalError, EvalResult};
+use crate::reference::{Conversion, Reference};
 use gyrolab::allan::streaming::{StreamedPoint, StreamingOadev, StreamingPlan};
 use gyrolab::allan::{AllanError, AllanOptions, DeviationKind, TauList};
 use gyrolab::dropout::DropoutTally;
 use gyrolab::sampling::{estimate_interval_of, CompactStamps};
 use gyrolab::stillness::{StillnessAccumulator, StillnessCheck, StillnessRule};
+use gyrolab::units::Quantity;
 use gyrolab::validate::InvalidOption;
-use gyrolab_io::recording::FileFormat;
-use gyrolab_io::series::{BatchReader, LineMap, SeriesData, SeriesOptions, SeriesReader, SkipReason};
+use gyrolab_io::recording::{FileFormat, TopicMeta};
+use gyrolab_io::series::{
+    BatchReader, ChannelInfo, LineMap, ReaderQuality, SeriesData, SeriesHeader, SeriesOptions, SeriesReader, SkipReason,
+};
 use gyrolab_io::DataError;
 use rayon::prelude::*;
 use serde::Serialize;
+
+pub mod parquet;
+pub mod recording;
 use std::io::Read;
 use std::path::Path;
 
@@ -122,8 +132,9 @@ pub enum MemoryPath {
     InMemory {
         /// The ceiling, bytes.
         memory_ceiling_bytes: u64,
-        /// The estimated in-memory size, bytes (`None`: not estimated: standard input, or a
-        /// recording or Parquet file, which are always read in memory).
+        /// The estimated in-memory size, bytes (`None`: not estimated: standard input, a
+        /// recording whose size alone shows that it fits, or a Parquet file whose footer cannot
+        /// be read, whose error the in-memory path gives).
         estimated_in_memory_bytes: Option<u64>,
     },
     /// Streamed in blocks.
@@ -153,6 +164,8 @@ pub struct StreamingSummary {
 /// The streamed taus of one channel.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct StreamedChannel {
+    /// The topic of a recording (null for a table).
+    pub topic: Option<String>,
     /// The channel's name.
     pub channel: String,
     /// One per point of its curve, in order.
@@ -178,9 +191,10 @@ impl StreamedTau {
     }
 }
 
-/// [`analyse_records`] within `memory_bytes`: a delimited text file whose estimated in-memory
-/// size is above the ceiling is streamed (octave OADEV only; other kinds and tau lists are
-/// refused there, naming the ceiling to raise), every other record is read in memory.
+/// [`analyse_records`] within `memory_bytes`: a delimited text file, a recording or a Parquet
+/// table whose estimated in-memory size is above the ceiling is streamed (octave OADEV only; other kinds and
+/// tau lists are refused there, naming the ceiling to raise), every other record is read in
+/// memory.
 pub fn analyse_records_within(
     request: &AllanRequest,
     memory_bytes: u64,
@@ -189,11 +203,42 @@ pub fn analyse_records_within(
         memory_ceiling_bytes: memory_bytes,
         estimated_in_memory_bytes: estimate,
     };
+    crate::allan::validate_request(request)?;
     let path = &request.file;
     if path == Path::new("-") {
         return Ok((analyse_records(request)?, in_memory(None)));
     }
     let (_, format, size) = gyrolab_io::recording::open_sniffed(path)?;
+    if format.is_recording() {
+        // Small enough by its size alone: no count.
+        if recording::size_bound(size) <= memory_bytes {
+            return Ok((analyse_records(request)?, in_memory(None)));
+        }
+        let counts = recording::imu_topic_counts(request)?;
+        let estimate = recording::counted_size(&counts);
+        if estimate <= memory_bytes {
+            return Ok((analyse_records(request)?, in_memory(Some(estimate))));
+        }
+        refuse_other_estimators(request, path, estimate, memory_bytes)?;
+        let (outcomes, summary) = recording::analyse_recording_streaming(request, memory_bytes, estimate, &counts)?;
+        return Ok((outcomes, MemoryPath::Streaming(summary)));
+    }
+    if format == FileFormat::Parquet && request.topics.is_empty() {
+        // Rows and columns from the footer; a file the reader refuses goes to the in-memory
+        // path, whose error the user gets as before.
+        let Ok(layout) = gyrolab_io::recording::open_sniffed(path)
+            .and_then(|(file, _, _)| gyrolab_io::parquet_table::parquet_layout(path, file))
+        else {
+            return Ok((analyse_records(request)?, in_memory(None)));
+        };
+        let estimate = parquet::table_size(&layout);
+        if estimate <= memory_bytes {
+            return Ok((analyse_records(request)?, in_memory(Some(estimate))));
+        }
+        refuse_other_estimators(request, path, estimate, memory_bytes)?;
+        let (outcome, summary) = parquet::analyse_parquet_streaming(request, memory_bytes, estimate, &layout)?;
+        return Ok((vec![outcome], MemoryPath::Streaming(summary)));
+    }
     if format != FileFormat::Text {
         return Ok((analyse_records(request)?, in_memory(None)));
     }
@@ -211,21 +256,28 @@ pub fn analyse_records_within(
         drop(reader);
         return Ok((analyse_records(request)?, in_memory(Some(estimate))));
     }
-    if request.kind != DeviationKind::Oadev || request.taus != TauList::Octave {
-        return Err(EvalError::conflict_on(
-            &["memory", "kind", "taus"],
-            format!(
-                "{}: about {} in memory, above the ceiling {{memory}} {}: records beyond it are streamed, which computes octave OADEV only (give {{kind}} oadev and {{taus}} octave, or raise {{memory}} above {})",
-                path.display(),
-                size_text(estimate),
-                size_text(memory_bytes),
-                size_text(estimate)
-            ),
-        ));
-    }
+    refuse_other_estimators(request, path, estimate, memory_bytes)?;
     let start = start_interval(path, &options, request.sample_rate_hz)?;
     let (outcome, summary) = analyse_streaming(request, reader, (rows, size), memory_bytes, estimate, start)?;
     Ok((vec![outcome], MemoryPath::Streaming(summary)))
+}
+
+/// A record beyond the ceiling is streamed, which computes octave OADEV only: another kind or
+/// tau list is refused, naming the options.
+fn refuse_other_estimators(request: &AllanRequest, path: &Path, estimate: u64, memory_bytes: u64) -> EvalResult<()> {
+    if request.kind == DeviationKind::Oadev && request.taus == TauList::Octave {
+        return Ok(());
+    }
+    Err(EvalError::conflict_on(
+        &["memory", "kind", "taus"],
+        format!(
+            "{}: about {} in memory, above the ceiling {{memory}} {}: records beyond it are streamed, which computes octave OADEV only (give {{kind}} oadev and {{taus}} octave, or raise {{memory}} above {})",
+            path.display(),
+            size_text(estimate),
+            size_text(memory_bytes),
+            size_text(estimate)
+        ),
+    ))
 }
 
 /// The reader options of the in-memory path ([`analyse_records`]), in blocks of [`BLOCK_ROWS`].
@@ -294,6 +346,282 @@ fn incomplete(path: &Path, what: &str, estimate: u64) -> DataError {
     )
 }
 
+/// The streamed channels of one record: their conversions to physical units, OADEV estimators
+/// and stillness checks.
+struct ChannelStreams {
+    conversions: Vec<(Quantity, Conversion)>,
+    estimators: Vec<StreamingOadev>,
+    stillness: Vec<Option<StillnessAccumulator>>,
+}
+
+impl ChannelStreams {
+    /// Streams for channels converted by `conversions`; the stillness checks cut their windows
+    /// at `start_interval` (none without it).
+    fn new(
+        path: &Path,
+        conversions: Vec<(Quantity, Conversion)>,
+        options: &AllanOptions,
+        plan: StreamingPlan,
+        start_interval: Option<f64>,
+    ) -> EvalResult<ChannelStreams> {
+        let estimators = conversions
+            .iter()
+            .map(|_| StreamingOadev::new(options, plan))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| EvalError::conflict(format!("{}: {e}", path.display())))?;
+        let stillness = conversions
+            .iter()
+            .map(|(q, _)| {
+                let tau0 = start_interval?;
+                StillnessRule::for_quantity(*q).and_then(|r| StillnessAccumulator::new(r, tau0))
+            })
+            .collect();
+        Ok(ChannelStreams { conversions, estimators, stillness })
+    }
+
+    /// Converts a block (one column per channel) in place and pushes it, channels in parallel;
+    /// the error of the first channel that refused a sample.
+    fn push(&mut self, block: &mut [Vec<f64>]) -> Result<(), (usize, AllanError)> {
+        let failed = self
+            .estimators
+            .par_iter_mut()
+            .zip(self.stillness.par_iter_mut())
+            .zip(block.par_iter_mut())
+            .zip(self.conversions.par_iter())
+            .enumerate()
+            .map(|(c, (((est, still), values), (_, conversion)))| {
+                conversion.apply(values);
+                if let Some(acc) = still {
+                    acc.push(values);
+                }
+                est.push(values).err().map(|e| (c, e))
+            })
+            .collect::<Vec<_>>()
+            .into_iter()
+            .flatten()
+            .min_by_key(|(c, _)| *c);
+        failed.map_or(Ok(()), Err)
+    }
+}
+
+/// The error of a sample the estimators refused (`index`: its row in the record).
+fn pushed_error(path: &Path, info: &ChannelInfo, lines: &LineMap, e: AllanError, estimate: u64) -> EvalError {
+    match e {
+        AllanError::NonFinite { index, value } => {
+            let line = lines.get(index).unwrap_or(0);
+            let e = if value.is_nan() {
+                incomplete(path, "a NaN or empty cell (a missing sample)", estimate)
+            } else {
+                DataError::new(
+                    path,
+                    format!("sample {value} is not a finite number: the Allan variance needs a complete record"),
+                )
+            };
+            e.at_line(line).at_column(info.column, Some(&info.name)).into()
+        }
+        e => DataError::new(path, format!("channel '{}': {e}", gyrolab_io::text::excerpt(&info.name))).into(),
+    }
+}
+
+/// What the reader side of a streamed record kept (no samples): its header, stamps (seconds,
+/// compactly; none without a time column), lines and dropout tally.
+struct StreamedRecord {
+    header: SeriesHeader,
+    quality: ReaderQuality,
+    stamps: Option<CompactStamps>,
+    lines: LineMap,
+    tally: DropoutTally,
+    topic: Option<TopicMeta>,
+}
+
+/// The end of a streamed record: refused when incomplete (gaps in the stamps, dropout rows, a
+/// stamp going back: the in-memory path analyses those, the estimators have taken every
+/// sample); else its timing as the in-memory path reads it, and each channel's curve, noise
+/// terms and stillness check, with the gravity check.
+fn finish_streamed(
+    request: &AllanRequest,
+    reference: &Reference,
+    options: &AllanOptions,
+    record: StreamedRecord,
+    streams: ChannelStreams,
+    estimate: u64,
+) -> EvalResult<(AllanOutcome, Vec<StreamedChannel>)> {
+    let path = request.file.as_path();
+    let StreamedRecord { header, quality, stamps, lines, tally, topic } = record;
+    let infos = header.channels.clone();
+    let located = |e: EvalError| crate::allan::located_in(e, header.rows, topic.as_ref());
+    // Gaps in the stamps: refused (the in-memory path places the samples on their grid).
+    if let Some(stamps) = &stamps {
+        if let Ok(e) = estimate_interval_of(stamps) {
+            if e.first_non_increasing.is_none() {
+                if let Some(g) = e.gaps.first() {
+                    let what = format!(
+                        "a gap in the time stamps: {} sample(s) missing (interval {} s where the record's is {} s; {} missing in {} gap(s))",
+                        g.missing,
+                        g.interval_s,
+                        e.interval_s,
+                        e.missing,
+                        e.gaps.len()
+                    );
+                    return Err(located(
+                        incomplete(path, &what, estimate).at_line(lines.get(g.index).unwrap_or(0)).into(),
+                    ));
+                }
+            }
+        }
+    }
+    // Dropout rows (every channel zero, or repeating the row before, beyond chance): the
+    // in-memory path analyses them as missing samples; the streamed one had them in its sums.
+    if tally.verdict().any() {
+        return Err(located(
+            incomplete(
+                path,
+                "dropout rows (every channel zero, or repeating the row before, more often than chance)",
+                estimate,
+            )
+            .into(),
+        ));
+    }
+    // The timing of the in-memory path on the stamps and lines kept (no samples).
+    let mut stub = SeriesData {
+        header: header.clone(),
+        lines,
+        time: None,
+        time_compact: stamps,
+        temperature: None,
+        table_rate: None,
+        channels: Vec::new(),
+        quality,
+    };
+    let timing = record_timing(&stub, path, request.sample_rate_hz, request.gaps).map_err(located)?;
+    // A stamp going back (a reset, a trailer of zeros) ends the record in memory; the streamed
+    // estimators have taken the samples after it: refused.
+    if let Some(r) = timing.reset {
+        let what = format!(
+            "the time stamps go back (from {} s to {} s: a clock reset or a trailer), which ends the record before it",
+            r.from_s, r.to_s
+        );
+        return Err(located(incomplete(path, &what, estimate).at_line(stub.lines.get(r.index).unwrap_or(0)).into()));
+    }
+    let lines = std::mem::take(&mut stub.lines);
+    drop(stub);
+    let tau0 = timing.tau0_s;
+    let mut notes = read_notes(&header);
+    notes.extend(timing.clock.map(ReadNote::Clock));
+    notes.extend(timing.note.clone());
+    let not_read: Vec<String> =
+        header.skipped.iter().filter(|s| s.reason == SkipReason::NotSelected).map(|s| s.name.clone()).collect();
+    if infos.len() < 2 && !not_read.is_empty() {
+        notes.push(ReadNote::DropoutsUnchecked { read: infos.iter().map(|c| c.name.clone()).collect(), not_read });
+    }
+    let setup = ChannelSetup {
+        path,
+        shown: path.display().to_string(),
+        topic: topic.as_ref().map(|t| t.topic.clone()),
+        lines: &lines,
+        tau0_s: tau0,
+        options,
+        reference,
+        fit_range_s: request.fit_range_s,
+        uncalibrated_hint: "give a calibration or a scale factor for noise terms in deg units",
+        allow_motion: request.allow_motion,
+    };
+    let ChannelStreams { conversions, estimators, stillness } = streams;
+    let finished: Vec<EvalResult<_>> = estimators
+        .into_par_iter()
+        .zip(stillness.into_par_iter())
+        .zip(infos.par_iter())
+        .zip(conversions.par_iter())
+        .map(|(((est, still), info), (quantity, _))| {
+            let (curve, points) = est.finish(tau0).map_err(|e| {
+                EvalError::Data(DataError::new(
+                    path,
+                    format!("channel '{}': {e}", gyrolab_io::text::excerpt(&info.name)),
+                ))
+            })?;
+            let streamed = StreamedChannel {
+                topic: topic.as_ref().map(|t| t.topic.clone()),
+                channel: info.name.clone(),
+                taus: points.iter().map(StreamedTau::of).collect(),
+            };
+            let stillness = match still {
+                Some(acc) => Some(acc.finish_at_interval(tau0)),
+                None => StillnessRule::for_quantity(*quantity).map(|rule| {
+                    StillnessCheck::not_evaluated(
+                        rule,
+                        "the interval of the streamed record's start could not be read from its first time stamps",
+                    )
+                }),
+            };
+            Ok((channel_analysis(&setup, info, *quantity, curve, stillness), streamed))
+        })
+        .collect();
+    let mut analyses = Vec::with_capacity(finished.len());
+    let mut streamed = Vec::with_capacity(finished.len());
+    for f in finished {
+        let (a, s) = f.map_err(located)?;
+        analyses.push(a);
+        streamed.push(s);
+    }
+    if let Some(g) = gravity_of(&mut analyses) {
+        notes.push(ReadNote::Gravity(g));
+    }
+    Ok((AllanOutcome { topic, analyses, sample_interval_s: tau0, notes }, streamed))
+}
+
+/// The summary of a streamed analysis: the plans' largest stride and EDF loss, every channel's
+/// taus.
+fn streaming_summary(
+    memory_bytes: u64,
+    estimate: u64,
+    plans: &[StreamingPlan],
+    channels: Vec<StreamedChannel>,
+) -> StreamingSummary {
+    let max_edf_loss = channels.iter().flat_map(|c| c.taus.iter().filter_map(|t| t.edf_loss)).reduce(f64::max);
+    let widest = plans.iter().max_by_key(|p| p.stride).copied().unwrap_or(StreamingPlan {
+        stride: 1,
+        full_resolution_below: 1,
+        head_samples: 0,
+    });
+    StreamingSummary {
+        memory_ceiling_bytes: memory_bytes,
+        estimated_in_memory_bytes: estimate,
+        stride: widest.stride,
+        full_resolution_below_m: widest.full_resolution_below,
+        noise_id_head_samples: plans.iter().map(|p| p.head_samples).min().unwrap_or(0),
+        max_edf_loss,
+        channels,
+    }
+}
+
+/// The Allan options of a request (octave OADEV when streamed).
+fn allan_options(request: &AllanRequest) -> AllanOptions {
+    AllanOptions { kind: request.kind, taus: request.taus.clone(), confidence: request.confidence, max_factor: None }
+}
+
+/// Each channel's conversion to physical units, as the in-memory path converts it.
+fn conversions_of(
+    path: &Path,
+    infos: &[ChannelInfo],
+    options: &AllanOptions,
+    reference: &Reference,
+) -> EvalResult<Vec<(Quantity, Conversion)>> {
+    let lines_probe = LineMap::default();
+    let probe = ChannelSetup {
+        path,
+        shown: path.display().to_string(),
+        topic: None,
+        lines: &lines_probe,
+        tau0_s: 1.0,
+        options,
+        reference,
+        fit_range_s: None,
+        uncalibrated_hint: "",
+        allow_motion: false,
+    };
+    infos.iter().map(|i| physical_conversion(&probe, i)).collect()
+}
+
 /// Streams one delimited text file through the estimators of its channels: the reader parses
 /// batches on every core, handed over in file order from this thread; the estimators take them
 /// on another (channels in parallel).
@@ -310,14 +638,9 @@ fn analyse_streaming(
     let reference = request.reference.resolve()?;
     let header = reader.header().clone();
     let infos = header.channels.clone();
-    let options = AllanOptions {
-        kind: request.kind,
-        taus: request.taus.clone(),
-        confidence: request.confidence,
-        max_factor: None,
-    };
+    let options = allan_options(request);
     // The stamps (about a byte a row), the batches in flight (one read, two queued, one taken)
-    // come off the ceiling before the plan shares it among the channels.
+    // and the stillness checks come off the ceiling before the plan shares it among the channels.
     let slots = infos.len() + 3;
     let stillness_bytes = start_interval.map_or(0, |tau0| stillness_footprint(rows, infos.len(), tau0));
     let overhead = rows + 4 * batch_footprint(reader.batch_bytes(), size, rows, slots) + stillness_bytes;
@@ -327,66 +650,18 @@ fn analyse_streaming(
         infos.len(),
         usize::try_from(budget).unwrap_or(usize::MAX),
     );
-    let lines_probe = LineMap::default();
-    let probe = ChannelSetup {
-        path,
-        shown: path.display().to_string(),
-        topic: None,
-        lines: &lines_probe,
-        tau0_s: 1.0,
-        options: &options,
-        reference: &reference,
-        fit_range_s: request.fit_range_s,
-        uncalibrated_hint: "",
-        allow_motion: request.allow_motion,
-    };
-    let conversions = infos.iter().map(|i| physical_conversion(&probe, i)).collect::<EvalResult<Vec<_>>>()?;
-    let mut estimators = infos
-        .iter()
-        .map(|_| StreamingOadev::new(&options, plan))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| EvalError::conflict(format!("{}: {e}", path.display())))?;
-
+    let conversions = conversions_of(path, &infos, &options, &reference)?;
+    let mut streams = ChannelStreams::new(path, conversions, &options, plan, start_interval)?;
     let mut stamps = CompactStamps::default();
     let mut lines = LineMap::default();
     let mut tally = DropoutTally::new(infos.len());
     let has_time = header.time_column.is_some();
-    // The stillness check cuts its windows as the samples arrive, at the interval of the
-    // record's start; its times are reported at the record's interval, learnt at the end.
-    let mut stillness: Vec<Option<StillnessAccumulator>> = conversions
-        .iter()
-        .map(|(q, _)| {
-            let tau0 = start_interval?;
-            StillnessRule::for_quantity(*q).and_then(|r| StillnessAccumulator::new(r, tau0))
-        })
-        .collect();
     let (read, pushed) = std::thread::scope(|scope| {
         let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Vec<f64>>>(2);
-        let conversions = &conversions;
-        let estimators = &mut estimators;
-        let stillness = &mut stillness;
+        let streams = &mut streams;
         let consumer = scope.spawn(move || -> Result<(), (usize, AllanError)> {
             for mut block in rx {
-                let failed = estimators
-                    .par_iter_mut()
-                    .zip(stillness.par_iter_mut())
-                    .zip(block.par_iter_mut())
-                    .zip(conversions.par_iter())
-                    .enumerate()
-                    .map(|(c, (((est, still), values), (_, conversion)))| {
-                        conversion.apply(values);
-                        if let Some(acc) = still {
-                            acc.push(values);
-                        }
-                        est.push(values).err().map(|e| (c, e))
-                    })
-                    .collect::<Vec<_>>()
-                    .into_iter()
-                    .flatten()
-                    .min_by_key(|(c, _)| *c);
-                if let Some(f) = failed {
-                    return Err(f);
-                }
+                streams.push(&mut block)?;
             }
             Ok(())
         });
@@ -413,149 +688,16 @@ fn analyse_streaming(
     // A sample the estimators refused comes before any later reader error.
     match pushed {
         Ok(Ok(())) => {}
-        Ok(Err((c, AllanError::NonFinite { index, value }))) => {
-            let info = &infos[c];
-            let line = lines.get(index).unwrap_or(0);
-            let e = if value.is_nan() {
-                incomplete(path, "a NaN or empty cell (a missing sample)", estimate)
-            } else {
-                DataError::new(
-                    path,
-                    format!("sample {value} is not a finite number: the Allan variance needs a complete record"),
-                )
-            };
-            return Err(e.at_line(line).at_column(info.column, Some(&info.name)).into());
-        }
-        Ok(Err((c, e))) => {
-            return Err(
-                DataError::new(path, format!("channel '{}': {e}", gyrolab_io::text::excerpt(&infos[c].name))).into()
-            )
-        }
+        Ok(Err((c, e))) => return Err(pushed_error(path, &infos[c], &lines, e, estimate)),
         Err(_) => return Err(EvalError::conflict(format!("{}: the streamed analysis failed", path.display()))),
     }
     read?;
     let quality = reader.quality().clone();
     drop(reader);
-    // Gaps in the stamps: refused (the in-memory path places the samples on their grid).
-    if has_time {
-        if let Ok(e) = estimate_interval_of(&stamps) {
-            if e.first_non_increasing.is_none() {
-                if let Some(g) = e.gaps.first() {
-                    let what = format!(
-                        "a gap in the time stamps: {} sample(s) missing (interval {} s where the record's is {} s; {} missing in {} gap(s))",
-                        g.missing,
-                        g.interval_s,
-                        e.interval_s,
-                        e.missing,
-                        e.gaps.len()
-                    );
-                    return Err(incomplete(path, &what, estimate).at_line(lines.get(g.index).unwrap_or(0)).into());
-                }
-            }
-        }
-    }
-    // Dropout rows (every channel zero, or repeating the row before, beyond chance): the
-    // in-memory path analyses them as missing samples; the streamed one had them in its sums.
-    let verdict = tally.verdict();
-    if verdict.any() {
-        return Err(incomplete(
-            path,
-            "dropout rows (every channel zero, or repeating the row before, more often than chance)",
-            estimate,
-        )
-        .into());
-    }
-    // The timing of the in-memory path on the stamps and lines kept (no samples).
-    let mut stub = SeriesData {
-        header: header.clone(),
-        lines,
-        time: None,
-        time_compact: has_time.then_some(stamps),
-        temperature: None,
-        table_rate: None,
-        channels: Vec::new(),
-        quality,
-    };
-    let timing = record_timing(&stub, path, request.sample_rate_hz, request.gaps)?;
-    // A stamp going back (a reset, a trailer of zeros) ends the record in memory; the streamed
-    // estimators have taken the samples after it: refused.
-    if let Some(r) = timing.reset {
-        let what = format!(
-            "the time stamps go back (from {} s to {} s: a clock reset or a trailer), which ends the record before it",
-            r.from_s, r.to_s
-        );
-        return Err(incomplete(path, &what, estimate).at_line(stub.lines.get(r.index).unwrap_or(0)).into());
-    }
-    let lines = std::mem::take(&mut stub.lines);
-    drop(stub);
-    let tau0 = timing.tau0_s;
-    let mut notes = read_notes(&header);
-    notes.extend(timing.note.clone());
-    let not_read: Vec<String> =
-        header.skipped.iter().filter(|s| s.reason == SkipReason::NotSelected).map(|s| s.name.clone()).collect();
-    if infos.len() < 2 && !not_read.is_empty() {
-        notes.push(ReadNote::DropoutsUnchecked { read: infos.iter().map(|c| c.name.clone()).collect(), not_read });
-    }
-    let setup = ChannelSetup {
-        path,
-        shown: path.display().to_string(),
-        topic: None,
-        lines: &lines,
-        tau0_s: tau0,
-        options: &options,
-        reference: &reference,
-        fit_range_s: request.fit_range_s,
-        uncalibrated_hint: "give a calibration or a scale factor for noise terms in deg units",
-        allow_motion: request.allow_motion,
-    };
-    let finished: Vec<EvalResult<_>> = estimators
-        .into_par_iter()
-        .zip(stillness.into_par_iter())
-        .zip(infos.par_iter())
-        .zip(conversions.par_iter())
-        .map(|(((est, still), info), (quantity, _))| {
-            let (curve, points) = est.finish(tau0).map_err(|e| {
-                EvalError::Data(DataError::new(
-                    path,
-                    format!("channel '{}': {e}", gyrolab_io::text::excerpt(&info.name)),
-                ))
-            })?;
-            let streamed =
-                StreamedChannel { channel: info.name.clone(), taus: points.iter().map(StreamedTau::of).collect() };
-            let stillness = match still {
-                Some(acc) => Some(acc.finish_at_interval(tau0)),
-                None => StillnessRule::for_quantity(*quantity).map(|rule| {
-                    StillnessCheck::not_evaluated(
-                        rule,
-                        "the interval of the streamed record's start could not be read from its first time stamps",
-                    )
-                }),
-            };
-            Ok((channel_analysis(&setup, info, *quantity, curve, stillness), streamed))
-        })
-        .collect();
-    let mut analyses = Vec::with_capacity(finished.len());
-    let mut streamed = Vec::with_capacity(finished.len());
-    for f in finished {
-        let (a, s) = f?;
-        analyses.push(a);
-        streamed.push(s);
-    }
-    if let Some(g) = gravity_of(&mut analyses) {
-        notes.push(ReadNote::Gravity(g));
-    }
-    refuse_motion(&analyses, path, request.allow_motion)?;
-    let max_edf_loss = streamed.iter().flat_map(|c| c.taus.iter().filter_map(|t| t.edf_loss)).reduce(f64::max);
-    let summary = StreamingSummary {
-        memory_ceiling_bytes: memory_bytes,
-        estimated_in_memory_bytes: estimate,
-        stride: plan.stride,
-        full_resolution_below_m: plan.full_resolution_below,
-        noise_id_head_samples: plan.head_samples,
-        max_edf_loss,
-        channels: streamed,
-    };
-    Ok((AllanOutcome { topic: None, analyses, sample_interval_s: tau0, notes }, summary))
+    let record = StreamedRecord { header, quality, stamps: has_time.then_some(stamps), lines, tally, topic: None };
+    let (outcome, channels) = finish_streamed(request, &reference, &options, record, streams, estimate)?;
+    refuse_motion(&outcome.analyses, path, request.allow_motion)?;
+    Ok((outcome, streaming_summary(memory_bytes, estimate, &[plan], channels)))
 }
 
 #[cfg(test)]

@@ -61,6 +61,54 @@ fn read_checked_parquet(path: &Path, file: std::fs::File, options: &SeriesOption
     if rows > limit {
         return Err(DataError::new(path, format!("{rows} rows: more than the {limit} this reader accepts")));
     }
+    let (names, leaves, skipped) = numeric_columns(&reader);
+    let mut columns: Vec<Vec<f64>> = leaves.iter().map(|_| Vec::with_capacity(rows as usize)).collect();
+    for g in 0..reader.num_row_groups() {
+        let group = reader.get_row_group(g).map_err(|e| perr(path, e))?;
+        for (k, &leaf) in leaves.iter().enumerate() {
+            let max_def = schema.column(leaf).max_def_level();
+            let col = group.get_column_reader(leaf).map_err(|e| perr(path, e))?;
+            read_column(col, max_def, &mut columns[k]).map_err(|e| perr(path, e))?;
+        }
+    }
+    let mut data = series_from_columns(path, &names, columns, RowKind::Row, options)?;
+    data.header.skipped.extend(skipped);
+    Ok(data)
+}
+
+/// The numeric columns of a Parquet file (named and chosen as [`read_parquet`] does) and its
+/// rows, from its footer alone.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParquetLayout {
+    /// Rows in the file.
+    pub rows: u64,
+    /// Names of the numeric columns, in file order.
+    pub names: Vec<String>,
+    /// The other columns, skipped.
+    pub skipped: Vec<SkippedColumn>,
+}
+
+/// Reads a Parquet file's layout ([`ParquetLayout`]) from its footer, the file opened once.
+pub fn parquet_layout(path: &Path, mut file: std::fs::File) -> Result<ParquetLayout, DataError> {
+    check_footer(path, &mut file)?;
+    crate::contained::contain(|| {
+        let len = file.metadata().map_err(|e| DataError::io(path, &e))?.len();
+        let reader = SerializedFileReader::new(BoundedFile { file, len }).map_err(|e| perr(path, e))?;
+        let (names, _, skipped) = numeric_columns(&reader);
+        let rows = reader.metadata().file_metadata().num_rows().max(0) as u64;
+        Ok(ParquetLayout { rows, names, skipped })
+    })
+    .unwrap_or_else(|panic| {
+        Err(DataError::new(path, format!("not a readable Parquet file: the Parquet reader failed on it ({panic})")))
+    })
+}
+
+/// The numeric leaf columns (INT32, INT64, FLOAT, DOUBLE, not repeated): names, leaf indices,
+/// and the other columns as skipped.
+fn numeric_columns<R: ChunkReader + 'static>(
+    reader: &SerializedFileReader<R>,
+) -> (Vec<String>, Vec<usize>, Vec<SkippedColumn>) {
+    let schema = reader.metadata().file_metadata().schema_descr();
     let mut names = Vec::new();
     let mut leaves = Vec::new();
     let mut skipped = Vec::new();
@@ -77,18 +125,97 @@ fn read_checked_parquet(path: &Path, file: std::fs::File, options: &SeriesOption
             skipped.push(SkippedColumn { column: i + 1, name, reason: SkipReason::NotNumeric });
         }
     }
-    let mut columns: Vec<Vec<f64>> = leaves.iter().map(|_| Vec::with_capacity(rows as usize)).collect();
+    (names, leaves, skipped)
+}
+
+/// The numeric columns of a Parquet file handed to `sink` in blocks of at most `block_rows`
+/// rows, in file order (row group by row group, every column read `block_rows` records at a
+/// time; nulls as NaN): memory bounded by the block whatever the file's length, and no limit on
+/// its rows. `sink` gets the columns in the order of [`ParquetLayout::names`].
+pub fn stream_parquet_file(
+    path: &Path,
+    mut file: std::fs::File,
+    block_rows: usize,
+    sink: &mut dyn FnMut(Vec<Vec<f64>>) -> Result<(), DataError>,
+) -> Result<(), DataError> {
+    check_footer(path, &mut file)?;
+    crate::contained::contain(|| stream_checked_parquet(path, file, block_rows.max(1), sink)).unwrap_or_else(|panic| {
+        Err(DataError::new(path, format!("not a readable Parquet file: the Parquet reader failed on it ({panic})")))
+    })
+}
+
+/// [`stream_parquet_file`] after its footer is checked.
+fn stream_checked_parquet(
+    path: &Path,
+    file: std::fs::File,
+    block_rows: usize,
+    sink: &mut dyn FnMut(Vec<Vec<f64>>) -> Result<(), DataError>,
+) -> Result<(), DataError> {
+    let len = file.metadata().map_err(|e| DataError::io(path, &e))?.len();
+    let reader = SerializedFileReader::new(BoundedFile { file, len }).map_err(|e| perr(path, e))?;
+    let (_, leaves, _) = numeric_columns(&reader);
+    let schema = reader.metadata().file_metadata().schema_descr_ptr();
     for g in 0..reader.num_row_groups() {
         let group = reader.get_row_group(g).map_err(|e| perr(path, e))?;
-        for (k, &leaf) in leaves.iter().enumerate() {
-            let max_def = schema.column(leaf).max_def_level();
-            let col = group.get_column_reader(leaf).map_err(|e| perr(path, e))?;
-            read_column(col, max_def, &mut columns[k]).map_err(|e| perr(path, e))?;
+        let mut readers = leaves
+            .iter()
+            .map(|&leaf| group.get_column_reader(leaf).map(|r| (r, schema.column(leaf).max_def_level())))
+            .collect::<parquet::errors::Result<Vec<_>>>()
+            .map_err(|e| perr(path, e))?;
+        loop {
+            let mut block: Vec<Vec<f64>> = Vec::with_capacity(readers.len());
+            for (r, max_def) in &mut readers {
+                let mut out = Vec::with_capacity(block_rows);
+                while out.len() < block_rows {
+                    let got = read_some(r, *max_def, block_rows - out.len(), &mut out).map_err(|e| perr(path, e))?;
+                    if got == 0 {
+                        break;
+                    }
+                }
+                block.push(out);
+            }
+            let n = block.first().map_or(0, Vec::len);
+            if block.iter().any(|c| c.len() != n) {
+                return Err(DataError::new(
+                    path,
+                    format!("not a readable Parquet file: the columns of row group {} differ in length", g + 1),
+                ));
+            }
+            if n == 0 {
+                break;
+            }
+            sink(block)?;
         }
     }
-    let mut data = series_from_columns(path, &names, columns, RowKind::Row, options)?;
-    data.header.skipped.extend(skipped);
-    Ok(data)
+    Ok(())
+}
+
+/// Reads up to `n` records of a column into `out` (nulls as NaN); the records read.
+fn read_some(col: &mut ColumnReader, max_def: i16, n: usize, out: &mut Vec<f64>) -> parquet::errors::Result<usize> {
+    macro_rules! some {
+        ($r:expr, $conv:expr) => {{
+            let mut values = Vec::new();
+            let mut defs = Vec::new();
+            let (records, _, _) =
+                $r.read_records(n, if max_def > 0 { Some(&mut defs) } else { None }, None, &mut values)?;
+            if max_def > 0 {
+                let mut it = values.iter();
+                for &d in &defs {
+                    out.push(if d == max_def { it.next().map_or(f64::NAN, $conv) } else { f64::NAN });
+                }
+            } else {
+                out.extend(values.iter().map($conv));
+            }
+            records
+        }};
+    }
+    Ok(match col {
+        ColumnReader::Int32ColumnReader(r) => some!(r, |v: &i32| f64::from(*v)),
+        ColumnReader::Int64ColumnReader(r) => some!(r, |v: &i64| *v as f64),
+        ColumnReader::FloatColumnReader(r) => some!(r, |v: &f32| f64::from(*v)),
+        ColumnReader::DoubleColumnReader(r) => some!(r, |v: &f64| *v),
+        _ => 0,
+    })
 }
 
 /// The file as the `parquet` crate reads it, bounded by its length. The crate's own reader of a
@@ -377,38 +504,8 @@ mod thrift {
 }
 
 /// Appends a column's values as f64, nulls as NaN.
-fn read_column(col: ColumnReader, max_def: i16, out: &mut Vec<f64>) -> parquet::errors::Result<()> {
-    macro_rules! drain {
-        ($r:expr, $conv:expr) => {{
-            let mut r = $r;
-            let mut values = Vec::new();
-            let mut defs = Vec::new();
-            loop {
-                values.clear();
-                defs.clear();
-                let (records, _, _) =
-                    r.read_records(BATCH, if max_def > 0 { Some(&mut defs) } else { None }, None, &mut values)?;
-                if records == 0 {
-                    break;
-                }
-                if max_def > 0 {
-                    let mut it = values.iter();
-                    for &d in &defs {
-                        out.push(if d == max_def { it.next().map_or(f64::NAN, $conv) } else { f64::NAN });
-                    }
-                } else {
-                    out.extend(values.iter().map($conv));
-                }
-            }
-        }};
-    }
-    match col {
-        ColumnReader::Int32ColumnReader(r) => drain!(r, |v: &i32| f64::from(*v)),
-        ColumnReader::Int64ColumnReader(r) => drain!(r, |v: &i64| *v as f64),
-        ColumnReader::FloatColumnReader(r) => drain!(r, |v: &f32| f64::from(*v)),
-        ColumnReader::DoubleColumnReader(r) => drain!(r, |v: &f64| *v),
-        _ => {}
-    }
+fn read_column(mut col: ColumnReader, max_def: i16, out: &mut Vec<f64>) -> parquet::errors::Result<()> {
+    while read_some(&mut col, max_def, BATCH, out)? > 0 {}
     Ok(())
 }
 

@@ -377,6 +377,17 @@ impl LineMap {
         self.len += 1;
     }
 
+    /// Appends `rows` rows numbered on from the last one (messages, table rows: numbered 1, 2, 3
+    /// ... from the first), in one step.
+    pub fn extend_numbered(&mut self, rows: usize) {
+        if rows == 0 {
+            return;
+        }
+        let next = self.len as u64 + 1;
+        self.push(next);
+        self.len += rows - 1;
+    }
+
     /// Appends the lines of the next rows, strictly increasing as a reader gives them (so a
     /// block whose last line is its first plus its length less one is a run of consecutive
     /// lines, the usual case, appended in one step).

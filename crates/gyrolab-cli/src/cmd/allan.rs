@@ -42,8 +42,9 @@ pub struct AllanArgs {
     #[arg(long, value_name = "FILE.yaml")]
     pub imu_utils_yaml: Option<PathBuf>,
     /// Memory ceiling (such as 1GiB, 512MiB, 2GB; default: half the machine's memory): a
-    /// delimited text file whose estimated in-memory size exceeds it is streamed (octave OADEV;
-    /// long taus from every stride-th angle point, their EDF loss reported; docs/METHODS.md 3.2).
+    /// delimited text file, a recording (MCAP, ROS 1 bag, ULog) or a Parquet table whose estimated in-memory
+    /// size exceeds it is streamed (octave OADEV; long taus from every stride-th angle point,
+    /// their EDF loss reported; docs/METHODS.md 3.2).
     #[arg(long, value_name = "SIZE")]
     pub memory: Option<String>,
     /// Write noise parameters for a filter stack, repeatable (all files or none): kalibr,

@@ -13,7 +13,7 @@
 //! decoder assumes ([`super::ros_msg::check_definition`]).
 
 use super::ros_msg::{check_definition, decode, Encoding, RosImuType};
-use super::{Collector, StampSource, Stop};
+use super::{Collector, StampSource, Stop, TopicInfo};
 use crate::error::DataError;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use std::collections::HashMap;
@@ -24,11 +24,108 @@ use std::path::Path;
 /// about 1 to 4 MiB; a longer declared length is damage, refused before anything is allocated.
 pub const MAX_RECORD_BYTES: u64 = 256 << 20;
 
+const OP_FOOTER: u8 = 0x02;
 const OP_SCHEMA: u8 = 0x03;
 const OP_CHANNEL: u8 = 0x04;
 const OP_MESSAGE: u8 = 0x05;
 const OP_CHUNK: u8 = 0x06;
 const OP_DATA_END: u8 = 0x0F;
+const OP_STATISTICS: u8 = 0x0B;
+
+/// The topics of an MCAP file with their message counts, from its summary section (the Schema,
+/// Channel and Statistics records a writer puts after the data; MCAP specification, "Summary
+/// Section" and "Footer"), without reading the data: `None` when the file has no summary or no
+/// Statistics record, or when anything in them does not add up (a pass then counts the
+/// messages). The span of every topic is the file's (the Statistics record's first and last
+/// message times); stamps are not kept.
+pub fn summary_topics(mut file: std::fs::File, size: u64) -> Option<Vec<TopicInfo>> {
+    use std::io::{Seek, SeekFrom};
+    // The end of the file: a Footer record (opcode, length 20: summary start, summary offset
+    // start, summary CRC) and the closing magic.
+    const TAIL: u64 = 9 + 20 + 8;
+    if size < 8 + TAIL {
+        return None;
+    }
+    let footer_at = size - TAIL;
+    file.seek(SeekFrom::Start(footer_at)).ok()?;
+    let mut tail = [0u8; 29];
+    file.read_exact(&mut tail).ok()?;
+    let mut f = Fields { b: &tail };
+    let (op, len) = f.u8_len().ok()?;
+    let summary_start = f.u64("summary start").ok()?;
+    if op != OP_FOOTER || len != 20 || summary_start < 8 || summary_start >= footer_at {
+        return None;
+    }
+    let n = footer_at - summary_start;
+    if n > MAX_RECORD_BYTES {
+        return None;
+    }
+    file.seek(SeekFrom::Start(summary_start)).ok()?;
+    let mut summary = Vec::new();
+    file.take(n).read_to_end(&mut summary).ok()?;
+    if summary.len() as u64 != n {
+        return None;
+    }
+    let mut schemas: HashMap<u16, String> = HashMap::new();
+    let mut channels: Vec<(u16, String, String, bool)> = Vec::new();
+    let mut counts: Option<(HashMap<u16, u64>, i64, i64)> = None;
+    let mut rest = Fields { b: &summary };
+    while !rest.b.is_empty() {
+        let (op, len) = rest.u8_len().ok()?;
+        let mut r = Fields { b: rest.take(len, "summary record").ok()? };
+        match op {
+            OP_SCHEMA => {
+                let id = r.u16("schema id").ok()?;
+                schemas.insert(id, r.string("schema name").ok()?);
+            }
+            OP_CHANNEL => {
+                let id = r.u16("channel id").ok()?;
+                let schema_id = r.u16("channel schema id").ok()?;
+                let topic = r.string("channel topic").ok()?;
+                let encoding = r.string("channel message encoding").ok()?;
+                let ty = schemas.get(&schema_id).cloned().unwrap_or_else(|| encoding.clone());
+                let imu = RosImuType::from_name(&ty).is_some() && (encoding == "cdr" || encoding == "ros1");
+                channels.push((id, topic, ty, imu));
+            }
+            OP_STATISTICS => {
+                let _messages = r.u64("message count").ok()?;
+                let _schemas = r.u16("schema count").ok()?;
+                let _channels = r.u32("channel count").ok()?;
+                let _attachments = r.u32("attachment count").ok()?;
+                let _metadata = r.u32("metadata count").ok()?;
+                let _chunks = r.u32("chunk count").ok()?;
+                let start = r.u64("message start time").ok()?;
+                let end = r.u64("message end time").ok()?;
+                let mut map = Fields { b: r.bytes32("channel message counts").ok()? };
+                let mut by_channel = HashMap::new();
+                while !map.b.is_empty() {
+                    let id = map.u16("channel id").ok()?;
+                    by_channel.insert(id, map.u64("message count").ok()?);
+                }
+                let ns = |t: u64| t.min(i64::MAX as u64) as i64;
+                counts = Some((by_channel, ns(start), ns(end)));
+            }
+            _ => {}
+        }
+    }
+    let (by_channel, start, end) = counts?;
+    let mut topics: Vec<TopicInfo> = Vec::new();
+    for (id, topic, ty, imu) in channels {
+        let messages = by_channel.get(&id).copied().unwrap_or(0);
+        match topics.iter_mut().find(|t| t.topic == topic && t.message_type == ty) {
+            Some(t) => t.messages += messages,
+            None => topics.push(TopicInfo {
+                topic,
+                message_type: ty,
+                messages,
+                imu,
+                span_ns: (messages > 0).then_some((start, end)),
+                stamps_ns: Vec::new(),
+            }),
+        }
+    }
+    Some(topics)
+}
 
 /// What a channel's messages are.
 struct ChannelState {

@@ -321,17 +321,44 @@ impl OpenedFile {
 
     /// [`read_recording`] of this file.
     pub fn read_recording(self, options: &RecordingOptions) -> Result<Recording, DataError> {
+        let format = self.format;
+        let path = self.path.clone();
+        let mut c = Collector::new(options);
+        let truncated = self.pass(&mut c)?;
+        c.finish(&path, format, truncated)
+    }
+
+    /// Reads the recording's IMU topics (`topics` selects; empty: all) in one pass and hands
+    /// their messages to `sink` in blocks of `block` messages, each topic's in stamp order
+    /// (messages out of order by up to 2 x `block` messages are put in order; an earlier one is
+    /// an error), holding at most 3 x `block` messages a topic: memory bounded whatever the
+    /// file's length. The topics are checked as [`OpenedFile::read_recording`] checks them.
+    pub fn stream_recording(
+        self,
+        topics: &[String],
+        block: usize,
+        sink: &mut TopicSink<'_>,
+    ) -> Result<StreamedRecording, DataError> {
+        let format = self.format;
+        let path = self.path.clone();
+        let mut c = Collector::streaming(topics, block, sink);
+        let truncated = self.pass(&mut c)?;
+        c.finish_stream(&path, format, truncated)
+    }
+
+    /// One pass of the file's reader into `c`; the note of a file that ends early or has
+    /// damaged chunks.
+    fn pass(self, c: &mut Collector<'_>) -> Result<Option<String>, DataError> {
         let OpenedFile { path, mut file, format, size } = self;
         let path = path.as_path();
         rewind(path, &mut file)?;
         if format == FileFormat::Sqlite {
             return Err(sqlite_refused(path));
         }
-        let mut c = Collector::new(options);
         let end = match format {
-            FileFormat::Mcap => mcap_file::read(path, file, size, &mut c),
-            FileFormat::RosBag => bag::read(path, file, size, &mut c),
-            FileFormat::ULog => ulog::read(path, file, &mut c),
+            FileFormat::Mcap => mcap_file::read(path, file, size, c),
+            FileFormat::RosBag => bag::read(path, file, size, c),
+            FileFormat::ULog => ulog::read(path, file, c),
             _ => {
                 return Err(DataError::new(
                     path,
@@ -369,8 +396,7 @@ impl OpenedFile {
                 ),
             );
         }
-        let truncated = (!notes.is_empty()).then(|| notes.join("; "));
-        c.finish(path, format, truncated)
+        Ok((!notes.is_empty()).then(|| notes.join("; ")))
     }
 }
 
@@ -424,6 +450,14 @@ fn sqlite_refused(path: &Path) -> DataError {
         path,
         "an SQLite database (a ROS 2 bag in the older .db3 storage?): not read; convert the bag to MCAP, rosbag2's default storage (`ros2 bag convert`), and give the .mcap file",
     )
+}
+
+/// The topics of an MCAP file with their message counts, from its summary section without
+/// reading its data; `None` for another format, or an MCAP file without a summary or
+/// statistics (a pass with [`RecordingOptions::inventory_only`] counts them then).
+pub fn mcap_summary_topics(path: &Path) -> Result<Option<Vec<TopicInfo>>, DataError> {
+    let (file, format, size) = open_sniffed(path)?;
+    Ok(if format == FileFormat::Mcap { mcap_file::summary_topics(file, size) } else { None })
 }
 
 /// Reads a recording (MCAP, ROS 1 bag, ULog) in one pass, the file opened once.
@@ -481,19 +515,63 @@ struct TopicState {
     out_of_order: u64,
     zero_stamps: u64,
     source: StampSource,
+    /// Streaming: messages handed over, the last stamp handed over, and whether the buffered
+    /// messages are out of stamp order.
+    streamed: u64,
+    first_streamed: i64,
+    last_streamed: Option<i64>,
+    unsorted: bool,
+    /// The stamp of the message pushed last (file order).
+    last_pushed: Option<i64>,
+}
+
+/// A block of one topic's messages handed to a streaming reader's sink, in stamp order
+/// ([`OpenedFile::stream_recording`]).
+#[derive(Debug, Clone, Copy)]
+pub struct TopicBlock<'a> {
+    /// Topic name.
+    pub topic: &'a str,
+    /// Message type.
+    pub message_type: &'a str,
+    /// Channel names with their units, as [`ImuTopic::names`].
+    pub names: &'a [String],
+    /// Time stamps, ns, increasing (ties kept) within and across the topic's blocks.
+    pub stamps_ns: &'a [i64],
+    /// One column per channel.
+    pub channels: &'a [Vec<f64>],
+}
+
+/// Where a streaming pass hands its blocks.
+pub type TopicSink<'s> = dyn FnMut(TopicBlock<'_>) -> Result<(), DataError> + 's;
+
+/// A recording streamed ([`OpenedFile::stream_recording`]): what was found, no samples.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StreamedRecording {
+    /// Its format.
+    pub format: FileFormat,
+    /// Every topic of the file (stamps not kept).
+    pub topics: Vec<TopicInfo>,
+    /// The streamed IMU topics, in order of their first block.
+    pub streamed: Vec<TopicMeta>,
+    /// Where the file ends early or is damaged (the messages before it were streamed).
+    pub truncated: Option<String>,
 }
 
 /// Gathers topics and messages during a pass over a recording.
-pub(crate) struct Collector {
+pub(crate) struct Collector<'s> {
     want: Vec<String>,
     stamps: bool,
     inventory_only: bool,
     topics: Vec<TopicState>,
     /// Chunks skipped as damaged: (byte offset, why).
     pub damaged_chunks: Vec<(u64, String)>,
+    /// Streaming: messages per block and the sink (`None`: messages are kept).
+    stream: Option<(usize, &'s mut TopicSink<'s>)>,
+    /// Streaming: topic ids in order of their first block.
+    stream_order: Vec<usize>,
 }
 
-impl Collector {
+impl<'s> Collector<'s> {
     fn new(options: &RecordingOptions) -> Self {
         Collector {
             want: options.topics.clone(),
@@ -501,7 +579,64 @@ impl Collector {
             inventory_only: options.inventory_only,
             topics: Vec::new(),
             damaged_chunks: Vec::new(),
+            stream: None,
+            stream_order: Vec::new(),
         }
+    }
+
+    /// A collector that hands each decoded topic's messages to `sink` in blocks of `block`
+    /// messages, in stamp order (a block is handed over when 3 x `block` are buffered, so that
+    /// messages out of order by up to 2 x `block` are put in order; an earlier one is an
+    /// error), keeping at most 3 x `block` messages a topic.
+    fn streaming(topics: &[String], block: usize, sink: &'s mut TopicSink<'s>) -> Self {
+        let mut c = Collector::new(&RecordingOptions { topics: topics.to_vec(), ..RecordingOptions::default() });
+        c.stream = Some((block.max(1), sink));
+        c
+    }
+
+    /// Streaming: hands the `n` earliest buffered messages of topic `id` to the sink (all of
+    /// them when `n` is larger), in stamp order.
+    fn flush(&mut self, path: &Path, id: usize, n: usize) -> Result<(), DataError> {
+        let Some((block, sink)) = self.stream.as_mut() else { return Ok(()) };
+        let window = 2 * *block;
+        let t = &mut self.topics[id];
+        if t.stamps.is_empty() {
+            return Ok(());
+        }
+        if t.unsorted {
+            let stamps = std::mem::take(&mut t.stamps);
+            let channels = std::mem::take(&mut t.channels);
+            (t.stamps, t.channels) = in_stamp_order(stamps, channels, 1);
+            t.unsorted = false;
+        }
+        if let Some(last) = t.last_streamed.filter(|&l| t.stamps[0] < l) {
+            return Err(DataError::new(
+                path,
+                format!(
+                    "topic '{}': a message stamped {} ns comes after messages stamped up to {last} ns were analysed: out of stamp order by more than the {} messages a streamed record is put in order over",
+                    crate::text::excerpt(&t.info.topic),
+                    t.stamps[0],
+                    window
+                ),
+            ));
+        }
+        let n = n.min(t.stamps.len());
+        if t.streamed == 0 {
+            self.stream_order.push(id);
+            t.first_streamed = t.stamps[0];
+        }
+        let columns: Vec<Vec<f64>> = t.channels.iter_mut().map(|c| c.drain(..n).collect()).collect();
+        let stamps: Vec<i64> = t.stamps.drain(..n).collect();
+        t.streamed += n as u64;
+        t.last_streamed = stamps.last().copied();
+        let names = t.layout.as_ref().map_or(&[][..], |l| &l.names[..]);
+        sink(TopicBlock {
+            topic: &t.info.topic,
+            message_type: &t.info.message_type,
+            names,
+            stamps_ns: &stamps,
+            channels: &columns,
+        })
     }
 
     /// Registers a topic (or finds it again: ROS 1 bags repeat connections); returns its id.
@@ -528,6 +663,11 @@ impl Collector {
             out_of_order: 0,
             zero_stamps: 0,
             source,
+            streamed: 0,
+            first_streamed: 0,
+            last_streamed: None,
+            unsorted: false,
+            last_pushed: None,
         });
         self.topics.len() - 1
     }
@@ -565,9 +705,11 @@ impl Collector {
         } else {
             stamp_ns
         };
-        if t.stamps.last().is_some_and(|&last| stamp < last) {
+        if t.last_pushed.is_some_and(|last| stamp < last) {
             t.out_of_order += 1;
+            t.unsorted = true;
         }
+        t.last_pushed = Some(stamp);
         t.stamps.push(stamp);
         for (c, v) in t.channels.iter_mut().zip(values) {
             c.push(*v);
@@ -605,11 +747,16 @@ impl Collector {
             ));
         }
         self.push(id, stamp_ns, log_ns, values);
+        if let Some((block, _)) = self.stream {
+            if self.topics[id].stamps.len() >= 3 * block {
+                self.flush(path, id, block)?;
+            }
+        }
         Ok(())
     }
 
     fn decoded_messages(&self) -> u64 {
-        self.topics.iter().filter(|t| t.decode).map(|t| t.stamps.len() as u64).sum()
+        self.topics.iter().filter(|t| t.decode).map(|t| t.stamps.len() as u64 + t.streamed).sum()
     }
 
     fn listing(&self) -> String {
@@ -633,7 +780,41 @@ impl Collector {
         format!("{}{}", shown.join(", "), if more > 0 { format!(" and {more} more") } else { String::new() })
     }
 
-    fn finish(self, path: &Path, format: FileFormat, truncated: Option<String>) -> Result<Recording, DataError> {
+    /// Streaming: the selection checked as [`Collector::finish`] checks it, every buffered
+    /// message handed over, and what was streamed.
+    fn finish_stream(
+        mut self,
+        path: &Path,
+        format: FileFormat,
+        truncated: Option<String>,
+    ) -> Result<StreamedRecording, DataError> {
+        self.check_selection(path, format)?;
+        for id in 0..self.topics.len() {
+            if self.topics[id].decode {
+                self.flush(path, id, usize::MAX)?;
+            }
+        }
+        let streamed = self
+            .stream_order
+            .iter()
+            .map(|&id| {
+                let t = &self.topics[id];
+                TopicMeta {
+                    topic: t.info.topic.clone(),
+                    message_type: t.info.message_type.clone(),
+                    stamp_source: if t.zero_stamps > 0 { StampSource::LogTime } else { t.source },
+                    messages: t.streamed,
+                    out_of_order: t.out_of_order,
+                    first_stamp_ns: t.first_streamed,
+                }
+            })
+            .collect();
+        let topics = self.topics.into_iter().map(|t| t.info).collect();
+        Ok(StreamedRecording { format, topics, streamed, truncated })
+    }
+
+    /// The topics named are in the file and are IMU topics, and some IMU message was decoded.
+    fn check_selection(&self, path: &Path, format: FileFormat) -> Result<(), DataError> {
         for w in &self.want {
             match self.topics.iter().find(|t| &t.info.topic == w) {
                 None => {
@@ -656,7 +837,7 @@ impl Collector {
                 Some(_) => {}
             }
         }
-        if !self.inventory_only && !self.topics.iter().any(|t| t.decode && !t.stamps.is_empty()) {
+        if !self.inventory_only && !self.topics.iter().any(|t| t.decode && (!t.stamps.is_empty() || t.streamed > 0)) {
             return Err(DataError::new(
                 path,
                 format!(
@@ -666,6 +847,11 @@ impl Collector {
                 ),
             ));
         }
+        Ok(())
+    }
+
+    fn finish(self, path: &Path, format: FileFormat, truncated: Option<String>) -> Result<Recording, DataError> {
+        self.check_selection(path, format)?;
         let mut topics = Vec::with_capacity(self.topics.len());
         let mut imu = Vec::new();
         for t in self.topics {
@@ -758,6 +944,58 @@ mod tests {
         assert_eq!(r.imu[0].stamps_ns, [10, 20, 30, 40]);
         assert_eq!(r.imu[0].channels[5], [1.0, 2.0, 3.0, 4.0]);
         assert_eq!(r.imu[0].out_of_order, 1);
+    }
+
+    #[test]
+    fn an_mcap_summary_counts_what_a_pass_counts() {
+        // the bundled ROS 2 MCAP (written by the Python `mcap` package): the summary's counts
+        // equal those of a pass over the data, topic by topic; a file without a summary (a
+        // ROS 1 bag here) gives none
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/recordings");
+        let mcap = root.join("simulated_imu_ros2.mcap");
+        let summary = mcap_summary_topics(&mcap).unwrap().expect("the file has a summary with statistics");
+        let options = RecordingOptions { inventory_only: true, ..Default::default() };
+        let pass = read_recording(&mcap, &options).unwrap().topics;
+        assert_eq!(summary.len(), pass.len());
+        for (s, p) in summary.iter().zip(&pass) {
+            assert_eq!((&s.topic, &s.message_type, s.messages, s.imu), (&p.topic, &p.message_type, p.messages, p.imu));
+        }
+        assert!(summary.iter().any(|t| t.imu && t.messages == 6000), "{summary:?}");
+        assert_eq!(mcap_summary_topics(&root.join("simulated_imu_ros1.bag")).unwrap(), None);
+    }
+
+    #[test]
+    fn streamed_messages_come_in_blocks_in_stamp_order() {
+        // blocks of 3, put in order over 6: a message out of order by two is put in place, one
+        // earlier than a message already handed over is an error naming the topic
+        let mut got: Vec<(Vec<i64>, Vec<f64>)> = Vec::new();
+        let mut sink = |b: TopicBlock<'_>| -> Result<(), DataError> {
+            assert_eq!((b.topic, b.names.len(), b.channels.len()), ("/imu", 6, 6));
+            got.push((b.stamps_ns.to_vec(), b.channels[5].clone()));
+            Ok(())
+        };
+        let mut c = Collector::streaming(&[], 3, &mut sink);
+        let id = c.topic("/imu", "sensor_msgs/msg/Imu", Some(ImuLayout::six()), StampSource::Header);
+        let path = Path::new("x.mcap");
+        for s in [10, 20, 40, 50, 30, 60, 70, 80, 90, 100] {
+            c.push_checked(path, id, s, 0, &[s as f64; 6], "here").unwrap();
+        }
+        let r = c.finish_stream(path, FileFormat::Mcap, None).unwrap();
+        assert_eq!(r.streamed.len(), 1);
+        assert_eq!((r.streamed[0].messages, r.streamed[0].out_of_order, r.streamed[0].first_stamp_ns), (10, 1, 10));
+        let stamps: Vec<i64> = got.iter().flat_map(|(s, _)| s.clone()).collect();
+        assert_eq!(stamps, [10, 20, 30, 40, 50, 60, 70, 80, 90, 100]);
+        assert!(got.iter().all(|(s, v)| s.iter().map(|&x| x as f64).eq(v.iter().copied())));
+        assert_eq!(got[0].0.len(), 3, "blocks of 3");
+        let mut sink = |_: TopicBlock<'_>| -> Result<(), DataError> { Ok(()) };
+        let mut c = Collector::streaming(&[], 2, &mut sink);
+        let id = c.topic("/imu", "sensor_msgs/msg/Imu", Some(ImuLayout::six()), StampSource::Header);
+        let mut result = Ok(());
+        for s in [10, 20, 30, 40, 50, 60, 15] {
+            result = result.and_then(|_| c.push_checked(path, id, s, 0, &[1.0; 6], "here"));
+        }
+        let e = result.and_then(|_| c.finish_stream(path, FileFormat::Mcap, None).map(|_| ())).unwrap_err().to_string();
+        assert!(e.contains("topic '/imu'") && e.contains("out of stamp order by more than the 4 messages"), "{e}");
     }
 
     #[test]
