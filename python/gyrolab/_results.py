@@ -57,8 +57,10 @@ class AllanResult:
     accelerometer: ``vrw_m_s_rt_h``, ``bias_instability_ug``, ``allan_minimum_ug``,
     ``accel_random_walk_m_s2_rt_h``, ...; ``None`` when absent); each is also an attribute
     (``r.arw_deg_rt_h``, ``r.vrw_m_s_rt_h``). ``readings`` says where each term was read (its
-    basis and supported tau range), ``fit`` is the five-term fit (gyro), ``noise_note`` why
-    there are no terms. ``stillness`` is the stillness check (``moved``, its episodes, levels in
+    basis and supported tau range), ``fit`` is the five-term fit (gyro), ``gmwm`` the GMWM fit
+    (its chosen model's ``parameters`` with two-sided intervals, Gauss-Markov processes with
+    ``correlation_time_s``; ``quality`` ``poor`` when no model describes the curve; the keys of
+    docs/JSON.md; None when not made), ``noise_note`` why there are no terms. ``stillness`` is the stillness check (``moved``, its episodes, levels in
     ``rule["unit"]``; None when no rule applies). ``taus_rounded`` maps each requested tau (s) that was not a whole
     multiple of the sample interval to the tau used.
     """
@@ -81,6 +83,7 @@ class AllanResult:
     noise: Dict[str, Any] = field(default_factory=dict)
     readings: List[Dict[str, Any]] = field(default_factory=list)
     fit: Optional[Dict[str, Any]] = None
+    gmwm: Optional[Dict[str, Any]] = None
     noise_note: Optional[str] = None
     stillness: Optional[Dict[str, Any]] = None
     taus_rounded: Dict[float, float] = field(default_factory=dict)
@@ -112,6 +115,7 @@ class AllanResult:
             noise={k: v for k, v in terms.items() if k not in ("readings", "fit", "kalibr")},
             readings=terms.get("readings", []),
             fit=terms.get("fit"),
+            gmwm=ch.get("gmwm"),
             noise_note=ch.get("noise_note"),
             stillness=ch.get("stillness"),
             taus_rounded=dict(rounded),

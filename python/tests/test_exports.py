@@ -94,3 +94,34 @@ def test_export_survives_pickling_and_bad_names_are_errors(record):
         r.export("gtsam")
     with pytest.raises(gyrolab.Error, match="estimator"):
         r.export("kalibr", estimator="median")
+
+
+def test_gmwm_gauss_markov_process_from_python():
+    # White noise and a sampled Gauss-Markov process (sigma 0.02 deg/s, T 5 s) at 100 Hz: the
+    # GMWM's chosen model holds it, with its correlation time and interval, and the GMWM export's
+    # random walk is the one that bounds it, sqrt(K_rw^2 + 2 sigma^2 / T) in rad/s^2/sqrt(Hz).
+    rng = np.random.default_rng(505)
+    n, tau0, sigma, t = 1 << 17, 0.01, 0.02, 5.0
+    phi = math.exp(-tau0 / t)
+    drive = rng.standard_normal(n) * sigma * math.sqrt(1 - phi * phi)
+    x = np.empty(n)
+    acc = 0.0
+    for i in range(n):
+        acc = phi * acc + drive[i]
+        x[i] = acc
+    rate = rng.standard_normal(n) * 0.01 / math.sqrt(tau0) + x
+    r = gyrolab.allan(pd.DataFrame({"gyro_x": rate}), rate_hz=1 / tau0, units={"gyro_x": "dps"})
+    g = r["gyro_x"].gmwm
+    assert g is not None and g["sided"] == "two-sided" and g["quality"] == "acceptable", g
+    markov = [p for p in g["parameters"] if p["process"] == "gauss_markov"]
+    assert len(markov) == 1, g["parameters"]
+    p = markov[0]
+    assert p["unit"] == "deg/s" and abs(p["value"] / sigma - 1) < 0.2, p
+    assert p["correlation_time_lower_s"] < p["correlation_time_s"] < p["correlation_time_upper_s"], p
+    assert abs(p["correlation_time_s"] / t - 1) < 0.35, p
+    k_rw = next((q["value"] for q in g["parameters"] if q["process"] == "random_walk"), 0.0)
+    want = math.radians(math.sqrt(k_rw**2 + 2 * p["value"] ** 2 / p["correlation_time_s"]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        kalibr = yaml.safe_load(r.export("kalibr", estimator="gmwm"))
+    assert kalibr["gyroscope_random_walk"] == pytest.approx(want, rel=1e-6)

@@ -173,3 +173,57 @@ fn update_rate_of_real_recordings_end_to_end() {
         assert!(text.contains(&format!("rostopic: /{topic}")), "{text}");
     }
 }
+
+/// White noise N 0.01 deg/sqrt(s) and a sampled Gauss-Markov process (sigma 0.02 deg/s, T 5 s)
+/// at 100 Hz for 2^17 samples, as a CSV.
+fn gauss_markov_record(dir: &std::path::Path) -> std::path::PathBuf {
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(36);
+    let (n, sigma, t, tau0) = (0.01f64, 0.02f64, 5.0f64, 0.01f64);
+    let phi = (-tau0 / t).exp();
+    let mut x = 0.0;
+    let mut text = String::from("time_s,rate_dps\n");
+    for i in 0..(1 << 17) {
+        let a: f64 = StandardNormal.sample(&mut rng);
+        let b: f64 = StandardNormal.sample(&mut rng);
+        x = phi * x + sigma * (1.0 - phi * phi).sqrt() * b;
+        text.push_str(&format!("{},{}\n", i as f64 * tau0, n / tau0.sqrt() * a + x));
+    }
+    let p = dir.join("gm.csv");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn a_gauss_markov_process_is_exported_as_the_random_walk_that_bounds_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = gauss_markov_record(dir.path());
+    let f = dir.path().join("kalibr.yaml");
+    gyrolab()
+        .arg("allan")
+        .arg(&rec)
+        .args(["--estimator", "gmwm", "--export"])
+        .arg(format!("kalibr={}", f.display()))
+        .assert()
+        .success();
+    let json = gyrolab().arg("allan").arg(&rec).arg("--json").assert().success().get_output().stdout.clone();
+    let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
+    let g = &v["channels"][0]["gmwm"];
+    let params = g["parameters"].as_array().unwrap();
+    let markov: Vec<&serde_json::Value> = params.iter().filter(|p| p["process"] == "gauss_markov").collect();
+    assert_eq!(markov.len(), 1, "{g}");
+    let (sigma, t) = (markov[0]["value"].as_f64().unwrap(), markov[0]["correlation_time_s"].as_f64().unwrap());
+    assert_eq!(markov[0]["unit"], "deg/s");
+    assert!((sigma / 0.02 - 1.0).abs() < 0.2 && (t / 5.0 - 1.0).abs() < 0.35, "sigma {sigma} T {t}");
+    assert_eq!(g["quality"], "acceptable", "{g}");
+    // The hand conversion: K^2 = K_rw^2 + 2 sigma^2 / T, deg -> rad (over this curve's taus,
+    // 0.01 to 164 s, the random walk is the tighter bound of T = 5 s: it exceeds the process by
+    // about 380 at 164 s, white noise by about 7.5e5 at 0.01 s).
+    let k_rw = params.iter().find(|p| p["process"] == "random_walk").map_or(0.0, |p| p["value"].as_f64().unwrap());
+    let want = (k_rw * k_rw + 2.0 * sigma * sigma / t).sqrt().to_radians();
+    let text = std::fs::read_to_string(&f).unwrap();
+    let got = value(&text, "gyroscope_random_walk");
+    assert!((got / want - 1.0).abs() < 1e-6, "{got} vs {want}\n{text}");
+    assert!(text.contains("gmwm_gauss_markov_bound") && text.contains("gauss_markov(sigma"), "{text}");
+}

@@ -6,7 +6,7 @@
 
 use crate::allan::AllanOutcome;
 use crate::error::{EvalError, EvalResult};
-use gyrolab::gmwm::{overbound_factors, Process};
+use gyrolab::gmwm::{gauss_markov_filter_bound, overbound_factors, MarkovBound, Process};
 use gyrolab::noise::Reading;
 use gyrolab::units::{self, Quantity};
 use gyrolab_io::noise_export::{real_text, ExportTerm, NoiseExport, Stack, TermSource};
@@ -105,7 +105,8 @@ pub fn parse_target(text: &str) -> EvalResult<(Stack, PathBuf)> {
 pub struct TermEstimate {
     /// The value.
     pub value: f64,
-    /// `value`, `upper_bound`, `fit_value` or `gmwm`.
+    /// `value`, `upper_bound`, `fit_value`, `gmwm` or `gmwm_gauss_markov_bound` (the GMWM term
+    /// plus the white noise or random walk bounding the model's Gauss-Markov processes).
     pub basis: String,
     /// What the basis means for this term (confidence and sidedness, the channel).
     pub detail: String,
@@ -203,27 +204,100 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
         }
         Estimator::Gmwm => {
             let Some(g) = &a.gmwm else { return [None, None] };
-            let model: Vec<&str> = g.parameters.iter().map(|p| p.process.name()).collect();
-            let term = |p: Process, unit: &str| {
-                g.parameter(p).map(|x| {
-                    (
-                        x.value,
-                        "gmwm".into(),
-                        format!(
-                            "GMWM estimate, {} % two-sided interval [{}, {}] {unit} (asymptotic sandwich covariance with the scales' covariance under the fitted model; coverage in simulation: docs/METHODS.md 3.1), model {}; {name}",
-                            percent(g.confidence),
-                            real_text(x.lower * to_si),
-                            real_text(x.upper * to_si),
-                            model.join(" + ")
-                        ),
-                    )
+            let model: Vec<String> = g
+                .parameters
+                .iter()
+                .map(|p| match p.correlation_time {
+                    Some(t) => format!(
+                        "gauss_markov(sigma {} {}, T {} s)",
+                        real_text(p.value * to_si),
+                        if a.quantity == Quantity::Acceleration { "m/s^2" } else { "rad/s" },
+                        real_text(t.value_s)
+                    ),
+                    None => p.process.name().to_string(),
                 })
+                .collect();
+            let interval = |x: &gyrolab::gmwm::GmwmParameter, unit: &str| {
+                format!(
+                    "{} % two-sided interval [{}, {}] {unit} (asymptotic sandwich covariance with the scales' covariance under the fitted model; coverage in simulation: docs/METHODS.md 3.1)",
+                    percent(g.confidence),
+                    real_text(x.lower * to_si),
+                    real_text(x.upper * to_si),
+                )
             };
             let accel = a.quantity == Quantity::Acceleration;
-            [
-                term(Process::White, if accel { "m/s^2/sqrt(Hz)" } else { "rad/s/sqrt(Hz)" }),
-                term(Process::RandomWalk, if accel { "m/s^3/sqrt(Hz)" } else { "rad/s^2/sqrt(Hz)" }),
-            ]
+            let poor = if g.quality == gyrolab::noise::FitQuality::Poor {
+                format!(
+                    "GMWM POOR FIT (weighted RMS residual {}): the model does not describe the curve; ",
+                    real_text(g.weighted_rms_residual)
+                )
+            } else {
+                String::new()
+            };
+            let model = format!("{}{}", poor, model.join(" + "));
+            // A filter without Gauss-Markov states takes each Gauss-Markov process as the white
+            // noise or the random walk that bounds it over the curve's taus (the tighter one;
+            // `gauss_markov_filter_bound`), added to the model's own.
+            let (tau_lo, tau_hi) = match (a.curve.points.first(), a.curve.points.last()) {
+                (Some(f), Some(l)) => (f.tau_s, l.tau_s),
+                _ => (a.curve.tau0_s, a.curve.tau0_s),
+            };
+            let (mut markov_n2, mut markov_k2, mut as_white, mut as_walk) = (0.0, 0.0, 0usize, 0usize);
+            for p in g.gauss_markov() {
+                let Some(t) = p.correlation_time else { continue };
+                match gauss_markov_filter_bound(p.value, t.value_s, tau_lo, tau_hi) {
+                    MarkovBound::White { n2 } => {
+                        markov_n2 += n2;
+                        as_white += 1;
+                    }
+                    MarkovBound::RandomWalk { k2 } => {
+                        markov_k2 += k2;
+                        as_walk += 1;
+                    }
+                }
+            }
+            let term = |process: Process, extra2: f64, extra: usize, unit: &str, rule: &str| {
+                let own = g.parameter(process);
+                let total2 = own.map_or(0.0, |x| x.value * x.value) + extra2;
+                if total2 <= 0.0 {
+                    return None;
+                }
+                if extra == 0 {
+                    return own.map(|x| {
+                        (
+                            x.value,
+                            "gmwm".to_string(),
+                            format!("GMWM estimate, {}, model {model}; {name}", interval(&x, unit)),
+                        )
+                    });
+                }
+                Some((
+                    total2.sqrt(),
+                    "gmwm_gauss_markov_bound".to_string(),
+                    format!(
+                        "GMWM: {} plus {rule} bounding {extra} Gauss-Markov process(es) of the model (on or above its continuous-time Allan variance at every tau, the tighter of white noise 2 sigma^2 T and random walk 2 sigma^2 / T over the curve's taus; docs/METHODS.md 3.1), model {model}; {name}",
+                        match own {
+                            Some(x) => format!("the estimate {} {unit}", real_text(x.value * to_si)),
+                            None => "no term of its own".to_string(),
+                        }
+                    ),
+                ))
+            };
+            let white = term(
+                Process::White,
+                markov_n2,
+                as_white,
+                if accel { "m/s^2/sqrt(Hz)" } else { "rad/s/sqrt(Hz)" },
+                "the white noise N^2 = 2 sigma^2 T",
+            );
+            let random_walk = term(
+                Process::RandomWalk,
+                markov_k2,
+                as_walk,
+                if accel { "m/s^3/sqrt(Hz)" } else { "rad/s^2/sqrt(Hz)" },
+                "the random walk K^2 = 2 sigma^2 / T",
+            );
+            [white, random_walk]
         }
     }
 }

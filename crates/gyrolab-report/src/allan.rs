@@ -81,17 +81,31 @@ pub struct StillnessJson {
 /// One GMWM parameter in JSON.
 #[derive(Debug, Clone, Serialize)]
 pub struct GmwmParameterJson {
-    /// `quantization`, `white`, `flicker`, `random_walk` or `drift`.
+    /// `quantization`, `white`, `flicker`, `random_walk`, `drift` or `gauss_markov`.
     pub process: &'static str,
-    /// The coefficient, in `unit`.
+    /// The coefficient, in `unit` (for `gauss_markov` its stationary standard deviation sigma).
     pub value: f64,
     /// Lower end of the two-sided interval at the fit's confidence.
     pub lower: f64,
     /// Upper end of the two-sided interval.
     pub upper: f64,
-    /// The coefficient's unit (Q deg, N deg/sqrt(s), B deg/s, K deg/s/sqrt(s), R deg/s^2 for a gyro
-    /// in deg/s; m/s, m/s/sqrt(s), m/s^2, m/s^2/sqrt(s), m/s^3 for an accelerometer).
+    /// The coefficient's unit (Q deg, N deg/sqrt(s), B deg/s, K deg/s/sqrt(s), R deg/s^2, a
+    /// Gauss-Markov sigma deg/s for a gyro in deg/s; m/s, m/s/sqrt(s), m/s^2, m/s^2/sqrt(s), m/s^3,
+    /// m/s^2 for an accelerometer).
     pub unit: &'static str,
+    /// A Gauss-Markov process's correlation time T, s (absent for the other processes).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub correlation_time_s: Option<f64>,
+    /// Lower end of T's two-sided interval at the fit's confidence, s (from the interval on ln T).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub correlation_time_lower_s: Option<f64>,
+    /// Upper end of T's two-sided interval, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub correlation_time_upper_s: Option<f64>,
+    /// True when T sits at an end of the range searched (the first or last tau): the record does
+    /// not resolve it and its interval means nothing.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub correlation_time_at_search_edge: Option<bool>,
 }
 
 /// The GMWM fit in JSON.
@@ -110,8 +124,16 @@ pub struct GmwmJson {
     pub scales: usize,
     /// The objective at the estimate.
     pub objective: f64,
-    /// The model-choice criterion, objective + 2 x parameters.
+    /// The objective's estimated optimism, 2 tr(Omega H Sigma) (docs/METHODS.md 3.1).
+    pub optimism: f64,
+    /// The model-choice criterion (wavelet information criterion), objective + optimism.
     pub criterion: f64,
+    /// The weighted RMS residual sqrt(objective / scales) (about 1 when the model describes the
+    /// curve).
+    pub weighted_rms_residual: f64,
+    /// `acceptable`, or `poor` when the weighted RMS residual exceeds 3: no model searched
+    /// describes the curve, and the parameters are not to be used.
+    pub quality: gyrolab::noise::FitQuality,
 }
 
 /// What the GMWM intervals are (text and JSON).
@@ -128,11 +150,13 @@ pub fn gmwm_unit(process: gyrolab::gmwm::Process, quantity: Quantity) -> &'stati
         (P::Flicker, false) => "deg/s",
         (P::RandomWalk, false) => "deg/s/sqrt(s)",
         (P::Drift, false) => "deg/s^2",
+        (P::GaussMarkov, false) => "deg/s",
         (P::Quantization, true) => "m/s",
         (P::White, true) => "m/s/sqrt(s)",
         (P::Flicker, true) => "m/s^2",
         (P::RandomWalk, true) => "m/s^2/sqrt(s)",
         (P::Drift, true) => "m/s^3",
+        (P::GaussMarkov, true) => "m/s^2",
     }
 }
 
@@ -152,11 +176,18 @@ pub fn gmwm_json(a: &ChannelAnalysis) -> Option<GmwmJson> {
                 lower: p.lower,
                 upper: p.upper,
                 unit: gmwm_unit(p.process, a.quantity),
+                correlation_time_s: p.correlation_time.map(|t| t.value_s),
+                correlation_time_lower_s: p.correlation_time.map(|t| t.lower_s),
+                correlation_time_upper_s: p.correlation_time.map(|t| t.upper_s),
+                correlation_time_at_search_edge: p.correlation_time.map(|t| t.at_search_edge),
             })
             .collect(),
         scales: g.scales,
         objective: g.objective,
+        optimism: g.optimism,
         criterion: g.criterion,
+        weighted_rms_residual: g.weighted_rms_residual,
+        quality: g.quality,
     })
 }
 
@@ -167,23 +198,39 @@ pub fn gmwm_text(a: &ChannelAnalysis) -> Option<String> {
         .parameters
         .iter()
         .map(|p| {
-            format!(
-                "{} {} [{}, {}] {}",
+            let main = format!(
+                "{} {}{} [{}, {}] {}",
                 p.process.name(),
+                if p.correlation_time.is_some() { "sigma " } else { "" },
                 sig(p.value, 4),
                 sig(p.lower, 3),
                 sig(p.upper, 3),
                 gmwm_unit(p.process, a.quantity)
-            )
+            );
+            match p.correlation_time {
+                Some(t) if t.at_search_edge => {
+                    format!("{main}, T {} s (at the edge of the taus searched: not resolved)", sig(t.value_s, 3))
+                }
+                Some(t) => format!("{main}, T {} [{}, {}] s", sig(t.value_s, 3), sig(t.lower_s, 3), sig(t.upper_s, 3)),
+                None => main,
+            }
         })
         .collect();
-    Some(format!(
-        "GMWM (Haar wavelet variance, model chosen by J + 2p over {} scales; {} % two-sided intervals, {}): {}\n",
+    let mut text = format!(
+        "GMWM (Haar wavelet variance, model chosen by the wavelet information criterion over {} scales; {} % two-sided intervals, {}): {}; weighted RMS residual {}\n",
         g.scales,
         short(100.0 * g.confidence, 4),
         GMWM_INTERVALS,
-        parts.join("; ")
-    ))
+        parts.join("; "),
+        sig(g.weighted_rms_residual, 3)
+    );
+    if g.quality == FitQuality::Poor {
+        text.push_str(&format!(
+            "warning: GMWM POOR FIT: the weighted RMS residual exceeds {}: no model of the processes searched describes this curve; do not use its values\n",
+            short(FIT_RMS_LIMIT, 3)
+        ));
+    }
+    Some(text)
 }
 
 /// Noise coefficients in JSON, each key naming its unit.

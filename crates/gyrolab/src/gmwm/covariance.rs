@@ -12,22 +12,40 @@
 //! coefficients h_alpha of IEEE Std 1139 / NIST SP 1065 (S_d(f) = S_y(f / tau0) / (2 tau0)):
 //! white N: N^2 / tau0; quantization Q: 4 Q^2 sin^2(pi f) / tau0^2 (differenced white angle noise);
 //! flicker floor B: B^2 / (2 pi |f|); random walk K: K^2 tau0 / (4 sin^2(pi f)); drift: none
-//! (deterministic). Each reproduces its AVAR of IEEE 952 annex C at long averaging times.
+//! (deterministic); a first-order Gauss-Markov process of variance sigma^2: sigma^2 times its AR(1)
+//! spectrum (module `gauss_markov`). Each reproduces its AVAR of IEEE 952 annex C at long averaging
+//! times.
 
-use super::{Process, WaveletVariance};
+use super::{Process, Shape, WaveletVariance};
 
-/// The model's spectral density per sample at frequency `f` (cycles per sample, 0 < f <= 1/2),
-/// (curve unit)^2 per cycle per sample; `model` holds (process, squared coefficient).
-fn spectral_density(model: &[(Process, f64)], tau0_s: f64, f: f64) -> f64 {
-    let s = (std::f64::consts::PI * f).sin();
+/// A model's terms prepared for the spectral density: (shape, weight, phi) with phi = exp(-tau0/T)
+/// for a Gauss-Markov process (0 otherwise).
+fn prepare(model: &[(Shape, f64)], tau0_s: f64) -> Vec<(Shape, f64, f64, f64)> {
     model
         .iter()
-        .map(|&(p, t)| match p {
-            Process::White => t / tau0_s,
-            Process::Quantization => 4.0 * t * s * s / (tau0_s * tau0_s),
-            Process::Flicker => t / (2.0 * std::f64::consts::PI * f),
-            Process::RandomWalk => t * tau0_s / (4.0 * s * s),
-            Process::Drift => 0.0,
+        .map(|&(shape, t)| match shape {
+            Shape::GaussMarkov(tc) => {
+                let one_minus_phi = -(-tau0_s / tc).exp_m1();
+                (shape, t, 1.0 - one_minus_phi, one_minus_phi)
+            }
+            Shape::Linear(_) => (shape, t, 0.0, 0.0),
+        })
+        .collect()
+}
+
+/// The model's spectral density per sample at frequency `f` (cycles per sample, 0 < f <= 1/2)
+/// with s2 = sin^2(pi f), (curve unit)^2 per cycle per sample.
+fn spectral_density(model: &[(Shape, f64, f64, f64)], tau0_s: f64, f: f64, s2: f64) -> f64 {
+    model
+        .iter()
+        .map(|&(shape, t, phi, one_minus_phi)| match shape {
+            Shape::Linear(Process::White) => t / tau0_s,
+            Shape::Linear(Process::Quantization) => 4.0 * t * s2 / (tau0_s * tau0_s),
+            Shape::Linear(Process::Flicker) => t / (2.0 * std::f64::consts::PI * f),
+            Shape::Linear(Process::RandomWalk) => t * tau0_s / (4.0 * s2),
+            Shape::Linear(Process::Drift | Process::GaussMarkov) => 0.0,
+            // gauss_markov_spectral_density, phi taken once per model.
+            Shape::GaussMarkov(_) => t * one_minus_phi * (1.0 + phi) / (one_minus_phi * one_minus_phi + 4.0 * phi * s2),
         })
         .sum()
 }
@@ -40,23 +58,23 @@ fn haar_gain(m: f64, f: f64, averaged: bool) -> f64 {
     num / (m * m * s * s)
 }
 
-/// Midpoint-rule integral of the product of the two scales' gains and S^2 over (a, b] in `n`
-/// steps (uniform, or uniform in log f when `log`).
+/// Midpoint-rule points of the product of the two scales' gains over (a, b] in `n` steps
+/// (uniform, or uniform in log f when `log`), appended as (f, sin^2(pi f), step x gains x
+/// `scale`).
 #[allow(clippy::too_many_arguments)]
-fn integrate(
-    model: &[(Process, f64)],
-    tau0_s: f64,
+fn points(
+    out: &mut Vec<[f64; 3]>,
     (m_lo, avg_lo): (f64, bool),
     (m_hi, avg_hi): (f64, bool),
     a: f64,
     b: f64,
     n: usize,
     log: bool,
-) -> f64 {
+    scale: f64,
+) {
     if b <= a {
-        return 0.0;
+        return;
     }
-    let mut sum = 0.0;
     for i in 0..n {
         let u = (i as f64 + 0.5) / n as f64;
         let (f, w) = if log {
@@ -65,34 +83,149 @@ fn integrate(
         } else {
             (a + u * (b - a), (b - a) / n as f64)
         };
-        let s = spectral_density(model, tau0_s, f);
-        sum += w * haar_gain(m_lo, f, avg_lo) * haar_gain(m_hi, f, avg_hi) * s * s;
+        let s = (std::f64::consts::PI * f).sin();
+        out.push([f, s * s, scale * w * haar_gain(m_lo, f, avg_lo) * haar_gain(m_hi, f, avg_hi)]);
     }
-    sum
 }
 
-/// Covariance matrix of the wavelet-variance estimates `wv` under the model (process, squared
-/// coefficient): entries (curve unit)^4. The integral over [-1/2, 1/2] is twice that over
-/// (0, 1/2], in three parts: up to 32 / m_hi exactly (512 steps), then with the larger scale's
-/// oscillation averaged up to 32 / m_lo (512 steps), then both averaged (256 log steps).
-pub fn wavelet_variance_covariance(wv: &[WaveletVariance], model: &[(Process, f64)]) -> Vec<Vec<f64>> {
-    let n = wv.len();
-    let mut cov = vec![vec![0.0; n]; n];
-    for j in 0..n {
-        for k in j..n {
-            let (a, b) = (&wv[j], &wv[k]);
-            let tau0 = a.tau_s / a.m as f64;
-            let (m_lo, m_hi) = ((a.m.min(b.m)) as f64, (a.m.max(b.m)) as f64);
-            let f1 = (32.0 / m_hi).min(0.5);
-            let f2 = (32.0 / m_lo).min(0.5);
-            let exact = integrate(model, tau0, (m_lo, false), (m_hi, false), 0.0, f1, 512, false);
-            let middle = integrate(model, tau0, (m_lo, false), (m_hi, true), f1, f2, 512, false);
-            let tail = integrate(model, tau0, (m_lo, true), (m_hi, true), f2, 0.5, 256, true);
-            let terms = a.terms.min(b.terms).max(1) as f64;
-            let c = 2.0 / terms * 2.0 * (exact + middle + tail);
-            cov[j][k] = c;
-            cov[k][j] = c;
+/// The quadrature of the covariance integrals of one set of scales, made once and used for every
+/// model fitted to them: per pair of scales j <= k, the points f, sin^2(pi f) and their weights
+/// (the step, both Haar gains and the factor 2 / M x 2), so that a model's covariance is the
+/// weighted sum of its S(f)^2. The integral over [-1/2, 1/2] is twice that over (0, 1/2], in three
+/// parts: up to 32 / m_hi exactly (512 steps), then with the larger scale's oscillation averaged up
+/// to 32 / m_lo (512 steps), then both averaged (256 log steps).
+pub struct CovarianceGrid {
+    n: usize,
+    tau0_s: f64,
+    /// Points of pair (j, k), j <= k, at index j n + k.
+    pairs: Vec<Vec<[f64; 3]>>,
+}
+
+impl CovarianceGrid {
+    /// The quadrature of the scales `wv`.
+    pub fn new(wv: &[WaveletVariance]) -> Self {
+        let n = wv.len();
+        let tau0_s = wv.first().map_or(1.0, |w| w.tau_s / w.m as f64);
+        let mut pairs = vec![Vec::new(); n * n];
+        for j in 0..n {
+            for k in j..n {
+                let (a, b) = (&wv[j], &wv[k]);
+                let (m_lo, m_hi) = ((a.m.min(b.m)) as f64, (a.m.max(b.m)) as f64);
+                let f1 = (32.0 / m_hi).min(0.5);
+                let f2 = (32.0 / m_lo).min(0.5);
+                let terms = a.terms.min(b.terms).max(1) as f64;
+                let scale = 2.0 / terms * 2.0;
+                let out = &mut pairs[j * n + k];
+                out.reserve(1280);
+                points(out, (m_lo, false), (m_hi, false), 0.0, f1, 512, false, scale);
+                points(out, (m_lo, false), (m_hi, true), f1, f2, 512, false, scale);
+                points(out, (m_lo, true), (m_hi, true), f2, 0.5, 256, true, scale);
+            }
         }
+        CovarianceGrid { n, tau0_s, pairs }
     }
-    cov
+
+    /// Covariance matrix of the wavelet-variance estimates under the model (shape, weight: the
+    /// squared coefficient or a Gauss-Markov sigma^2): entries (curve unit)^4.
+    #[allow(clippy::needless_range_loop)] // a symmetric fill: cov[j][k] and cov[k][j] at once
+    pub fn covariance(&self, model: &[(Shape, f64)]) -> Vec<Vec<f64>> {
+        let n = self.n;
+        let prepared = prepare(model, self.tau0_s);
+        let mut cov = vec![vec![0.0; n]; n];
+        for j in 0..n {
+            for k in j..n {
+                let c: f64 = self.pairs[j * n + k]
+                    .iter()
+                    .map(|&[f, s2, w]| {
+                        let s = spectral_density(&prepared, self.tau0_s, f, s2);
+                        w * s * s
+                    })
+                    .sum();
+                cov[j][k] = c;
+                cov[k][j] = c;
+            }
+        }
+        cov
+    }
+}
+
+/// The covariance integrals of a set of shapes on a [`CovarianceGrid`], made in one pass over its
+/// points: for every two shapes a <= b and every pair of scales j <= k, the sum over the pair's
+/// points of w s_a(f) s_b(f) (unit weights). The covariance of any model of these shapes is then
+/// sum over a, b of theta_a theta_b times them, without another pass over the points.
+pub struct ShapeIntegrals {
+    shapes: Vec<Shape>,
+    n: usize,
+    /// Index (a, b), a <= b, at a p + b; each over the pairs of scales at j n + k.
+    values: Vec<Vec<f64>>,
+}
+
+impl ShapeIntegrals {
+    /// The integrals of `shapes` on `grid`.
+    pub fn new(grid: &CovarianceGrid, shapes: &[Shape]) -> Self {
+        let p = shapes.len();
+        let n = grid.n;
+        let unit: Vec<(Shape, f64)> = shapes.iter().map(|&s| (s, 1.0)).collect();
+        let prepared = prepare(&unit, grid.tau0_s);
+        let mut values = vec![vec![0.0; n * n]; p * p];
+        let mut dens = vec![0.0; p];
+        for j in 0..n {
+            for k in j..n {
+                let idx = j * n + k;
+                let mut acc = vec![0.0; p * p];
+                for &[f, s2, w] in &grid.pairs[idx] {
+                    for (d, term) in dens.iter_mut().zip(&prepared) {
+                        *d = spectral_density(std::slice::from_ref(term), grid.tau0_s, f, s2);
+                    }
+                    for a in 0..p {
+                        let wa = w * dens[a];
+                        for b in a..p {
+                            acc[a * p + b] += wa * dens[b];
+                        }
+                    }
+                }
+                for a in 0..p {
+                    for b in a..p {
+                        values[a * p + b][idx] = acc[a * p + b];
+                    }
+                }
+            }
+        }
+        ShapeIntegrals { shapes: shapes.to_vec(), n, values }
+    }
+
+    /// The covariance of the wavelet-variance estimates under `model`, whose shapes must all be
+    /// among these (None otherwise).
+    #[allow(clippy::needless_range_loop)] // a symmetric fill: cov[j][k] and cov[k][j] at once
+    pub fn covariance(&self, model: &[(Shape, f64)]) -> Option<Vec<Vec<f64>>> {
+        let p = self.shapes.len();
+        let at: Vec<(usize, f64)> = model
+            .iter()
+            .map(|(s, t)| self.shapes.iter().position(|x| x == s).map(|i| (i, *t)))
+            .collect::<Option<_>>()?;
+        let n = self.n;
+        let mut cov = vec![vec![0.0; n]; n];
+        for j in 0..n {
+            for k in j..n {
+                let idx = j * n + k;
+                let mut c = 0.0;
+                for (x, &(a, ta)) in at.iter().enumerate() {
+                    for &(b, tb) in &at[x..] {
+                        let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
+                        let v = self.values[lo * p + hi][idx];
+                        c += if a == b { ta * tb * v } else { 2.0 * ta * tb * v };
+                    }
+                }
+                cov[j][k] = c;
+                cov[k][j] = c;
+            }
+        }
+        Some(cov)
+    }
+}
+
+/// Covariance matrix of the wavelet-variance estimates `wv` under the model (shape, weight: the
+/// squared coefficient or a Gauss-Markov sigma^2): entries (curve unit)^4 ([`CovarianceGrid`]).
+pub fn wavelet_variance_covariance(wv: &[WaveletVariance], model: &[(Shape, f64)]) -> Vec<Vec<f64>> {
+    CovarianceGrid::new(wv).covariance(model)
 }

@@ -9,21 +9,31 @@
 //! IEEE Std 952-1997 annex C (the Allan variance of each process, which fixes its wavelet
 //! variance through nu^2 = AVAR / 2).
 //!
-//! Scope of this implementation (stated in METHODS): the processes are those whose wavelet
-//! variance is linear in a parameter (white noise N, quantization Q, the flicker floor of bias
-//! instability B, random walk K, drift R), so for a fixed weight matrix the GMWM objective is a
-//! non-negative weighted least-squares problem solved exactly (every subset of processes, the
-//! best feasible one); Omega is the inverse of a diagonal estimate of the wavelet-variance
-//! covariance, var(nu_hat^2_j) = 2 nu^4_j / edf_j (the chi-squared approximation with the
-//! curve's equivalent degrees of freedom), re-evaluated at the fitted nu(theta) a few times; the
-//! intervals use the full covariance across scales (module `covariance`, Percival and Walden
-//! 2000, ch. 8) in a sandwich. First-order Gauss-Markov processes are not included.
+//! Scope of this implementation (stated in METHODS): the processes whose wavelet variance is
+//! linear in a parameter (white noise N, quantization Q, the flicker floor of bias instability B,
+//! random walk K, drift R) and up to two first-order Gauss-Markov processes (sigma, correlation
+//! time T; module `gauss_markov`). For a fixed weight matrix and fixed correlation times the GMWM
+//! objective is a non-negative weighted least-squares problem solved exactly (every subset of
+//! processes, the best feasible one); the correlation times are profiled out (a grid of one per
+//! octave over the scales, then golden-section refinement of each ln T). Omega is the inverse of a
+//! diagonal estimate of the wavelet-variance covariance, var(nu_hat^2_j) = 2 nu^4_j / edf_j (the
+//! chi-squared approximation with the curve's equivalent degrees of freedom), re-evaluated at the
+//! fitted nu(theta) a few times; the intervals use the full covariance across scales (module
+//! `covariance`, Percival and Walden 2000, ch. 8) in a sandwich with the model's Jacobian; the
+//! model is chosen by a wavelet information criterion, the objective plus its estimated optimism
+//! (module `select`).
 
 mod covariance;
+mod gauss_markov;
 mod overbound;
+mod select;
 
-pub use covariance::wavelet_variance_covariance;
+pub use covariance::{wavelet_variance_covariance, CovarianceGrid, ShapeIntegrals};
+pub use gauss_markov::{
+    gauss_markov_filter_bound, gauss_markov_spectral_density, gauss_markov_wavelet_variance, MarkovBound,
+};
 pub use overbound::{overbound_factors, OverboundFactors};
+pub use select::{gmwm, select_model, select_model_with_gauss_markov, MAX_GAUSS_MARKOV};
 
 use crate::allan::chi_squared_quantile;
 use crate::allan::{AllanCurve, DeviationKind};
@@ -46,14 +56,18 @@ pub enum Process {
     RandomWalk,
     /// Drift (rate ramp) R (AVAR = R^2 tau^2 / 2).
     Drift,
+    /// First-order Gauss-Markov process: stationary standard deviation sigma and correlation time
+    /// T (autocovariance sigma^2 exp(-|t| / T)), sampled every tau0 (module `gauss_markov`).
+    GaussMarkov,
 }
 
-/// Every process, in the order of the parameter vector.
+/// The five processes whose wavelet variance is linear in their squared coefficient, in the
+/// order of the parameter vector (the Gauss-Markov processes come after them).
 pub const PROCESSES: [Process; 5] =
     [Process::Quantization, Process::White, Process::Flicker, Process::RandomWalk, Process::Drift];
 
 impl Process {
-    /// `quantization`, `white`, `flicker`, `random_walk`, `drift`.
+    /// `quantization`, `white`, `flicker`, `random_walk`, `drift`, `gauss_markov`.
     pub fn name(self) -> &'static str {
         match self {
             Process::Quantization => "quantization",
@@ -61,10 +75,12 @@ impl Process {
             Process::Flicker => "flicker",
             Process::RandomWalk => "random_walk",
             Process::Drift => "drift",
+            Process::GaussMarkov => "gauss_markov",
         }
     }
 
-    /// The Haar wavelet variance at `tau_s` per unit squared coefficient (nu^2 = AVAR / 2).
+    /// The Haar wavelet variance at `tau_s` per unit squared coefficient (nu^2 = AVAR / 2); NaN for
+    /// [`Process::GaussMarkov`], whose shape depends on its correlation time ([`Shape::unit`]).
     pub fn unit_wavelet_variance(self, tau_s: f64) -> f64 {
         0.5 * match self {
             Process::Quantization => 3.0 / (tau_s * tau_s),
@@ -72,6 +88,36 @@ impl Process {
             Process::Flicker => FLICKER * FLICKER,
             Process::RandomWalk => tau_s / 3.0,
             Process::Drift => tau_s * tau_s / 2.0,
+            Process::GaussMarkov => f64::NAN,
+        }
+    }
+}
+
+/// A term of a model with everything fixed but its weight: one of the five linear processes, or
+/// a first-order Gauss-Markov process of a given correlation time (weight: its variance sigma^2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    /// A process whose wavelet variance is linear in its squared coefficient (not
+    /// [`Process::GaussMarkov`]).
+    Linear(Process),
+    /// A first-order Gauss-Markov process of correlation time T, s.
+    GaussMarkov(f64),
+}
+
+impl Shape {
+    /// The process of the term.
+    pub fn process(self) -> Process {
+        match self {
+            Shape::Linear(p) => p,
+            Shape::GaussMarkov(_) => Process::GaussMarkov,
+        }
+    }
+
+    /// The Haar wavelet variance at the scale of `w` per unit weight.
+    pub fn unit(self, w: &WaveletVariance) -> f64 {
+        match self {
+            Shape::Linear(p) => p.unit_wavelet_variance(w.tau_s),
+            Shape::GaussMarkov(t) => gauss_markov_wavelet_variance(t, w.tau_s / w.m as f64, w.m as f64),
         }
     }
 }
@@ -138,24 +184,42 @@ pub fn wavelet_variance(curve: &AllanCurve) -> Result<Vec<WaveletVariance>, Gmwm
     Ok(out)
 }
 
+/// The correlation time of a Gauss-Markov parameter with its interval.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct CorrelationTime {
+    /// The estimate T, s.
+    pub value_s: f64,
+    /// Lower end of the two-sided interval, s (exp of the interval on ln T).
+    pub lower_s: f64,
+    /// Upper end of the two-sided interval, s.
+    pub upper_s: f64,
+    /// True when T sits at an end of the range searched (the first and last scales): the record
+    /// does not resolve it, and the interval is not meaningful.
+    pub at_search_edge: bool,
+}
+
 /// One estimated parameter of a GMWM fit, in the curve's coefficient units (for a gyro in deg/s:
-/// Q deg, N deg/sqrt(s), B deg/s, K deg/s/sqrt(s), R deg/s^2).
+/// Q deg, N deg/sqrt(s), B deg/s, K deg/s/sqrt(s), R deg/s^2, a Gauss-Markov sigma deg/s).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct GmwmParameter {
     /// The process.
     pub process: Process,
-    /// The coefficient (square root of the fitted wavelet-variance weight).
+    /// The coefficient (square root of the fitted wavelet-variance weight; for a Gauss-Markov
+    /// process its stationary standard deviation sigma).
     pub value: f64,
     /// Lower end of the two-sided interval at `confidence` (0 when the interval reaches zero).
     pub lower: f64,
     /// Upper end of the two-sided interval.
     pub upper: f64,
+    /// The correlation time of a Gauss-Markov process (None for the other processes).
+    pub correlation_time: Option<CorrelationTime>,
 }
 
 /// A GMWM fit.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct GmwmFit {
-    /// The processes of the chosen model with their coefficients and intervals.
+    /// The processes of the chosen model with their coefficients and intervals (the linear
+    /// processes first, then the Gauss-Markov processes by increasing correlation time).
     pub parameters: Vec<GmwmParameter>,
     /// Two-sided confidence level of the intervals.
     pub confidence: f64,
@@ -163,115 +227,229 @@ pub struct GmwmFit {
     pub scales: usize,
     /// The objective at the estimate, (nu_hat - nu)' Omega (nu_hat - nu).
     pub objective: f64,
-    /// The model-choice criterion: objective + 2 x number of parameters (smaller is better).
+    /// The estimated optimism of the objective, 2 tr(Omega H Sigma) (H the fit's hat matrix,
+    /// Sigma the wavelet variances' covariance under the fitted model); 2 x parameters when Omega
+    /// = Sigma^-1.
+    pub optimism: f64,
+    /// The model-choice criterion (wavelet information criterion): objective + optimism (smaller
+    /// is better).
     pub criterion: f64,
+    /// The weighted RMS residual sqrt(objective / scales) (about 1 when the model and the
+    /// weights are right).
+    pub weighted_rms_residual: f64,
+    /// Poor when the weighted RMS residual exceeds [`crate::noise::FIT_RMS_LIMIT`] (the limit of
+    /// the five-term fit): no model of the processes searched describes the curve, and its values
+    /// are not to be used.
+    pub quality: crate::noise::FitQuality,
 }
 
 impl GmwmFit {
-    /// The coefficient of a process, when the model holds it.
+    /// The coefficient of a process, when the model holds it (the first Gauss-Markov process for
+    /// [`Process::GaussMarkov`]).
     pub fn value(&self, process: Process) -> Option<f64> {
         self.parameter(process).map(|p| p.value)
     }
 
-    /// The parameter of a process, when the model holds it.
+    /// The parameter of a process, when the model holds it (the first Gauss-Markov process for
+    /// [`Process::GaussMarkov`]).
     pub fn parameter(&self, process: Process) -> Option<GmwmParameter> {
         self.parameters.iter().find(|p| p.process == process).copied()
     }
 
-    /// The model's wavelet variance at `tau_s`.
-    pub fn wavelet_variance(&self, tau_s: f64) -> f64 {
-        self.parameters.iter().map(|p| p.value * p.value * p.process.unit_wavelet_variance(tau_s)).sum()
+    /// The Gauss-Markov parameters, by increasing correlation time.
+    pub fn gauss_markov(&self) -> Vec<GmwmParameter> {
+        self.parameters.iter().filter(|p| p.process == Process::GaussMarkov).copied().collect()
+    }
+
+    /// The terms of the model with their weights (squared coefficients, or sigma^2).
+    pub fn shapes(&self) -> Vec<(Shape, f64)> {
+        self.parameters
+            .iter()
+            .map(|p| {
+                let shape = match p.correlation_time {
+                    Some(t) => Shape::GaussMarkov(t.value_s),
+                    None => Shape::Linear(p.process),
+                };
+                (shape, p.value * p.value)
+            })
+            .collect()
+    }
+
+    /// The model's wavelet variance at the scale of `w` (its tau and averaging factor).
+    pub fn wavelet_variance(&self, w: &WaveletVariance) -> f64 {
+        self.shapes().iter().map(|(s, t)| t * s.unit(w)).sum()
     }
 }
+
+/// A fitted model: each term with its weight (squared coefficient, or a Gauss-Markov sigma^2).
+type Model = Vec<(Shape, f64)>;
 
 /// Reweighting rounds: Omega evaluated at nu_hat, then at the fitted nu(theta).
 const ROUNDS: usize = 4;
 
-/// GMWM fit of a given set of processes (at least one) to the wavelet variance: non-negative
-/// weighted least squares in the squared coefficients with Omega = diag(edf_j / (2 nu_j^4)), nu_j
-/// the fitted wavelet variance (the estimate in the first round). Processes whose weight is zero
-/// at the optimum are left out of the result. Intervals: theta +- z sqrt(var), var from the
-/// sandwich covariance with the wavelet variances' covariance across scales under the fitted
-/// model ([`wavelet_variance_covariance`]), clipped at zero, then square-rooted; two-sided at
-/// `confidence`.
+/// GMWM fit of a given set of linear processes (at least one; not [`Process::GaussMarkov`]) to
+/// the wavelet variance: non-negative weighted least squares in the squared coefficients with
+/// Omega = diag(edf_j / (2 nu_j^4)), nu_j the fitted wavelet variance (the estimate in the first
+/// round). Processes whose weight is zero at the optimum are left out of the result. Intervals:
+/// theta +- z sqrt(var), var from the sandwich covariance with the wavelet variances' covariance
+/// across scales under the fitted model ([`wavelet_variance_covariance`]), clipped at zero, then
+/// square-rooted; two-sided at `confidence`.
 pub fn fit_processes(wv: &[WaveletVariance], processes: &[Process], confidence: f64) -> Result<GmwmFit, GmwmError> {
-    let (fit, sigma2) = fit_estimate(wv, processes, confidence)?;
-    Ok(with_intervals(fit, wv, &sigma2))
+    let shapes: Vec<Shape> =
+        processes.iter().filter(|p| **p != Process::GaussMarkov).map(|&p| Shape::Linear(p)).collect();
+    let (model, sigma2) = fit_estimate(wv, &shapes, confidence)?;
+    let integrals = ShapeIntegrals::new(&CovarianceGrid::new(wv), &shapes);
+    Ok(finish(wv, &integrals, &model, &sigma2, confidence, (0.0, f64::INFINITY)))
 }
 
-/// The estimate of [`fit_processes`] with its objective, intervals not yet made (NaN), and the
-/// final weights' variances sigma2.
-fn fit_estimate(
-    wv: &[WaveletVariance],
-    processes: &[Process],
-    confidence: f64,
-) -> Result<(GmwmFit, Vec<f64>), GmwmError> {
+fn check(wv: &[WaveletVariance], parameters: usize, confidence: f64) -> Result<(), GmwmError> {
     if confidence.is_nan() || confidence <= 0.0 || confidence >= 1.0 {
         return Err(GmwmError::Confidence(confidence));
     }
-    let p = processes.len();
-    if wv.len() <= p || p == 0 {
-        return Err(GmwmError::TooFewScales { scales: wv.len(), parameters: p });
+    if wv.len() <= parameters || parameters == 0 {
+        return Err(GmwmError::TooFewScales { scales: wv.len(), parameters });
     }
-    let mut sigma2: Vec<f64> = wv.iter().map(|w| 2.0 * w.nu2 * w.nu2 / w.edf).collect();
-    let mut best = nnls_subsets(wv, processes, &sigma2);
-    for _ in 1..ROUNDS {
-        sigma2 = wv
-            .iter()
-            .map(|w| {
-                let model: f64 = best.iter().map(|&(pr, t)| t * pr.unit_wavelet_variance(w.tau_s)).sum();
-                let nu = if model > 0.0 { model } else { w.nu2 };
-                2.0 * nu * nu / w.edf
-            })
-            .collect();
-        best = nnls_subsets(wv, processes, &sigma2);
-    }
-    let chosen: Vec<Process> = best.iter().map(|x| x.0).collect();
-    let theta: Vec<f64> = best.iter().map(|x| x.1).collect();
-    let objective = objective(wv, &chosen, &theta, &sigma2);
-    let parameters = chosen
-        .iter()
-        .zip(&theta)
-        .map(|(&process, &t)| GmwmParameter { process, value: t.sqrt(), lower: f64::NAN, upper: f64::NAN })
-        .collect();
-    let fit = GmwmFit { parameters, confidence, scales: wv.len(), objective, criterion: objective + 2.0 * p as f64 };
-    Ok((fit, sigma2))
+    Ok(())
 }
 
-/// The fit with its two-sided intervals: theta +- z sqrt(var) on the squared coefficients
-/// ([`estimate_covariance`]), clipped at 0, square-rooted.
-fn with_intervals(mut fit: GmwmFit, wv: &[WaveletVariance], sigma2: &[f64]) -> GmwmFit {
-    let chosen: Vec<Process> = fit.parameters.iter().map(|p| p.process).collect();
-    let theta: Vec<f64> = fit.parameters.iter().map(|p| p.value * p.value).collect();
-    let cov = estimate_covariance(wv, &chosen, &theta, sigma2);
-    let z = chi_squared_quantile(fit.confidence, 1.0).map_or(f64::NAN, f64::sqrt);
-    for (i, (par, &t)) in fit.parameters.iter_mut().zip(&theta).enumerate() {
-        let se = cov.get(i).and_then(|r| r.get(i)).map_or(f64::NAN, |v| v.max(0.0).sqrt());
-        par.lower = (t - z * se).max(0.0).sqrt();
-        par.upper = (t + z * se).max(0.0).sqrt();
-    }
-    fit
+/// The chi-squared variances 2 nu^4 / edf of the estimates at the model's wavelet variance (at
+/// the estimate where the model gives nothing).
+fn chi_squared_variances(wv: &[WaveletVariance], model: &[(Shape, f64)]) -> Vec<f64> {
+    wv.iter()
+        .map(|w| {
+            let fitted: f64 = model.iter().map(|(s, t)| t * s.unit(w)).sum();
+            let nu = if fitted > 0.0 { fitted } else { w.nu2 };
+            2.0 * nu * nu / w.edf
+        })
+        .collect()
 }
 
-/// The covariance of the squared coefficients: the sandwich (X' W X)^-1 X' W Sigma W X (X' W
-/// X)^-1 of the weighted fit (W = diag(1 / sigma2)) with Sigma the covariance of the wavelet
-/// variances across scales under the fitted model ([`wavelet_variance_covariance`]); its
-/// diagonal is raised to the chi-squared variance 2 nu^4 / edf where that is larger (the
-/// large-sample formula understates the variance at scales with few independent terms), the
-/// correlations kept. Empty when the information matrix is singular.
-fn estimate_covariance(wv: &[WaveletVariance], set: &[Process], theta: &[f64], sigma2: &[f64]) -> Vec<Vec<f64>> {
-    let Some(bread) = information(wv, set, sigma2).and_then(|m| invert(&m)) else { return Vec::new() };
-    let model: Vec<(Process, f64)> = set.iter().copied().zip(theta.iter().copied()).collect();
-    let spectral = wavelet_variance_covariance(wv, &model);
+/// The weights of fixed shapes by reweighted non-negative least squares (zero weights dropped),
+/// with the final Omega's variances.
+fn fit_estimate(wv: &[WaveletVariance], shapes: &[Shape], confidence: f64) -> Result<(Model, Vec<f64>), GmwmError> {
+    check(wv, shapes.len(), confidence)?;
+    let x = design(wv, shapes);
+    let nu: Vec<f64> = wv.iter().map(|w| w.nu2).collect();
+    let mut sigma2 = chi_squared_variances(wv, &[]);
+    let mut best = Vec::new();
+    for round in 0..ROUNDS {
+        if round > 0 {
+            sigma2 = chi_squared_variances(wv, &best);
+        }
+        let (kept, theta, _) = nnls(&x, &nu, &sigma2);
+        best = kept.iter().zip(theta).map(|(&c, t)| (shapes[c], t)).collect();
+    }
+    Ok((best, sigma2))
+}
+
+/// The design matrix x[j][c]: the unit wavelet variance of shape c at scale j.
+fn design(wv: &[WaveletVariance], shapes: &[Shape]) -> Vec<Vec<f64>> {
+    wv.iter().map(|w| shapes.iter().map(|s| s.unit(w)).collect()).collect()
+}
+
+/// The exact non-negative least-squares optimum over every subset of the columns of `x`: the
+/// unconstrained weighted fit of each subset, kept when all its weights are positive, the one with
+/// the smallest objective chosen (the KKT solution is among them). Returns the kept columns, their
+/// weights and the objective (empty and infinite when no subset is feasible).
+fn nnls(x: &[Vec<f64>], nu: &[f64], sigma2: &[f64]) -> (Vec<usize>, Vec<f64>, f64) {
+    let p = x.first().map_or(0, Vec::len);
+    let mut best: (Vec<usize>, Vec<f64>, f64) = (Vec::new(), Vec::new(), f64::INFINITY);
+    // The normal equations of all columns, once; each subset's are a sub-block.
+    let Some(g) = information(x, sigma2) else { return best };
+    let mut rhs = vec![0.0; p];
+    for ((row, n), s2) in x.iter().zip(nu).zip(sigma2) {
+        for (r, v) in rhs.iter_mut().zip(row) {
+            *r += v * n / s2;
+        }
+    }
+    for mask in 1u32..(1u32 << p) {
+        let cols: Vec<usize> = (0..p).filter(|c| mask & (1 << c) != 0).collect();
+        let sub: Vec<Vec<f64>> = cols.iter().map(|&r| cols.iter().map(|&c| g[r][c]).collect()).collect();
+        let Some(inv) = invert(&sub) else { continue };
+        let theta: Vec<f64> = inv.iter().map(|row| row.iter().zip(&cols).map(|(a, &c)| a * rhs[c]).sum()).collect();
+        if theta.iter().any(|t| !(t.is_finite() && *t > 0.0)) {
+            continue;
+        }
+        let j = objective(x, nu, sigma2, &cols, &theta);
+        if j < best.2 {
+            best = (cols, theta, j);
+        }
+    }
+    best
+}
+
+/// (nu_hat - X theta)' W (nu_hat - X theta) over the columns `cols`.
+fn objective(x: &[Vec<f64>], nu: &[f64], sigma2: &[f64], cols: &[usize], theta: &[f64]) -> f64 {
+    x.iter()
+        .zip(nu)
+        .zip(sigma2)
+        .map(|((row, n), s2)| {
+            let model: f64 = cols.iter().zip(theta).map(|(&c, t)| t * row[c]).sum();
+            (n - model).powi(2) / s2
+        })
+        .sum()
+}
+
+/// D' W D with W = diag(1 / sigma2), D given by rows (one per scale).
+fn information(d: &[Vec<f64>], sigma2: &[f64]) -> Option<Vec<Vec<f64>>> {
+    let p = d.first().map_or(0, Vec::len);
+    let mut m = vec![vec![0.0; p]; p];
+    for (row, s2) in d.iter().zip(sigma2) {
+        if s2.is_nan() || *s2 <= 0.0 {
+            return None;
+        }
+        for (out, a) in m.iter_mut().zip(row) {
+            for (cell, b) in out.iter_mut().zip(row) {
+                *cell += a * b / s2;
+            }
+        }
+    }
+    Some(m)
+}
+
+/// Step of the central difference of a Gauss-Markov column in ln T.
+const LN_T_STEP: f64 = 1e-4;
+
+/// The Jacobian of the model's wavelet variance by rows (one per scale) in the parameters: the
+/// weight of each shape, and for a Gauss-Markov process also ln T (sigma^2 times the central
+/// difference of its unit column).
+fn jacobian(wv: &[WaveletVariance], model: &[(Shape, f64)]) -> Vec<Vec<f64>> {
+    wv.iter()
+        .map(|w| {
+            let mut row = Vec::with_capacity(model.len() + 2);
+            for &(s, t) in model {
+                row.push(s.unit(w));
+                if let Shape::GaussMarkov(tc) = s {
+                    let up = Shape::GaussMarkov(tc * LN_T_STEP.exp()).unit(w);
+                    let down = Shape::GaussMarkov(tc * (-LN_T_STEP).exp()).unit(w);
+                    row.push(t * (up - down) / (2.0 * LN_T_STEP));
+                }
+            }
+            row
+        })
+        .collect()
+}
+
+/// The sandwich covariance B D' W Sigma W D B (B = (D' W D)^-1, W = diag(1 / sigma2)) of the
+/// parameters of [`jacobian`], with Sigma the covariance of the wavelet variances across scales
+/// under the fitted model ([`wavelet_variance_covariance`]), its diagonal raised to the
+/// chi-squared variance 2 nu^4 / edf where that is larger (the large-sample formula understates
+/// the variance at scales with few independent terms), the correlations kept; and the optimism 2
+/// tr(B meat) = 2 tr(W H Sigma). `None` when the information matrix is singular.
+fn sandwich(
+    wv: &[WaveletVariance],
+    integrals: &ShapeIntegrals,
+    model: &[(Shape, f64)],
+    sigma2: &[f64],
+) -> Option<(Vec<Vec<f64>>, f64)> {
+    let d = jacobian(wv, model);
+    let bread = information(&d, sigma2).and_then(|m| invert(&m))?;
+    let spectral = integrals.covariance(model)?;
     let n = wv.len();
     let diag: Vec<f64> = (0..n).map(|j| spectral[j][j].max(sigma2[j])).collect();
-    let p = set.len();
-    // A = W X (n x p); meat = A' Sigma A.
-    let a: Vec<Vec<f64>> = wv
-        .iter()
-        .zip(sigma2)
-        .map(|(w, s2)| set.iter().map(|pr| pr.unit_wavelet_variance(w.tau_s) / s2).collect())
-        .collect();
+    let p = bread.len();
+    // A = W D (n x p); meat = A' Sigma A.
+    let a: Vec<Vec<f64>> = d.iter().zip(sigma2).map(|(row, s2)| row.iter().map(|v| v / s2).collect()).collect();
     let sigma = |j: usize, k: usize| -> f64 {
         if j == k {
             return diag[j];
@@ -300,104 +478,81 @@ fn estimate_covariance(wv: &[WaveletVariance], set: &[Process], theta: &[f64], s
     let mul = |x: &[Vec<f64>], y: &[Vec<f64>]| -> Vec<Vec<f64>> {
         (0..p).map(|r| (0..p).map(|q| (0..p).map(|t| x[r][t] * y[t][q]).sum()).collect()).collect()
     };
-    mul(&mul(&bread, &meat), &bread)
+    let optimism = 2.0 * (0..p).map(|r| (0..p).map(|q| bread[r][q] * meat[q][r]).sum::<f64>()).sum::<f64>();
+    Some((mul(&mul(&bread, &meat), &bread), optimism))
 }
 
-/// The GMWM fit with the model chosen by the criterion J + 2 p over every non-empty subset of
-/// `candidates` (a simplified wavelet information criterion: the objective is approximately
-/// chi-squared with (scales - p) degrees of freedom when the model holds, so 2 p is the AIC
-/// penalty; Guerrier et al.'s WIC estimates the optimism instead).
-pub fn select_model(wv: &[WaveletVariance], candidates: &[Process], confidence: f64) -> Result<GmwmFit, GmwmError> {
-    let mut best: Option<(GmwmFit, Vec<f64>)> = None;
-    let mut last_err = None;
-    for mask in 1u32..(1u32 << candidates.len()) {
-        let set: Vec<Process> =
-            candidates.iter().enumerate().filter(|(i, _)| mask & (1 << i) != 0).map(|(_, &p)| p).collect();
-        match fit_estimate(wv, &set, confidence) {
-            Ok((mut f, sigma2)) => {
-                // The penalty counts the processes the model keeps.
-                f.criterion = f.objective + 2.0 * f.parameters.len() as f64;
-                if best.as_ref().is_none_or(|b| f.criterion < b.0.criterion - 1e-12) {
-                    best = Some((f, sigma2));
-                }
-            }
-            Err(e) => last_err = Some(e),
+/// The fit of a model (linear processes and Gauss-Markov processes with their weights) with its
+/// objective, intervals and criterion. `search` is the range of correlation times searched (an
+/// estimate at either end is flagged).
+fn finish(
+    wv: &[WaveletVariance],
+    integrals: &ShapeIntegrals,
+    model: &[(Shape, f64)],
+    sigma2: &[f64],
+    confidence: f64,
+    search: (f64, f64),
+) -> GmwmFit {
+    let mut model: Vec<(Shape, f64)> = model.to_vec();
+    model.sort_by(|a, b| {
+        let key = |s: &Shape| match s {
+            Shape::Linear(p) => (0, PROCESSES.iter().position(|q| q == p).unwrap_or(0) as f64),
+            Shape::GaussMarkov(t) => (1, *t),
+        };
+        let (ka, kb) = (key(&a.0), key(&b.0));
+        ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
+    });
+    let shapes: Vec<Shape> = model.iter().map(|m| m.0).collect();
+    let theta: Vec<f64> = model.iter().map(|m| m.1).collect();
+    let x = design(wv, &shapes);
+    let nu: Vec<f64> = wv.iter().map(|w| w.nu2).collect();
+    let cols: Vec<usize> = (0..shapes.len()).collect();
+    let objective = objective(&x, &nu, sigma2, &cols, &theta);
+    let (cov, optimism) = sandwich(wv, integrals, &model, sigma2).unwrap_or((Vec::new(), f64::NAN));
+    let z = chi_squared_quantile(confidence, 1.0).map_or(f64::NAN, f64::sqrt);
+    let se = |i: usize| cov.get(i).and_then(|r| r.get(i)).map_or(f64::NAN, |v| v.max(0.0).sqrt());
+    let mut parameters = Vec::with_capacity(model.len());
+    let mut i = 0;
+    for &(shape, t) in &model {
+        let s = se(i);
+        let mut par = GmwmParameter {
+            process: shape.process(),
+            value: t.sqrt(),
+            lower: (t - z * s).max(0.0).sqrt(),
+            upper: (t + z * s).max(0.0).sqrt(),
+            correlation_time: None,
+        };
+        i += 1;
+        if let Shape::GaussMarkov(tc) = shape {
+            let s = se(i);
+            i += 1;
+            let edge = |b: f64| b.is_finite() && (tc / b - 1.0).abs() < 1e-6;
+            par.correlation_time = Some(CorrelationTime {
+                value_s: tc,
+                lower_s: tc * (-z * s).exp(),
+                upper_s: tc * (z * s).exp(),
+                at_search_edge: edge(search.0) || edge(search.1),
+            });
         }
+        parameters.push(par);
     }
-    match (best, last_err) {
-        // Intervals for the chosen model only.
-        (Some((b, sigma2)), _) => Ok(with_intervals(b, wv, &sigma2)),
-        (None, Some(e)) => Err(e),
-        (None, None) => Err(GmwmError::TooFewScales { scales: wv.len(), parameters: 0 }),
+    let optimism = if optimism.is_finite() { optimism } else { 2.0 * i as f64 };
+    let weighted_rms_residual = (objective / wv.len() as f64).sqrt();
+    let quality = if weighted_rms_residual > crate::noise::FIT_RMS_LIMIT {
+        crate::noise::FitQuality::Poor
+    } else {
+        crate::noise::FitQuality::Acceptable
+    };
+    GmwmFit {
+        parameters,
+        confidence,
+        scales: wv.len(),
+        objective,
+        optimism,
+        criterion: objective + optimism,
+        weighted_rms_residual,
+        quality,
     }
-}
-
-/// GMWM of an octave Allan curve with the model chosen over every process ([`PROCESSES`]).
-pub fn gmwm(curve: &AllanCurve, confidence: f64) -> Result<GmwmFit, GmwmError> {
-    let wv = wavelet_variance(curve)?;
-    select_model(&wv, &PROCESSES, confidence)
-}
-
-/// The exact non-negative least-squares optimum over every subset of `processes`: the
-/// unconstrained weighted fit of each subset, kept when all its weights are positive, the one
-/// with the smallest objective chosen (the KKT solution is among them).
-fn nnls_subsets(wv: &[WaveletVariance], processes: &[Process], sigma2: &[f64]) -> Vec<(Process, f64)> {
-    let mut best: Option<(f64, Vec<(Process, f64)>)> = None;
-    for mask in 1u32..(1u32 << processes.len()) {
-        let set: Vec<Process> =
-            processes.iter().enumerate().filter(|(i, _)| mask & (1 << i) != 0).map(|(_, &p)| p).collect();
-        let Some(theta) = weighted_fit(wv, &set, sigma2) else { continue };
-        if theta.iter().any(|t| !(t.is_finite() && *t > 0.0)) {
-            continue;
-        }
-        let j = objective(wv, &set, &theta, sigma2);
-        if best.as_ref().is_none_or(|b| j < b.0) {
-            best = Some((j, set.into_iter().zip(theta).collect()));
-        }
-    }
-    best.map(|b| b.1).unwrap_or_default()
-}
-
-fn objective(wv: &[WaveletVariance], set: &[Process], theta: &[f64], sigma2: &[f64]) -> f64 {
-    wv.iter()
-        .zip(sigma2)
-        .map(|(w, s2)| {
-            let model: f64 = set.iter().zip(theta).map(|(p, t)| t * p.unit_wavelet_variance(w.tau_s)).sum();
-            (w.nu2 - model).powi(2) / s2
-        })
-        .sum()
-}
-
-/// X' Omega X with Omega = diag(1 / sigma2).
-fn information(wv: &[WaveletVariance], set: &[Process], sigma2: &[f64]) -> Option<Vec<Vec<f64>>> {
-    let p = set.len();
-    let mut m = vec![vec![0.0; p]; p];
-    for (w, s2) in wv.iter().zip(sigma2) {
-        if s2.is_nan() || *s2 <= 0.0 {
-            return None;
-        }
-        let x: Vec<f64> = set.iter().map(|pr| pr.unit_wavelet_variance(w.tau_s)).collect();
-        for (row, xa) in m.iter_mut().zip(&x) {
-            for (cell, xb) in row.iter_mut().zip(&x) {
-                *cell += xa * xb / s2;
-            }
-        }
-    }
-    Some(m)
-}
-
-/// The weighted least-squares weights of `set` (normal equations, columns scaled to unit
-/// diagonal for conditioning).
-fn weighted_fit(wv: &[WaveletVariance], set: &[Process], sigma2: &[f64]) -> Option<Vec<f64>> {
-    let m = information(wv, set, sigma2)?;
-    let mut rhs = vec![0.0; set.len()];
-    for (w, s2) in wv.iter().zip(sigma2) {
-        for (r, pr) in rhs.iter_mut().zip(set) {
-            *r += pr.unit_wavelet_variance(w.tau_s) * w.nu2 / s2;
-        }
-    }
-    let inv = invert(&m)?;
-    Some(inv.iter().map(|row| row.iter().zip(&rhs).map(|(a, b)| a * b).sum()).collect())
 }
 
 /// Inverse of a small symmetric positive matrix (scaled to unit diagonal, Gauss-Jordan with

@@ -1,0 +1,257 @@
+//! Model choice of the GMWM: every subset of the linear processes, and models with one or two
+//! first-order Gauss-Markov processes whose correlation times are profiled out; the model with the
+//! smallest wavelet information criterion is chosen (docs/METHODS.md 3.1, "GMWM").
+//!
+//! Sources: the criterion is a prediction-accuracy criterion in the sense of the Wavelet
+//! Variance Information Criterion (WVIC) of the GMWM authors (S. Guerrier and co-authors, SMAC
+//! Group's gmwm tools): the objective plus its optimism, the expected excess of the objective on
+//! new data over the objective at the estimate. The optimism is B. Efron's covariance penalty
+//! ("The estimation of prediction error: covariance penalties and cross-validation", JASA
+//! 99(467), 2004), 2 sum_j Omega_jj cov(nu_hat_j, nu_j(theta_hat)), taken to first order: 2
+//! tr(Omega H Sigma), H = D (D' Omega D)^-1 D' Omega the fit's hat matrix and Sigma the wavelet
+//! variances' covariance under the fitted model (2 x parameters when Omega = Sigma^-1, the AIC
+//! penalty). The GMWM authors estimate the same optimism by simulation instead.
+
+use super::{check, chi_squared_variances, design, finish, fit_estimate, nnls};
+use super::{CovarianceGrid, GmwmError, GmwmFit, Process, Shape, ShapeIntegrals, WaveletVariance, PROCESSES, ROUNDS};
+use crate::allan::AllanCurve;
+
+/// The most first-order Gauss-Markov processes a model holds in [`gmwm`].
+pub const MAX_GAUSS_MARKOV: usize = 2;
+
+/// Grid steps per octave of the correlation-time search (each point then refined within a step).
+const GRID_PER_OCTAVE: f64 = 1.0;
+
+/// Two Gauss-Markov processes are searched at least this many grid steps apart (a factor of 4
+/// in T): closer, their sum is one process.
+const MIN_GAP_STEPS: usize = 2;
+
+/// Golden-section steps of each ln T refinement.
+const GOLDEN_STEPS: usize = 24;
+
+/// The GMWM fit with the model chosen by the criterion (objective + optimism, [`GmwmFit`]) over
+/// every non-empty subset of the linear processes in `candidates` ([`Process::GaussMarkov`] in
+/// it is ignored; see [`select_model_with_gauss_markov`]).
+pub fn select_model(wv: &[WaveletVariance], candidates: &[Process], confidence: f64) -> Result<GmwmFit, GmwmError> {
+    select_linear(wv, &CovarianceGrid::new(wv), candidates, confidence)
+}
+
+/// [`select_model`] with the scales' quadrature made.
+fn select_linear(
+    wv: &[WaveletVariance],
+    grid: &CovarianceGrid,
+    candidates: &[Process],
+    confidence: f64,
+) -> Result<GmwmFit, GmwmError> {
+    let linear: Vec<Process> = candidates.iter().copied().filter(|p| *p != Process::GaussMarkov).collect();
+    let shapes: Vec<Shape> = linear.iter().map(|&p| Shape::Linear(p)).collect();
+    let integrals = ShapeIntegrals::new(grid, &shapes);
+    let mut best: Option<GmwmFit> = None;
+    let mut last_err = None;
+    let mut seen: Vec<Vec<Process>> = Vec::new();
+    for mask in 1u32..(1u32 << linear.len()) {
+        let set: Vec<Shape> =
+            linear.iter().enumerate().filter(|(i, _)| mask & (1 << i) != 0).map(|(_, &p)| Shape::Linear(p)).collect();
+        match fit_estimate(wv, &set, confidence) {
+            Ok((model, sigma2)) => {
+                // Subsets whose fit drops the same processes give the same model: judged once.
+                let kept: Vec<Process> = model.iter().map(|m| m.0.process()).collect();
+                if kept.is_empty() || seen.contains(&kept) {
+                    continue;
+                }
+                seen.push(kept);
+                let fit = finish(wv, &integrals, &model, &sigma2, confidence, (0.0, f64::INFINITY));
+                if best.as_ref().is_none_or(|b| fit.criterion < b.criterion - 1e-12) {
+                    best = Some(fit);
+                }
+            }
+            Err(e) => last_err = Some(e),
+        }
+    }
+    match (best, last_err) {
+        (Some(b), _) => Ok(b),
+        (None, Some(e)) => Err(e),
+        (None, None) => Err(GmwmError::TooFewScales { scales: wv.len(), parameters: 0 }),
+    }
+}
+
+/// The GMWM fit with the model chosen by the criterion over the linear models of
+/// [`select_model`] and the models of the linear processes in `candidates` (the flicker floor
+/// left out: a sum of Gauss-Markov processes stands for bias instability there) plus one to
+/// `max_gauss_markov` first-order Gauss-Markov processes. Their correlation times are searched
+/// between the first and the last scale: a grid of one per octave (two processes at least two
+/// octaves apart), then each ln T refined by golden section within a grid step, again after
+/// each reweighting of Omega; the linear processes of each such model are then thinned by the
+/// criterion with the correlation times held.
+pub fn select_model_with_gauss_markov(
+    wv: &[WaveletVariance],
+    candidates: &[Process],
+    max_gauss_markov: usize,
+    confidence: f64,
+) -> Result<GmwmFit, GmwmError> {
+    let grid = CovarianceGrid::new(wv);
+    let mut best = select_linear(wv, &grid, candidates, confidence)?;
+    let linear: Vec<Process> =
+        candidates.iter().copied().filter(|p| !matches!(p, Process::GaussMarkov | Process::Flicker)).collect();
+    for k in 1..=max_gauss_markov {
+        let Some(fit) = gauss_markov_model(wv, &grid, &linear, k, confidence) else { continue };
+        if fit.criterion < best.criterion - 1e-12 {
+            best = fit;
+        }
+    }
+    Ok(best)
+}
+
+/// GMWM of an octave Allan curve with the model chosen over every process ([`PROCESSES`] and up
+/// to [`MAX_GAUSS_MARKOV`] Gauss-Markov processes).
+pub fn gmwm(curve: &AllanCurve, confidence: f64) -> Result<GmwmFit, GmwmError> {
+    let wv = super::wavelet_variance(curve)?;
+    select_model_with_gauss_markov(&wv, &PROCESSES, MAX_GAUSS_MARKOV, confidence)
+}
+
+/// The profile objective of the correlation times `ts` with the linear shapes: the non-negative
+/// fit's objective, infinite when it drops a Gauss-Markov process.
+fn profile(wv: &[WaveletVariance], linear: &[Shape], ts: &[f64], nu: &[f64], sigma2: &[f64]) -> f64 {
+    let mut shapes = linear.to_vec();
+    shapes.extend(ts.iter().map(|&t| Shape::GaussMarkov(t)));
+    let x = design(wv, &shapes);
+    let (kept, _, j) = nnls(&x, nu, sigma2);
+    let all_markov = (linear.len()..shapes.len()).all(|c| kept.contains(&c));
+    if all_markov {
+        j
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The best model with `k` Gauss-Markov processes and the linear processes `linear`; `None` when
+/// the record has too few scales or no fit keeps all `k` processes.
+fn gauss_markov_model(
+    wv: &[WaveletVariance],
+    grid: &CovarianceGrid,
+    linear: &[Process],
+    k: usize,
+    confidence: f64,
+) -> Option<GmwmFit> {
+    let n = wv.len();
+    check(wv, 2 * k + 1, confidence).ok()?;
+    let (lo, hi) = (wv.first()?.tau_s, wv.last()?.tau_s);
+    let steps = ((hi / lo).log2() * GRID_PER_OCTAVE).round() as usize;
+    if steps < MIN_GAP_STEPS * (k - 1) {
+        return None;
+    }
+    let times: Vec<f64> = (0..=steps).map(|i| lo * 2f64.powf(i as f64 / GRID_PER_OCTAVE)).collect();
+    let lin: Vec<Shape> = linear.iter().map(|&p| Shape::Linear(p)).collect();
+    let nu: Vec<f64> = wv.iter().map(|w| w.nu2).collect();
+    let mut sigma2 = chi_squared_variances(wv, &[]);
+    // The grid: every k-tuple of increasing indices at least MIN_GAP_STEPS apart.
+    let mut best: Option<(f64, Vec<f64>)> = None;
+    for idx in tuples(k, 0, steps) {
+        let ts: Vec<f64> = idx.iter().map(|&i| times[i]).collect();
+        let j = profile(wv, &lin, &ts, &nu, &sigma2);
+        if j.is_finite() && best.as_ref().is_none_or(|b| j < b.0) {
+            best = Some((j, ts));
+        }
+    }
+    let mut ts = best?.1;
+    let step = std::f64::consts::LN_2 / GRID_PER_OCTAVE;
+    let mut model = Vec::new();
+    for round in 0..ROUNDS {
+        if round > 0 {
+            sigma2 = chi_squared_variances(wv, &model);
+        }
+        for c in 0..k {
+            let below = if c == 0 { lo.ln() } else { ts[c - 1].ln() + step };
+            let above = if c + 1 == k { hi.ln() } else { ts[c + 1].ln() - step };
+            let (a, b) = ((ts[c].ln() - step).max(below), (ts[c].ln() + step).min(above));
+            if a >= b {
+                continue;
+            }
+            let mut trial = ts.clone();
+            let mut eval = |x: f64| {
+                trial[c] = x.exp();
+                profile(wv, &lin, &trial, &nu, &sigma2)
+            };
+            ts[c] = golden_minimum(&mut eval, a, b, ts[c].ln()).exp();
+        }
+        let mut shapes = lin.clone();
+        shapes.extend(ts.iter().map(|&t| Shape::GaussMarkov(t)));
+        let x = design(wv, &shapes);
+        let (kept, theta, _) = nnls(&x, &nu, &sigma2);
+        model = kept.iter().zip(theta).map(|(&c, t)| (shapes[c], t)).collect();
+    }
+    if model.iter().filter(|m| matches!(m.0, Shape::GaussMarkov(_))).count() < k || n <= model.len() + k {
+        return None;
+    }
+    // Thin the linear processes by the criterion, the correlation times held.
+    let markov: Vec<Shape> = model.iter().map(|m| m.0).filter(|s| matches!(s, Shape::GaussMarkov(_))).collect();
+    let kept_linear: Vec<Shape> = model.iter().map(|m| m.0).filter(|s| matches!(s, Shape::Linear(_))).collect();
+    let mut all = kept_linear.clone();
+    all.extend(&markov);
+    let integrals = ShapeIntegrals::new(grid, &all);
+    let mut best_fit: Option<GmwmFit> = None;
+    for mask in 0u32..(1u32 << kept_linear.len()) {
+        let mut shapes: Vec<Shape> =
+            kept_linear.iter().enumerate().filter(|(i, _)| mask & (1 << i) != 0).map(|(_, &s)| s).collect();
+        shapes.extend(&markov);
+        let Ok((m, s2)) = fit_estimate(wv, &shapes, confidence) else { continue };
+        if m.iter().filter(|x| matches!(x.0, Shape::GaussMarkov(_))).count() < k {
+            continue;
+        }
+        let fit = finish(wv, &integrals, &m, &s2, confidence, (lo, hi));
+        if best_fit.as_ref().is_none_or(|b| fit.criterion < b.criterion - 1e-12) {
+            best_fit = Some(fit);
+        }
+    }
+    best_fit
+}
+
+/// Every k-tuple of increasing grid indices from `first` to `last`, at least [`MIN_GAP_STEPS`]
+/// apart.
+fn tuples(k: usize, first: usize, last: usize) -> Vec<Vec<usize>> {
+    if k == 0 {
+        return vec![Vec::new()];
+    }
+    let mut out = Vec::new();
+    for i in first..=last {
+        for mut rest in tuples(k - 1, i + MIN_GAP_STEPS, last) {
+            rest.insert(0, i);
+            out.push(rest);
+        }
+        if i + MIN_GAP_STEPS > last && k > 1 {
+            break;
+        }
+    }
+    out
+}
+
+/// The minimum of `f` over [a, b] by golden-section search from the bracket, `start` kept when
+/// nothing better is found.
+fn golden_minimum(f: &mut impl FnMut(f64) -> f64, a: f64, b: f64, start: f64) -> f64 {
+    let r = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut a, mut b) = (a, b);
+    let mut c = b - r * (b - a);
+    let mut d = a + r * (b - a);
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..GOLDEN_STEPS {
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - r * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + r * (b - a);
+            fd = f(d);
+        }
+    }
+    let (x, fx) = if fc < fd { (c, fc) } else { (d, fd) };
+    if fx <= f(start) {
+        x
+    } else {
+        start
+    }
+}
