@@ -245,7 +245,7 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
             let (mut markov_n2, mut markov_k2, mut as_white, mut as_walk) = (0.0, 0.0, 0usize, 0usize);
             for p in g.gauss_markov() {
                 let Some(t) = p.correlation_time else { continue };
-                match gauss_markov_filter_bound(p.value, t.value_s, tau_lo, tau_hi) {
+                match gauss_markov_filter_bound(p.value, t.value_s, a.curve.tau0_s, tau_lo, tau_hi) {
                     MarkovBound::White { n2 } => {
                         markov_n2 += n2;
                         as_white += 1;
@@ -275,7 +275,7 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
                     total2.sqrt(),
                     "gmwm_gauss_markov_bound".to_string(),
                     format!(
-                        "GMWM: {} plus {rule} bounding {extra} Gauss-Markov process(es) of the model (on or above its continuous-time Allan variance at every tau, the tighter of white noise 2 sigma^2 T and random walk 2 sigma^2 / T over the curve's taus; docs/METHODS.md 3.1), model {model}; {name}",
+                        "GMWM: {} plus {rule} bounding {extra} Gauss-Markov process(es) of the model (on or above its Allan variance at every tau, all sampled at the record's rate: the tighter of white noise sigma^2 tau0 (1 + phi) / (1 - phi), about 2 sigma^2 T, and random walk 2 sigma^2 / T over the curve's taus; docs/METHODS.md 3.1), model {model}; {name}",
                         match own {
                             Some(x) => format!("the estimate {} {unit}", real_text(x.value * to_si)),
                             None => "no term of its own".to_string(),
@@ -288,7 +288,7 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
                 markov_n2,
                 as_white,
                 if accel { "m/s^2/sqrt(Hz)" } else { "rad/s/sqrt(Hz)" },
-                "the white noise N^2 = 2 sigma^2 T",
+                "the white noise N^2 = sigma^2 tau0 (1 + phi) / (1 - phi)",
             );
             let random_walk = term(
                 Process::RandomWalk,
@@ -392,6 +392,9 @@ pub fn combine_terms(
             warnings.push(format!("{} not estimated: not written to the exports", what[i]));
             continue;
         };
+        if t.detail.contains("GMWM POOR FIT") {
+            warnings.push(format!("{} is from a GMWM POOR FIT in the exports: {}", what[i], t.detail));
+        }
         if t.basis == "upper_bound" || t.basis == "fit_value" {
             let kind = if t.basis == "upper_bound" { "an upper bound, not a value," } else { "a five-term fit value" };
             warnings.push(format!("{} is {kind} in the exports: {}", what[i], t.detail));

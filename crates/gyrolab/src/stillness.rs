@@ -432,6 +432,9 @@ pub fn gravity_check(axes: [&StillnessCheck; 3], tolerance_m_s2: f64) -> Option<
     let by_start = |c: &StillnessCheck| -> std::collections::HashMap<u64, f64> {
         c.window_means.iter().map(|&(s, m)| (s.to_bits(), m)).collect()
     };
+    if axes.iter().any(|c| c.window_means.iter().any(|(s, _)| !s.is_finite())) {
+        return None;
+    }
     let (ys, zs) = (by_start(axes[1]), by_start(axes[2]));
     for &(t, x) in &axes[0].window_means {
         if let (Some(&y), Some(&z)) = (ys.get(&t.to_bits()), zs.get(&t.to_bits())) {

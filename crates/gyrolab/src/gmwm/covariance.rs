@@ -90,7 +90,7 @@ fn points(
 
 /// The quadrature of the covariance integrals of one set of scales, made once and used for every
 /// model fitted to them: per pair of scales j <= k, the points f, sin^2(pi f) and their weights
-/// (the step, both Haar gains and the factor 2 / M x 2), so that a model's covariance is the
+/// (the step, both Haar gains and the factor 2 / sqrt(M_j M_k) x 2), so that a model's covariance is the
 /// weighted sum of its S(f)^2. The integral over [-1/2, 1/2] is twice that over (0, 1/2], in three
 /// parts: up to 32 / m_hi exactly (512 steps), then with the larger scale's oscillation averaged up
 /// to 32 / m_lo (512 steps), then both averaged (256 log steps).
@@ -113,7 +113,10 @@ impl CovarianceGrid {
                 let (m_lo, m_hi) = ((a.m.min(b.m)) as f64, (a.m.max(b.m)) as f64);
                 let f1 = (32.0 / m_hi).min(0.5);
                 let f2 = (32.0 / m_lo).min(0.5);
-                let terms = a.terms.min(b.terms).max(1) as f64;
+                // 2 / sqrt(M_j M_k): the matrix stays a scaled Gram matrix (positive
+                // semi-definite); 2 / min(M_j, M_k) raised the correlations of scales with
+                // different numbers of terms above 1.
+                let terms = ((a.terms.max(1) as f64) * (b.terms.max(1) as f64)).sqrt();
                 let scale = 2.0 / terms * 2.0;
                 let out = &mut pairs[j * n + k];
                 out.reserve(1280);

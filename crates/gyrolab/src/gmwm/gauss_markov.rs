@@ -72,10 +72,12 @@ pub fn gauss_markov_spectral_density(correlation_time_s: f64, tau0_s: f64, f: f6
 }
 
 /// How a filter without Gauss-Markov states takes a Gauss-Markov process: as the white noise or
-/// the random walk whose Allan variance lies on or above the process's at every tau.
+/// the random walk whose Allan variance lies on or above the process's at every tau, all three
+/// sampled at the record's rate.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum MarkovBound {
-    /// White rate noise of N^2 = 2 sigma^2 T (the process's long-tau limit).
+    /// White rate noise of N^2 = sigma^2 tau0 (1 + phi) / (1 - phi) (the sampled process's
+    /// long-tau limit; 2 sigma^2 T when T >> tau0).
     White {
         /// N^2, (curve unit)^2 s.
         n2: f64,
@@ -97,26 +99,39 @@ fn continuous_shape(x: f64) -> f64 {
     }
 }
 
-/// The bound of a Gauss-Markov process (sigma, T) a filter without its states can take over the
-/// taus `tau_min_s..tau_max_s` of a curve. Both bound the continuous-time process's Allan variance
-/// at every tau: white noise N^2 = 2 sigma^2 T (since h < 1) and the random walk K^2 = 2 sigma^2 /
-/// T (since h <= x^2 / 3). The one chosen is the tighter over the range: white noise exceeds the
-/// process most at tau_min, by 1 / h(tau_min / T); the random walk at tau_max, by (x^2 / 3) /
-/// h(x), x = tau_max / T.
+/// The bound of a Gauss-Markov process (sigma, T) sampled every `tau0_s` that a filter without
+/// its states can take over the taus `tau_min_s..tau_max_s` of a curve. Compared as sampled
+/// processes (the filter's own noise is sampled at the same rate), both bound the process at
+/// every tau: white noise of N^2 = sigma^2 tau0 (1 + phi) / (1 - phi), the sum of the process's
+/// autocovariance (m AVAR(m tau0) rises to it), and the random walk K^2 = 2 sigma^2 / T, whose
+/// sampled Allan variance u (2m^3/3 + m/3) sigma^2 / m^2 is the first term of the process's
+/// alternating series (module doc). The one chosen is the tighter over the range, judged on the
+/// continuous-time shape h: white noise exceeds the process most at tau_min, by 1 / h(tau_min /
+/// T); the random walk at tau_max, by (x^2 / 3) / h(x), x = tau_max / T.
 ///
 /// ```
 /// use gyrolab::gmwm::{gauss_markov_filter_bound, MarkovBound};
-/// // T = 0.01 s seen from 0.01 s to 1000 s acts as white noise, N^2 = 2 sigma^2 T.
-/// let b = gauss_markov_filter_bound(0.2, 0.01, 0.01, 1000.0);
-/// assert_eq!(b, MarkovBound::White { n2: 2.0 * 0.04 * 0.01 });
+/// // T = 1 s seen from 0.01 s to 1000 s by 100 Hz samples acts as white noise,
+/// // N^2 = sigma^2 tau0 (1 + phi) / (1 - phi), about 2 sigma^2 T.
+/// let MarkovBound::White { n2 } = gauss_markov_filter_bound(0.5, 1.0, 0.01, 0.01, 1000.0) else { panic!() };
+/// let phi = (-0.01f64).exp();
+/// assert!((n2 - 0.25 * 0.01 * (1.0 + phi) / (1.0 - phi)).abs() < 1e-12 * n2);
+/// assert!((n2 / (2.0 * 0.25 * 1.0) - 1.0).abs() < 1e-4);
 /// ```
-pub fn gauss_markov_filter_bound(sigma: f64, correlation_time_s: f64, tau_min_s: f64, tau_max_s: f64) -> MarkovBound {
+pub fn gauss_markov_filter_bound(
+    sigma: f64,
+    correlation_time_s: f64,
+    tau0_s: f64,
+    tau_min_s: f64,
+    tau_max_s: f64,
+) -> MarkovBound {
     let (s2, t) = (sigma * sigma, correlation_time_s);
     let white_excess = 1.0 / continuous_shape(tau_min_s / t);
     let x = tau_max_s / t;
     let walk_excess = x * x / 3.0 / continuous_shape(x);
     if white_excess <= walk_excess {
-        MarkovBound::White { n2: 2.0 * s2 * t }
+        let one_minus_phi = -(-tau0_s / t).exp_m1();
+        MarkovBound::White { n2: s2 * tau0_s * (2.0 - one_minus_phi) / one_minus_phi }
     } else {
         MarkovBound::RandomWalk { k2: 2.0 * s2 / t }
     }
@@ -177,22 +192,29 @@ mod tests {
     }
 
     #[test]
-    fn the_random_walk_of_its_short_tau_limit_bounds_it() {
-        // nu^2 <= (K^2 tau / 6) (1 + 1 / (2 m^2)), K^2 = 2 / T: the bound the filter exports
-        // use for a Gauss-Markov process (equality in the limit m u -> 0).
-        for &t in &[0.03, 1.0, 40.0, 3e3, 1e6] {
+    fn the_sampled_white_noise_and_random_walk_bound_it() {
+        // Sampled at tau0 = 0.01 s: nu^2 of the process <= that of white noise N^2 = sigma^2
+        // tau0 (1 + phi) / (1 - phi), N^2 / (2 m tau0), and <= that of the sampled random walk
+        // K^2 = 2 / T, K^2 tau0 (2 m^2 + 1) / (12 m) (sigma = 1), over 24 octaves.
+        let tau0: f64 = 0.01;
+        for &t in &[0.01, 0.03, 1.0, 40.0, 3e3, 1e6] {
+            let phi = (-tau0 / t).exp();
+            let n2 = tau0 * (1.0 + phi) / (1.0 - phi);
             for j in 0..24 {
                 let m = f64::from(1u32 << j);
-                let bound = 2.0 / t * (m * 0.01) / 6.0 * (1.0 + 1.0 / (2.0 * m * m));
-                let nu2 = gauss_markov_wavelet_variance(t, 0.01, m);
-                assert!(nu2 <= bound * (1.0 + 1e-12), "T {t} m {m}: {nu2} > {bound}");
+                let nu2 = gauss_markov_wavelet_variance(t, tau0, m);
+                let white = n2 / (2.0 * m * tau0);
+                let walk = 2.0 / t * tau0 * (2.0 * m * m + 1.0) / (12.0 * m);
+                assert!(nu2 <= white * (1.0 + 1e-9), "T {t} m {m}: {nu2} > white {white}");
+                assert!(nu2 <= walk * (1.0 + 1e-12), "T {t} m {m}: {nu2} > walk {walk}");
             }
         }
     }
 
     #[test]
     fn the_filter_bound_lies_on_or_above_the_process() {
-        // Both bounds above the continuous-time Allan variance at every tau; the choice follows T.
+        // Both continuous-time bounds above the continuous-time Allan variance at every tau; the
+        // choice follows T.
         for &t in &[0.01, 0.5, 30.0, 2000.0] {
             for j in 0..40 {
                 let tau = 0.01 * 1.5f64.powi(j);
@@ -200,13 +222,17 @@ mod tests {
                 assert!(2.0 * t / tau >= avar && 2.0 / t * tau / 3.0 >= avar * (1.0 - 1e-12), "T {t} tau {tau}");
             }
         }
-        assert!(matches!(gauss_markov_filter_bound(1.0, 0.02, 0.01, 1000.0), MarkovBound::White { .. }));
-        assert!(matches!(gauss_markov_filter_bound(1.0, 800.0, 0.01, 1000.0), MarkovBound::RandomWalk { .. }));
+        assert!(matches!(gauss_markov_filter_bound(1.0, 0.02, 0.01, 0.01, 1000.0), MarkovBound::White { .. }));
+        assert!(matches!(gauss_markov_filter_bound(1.0, 800.0, 0.01, 0.01, 1000.0), MarkovBound::RandomWalk { .. }));
         // A process the record sees from both sides: the tighter bound over the range.
-        let b = gauss_markov_filter_bound(1.0, 3.0, 0.01, 1000.0);
+        let b = gauss_markov_filter_bound(1.0, 3.0, 0.01, 0.01, 1000.0);
         let white = 1.0 / continuous_shape(0.01 / 3.0);
         let walk = (1000.0f64 / 3.0).powi(2) / 3.0 / continuous_shape(1000.0 / 3.0);
         assert_eq!(matches!(b, MarkovBound::White { .. }), white <= walk, "{b:?} {white} {walk}");
+        // At T = tau0 the sampled white noise is 8 % above 2 sigma^2 T.
+        let MarkovBound::White { n2 } = gauss_markov_filter_bound(1.0, 0.01, 0.01, 0.01, 1000.0) else { panic!() };
+        let phi = (-1.0f64).exp();
+        assert!((n2 / (0.01 * (1.0 + phi) / (1.0 - phi)) - 1.0).abs() < 1e-12 && n2 > 1.08 * 0.02);
     }
 
     #[test]

@@ -229,7 +229,7 @@ pub struct GmwmFit {
     pub objective: f64,
     /// The estimated optimism of the objective, 2 tr(Omega H Sigma) (H the fit's hat matrix,
     /// Sigma the wavelet variances' covariance under the fitted model); 2 x parameters when Omega
-    /// = Sigma^-1.
+    /// = Sigma^-1. Infinite (the model not eligible) when the covariance cannot be made.
     pub optimism: f64,
     /// The model-choice criterion (wavelet information criterion): objective + optimism (smaller
     /// is better).
@@ -526,7 +526,9 @@ fn finish(
         if let Shape::GaussMarkov(tc) = shape {
             let s = se(i);
             i += 1;
-            let edge = |b: f64| b.is_finite() && (tc / b - 1.0).abs() < 1e-6;
+            // Within 1e-4 in ln T of an end of the range searched (golden-section steps stop
+            // short of the ends by a few 1e-6).
+            let edge = |b: f64| b.is_finite() && (tc / b).ln().abs() < 1e-4;
             par.correlation_time = Some(CorrelationTime {
                 value_s: tc,
                 lower_s: tc * (-z * s).exp(),
@@ -536,7 +538,9 @@ fn finish(
         }
         parameters.push(par);
     }
-    let optimism = if optimism.is_finite() { optimism } else { 2.0 * i as f64 };
+    // A model whose covariance could not be made (a singular information matrix: a correlation
+    // time collinear with another term) is not eligible: no optimism, an infinite criterion.
+    let optimism = if optimism.is_finite() && optimism >= 0.0 { optimism } else { f64::INFINITY };
     let weighted_rms_residual = (objective / wv.len() as f64).sqrt();
     let quality = if weighted_rms_residual > crate::noise::FIT_RMS_LIMIT {
         crate::noise::FitQuality::Poor

@@ -81,7 +81,7 @@ fn select_linear(
 /// `max_gauss_markov` first-order Gauss-Markov processes. Their correlation times are searched
 /// between the first and the last scale: a grid of one per octave (two processes at least two
 /// octaves apart), then each ln T refined by golden section within a grid step, again after
-/// each reweighting of Omega; the linear processes of each such model are then thinned by the
+/// each reweighting of Omega (at most [`MAX_GAUSS_MARKOV`] processes, whatever is asked); the linear processes of each such model are then thinned by the
 /// criterion with the correlation times held.
 pub fn select_model_with_gauss_markov(
     wv: &[WaveletVariance],
@@ -91,6 +91,7 @@ pub fn select_model_with_gauss_markov(
 ) -> Result<GmwmFit, GmwmError> {
     let grid = CovarianceGrid::new(wv);
     let mut best = select_linear(wv, &grid, candidates, confidence)?;
+    let max_gauss_markov = max_gauss_markov.min(MAX_GAUSS_MARKOV);
     let linear: Vec<Process> =
         candidates.iter().copied().filter(|p| !matches!(p, Process::GaussMarkov | Process::Flicker)).collect();
     for k in 1..=max_gauss_markov {
@@ -161,8 +162,10 @@ fn gauss_markov_model(
             sigma2 = chi_squared_variances(wv, &model);
         }
         for c in 0..k {
-            let below = if c == 0 { lo.ln() } else { ts[c - 1].ln() + step };
-            let above = if c + 1 == k { hi.ln() } else { ts[c + 1].ln() - step };
+            // Two processes stay at least MIN_GAP_STEPS grid steps apart.
+            let gap = MIN_GAP_STEPS as f64 * step;
+            let below = if c == 0 { lo.ln() } else { ts[c - 1].ln() + gap };
+            let above = if c + 1 == k { hi.ln() } else { ts[c + 1].ln() - gap };
             let (a, b) = ((ts[c].ln() - step).max(below), (ts[c].ln() + step).min(above));
             if a >= b {
                 continue;
@@ -225,10 +228,11 @@ fn tuples(k: usize, first: usize, last: usize) -> Vec<Vec<usize>> {
     out
 }
 
-/// The minimum of `f` over [a, b] by golden-section search from the bracket, `start` kept when
-/// nothing better is found.
+/// The minimum of `f` over [a, b] by golden-section search, the ends and `start` also tried (a
+/// minimum at an end is returned exactly there).
 fn golden_minimum(f: &mut impl FnMut(f64) -> f64, a: f64, b: f64, start: f64) -> f64 {
     let r = (5f64.sqrt() - 1.0) / 2.0;
+    let (a0, b0) = (a, b);
     let (mut a, mut b) = (a, b);
     let mut c = b - r * (b - a);
     let mut d = a + r * (b - a);
@@ -248,10 +252,18 @@ fn golden_minimum(f: &mut impl FnMut(f64) -> f64, a: f64, b: f64, start: f64) ->
             fd = f(d);
         }
     }
-    let (x, fx) = if fc < fd { (c, fc) } else { (d, fd) };
-    if fx <= f(start) {
-        x
-    } else {
-        start
+    let mut best = (start, f(start));
+    for x in [c, d, a0, b0] {
+        let fx = if x == c {
+            fc
+        } else if x == d {
+            fd
+        } else {
+            f(x)
+        };
+        if fx < best.1 {
+            best = (x, fx);
+        }
     }
+    best.0
 }
