@@ -398,6 +398,9 @@ table.sign-off td:nth-child(2) { min-width: 160px; }
 section.sign-off { break-inside: avoid; page-break-inside: avoid; }
 tr { break-inside: avoid; page-break-inside: avoid; }
 @page { size: A4; margin: 14mm 12mm; }
+/* No ligatures: report numbers, hashes and identifiers copy out of the PDF as typed ("ff", not
+   the single glyph U+FB00). */
+html { font-variant-ligatures: none; font-feature-settings: "liga" 0, "clig" 0; }
 @media print {
   body { max-width: none; padding: 0; font-size: 10pt; }
   * { -webkit-print-color-adjust: exact; print-color-adjust: exact; }
@@ -674,7 +677,7 @@ fn page_style(report_number: &str) -> String {
         })
         .collect();
     format!(
-        "\n@page {{ @bottom-left {{ content: \"Report {number}\"; font-size: 8pt; color: #333; }} \
+        "\n@page {{ @bottom-left {{ content: \"Report {number}\"; font-size: 8pt; color: #333; font-variant-ligatures: none; }} \
          @bottom-right {{ content: \"page \" counter(page) \" of \" counter(pages); font-size: 8pt; color: #333; }} }}\n"
     )
 }
@@ -953,5 +956,11 @@ mod tests {
             h.contains("href=\"#def-bias_stability_dph_-T-s\"") && h.contains("id=\"def-bias_stability_dph_-T-s\"")
         );
         assert!(!h.contains("<script"));
+        // No ligatures anywhere, the page margins included: "dba4ebff" copies out of the PDF as
+        // typed (pypdf read Chromium's "ff" ligature as U+FB00 and the report number failed to
+        // match; crates/gyrolab-cli/tests/pdf.rs).
+        assert!(h.contains("html { font-variant-ligatures: none;"));
+        assert!(page_style("GYR-1-ff")
+            .contains("Report GYR-1-ff\"; font-size: 8pt; color: #333; font-variant-ligatures: none;"));
     }
 }
