@@ -22,6 +22,9 @@ fi
 # and removed at exit; installs the Debian package postgresql when missing): docs/STORE.md.
 source scripts/pg-test-server.sh start
 cargo test --workspace --all-targets
+# The documentation examples (`--all-targets` leaves doctests out): each public formula's example
+# with its published or hand value runs here.
+cargo test --workspace --doc
 bin=target/debug/gyrolab
 # Both are built by the line above; should a cargo version not leave them there, build them (once).
 if [ ! -x "$bin" ]; then

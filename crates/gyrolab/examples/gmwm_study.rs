@@ -131,8 +131,8 @@ fn main() {
             ],
         ),
     ];
-    println!("| model | term | slope lines: bias / RMSE (n resolved) | five-term fit: bias / RMSE (n) | GMWM: bias / RMSE (n) | GMWM 68.3 % coverage |");
-    println!("|---|---|---|---|---|---|");
+    println!("| model | term | slope lines: bias / RMSE (n resolved) | five-term fit: bias / RMSE (n) | GMWM: bias / RMSE (n) | GMWM 68.3 % coverage | coverage where the chosen model holds the term |");
+    println!("|---|---|---|---|---|---|---|");
     for (label, set, terms) in &models {
         let mut model = SensorModel::default();
         set(&mut model);
@@ -205,14 +205,17 @@ fn main() {
             }
         }
         for (i, t) in terms.iter().enumerate() {
+            let held = gm[i].n.max(1) as f64;
             println!(
-                "| {label} | {} | {} | {} | {} | {:.1} % of {} |",
+                "| {label} | {} | {} | {} | {} | {:.1} % of {} | {:.1} % of {} |",
                 t.name,
                 slope[i].text(),
                 fit[i].text(),
                 gm[i].text(),
                 100.0 * covered[i] as f64 / seeds as f64,
-                seeds
+                seeds,
+                100.0 * covered[i] as f64 / held,
+                gm[i].n
             );
         }
         eprintln!(

@@ -15,6 +15,15 @@
 //! (deterministic); a first-order Gauss-Markov process of variance sigma^2: sigma^2 times its AR(1)
 //! spectrum (module `gauss_markov`). Each reproduces its AVAR of IEEE 952 annex C at long averaging
 //! times.
+//!
+//! A drift is deterministic: its Haar coefficients are one constant c_j per scale (c_j^2 its
+//! wavelet variance), so nu_hat^2_j = c_j^2 + 2 c_j e_bar_j + mean(e^2), e the coefficients of the
+//! rest. Beside the stochastic part's variance this adds 4 c_j^2 var(e_bar_j) (the third moments of
+//! a Gaussian rest vanish). The mean of M Haar coefficients at averaging factor m telescopes to
+//! half the difference of two averages of M m-sample means, m samples apart, so var(e_bar_j) =
+//! integral over [-1/2, 1/2] of |H_j(f)|^2 F_M(f) S(f) df with the Fejer kernel F_M(f) =
+//! sin^2(pi f M) / (M^2 sin^2(pi f)) (derived here from the filters above; white noise gives m /
+//! (3 M^2) sigma^2 per sample when M >= 2m, the hand value of the tests).
 
 use super::{Process, Shape, WaveletVariance};
 
@@ -88,6 +97,39 @@ fn points(
     }
 }
 
+/// Midpoint-rule points of |H_j(f)|^2 F_M(f) (Haar gain at averaging factor `m`, Fejer kernel
+/// of `terms` = M terms) over (a, b] in `n` steps (uniform, or uniform in log f when `log`), each
+/// oscillation averaged where asked (sin^4 to 3/8, sin^2 to 1/2), appended as (f, sin^2(pi f),
+/// step x kernel x `scale`).
+#[allow(clippy::too_many_arguments)]
+fn mean_points(
+    out: &mut Vec<[f64; 3]>,
+    (m, avg_m): (f64, bool),
+    (terms, avg_terms): (f64, bool),
+    a: f64,
+    b: f64,
+    n: usize,
+    log: bool,
+    scale: f64,
+) {
+    if b <= a {
+        return;
+    }
+    for i in 0..n {
+        let u = (i as f64 + 0.5) / n as f64;
+        let (f, w) = if log {
+            let f = a * (b / a).powf(u);
+            (f, f * (b / a).ln() / n as f64)
+        } else {
+            (a + u * (b - a), (b - a) / n as f64)
+        };
+        let s = (std::f64::consts::PI * f).sin();
+        let fejer_num = if avg_terms { 0.5 } else { (std::f64::consts::PI * f * terms).sin().powi(2) };
+        let fejer = fejer_num / (terms * terms * s * s);
+        out.push([f, s * s, scale * w * haar_gain(m, f, avg_m) * fejer]);
+    }
+}
+
 /// The quadrature of the covariance integrals of one set of scales, made once and used for every
 /// model fitted to them: per pair of scales j <= k, the points f, sin^2(pi f) and their weights
 /// (the step, both Haar gains and the factor 2 / sqrt(M_j M_k) x 2), so that a model's covariance is the
@@ -99,6 +141,9 @@ pub struct CovarianceGrid {
     tau0_s: f64,
     /// Points of pair (j, k), j <= k, at index j n + k.
     pairs: Vec<Vec<[f64; 3]>>,
+    /// Points of the variance of the mean coefficient at scale j (module notes: the drift's
+    /// cross term), each weight the step times |H_j|^2 F_M times 2 (both halves of the band).
+    means: Vec<Vec<[f64; 3]>>,
 }
 
 impl CovarianceGrid {
@@ -125,7 +170,53 @@ impl CovarianceGrid {
                 points(out, (m_lo, true), (m_hi, true), f2, 0.5, 256, true, scale);
             }
         }
-        CovarianceGrid { n, tau0_s, pairs }
+        let means = wv
+            .iter()
+            .map(|w| {
+                let (m, terms) = (w.m as f64, w.terms.max(1) as f64);
+                let (lo, hi) = (m.min(terms), m.max(terms));
+                let (f1, f2) = ((32.0 / hi).min(0.5), (32.0 / lo).min(0.5));
+                // Which oscillation is averaged first: the faster one (the larger of m and M).
+                let fast_is_m = m >= terms;
+                let mut out = Vec::with_capacity(1280);
+                mean_points(&mut out, (m, false), (terms, false), 0.0, f1, 512, false, 2.0);
+                mean_points(&mut out, (m, fast_is_m), (terms, !fast_is_m), f1, f2, 512, false, 2.0);
+                mean_points(&mut out, (m, true), (terms, true), f2, 0.5, 256, true, 2.0);
+                out
+            })
+            .collect();
+        CovarianceGrid { n, tau0_s, pairs, means }
+    }
+
+    /// The variances of the wavelet-variance estimates under `model` (the diagonal of
+    /// [`CovarianceGrid::covariance`] plus a drift's cross term, module notes), (curve unit)^4.
+    pub fn variances(&self, wv: &[WaveletVariance], model: &[(Shape, f64)]) -> Vec<f64> {
+        let prepared = prepare(model, self.tau0_s);
+        let drift = Shape::Linear(Process::Drift);
+        let weight: f64 = model.iter().filter(|(s, _)| *s == drift).map(|(_, t)| *t).sum();
+        let means = if weight > 0.0 { self.mean_coefficient_variance(model) } else { vec![0.0; self.n] };
+        (0..self.n)
+            .map(|j| {
+                let spectral: f64 = self.pairs[j * self.n + j]
+                    .iter()
+                    .map(|&[f, s2, w]| {
+                        let s = spectral_density(&prepared, self.tau0_s, f, s2);
+                        w * s * s
+                    })
+                    .sum();
+                spectral + wv.get(j).map_or(0.0, |w| 4.0 * weight * drift.unit(w) * means[j])
+            })
+            .collect()
+    }
+
+    /// The variance of the mean of the wavelet coefficients at each scale under the stochastic
+    /// part of `model` (its drift has no spectrum), (curve unit)^2 (module notes).
+    pub fn mean_coefficient_variance(&self, model: &[(Shape, f64)]) -> Vec<f64> {
+        let prepared = prepare(model, self.tau0_s);
+        self.means
+            .iter()
+            .map(|pts| pts.iter().map(|&[f, s2, w]| w * spectral_density(&prepared, self.tau0_s, f, s2)).sum())
+            .collect()
     }
 
     /// Covariance matrix of the wavelet-variance estimates under the model (shape, weight: the
@@ -161,6 +252,8 @@ pub struct ShapeIntegrals {
     n: usize,
     /// Index (a, b), a <= b, at a p + b; each over the pairs of scales at j n + k.
     values: Vec<Vec<f64>>,
+    /// Per shape, per scale: the variance of the mean coefficient per unit weight.
+    means: Vec<Vec<f64>>,
 }
 
 impl ShapeIntegrals {
@@ -194,7 +287,29 @@ impl ShapeIntegrals {
                 }
             }
         }
-        ShapeIntegrals { shapes: shapes.to_vec(), n, values }
+        let means = unit.iter().map(|term| grid.mean_coefficient_variance(std::slice::from_ref(term))).collect();
+        ShapeIntegrals { shapes: shapes.to_vec(), n, values, means }
+    }
+
+    /// The drift's cross term 4 c_j^2 var(e_bar_j) at each scale under `model` (module notes),
+    /// (curve unit)^4: zero without a drift. `None` when a shape is not among these.
+    pub fn drift_cross_variance(&self, wv: &[WaveletVariance], model: &[(Shape, f64)]) -> Option<Vec<f64>> {
+        let drift = Shape::Linear(Process::Drift);
+        let weight: f64 = model.iter().filter(|(s, _)| *s == drift).map(|(_, t)| *t).sum();
+        let mut out = vec![0.0; self.n];
+        if weight <= 0.0 {
+            return Some(out);
+        }
+        for (s, t) in model {
+            let a = self.shapes.iter().position(|x| x == s)?;
+            for (o, v) in out.iter_mut().zip(&self.means[a]) {
+                *o += t * v;
+            }
+        }
+        for (o, w) in out.iter_mut().zip(wv) {
+            *o *= 4.0 * weight * drift.unit(w);
+        }
+        Some(out)
     }
 
     /// The covariance of the wavelet-variance estimates under `model`, whose shapes must all be

@@ -12,7 +12,7 @@
 //! variances' covariance under the fitted model (2 x parameters when Omega = Sigma^-1, the AIC
 //! penalty). The GMWM authors estimate the same optimism by simulation instead.
 
-use super::{check, chi_squared_variances, design, finish, fit_estimate, nnls};
+use super::{check, design, finish, fit_estimate, nnls, omega_variances};
 use super::{CovarianceGrid, GmwmError, GmwmFit, Process, Shape, ShapeIntegrals, WaveletVariance, PROCESSES, ROUNDS};
 use crate::allan::AllanCurve;
 
@@ -33,46 +33,46 @@ const GOLDEN_STEPS: usize = 24;
 /// every non-empty subset of the linear processes in `candidates` ([`Process::GaussMarkov`] in
 /// it is ignored; see [`select_model_with_gauss_markov`]).
 pub fn select_model(wv: &[WaveletVariance], candidates: &[Process], confidence: f64) -> Result<GmwmFit, GmwmError> {
-    select_linear(wv, &CovarianceGrid::new(wv), candidates, confidence)
+    select_model_with_gauss_markov(wv, candidates, 0, confidence)
 }
 
-/// [`select_model`] with the scales' quadrature made.
-fn select_linear(
+/// A model fitted for the comparison: its terms and weights, the variances of its Omega, the
+/// range of correlation times searched, and which [`ShapeIntegrals`] hold its shapes.
+struct Candidate {
+    model: Vec<(Shape, f64)>,
+    sigma2: Vec<f64>,
+    search: (f64, f64),
+    integrals: usize,
+}
+
+/// Every subset of the linear processes `linear` fitted (subsets whose fit drops the same
+/// processes kept once), with the last error when none could be fitted.
+fn linear_candidates(
     wv: &[WaveletVariance],
     grid: &CovarianceGrid,
-    candidates: &[Process],
+    linear: &[Process],
     confidence: f64,
-) -> Result<GmwmFit, GmwmError> {
-    let linear: Vec<Process> = candidates.iter().copied().filter(|p| *p != Process::GaussMarkov).collect();
-    let shapes: Vec<Shape> = linear.iter().map(|&p| Shape::Linear(p)).collect();
-    let integrals = ShapeIntegrals::new(grid, &shapes);
-    let mut best: Option<GmwmFit> = None;
+    integrals: usize,
+    out: &mut Vec<Candidate>,
+) -> Option<GmwmError> {
     let mut last_err = None;
     let mut seen: Vec<Vec<Process>> = Vec::new();
     for mask in 1u32..(1u32 << linear.len()) {
         let set: Vec<Shape> =
             linear.iter().enumerate().filter(|(i, _)| mask & (1 << i) != 0).map(|(_, &p)| Shape::Linear(p)).collect();
-        match fit_estimate(wv, &set, confidence) {
+        match fit_estimate(wv, grid, &set, confidence) {
             Ok((model, sigma2)) => {
-                // Subsets whose fit drops the same processes give the same model: judged once.
                 let kept: Vec<Process> = model.iter().map(|m| m.0.process()).collect();
                 if kept.is_empty() || seen.contains(&kept) {
                     continue;
                 }
                 seen.push(kept);
-                let fit = finish(wv, &integrals, &model, &sigma2, confidence, (0.0, f64::INFINITY));
-                if best.as_ref().is_none_or(|b| fit.criterion < b.criterion - 1e-12) {
-                    best = Some(fit);
-                }
+                out.push(Candidate { model, sigma2, search: (0.0, f64::INFINITY), integrals });
             }
             Err(e) => last_err = Some(e),
         }
     }
-    match (best, last_err) {
-        (Some(b), _) => Ok(b),
-        (None, Some(e)) => Err(e),
-        (None, None) => Err(GmwmError::TooFewScales { scales: wv.len(), parameters: 0 }),
-    }
+    last_err
 }
 
 /// The GMWM fit with the model chosen by the criterion over the linear models of
@@ -81,8 +81,10 @@ fn select_linear(
 /// `max_gauss_markov` first-order Gauss-Markov processes. Their correlation times are searched
 /// between the first and the last scale: a grid of one per octave (two processes at least two
 /// octaves apart), then each ln T refined by golden section within a grid step, again after
-/// each reweighting of Omega (at most [`MAX_GAUSS_MARKOV`] processes, whatever is asked); the linear processes of each such model are then thinned by the
-/// criterion with the correlation times held.
+/// each reweighting of Omega (at most [`MAX_GAUSS_MARKOV`] processes, whatever is asked); each
+/// such model is then offered with every subset of the linear processes searched, the
+/// correlation times held (every subset, not only of those the search's fit kept: that fit may
+/// keep a drift where a random walk describes the curve as well).
 pub fn select_model_with_gauss_markov(
     wv: &[WaveletVariance],
     candidates: &[Process],
@@ -90,17 +92,26 @@ pub fn select_model_with_gauss_markov(
     confidence: f64,
 ) -> Result<GmwmFit, GmwmError> {
     let grid = CovarianceGrid::new(wv);
-    let mut best = select_linear(wv, &grid, candidates, confidence)?;
+    let linear: Vec<Process> = candidates.iter().copied().filter(|p| *p != Process::GaussMarkov).collect();
+    let mut integrals = vec![ShapeIntegrals::new(&grid, &linear.iter().map(|&p| Shape::Linear(p)).collect::<Vec<_>>())];
+    let mut all = Vec::new();
+    let last_err = linear_candidates(wv, &grid, &linear, confidence, 0, &mut all);
     let max_gauss_markov = max_gauss_markov.min(MAX_GAUSS_MARKOV);
-    let linear: Vec<Process> =
-        candidates.iter().copied().filter(|p| !matches!(p, Process::GaussMarkov | Process::Flicker)).collect();
+    let without_flicker: Vec<Process> = linear.iter().copied().filter(|p| *p != Process::Flicker).collect();
     for k in 1..=max_gauss_markov {
-        let Some(fit) = gauss_markov_model(wv, &grid, &linear, k, confidence) else { continue };
-        if fit.criterion < best.criterion - 1e-12 {
-            best = fit;
+        gauss_markov_candidates(wv, &grid, &without_flicker, k, confidence, &mut integrals, &mut all);
+    }
+    let mut best: Option<GmwmFit> = None;
+    for c in &all {
+        let fit = finish(wv, &integrals[c.integrals], &c.model, &c.sigma2, confidence, c.search);
+        if best.as_ref().is_none_or(|b| fit.criterion < b.criterion - 1e-12) {
+            best = Some(fit);
         }
     }
-    Ok(best)
+    match best {
+        Some(b) => Ok(b),
+        None => Err(last_err.unwrap_or(GmwmError::TooFewScales { scales: wv.len(), parameters: 0 })),
+    }
 }
 
 /// GMWM of an octave Allan curve with the model chosen over every process ([`PROCESSES`] and up
@@ -125,15 +136,18 @@ fn profile(wv: &[WaveletVariance], linear: &[Shape], ts: &[f64], nu: &[f64], sig
     }
 }
 
-/// The best model with `k` Gauss-Markov processes and the linear processes `linear`; `None` when
-/// the record has too few scales or no fit keeps all `k` processes.
-fn gauss_markov_model(
+/// The models with `k` Gauss-Markov processes (correlation times searched) and each subset of
+/// the linear processes `linear` the search kept, added to `out` (their shapes' integrals to
+/// `integrals`); nothing when the record has too few scales or no fit keeps all `k` processes.
+fn gauss_markov_candidates(
     wv: &[WaveletVariance],
     grid: &CovarianceGrid,
     linear: &[Process],
     k: usize,
     confidence: f64,
-) -> Option<GmwmFit> {
+    integrals: &mut Vec<ShapeIntegrals>,
+    out: &mut Vec<Candidate>,
+) -> Option<()> {
     let n = wv.len();
     check(wv, 2 * k + 1, confidence).ok()?;
     let (lo, hi) = (wv.first()?.tau_s, wv.last()?.tau_s);
@@ -144,7 +158,7 @@ fn gauss_markov_model(
     let times: Vec<f64> = (0..=steps).map(|i| lo * 2f64.powf(i as f64 / GRID_PER_OCTAVE)).collect();
     let lin: Vec<Shape> = linear.iter().map(|&p| Shape::Linear(p)).collect();
     let nu: Vec<f64> = wv.iter().map(|w| w.nu2).collect();
-    let mut sigma2 = chi_squared_variances(wv, &[]);
+    let mut sigma2 = omega_variances(wv, grid, &[]);
     // The grid: every k-tuple of increasing indices at least MIN_GAP_STEPS apart.
     let mut best: Option<(f64, Vec<f64>)> = None;
     for idx in tuples(k, 0, steps) {
@@ -159,7 +173,7 @@ fn gauss_markov_model(
     let mut model = Vec::new();
     for round in 0..ROUNDS {
         if round > 0 {
-            sigma2 = chi_squared_variances(wv, &model);
+            sigma2 = omega_variances(wv, grid, &model);
         }
         for c in 0..k {
             // Two processes stay at least MIN_GAP_STEPS grid steps apart.
@@ -186,27 +200,28 @@ fn gauss_markov_model(
     if model.iter().filter(|m| matches!(m.0, Shape::GaussMarkov(_))).count() < k || n <= model.len() + k {
         return None;
     }
-    // Thin the linear processes by the criterion, the correlation times held.
+    // Every subset of the linear processes searched, not only of those the search's fit kept (it
+    // may keep a drift where a random walk describes the curve as well: the two are close at the
+    // last scales), the correlation times held; judged by the criterion with the other candidates.
     let markov: Vec<Shape> = model.iter().map(|m| m.0).filter(|s| matches!(s, Shape::GaussMarkov(_))).collect();
-    let kept_linear: Vec<Shape> = model.iter().map(|m| m.0).filter(|s| matches!(s, Shape::Linear(_))).collect();
-    let mut all = kept_linear.clone();
+    let mut all = lin.clone();
     all.extend(&markov);
-    let integrals = ShapeIntegrals::new(grid, &all);
-    let mut best_fit: Option<GmwmFit> = None;
-    for mask in 0u32..(1u32 << kept_linear.len()) {
+    integrals.push(ShapeIntegrals::new(grid, &all));
+    let index = integrals.len() - 1;
+    let mut seen: Vec<Vec<Shape>> = Vec::new();
+    for mask in 0u32..(1u32 << lin.len()) {
         let mut shapes: Vec<Shape> =
-            kept_linear.iter().enumerate().filter(|(i, _)| mask & (1 << i) != 0).map(|(_, &s)| s).collect();
+            lin.iter().enumerate().filter(|(i, _)| mask & (1 << i) != 0).map(|(_, &s)| s).collect();
         shapes.extend(&markov);
-        let Ok((m, s2)) = fit_estimate(wv, &shapes, confidence) else { continue };
-        if m.iter().filter(|x| matches!(x.0, Shape::GaussMarkov(_))).count() < k {
+        let Ok((m, s2)) = fit_estimate(wv, grid, &shapes, confidence) else { continue };
+        let kept: Vec<Shape> = m.iter().map(|x| x.0).collect();
+        if kept.iter().filter(|x| matches!(x, Shape::GaussMarkov(_))).count() < k || seen.contains(&kept) {
             continue;
         }
-        let fit = finish(wv, &integrals, &m, &s2, confidence, (lo, hi));
-        if best_fit.as_ref().is_none_or(|b| fit.criterion < b.criterion - 1e-12) {
-            best_fit = Some(fit);
-        }
+        seen.push(kept);
+        out.push(Candidate { model: m, sigma2: s2, search: (lo, hi), integrals: index });
     }
-    best_fit
+    Some(())
 }
 
 /// Every k-tuple of increasing grid indices from `first` to `last`, at least [`MIN_GAP_STEPS`]
