@@ -22,8 +22,11 @@
 //! a Gaussian rest vanish). The mean of M Haar coefficients at averaging factor m telescopes to
 //! half the difference of two averages of M m-sample means, m samples apart, so var(e_bar_j) =
 //! integral over [-1/2, 1/2] of |H_j(f)|^2 F_M(f) S(f) df with the Fejer kernel F_M(f) =
-//! sin^2(pi f M) / (M^2 sin^2(pi f)) (derived here from the filters above; white noise gives m /
-//! (3 M^2) sigma^2 per sample when M >= 2m, the hand value of the tests).
+//! sin^2(pi f M) / (M^2 sin^2(pi f)) (derived here from the filters above; white noise of variance
+//! sigma^2 per sample gives (2 m^2 + 1) sigma^2 / (6 m M^2) when M >= 2m - 1, and the tests check
+//! it and a random walk against direct sums of the coefficients' weights). On a record with gaps
+//! the means telescope once per segment; the term is then understated (not corrected: a curve
+//! does not carry its segments).
 
 use super::{Process, Shape, WaveletVariance};
 

@@ -284,12 +284,12 @@ impl GmwmFit {
 /// A fitted model: each term with its weight (squared coefficient, or a Gauss-Markov sigma^2).
 type Model = Vec<(Shape, f64)>;
 
-/// Reweighting rounds: Omega evaluated at nu_hat, then at the fitted nu(theta).
+/// Reweighting rounds: Omega from the estimates (chi-squared), then from the fitted model's variances.
 const ROUNDS: usize = 4;
 
 /// GMWM fit of a given set of linear processes (at least one; not [`Process::GaussMarkov`]) to
 /// the wavelet variance: non-negative weighted least squares in the squared coefficients with
-/// Omega = diag(1 / var(nu_hat_j)), the variances under the fitted model
+/// Omega = diag(1 / var(nu_hat^2_j)), the variances under the fitted model
 /// ([`CovarianceGrid::variances`]; in the first round the chi-squared 2 nu_hat_j^4 / edf_j at the
 /// estimates). Processes whose weight is zero at the optimum are left out of the result.
 /// Intervals: theta +- z sqrt(var), var from the sandwich covariance with the wavelet variances'
@@ -441,14 +441,19 @@ fn jacobian(wv: &[WaveletVariance], model: &[(Shape, f64)]) -> Vec<Vec<f64>> {
 }
 
 /// The covariance of the wavelet-variance estimates across scales under a fitted model,
-/// (curve unit)^4: the large-sample spectral covariance ([`wavelet_variance_covariance`]) with a
-/// drift's cross term 4 c_j^2 var(e_bar_j) on its diagonal
-/// ([`ShapeIntegrals::drift_cross_variance`]), the spectral correlations kept. Checked against
-/// the covariance of the estimates over simulated records (tests: within their sampling error
-/// at every scale, with and without a drift). The chi-squared variance 2 nu^4 / edf is not used
-/// here: with the curve's equivalent degrees of freedom it overstated the variance up to 1.5
-/// times at middle scales, and without bound at scales a drift dominates. `None` when a shape is
-/// not among `integrals`.
+/// (curve unit)^4: the large-sample spectral covariance S ([`wavelet_variance_covariance`]) plus
+/// a drift's cross terms C ([`ShapeIntegrals::drift_cross_variance`]) correlated as the spectral
+/// part is: Sigma_jk = S_jk + rho_jk sqrt(C_j C_k), rho_jk = S_jk / sqrt(S_jj S_kk) (a sum of two
+/// positive semi-definite matrices; the correlation of the coefficients' means across scales
+/// equals the spectral one for white noise). The diagonal is checked against the variance of the
+/// estimates over simulated records (test `scale_covariance_equals_the_spread_over_simulated_
+/// records`, with and without a drift). The large-sample formula drops the (1 - |lag| / M)
+/// weighting of the coefficients' autocovariance, so it overstates the variance where a scale has
+/// few coefficients per filter width: by about 1 / 0.75 at the last scale of a white-noise record
+/// (M = 2m + 1), 1 / 0.92 one octave below (conservative; not corrected). The chi-squared variance
+/// 2 nu^4 / edf is not used here: with the curve's equivalent degrees of freedom it overstated the
+/// variance up to 1.5 times at middle scales, and without bound at scales a drift dominates.
+/// `None` when a shape is not among `integrals`.
 pub(crate) fn scale_covariance(
     wv: &[WaveletVariance],
     integrals: &ShapeIntegrals,
@@ -457,15 +462,14 @@ pub(crate) fn scale_covariance(
     let spectral = integrals.covariance(model)?;
     let cross = integrals.drift_cross_variance(wv, model)?;
     let n = wv.len();
-    let diag: Vec<f64> = (0..n).map(|j| spectral[j][j] + cross[j]).collect();
     let mut sigma = vec![vec![0.0; n]; n];
     for j in 0..n {
         for k in 0..n {
             let (sj, sk) = (spectral[j][j], spectral[k][k]);
             sigma[j][k] = if j == k {
-                diag[j]
+                sj + cross[j]
             } else if sj > 0.0 && sk > 0.0 {
-                spectral[j][k] / (sj * sk).sqrt() * (diag[j] * diag[k]).sqrt()
+                spectral[j][k] * (1.0 + (cross[j] * cross[k]).sqrt() / (sj * sk).sqrt())
             } else {
                 0.0
             };
@@ -506,8 +510,7 @@ fn sandwich(
     let mul = |x: &[Vec<f64>], y: &[Vec<f64>]| -> Vec<Vec<f64>> {
         (0..p).map(|r| (0..p).map(|q| (0..p).map(|t| x[r][t] * y[t][q]).sum()).collect()).collect()
     };
-    let trace = |m: &[Vec<f64>]| 2.0 * (0..p).map(|r| (0..p).map(|q| bread[r][q] * m[q][r]).sum::<f64>()).sum::<f64>();
-    let optimism = trace(&meat);
+    let optimism = 2.0 * (0..p).map(|r| (0..p).map(|q| bread[r][q] * meat[q][r]).sum::<f64>()).sum::<f64>();
     Some((mul(&mul(&bread, &meat), &bread), optimism))
 }
 

@@ -137,8 +137,10 @@ fn profile(wv: &[WaveletVariance], linear: &[Shape], ts: &[f64], nu: &[f64], sig
 }
 
 /// The models with `k` Gauss-Markov processes (correlation times searched) and each subset of
-/// the linear processes `linear` the search kept, added to `out` (their shapes' integrals to
-/// `integrals`); nothing when the record has too few scales or no fit keeps all `k` processes.
+/// the linear processes `linear`, added to `out` (their shapes' integrals to `integrals`);
+/// nothing when the record has too few scales or the search's fit does not keep all `k`
+/// processes. A subset is offered only when the scales outnumber its parameters (weights and
+/// correlation times).
 fn gauss_markov_candidates(
     wv: &[WaveletVariance],
     grid: &CovarianceGrid,
@@ -197,7 +199,7 @@ fn gauss_markov_candidates(
         let (kept, theta, _) = nnls(&x, &nu, &sigma2);
         model = kept.iter().zip(theta).map(|(&c, t)| (shapes[c], t)).collect();
     }
-    if model.iter().filter(|m| matches!(m.0, Shape::GaussMarkov(_))).count() < k || n <= model.len() + k {
+    if model.iter().filter(|m| matches!(m.0, Shape::GaussMarkov(_))).count() < k {
         return None;
     }
     // Every subset of the linear processes searched, not only of those the search's fit kept (it
@@ -213,6 +215,9 @@ fn gauss_markov_candidates(
         let mut shapes: Vec<Shape> =
             lin.iter().enumerate().filter(|(i, _)| mask & (1 << i) != 0).map(|(_, &s)| s).collect();
         shapes.extend(&markov);
+        if n <= shapes.len() + k {
+            continue;
+        }
         let Ok((m, s2)) = fit_estimate(wv, grid, &shapes, confidence) else { continue };
         let kept: Vec<Shape> = m.iter().map(|x| x.0).collect();
         if kept.iter().filter(|x| matches!(x, Shape::GaussMarkov(_))).count() < k || seen.contains(&kept) {

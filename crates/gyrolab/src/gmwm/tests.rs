@@ -377,3 +377,51 @@ fn scale_covariance_equals_the_spread_over_simulated_records() {
     let last = *spectral_only.last().unwrap();
     assert!(last > 5.0, "the drift's cross term matters at the last scale: spectral part alone {last}");
 }
+
+/// The variance of the mean of `terms` Haar coefficients at averaging factor `m` by direct sums of
+/// the coefficients' weights on the samples (W_t = (mean x[t+m..t+2m) - mean x[t..t+m)) / 2):
+/// white noise of unit variance per sample, and a random walk of unit step variance (its start
+/// cancels: each coefficient's weights sum to zero).
+fn mean_coefficient_variance_by_sums(m: usize, terms: usize) -> (f64, f64) {
+    let len = terms + 2 * m - 1;
+    let mut g = vec![0.0; len];
+    for t in 0..terms {
+        for i in 0..m {
+            g[t + i] -= 0.5 / (m as f64 * terms as f64);
+            g[t + m + i] += 0.5 / (m as f64 * terms as f64);
+        }
+    }
+    let white = g.iter().map(|x| x * x).sum();
+    // x_i = sum of steps u_1..u_i: the step u_l carries G_l = sum over i >= l of g_i.
+    let mut tail = 0.0;
+    let mut walk = 0.0;
+    for x in g.iter().rev() {
+        tail += x;
+        walk += tail * tail;
+    }
+    (white, walk)
+}
+
+#[test]
+fn mean_coefficient_variance_equals_direct_sums() {
+    // tau0 = 1 s: white noise N = 1 is unit variance per sample, a random walk K = 1 unit steps.
+    let pairs = [(1usize, 2usize), (1, 50), (2, 3), (4, 7), (8, 40), (16, 16), (32, 20), (64, 129), (128, 300)];
+    let wv: Vec<WaveletVariance> = pairs
+        .iter()
+        .map(|&(m, terms)| WaveletVariance { tau_s: m as f64, nu2: 1.0, edf: 10.0, m: m as u64, terms: terms as u64 })
+        .collect();
+    let grid = CovarianceGrid::new(&wv);
+    let white = grid.mean_coefficient_variance(&[(Shape::Linear(Process::White), 1.0)]);
+    let walk = grid.mean_coefficient_variance(&[(Shape::Linear(Process::RandomWalk), 1.0)]);
+    for (i, &(m, terms)) in pairs.iter().enumerate() {
+        let (w, k) = mean_coefficient_variance_by_sums(m, terms);
+        assert!((white[i] / w - 1.0).abs() < 2e-3, "white m {m} M {terms}: {} vs {w}", white[i]);
+        assert!((walk[i] / k - 1.0).abs() < 2e-3, "random walk m {m} M {terms}: {} vs {k}", walk[i]);
+        if terms + 1 >= 2 * m {
+            // The closed form (module notes) where the two ends' averages do not overlap.
+            let (mf, tf) = (m as f64, terms as f64);
+            let hand = (2.0 * mf * mf + 1.0) / (6.0 * mf * tf * tf);
+            assert!((w / hand - 1.0).abs() < 1e-12, "m {m} M {terms}: sum {w} vs (2m^2+1)/(6mM^2) {hand}");
+        }
+    }
+}
