@@ -70,6 +70,21 @@ fn haar_gain(m: f64, f: f64, averaged: bool) -> f64 {
     num / (m * m * s * s)
 }
 
+/// The nodes and weights (f, step) of the midpoint rule over (a, b] in `n` steps, uniform or
+/// uniform in log f when `log`; none when b <= a.
+fn midpoints(a: f64, b: f64, n: usize, log: bool) -> impl Iterator<Item = (f64, f64)> {
+    let n = if b > a { n } else { 0 };
+    (0..n).map(move |i| {
+        let u = (i as f64 + 0.5) / n as f64;
+        if log {
+            let f = a * (b / a).powf(u);
+            (f, f * (b / a).ln() / n as f64)
+        } else {
+            (a + u * (b - a), (b - a) / n as f64)
+        }
+    })
+}
+
 /// Midpoint-rule points of the product of the two scales' gains over (a, b] in `n` steps
 /// (uniform, or uniform in log f when `log`), appended as (f, sin^2(pi f), step x gains x
 /// `scale`).
@@ -84,17 +99,7 @@ fn points(
     log: bool,
     scale: f64,
 ) {
-    if b <= a {
-        return;
-    }
-    for i in 0..n {
-        let u = (i as f64 + 0.5) / n as f64;
-        let (f, w) = if log {
-            let f = a * (b / a).powf(u);
-            (f, f * (b / a).ln() / n as f64)
-        } else {
-            (a + u * (b - a), (b - a) / n as f64)
-        };
+    for (f, w) in midpoints(a, b, n, log) {
         let s = (std::f64::consts::PI * f).sin();
         out.push([f, s * s, scale * w * haar_gain(m_lo, f, avg_lo) * haar_gain(m_hi, f, avg_hi)]);
     }
@@ -115,17 +120,7 @@ fn mean_points(
     log: bool,
     scale: f64,
 ) {
-    if b <= a {
-        return;
-    }
-    for i in 0..n {
-        let u = (i as f64 + 0.5) / n as f64;
-        let (f, w) = if log {
-            let f = a * (b / a).powf(u);
-            (f, f * (b / a).ln() / n as f64)
-        } else {
-            (a + u * (b - a), (b - a) / n as f64)
-        };
+    for (f, w) in midpoints(a, b, n, log) {
         let s = (std::f64::consts::PI * f).sin();
         let fejer_num = if avg_terms { 0.5 } else { (std::f64::consts::PI * f * terms).sin().powi(2) };
         let fejer = fejer_num / (terms * terms * s * s);
