@@ -5,7 +5,7 @@
 # it is missing, saying so first (scripts/install-test-deps.sh: opt-outs GYROLAB_SKIP_PYTHON=1,
 # GYROLAB_SKIP_BROWSER=1, each check then printing SKIPPED:).
 #
-# One build: `cargo test --workspace --all-targets` builds the gyrolab binary and the examples
+# One build: `cargo test --workspace --all-targets` builds the gyrolab binary and the libraries
 # with the workspace's features; the checks below use those files (a `cargo build -p ...` here
 # would resolve other features and build the crates again; docs/PERFORMANCE.md).
 set -euo pipefail
@@ -26,15 +26,16 @@ cargo test --workspace --all-targets
 # with its published or hand value runs here.
 cargo test --workspace --doc
 bin=target/debug/gyrolab
-# Both are built by the line above; should a cargo version not leave them there, build them (once).
+# The binary is built by `cargo test --workspace --all-targets` (should a cargo version not leave it
+# there, build it once).
 if [ ! -x "$bin" ]; then
     echo "test.sh: $bin not left by cargo test: building it" >&2
     cargo build --quiet -p gyrolab-cli
 fi
-if [ ! -x target/debug/examples/chi2_quantiles ]; then
-    echo "test.sh: target/debug/examples/chi2_quantiles not left by cargo test: building it" >&2
-    cargo build --quiet -p gyrolab --example chi2_quantiles
-fi
+# `--all-targets` builds the examples as test harnesses, not their own programs: link the one the
+# scipy check runs. `--workspace` keeps the test build's feature set, so no dependency is compiled
+# again (a `-p gyrolab` build resolves that package's features alone; docs/PERFORMANCE.md).
+cargo build --quiet --workspace --example chi2_quantiles
 # The hostile recordings written by crates/gyrolab-cli/tests/hostile.rs, each read again by
 # `allan` and `inspect` under an address-space limit of 2 GiB (issue 31).
 bash scripts/test_hostile_ulimit.sh "$bin"
