@@ -227,3 +227,44 @@ fn a_gauss_markov_process_is_exported_as_the_random_walk_that_bounds_it() {
     assert!((got / want - 1.0).abs() < 1e-6, "{got} vs {want}\n{text}");
     assert!(text.contains("gmwm_gauss_markov_bound") && text.contains("gauss_markov(sigma"), "{text}");
 }
+
+/// A random walk the chosen GMWM model leaves out (white noise + a drift chosen for N 0.3
+/// deg/sqrt(h), K 3 deg/h/sqrt(h), seed 6) is bounded by the model-averaged interval: the text
+/// names it, the JSON lists it under `left_out`, and the Kalibr export writes that bound in rad
+/// with the basis `gmwm_upper_bound`.
+#[test]
+fn a_random_walk_left_out_by_the_chosen_model_is_exported_as_its_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = dir.path().join("sim.csv");
+    gyrolab()
+        .args(["simulate", "static", "--duration-s", "2000", "--sample-rate-hz", "50", "--arw-deg-rt-h", "0.3"])
+        .args(["--rrw-deg-h-rt-h", "3", "--seed", "6", "--out"])
+        .arg(&sim)
+        .assert()
+        .success();
+    let json = gyrolab().arg("allan").arg(&sim).arg("--json").assert().success().get_output().stdout.clone();
+    let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
+    let g = &v["channels"][0]["gmwm"];
+    assert!(g["parameters"].as_array().unwrap().iter().all(|p| p["process"] != "random_walk"), "{g}");
+    let left = g["left_out"].as_array().unwrap();
+    let k = left.iter().find(|b| b["process"] == "random_walk").unwrap_or_else(|| panic!("{g}"));
+    assert_eq!(k["unit"], "deg/s/sqrt(s)");
+    assert_eq!(k["confidence_one_sided"], 0.8415);
+    let (upper, weight) = (k["upper"].as_f64().unwrap(), k["model_weight"].as_f64().unwrap());
+    assert!(upper > 0.0 && weight > 0.1585 && weight < 1.0, "{k}");
+    let text = gyrolab().arg("allan").arg(&sim).assert().success().get_output().stdout.clone();
+    let text = String::from_utf8_lossy(&text).to_string();
+    assert!(text.contains("left out by the chosen model: random_walk <"), "{text}");
+    let f = dir.path().join("kalibr.yaml");
+    gyrolab()
+        .arg("allan")
+        .arg(&sim)
+        .args(["--estimator", "gmwm", "--export"])
+        .arg(format!("kalibr={}", f.display()))
+        .assert()
+        .success();
+    let yaml = std::fs::read_to_string(&f).unwrap();
+    let got = value(&yaml, "gyroscope_random_walk");
+    assert!((got / upper.to_radians() - 1.0).abs() < 1e-6, "{got} vs {upper} deg\n{yaml}");
+    assert!(yaml.contains("gmwm_upper_bound") && yaml.contains("84.2 % upper bound"), "{yaml}");
+}

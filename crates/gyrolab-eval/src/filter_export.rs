@@ -105,8 +105,9 @@ pub fn parse_target(text: &str) -> EvalResult<(Stack, PathBuf)> {
 pub struct TermEstimate {
     /// The value.
     pub value: f64,
-    /// `value`, `upper_bound`, `fit_value`, `gmwm` or `gmwm_gauss_markov_bound` (the GMWM term
-    /// plus the white noise or random walk bounding the model's Gauss-Markov processes).
+    /// `value`, `upper_bound`, `fit_value`, `gmwm`, `gmwm_gauss_markov_bound` (the GMWM term
+    /// plus the white noise or random walk bounding the model's Gauss-Markov processes) or
+    /// `gmwm_upper_bound` (a term the chosen GMWM model leaves out: its model-averaged bound).
     pub basis: String,
     /// What the basis means for this term (confidence and sidedness, the channel).
     pub detail: String,
@@ -219,7 +220,7 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
                 .collect();
             let interval = |x: &gyrolab::gmwm::GmwmParameter, unit: &str| {
                 format!(
-                    "{} % two-sided interval [{}, {}] {unit} (asymptotic sandwich covariance with the scales' covariance under the fitted model; coverage in simulation: docs/METHODS.md 3.1)",
+                    "{} % two-sided interval [{}, {}] {unit} (asymptotic sandwich covariance with the scales' covariance under the fitted model, averaged over the candidate models by their criterion weights; coverage in simulation: docs/METHODS.md 3.1)",
                     percent(g.confidence),
                     real_text(x.lower * to_si),
                     real_text(x.upper * to_si),
@@ -260,7 +261,20 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
                 let own = g.parameter(process);
                 let total2 = own.map_or(0.0, |x| x.value * x.value) + extra2;
                 if total2 <= 0.0 {
-                    return None;
+                    // A process the chosen model leaves out: its model-averaged upper bound, where
+                    // the candidate models holding it weigh enough to give one.
+                    return g.left_out.iter().find(|b| b.process == process).map(|b| {
+                        (
+                            b.upper,
+                            "gmwm_upper_bound".to_string(),
+                            format!(
+                                "GMWM: left out by the chosen model ({model}); one-sided {} % upper bound {} {unit} from the intervals averaged over the candidate models, those holding it weighing {} % (docs/METHODS.md 3.1); {name}",
+                                percent(1.0 - (1.0 - g.confidence) / 2.0),
+                                real_text(b.upper * to_si),
+                                percent(b.model_weight),
+                            ),
+                        )
+                    });
                 }
                 if extra == 0 {
                     return own.map(|x| {

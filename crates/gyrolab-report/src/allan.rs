@@ -106,6 +106,25 @@ pub struct GmwmParameterJson {
     /// not resolve it and its interval means nothing.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub correlation_time_at_search_edge: Option<bool>,
+    /// The summed weight (0 to 1) of the candidate models holding this process (for
+    /// `gauss_markov`: holding one), exp(-criterion / 2) normalised; the linear processes'
+    /// intervals are averaged over the candidates with these weights (docs/METHODS.md 3.1).
+    pub model_weight: f64,
+}
+
+/// A process the chosen GMWM model leaves out, with its model-averaged upper bound.
+#[derive(Debug, Clone, Serialize)]
+pub struct GmwmBoundJson {
+    /// `quantization`, `white`, `flicker`, `random_walk` or `drift`.
+    pub process: &'static str,
+    /// The upper bound of its coefficient, in `unit`.
+    pub upper: f64,
+    /// The coefficient's unit.
+    pub unit: &'static str,
+    /// One-sided confidence of the bound, 1 - (1 - confidence) / 2 (0.8415 for 0.683).
+    pub confidence_one_sided: f64,
+    /// The summed weight of the candidate models holding the process.
+    pub model_weight: f64,
 }
 
 /// The GMWM fit in JSON.
@@ -120,6 +139,9 @@ pub struct GmwmJson {
     pub intervals: &'static str,
     /// The parameters of the chosen model.
     pub parameters: Vec<GmwmParameterJson>,
+    /// Processes the chosen model leaves out but candidate models weighing more than (1 -
+    /// confidence) / 2 hold: an upper bound for each (one-sided).
+    pub left_out: Vec<GmwmBoundJson>,
     /// Scales (octave taus) used.
     pub scales: usize,
     /// The objective at the estimate.
@@ -138,7 +160,7 @@ pub struct GmwmJson {
 
 /// What the GMWM intervals are (text and JSON).
 pub const GMWM_INTERVALS: &str =
-    "asymptotic: sandwich covariance with the wavelet variances correlated across scales as the fitted model makes them (Percival and Walden 2000, ch. 8); simulated coverage in docs/METHODS.md 3.1";
+    "asymptotic: sandwich covariance with the wavelet variances correlated across scales as the fitted model makes them (Percival and Walden 2000, ch. 8), the linear processes' intervals averaged over the candidate models by their criterion weights (MATA-Wald, Turek and Fletcher 2012); simulated coverage in docs/METHODS.md 3.1";
 
 /// The unit of a GMWM coefficient for the curve's quantity.
 pub fn gmwm_unit(process: gyrolab::gmwm::Process, quantity: Quantity) -> &'static str {
@@ -180,6 +202,18 @@ pub fn gmwm_json(a: &ChannelAnalysis) -> Option<GmwmJson> {
                 correlation_time_lower_s: p.correlation_time.map(|t| t.lower_s),
                 correlation_time_upper_s: p.correlation_time.map(|t| t.upper_s),
                 correlation_time_at_search_edge: p.correlation_time.map(|t| t.at_search_edge),
+                model_weight: p.model_weight,
+            })
+            .collect(),
+        left_out: g
+            .left_out
+            .iter()
+            .map(|b| GmwmBoundJson {
+                process: b.process.name(),
+                upper: b.upper,
+                unit: gmwm_unit(b.process, a.quantity),
+                confidence_one_sided: 1.0 - (1.0 - g.confidence) / 2.0,
+                model_weight: b.model_weight,
             })
             .collect(),
         scales: g.scales,
@@ -216,12 +250,27 @@ pub fn gmwm_text(a: &ChannelAnalysis) -> Option<String> {
             }
         })
         .collect();
+    let left_out: String = g
+        .left_out
+        .iter()
+        .map(|b| {
+            format!(
+                "; left out by the chosen model: {} < {} {} (one-sided {} %, models holding it weigh {} %)",
+                b.process.name(),
+                sig(b.upper, 3),
+                gmwm_unit(b.process, a.quantity),
+                short(100.0 * (1.0 - (1.0 - g.confidence) / 2.0), 4),
+                short(100.0 * b.model_weight, 2)
+            )
+        })
+        .collect();
     let mut text = format!(
-        "GMWM (Haar wavelet variance, model chosen by the wavelet information criterion over {} scales; {} % two-sided intervals, {}): {}; weighted RMS residual {}\n",
+        "GMWM (Haar wavelet variance, model chosen by the wavelet information criterion over {} scales; {} % two-sided intervals, {}): {}{}; weighted RMS residual {}\n",
         g.scales,
         short(100.0 * g.confidence, 4),
         GMWM_INTERVALS,
         parts.join("; "),
+        left_out,
         sig(g.weighted_rms_residual, 3)
     );
     if g.quality == FitQuality::Poor {

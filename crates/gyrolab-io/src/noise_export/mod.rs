@@ -98,7 +98,8 @@ impl Stack {
 /// How an exported term was obtained.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TermSource {
-    /// `value`, `upper_bound`, `fit_value` or `gmwm`.
+    /// `value`, `upper_bound`, `fit_value`, `gmwm`, `gmwm_gauss_markov_bound` or
+    /// `gmwm_upper_bound` (gyrolab-eval's `TermEstimate`).
     pub basis: String,
     /// What the basis means for this term, for the file's header (confidence and sidedness of a
     /// bound or interval, the channel it comes from).

@@ -23,11 +23,13 @@
 //! sandwich with the model's Jacobian; the model is chosen by a wavelet information criterion, the
 //! objective plus its estimated optimism (module `select`).
 
+mod average;
 mod covariance;
 mod gauss_markov;
 mod overbound;
 mod select;
 
+pub use average::model_weights;
 pub use covariance::{wavelet_variance_covariance, CovarianceGrid, ShapeIntegrals};
 pub use gauss_markov::{
     gauss_markov_filter_bound, gauss_markov_spectral_density, gauss_markov_wavelet_variance, MarkovBound,
@@ -213,6 +215,23 @@ pub struct GmwmParameter {
     pub upper: f64,
     /// The correlation time of a Gauss-Markov process (None for the other processes).
     pub correlation_time: Option<CorrelationTime>,
+    /// The summed weight of the candidate models holding this process (for a Gauss-Markov
+    /// process: holding one), exp(-criterion / 2) normalised over the candidates (module
+    /// `average`); 1 for the fit of a single model ([`fit_processes`]).
+    pub model_weight: f64,
+}
+
+/// A linear process the chosen model leaves out, bounded by the model-averaged distribution: its
+/// coefficient lies below `upper` at the one-sided level 1 - (1 - confidence) / 2 (84.15 % for
+/// 68.3 %), the same as the upper end of the two-sided intervals.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct GmwmBound {
+    /// The process.
+    pub process: Process,
+    /// The upper bound of its coefficient, in the units of [`GmwmParameter::value`].
+    pub upper: f64,
+    /// The summed weight of the candidate models holding it.
+    pub model_weight: f64,
 }
 
 /// A GMWM fit.
@@ -241,6 +260,9 @@ pub struct GmwmFit {
     /// the five-term fit): no model of the processes searched describes the curve, and its values
     /// are not to be used.
     pub quality: crate::noise::FitQuality,
+    /// The linear processes the chosen model leaves out whose model-averaged upper bound is
+    /// above zero (candidate models holding them carry weight above (1 - confidence) / 2).
+    pub left_out: Vec<GmwmBound>,
 }
 
 impl GmwmFit {
@@ -301,7 +323,7 @@ pub fn fit_processes(wv: &[WaveletVariance], processes: &[Process], confidence: 
     let grid = CovarianceGrid::new(wv);
     let (model, sigma2) = fit_estimate(wv, &grid, &shapes, confidence)?;
     let integrals = ShapeIntegrals::new(&grid, &shapes);
-    Ok(finish(wv, &integrals, &model, &sigma2, confidence, (0.0, f64::INFINITY)))
+    Ok(finish(wv, &integrals, &model, &sigma2, confidence, (0.0, f64::INFINITY)).0)
 }
 
 fn check(wv: &[WaveletVariance], parameters: usize, confidence: f64) -> Result<(), GmwmError> {
@@ -515,8 +537,9 @@ fn sandwich(
 }
 
 /// The fit of a model (linear processes and Gauss-Markov processes with their weights) with its
-/// objective, intervals and criterion. `search` is the range of correlation times searched (an
-/// estimate at either end is flagged).
+/// objective, intervals and criterion, and each linear process's weight with its standard error
+/// (the inputs of the model averaging, module `average`). `search` is the range of correlation
+/// times searched (an estimate at either end is flagged).
 fn finish(
     wv: &[WaveletVariance],
     integrals: &ShapeIntegrals,
@@ -524,7 +547,7 @@ fn finish(
     sigma2: &[f64],
     confidence: f64,
     search: (f64, f64),
-) -> GmwmFit {
+) -> (GmwmFit, Vec<average::Moment>) {
     let mut model: Vec<(Shape, f64)> = model.to_vec();
     model.sort_by(|a, b| {
         let key = |s: &Shape| match s {
@@ -544,6 +567,7 @@ fn finish(
     let z = chi_squared_quantile(confidence, 1.0).map_or(f64::NAN, f64::sqrt);
     let se = |i: usize| cov.get(i).and_then(|r| r.get(i)).map_or(f64::NAN, |v| v.max(0.0).sqrt());
     let mut parameters = Vec::with_capacity(model.len());
+    let mut moments = Vec::with_capacity(model.len());
     let mut i = 0;
     for &(shape, t) in &model {
         let s = se(i);
@@ -553,7 +577,11 @@ fn finish(
             lower: (t - z * s).max(0.0).sqrt(),
             upper: (t + z * s).max(0.0).sqrt(),
             correlation_time: None,
+            model_weight: 1.0,
         };
+        if let Shape::Linear(p) = shape {
+            moments.push(average::Moment { process: p, weight: t, se: s });
+        }
         i += 1;
         if let Shape::GaussMarkov(tc) = shape {
             let s = se(i);
@@ -579,7 +607,7 @@ fn finish(
     } else {
         crate::noise::FitQuality::Acceptable
     };
-    GmwmFit {
+    let fit = GmwmFit {
         parameters,
         confidence,
         scales: wv.len(),
@@ -588,7 +616,9 @@ fn finish(
         criterion: objective + optimism,
         weighted_rms_residual,
         quality,
-    }
+        left_out: Vec::new(),
+    };
+    (fit, moments)
 }
 
 /// Inverse of a small symmetric positive matrix (scaled to unit diagonal, Gauss-Jordan with

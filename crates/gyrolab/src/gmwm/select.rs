@@ -10,9 +10,11 @@
 //! 99(467), 2004), 2 sum_j Omega_jj cov(nu_hat_j, nu_j(theta_hat)), taken to first order: 2
 //! tr(Omega H Sigma), H = D (D' Omega D)^-1 D' Omega the fit's hat matrix and Sigma the wavelet
 //! variances' covariance under the fitted model (2 x parameters when Omega = Sigma^-1, the AIC
-//! penalty). The GMWM authors estimate the same optimism by simulation instead.
+//! penalty). The GMWM authors estimate the same optimism by simulation instead. The chosen
+//! model's intervals of the linear processes are then averaged over every candidate (module
+//! `average`).
 
-use super::{check, design, finish, fit_estimate, nnls, omega_variances};
+use super::{average, check, design, finish, fit_estimate, nnls, omega_variances};
 use super::{CovarianceGrid, GmwmError, GmwmFit, Process, Shape, ShapeIntegrals, WaveletVariance, PROCESSES, ROUNDS};
 use crate::allan::AllanCurve;
 
@@ -101,15 +103,16 @@ pub fn select_model_with_gauss_markov(
     for k in 1..=max_gauss_markov {
         gauss_markov_candidates(wv, &grid, &without_flicker, k, confidence, &mut integrals, &mut all);
     }
-    let mut best: Option<GmwmFit> = None;
-    for c in &all {
-        let fit = finish(wv, &integrals[c.integrals], &c.model, &c.sigma2, confidence, c.search);
-        if best.as_ref().is_none_or(|b| fit.criterion < b.criterion - 1e-12) {
-            best = Some(fit);
+    let fits: Vec<_> =
+        all.iter().map(|c| finish(wv, &integrals[c.integrals], &c.model, &c.sigma2, confidence, c.search)).collect();
+    let mut best: Option<usize> = None;
+    for (i, (fit, _)) in fits.iter().enumerate() {
+        if best.is_none_or(|b| fit.criterion < fits[b].0.criterion - 1e-12) {
+            best = Some(i);
         }
     }
     match best {
-        Some(b) => Ok(b),
+        Some(b) => Ok(average::model_average(&fits, b)),
         None => Err(last_err.unwrap_or(GmwmError::TooFewScales { scales: wv.len(), parameters: 0 })),
     }
 }

@@ -1,0 +1,246 @@
+//! Model-averaged intervals of the GMWM's linear processes over the candidate models of the model
+//! choice (docs/METHODS.md 3.1, "Model averaging").
+//!
+//! Sources: S. T. Buckland, K. P. Burnham and N. H. Augustin, "Model selection: an integral part
+//! of inference", Biometrics 53(2), 1997 (model weights exp(-Delta_m / 2) from an information
+//! criterion, Delta_m its excess over the smallest); D. Turek and D. Fletcher, "Model-averaged
+//! Wald confidence intervals", Computational Statistics & Data Analysis 56(9), 2012 (the MATA-Wald
+//! interval: the limits where the weighted mixture of the candidates' normal sampling distributions
+//! reaches alpha / 2 and 1 - alpha / 2). A candidate without the process holds it at zero, a point
+//! mass there: a term that only some candidates hold gets an interval reaching zero, and a term
+//! the chosen model leaves out an upper bound when the candidates holding it weigh more than
+//! alpha / 2. Intervals after a model choice that ignore it cover less than their level (the
+//! choice drops a term in some records, and the sampling spread of the chosen model's estimate is
+//! conditional on that choice); the mixture puts the choice's own uncertainty into the interval.
+
+use super::{GmwmBound, GmwmFit, Process};
+use statrs::function::erf::erfc;
+
+/// A linear process's weight (squared coefficient) in one candidate's fit and its standard error
+/// (from the candidate's sandwich covariance).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Moment {
+    /// The process.
+    pub process: Process,
+    /// Its fitted weight (squared coefficient), (curve unit)^2 per its shape.
+    pub weight: f64,
+    /// The weight's standard error (NaN when the covariance could not be made).
+    pub se: f64,
+}
+
+/// The model weights exp(-(c_m - c_min) / 2) of criteria `c_m`, normalised to sum 1 (Buckland,
+/// Burnham and Augustin 1997); 0 for a criterion that is not finite, all 0 when none is.
+///
+/// ```
+/// let w = gyrolab::gmwm::model_weights(&[10.0, 12.0, f64::INFINITY]);
+/// // exp(-1) / (1 + exp(-1)) = 0.2689...
+/// assert!((w[1] - 0.268_941_421_369_995).abs() < 1e-12);
+/// assert_eq!(w[2], 0.0);
+/// assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+/// ```
+pub fn model_weights(criteria: &[f64]) -> Vec<f64> {
+    let best = criteria.iter().copied().filter(|c| c.is_finite()).fold(f64::INFINITY, f64::min);
+    if !best.is_finite() {
+        return vec![0.0; criteria.len()];
+    }
+    let raw: Vec<f64> = criteria.iter().map(|&c| if c.is_finite() { (-(c - best) / 2.0).exp() } else { 0.0 }).collect();
+    let total: f64 = raw.iter().sum();
+    raw.iter().map(|r| r / total).collect()
+}
+
+/// A mixture of normal distributions (weight, mean, standard deviation) and point masses
+/// (weight, location).
+#[derive(Default)]
+struct Mixture {
+    normals: Vec<(f64, f64, f64)>,
+    points: Vec<(f64, f64)>,
+}
+
+impl Mixture {
+    /// The mixture's distribution function at `x`; `strict` counts the point masses below `x` only.
+    fn cdf(&self, x: f64, strict: bool) -> f64 {
+        let normal: f64 =
+            self.normals.iter().map(|&(w, m, s)| w * 0.5 * erfc(-(x - m) / (s * std::f64::consts::SQRT_2))).sum();
+        let points: f64 = self.points.iter().filter(|p| if strict { p.1 < x } else { p.1 <= x }).map(|p| p.0).sum();
+        normal + points
+    }
+
+    /// The smallest x with cdf(x) >= q (q in (0, 1), the weights summing to 1): an atom when the
+    /// distribution jumps over q there, else by bisection of the continuous part between atoms.
+    fn quantile(&self, q: f64) -> f64 {
+        for &(_, at) in &self.points {
+            if self.cdf(at, true) < q && self.cdf(at, false) >= q {
+                return at;
+            }
+        }
+        let spread = |sign: f64| {
+            let normals = self.normals.iter().map(|&(_, m, s)| m + sign * 40.0 * s);
+            let points = self.points.iter().map(|p| p.1);
+            normals.chain(points).fold(0.0, |a: f64, b| if sign < 0.0 { a.min(b) } else { a.max(b) })
+        };
+        let (mut lo, mut hi) = (spread(-1.0), spread(1.0));
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if self.cdf(mid, false) >= q {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        hi
+    }
+}
+
+/// The chosen candidate `chosen` of `fits` with its linear processes' intervals replaced by the
+/// model-averaged (MATA-Wald) intervals over every candidate (weights [`model_weights`] of the
+/// criteria), each parameter's [`GmwmParameter::model_weight`](super::GmwmParameter) set, and the
+/// bounds of the processes it leaves out in [`GmwmFit::left_out`]. Gauss-Markov parameters keep the
+/// chosen model's intervals (their correlation times differ between candidates, so they are not
+/// one parameter across them). On the weight scale (squared coefficient), then square-rooted, as
+/// the single-model intervals are.
+pub(crate) fn model_average(fits: &[(GmwmFit, Vec<Moment>)], chosen: usize) -> GmwmFit {
+    let mut out = fits[chosen].0.clone();
+    let weights = model_weights(&fits.iter().map(|f| f.0.criterion).collect::<Vec<_>>());
+    // One candidate with all the weight (the others' criteria more than about 1,490 above): its
+    // own intervals, unchanged.
+    if weights.iter().filter(|w| **w > 0.0).count() <= 1 {
+        return out;
+    }
+    let alpha = 1.0 - out.confidence;
+    let mut processes: Vec<Process> = Vec::new();
+    for m in fits.iter().flat_map(|f| &f.1) {
+        if !processes.contains(&m.process) {
+            processes.push(m.process);
+        }
+    }
+    let markov_weight: f64 = fits
+        .iter()
+        .zip(&weights)
+        .filter(|(f, _)| f.0.parameters.iter().any(|p| p.process == Process::GaussMarkov))
+        .map(|(_, w)| w)
+        .sum();
+    for p in out.parameters.iter_mut().filter(|p| p.process == Process::GaussMarkov) {
+        p.model_weight = markov_weight;
+    }
+    for process in super::PROCESSES.iter().copied().filter(|p| processes.contains(p)) {
+        let mut mixture = Mixture::default();
+        let mut holding = 0.0;
+        for ((_, moments), &w) in fits.iter().zip(&weights) {
+            if w == 0.0 {
+                continue;
+            }
+            match moments.iter().find(|m| m.process == process) {
+                Some(m) if m.se.is_finite() && m.se > 0.0 => {
+                    mixture.normals.push((w, m.weight, m.se));
+                    holding += w;
+                }
+                Some(m) => {
+                    mixture.points.push((w, m.weight));
+                    holding += w;
+                }
+                None => mixture.points.push((w, 0.0)),
+            }
+        }
+        let lower = mixture.quantile(alpha / 2.0);
+        let upper = mixture.quantile(1.0 - alpha / 2.0);
+        match out.parameters.iter_mut().find(|p| p.process == process) {
+            Some(p) => {
+                p.lower = lower.max(0.0).sqrt();
+                p.upper = upper.max(0.0).sqrt();
+                p.model_weight = holding;
+            }
+            None if upper > 0.0 => {
+                out.left_out.push(GmwmBound { process, upper: upper.sqrt(), model_weight: holding });
+            }
+            None => {}
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fit(criterion: f64, params: &[Process]) -> GmwmFit {
+        GmwmFit {
+            parameters: params
+                .iter()
+                .map(|&process| super::super::GmwmParameter {
+                    process,
+                    value: 1.0,
+                    lower: 0.5,
+                    upper: 1.5,
+                    correlation_time: None,
+                    model_weight: 1.0,
+                })
+                .collect(),
+            confidence: 0.683,
+            scales: 10,
+            objective: criterion,
+            optimism: 0.0,
+            criterion,
+            weighted_rms_residual: 1.0,
+            quality: crate::noise::FitQuality::Acceptable,
+            left_out: Vec::new(),
+        }
+    }
+
+    /// Two candidates, criteria 0 and 1 (weights 0.62246 and 0.37754): white noise in both
+    /// (weights 100 +- 2 and 98 +- 3), a random walk only in the second (4 +- 1). The chosen model's
+    /// white-noise interval is the mixture's 15.85 % and 84.15 % quantiles and the random walk's
+    /// bound the 84.15 % one, both computed independently with Python's statistics.NormalDist
+    /// (bisection of the mixture, and 4 + inv_cdf((0.8415 - w0) / w1) for the bound).
+    #[test]
+    fn mixture_intervals_and_bounds_by_an_independent_computation() {
+        let fits = vec![
+            (fit(0.0, &[Process::White]), vec![Moment { process: Process::White, weight: 100.0, se: 2.0 }]),
+            (
+                fit(1.0, &[Process::White, Process::RandomWalk]),
+                vec![
+                    Moment { process: Process::White, weight: 98.0, se: 3.0 },
+                    Moment { process: Process::RandomWalk, weight: 4.0, se: 1.0 },
+                ],
+            ),
+        ];
+        let out = model_average(&fits, 0);
+        let white = out.parameter(Process::White).unwrap();
+        assert_eq!(white.value, 1.0);
+        assert!((white.lower - 9.835_060_649_085_486).abs() < 1e-9, "{white:?}");
+        assert!((white.upper - 10.087_186_915_682_034).abs() < 1e-9, "{white:?}");
+        assert_eq!(white.model_weight, 1.0);
+        assert_eq!(out.left_out.len(), 1);
+        let k = out.left_out[0];
+        assert_eq!(k.process, Process::RandomWalk);
+        assert!((k.upper - 2.049_962_937_292_862).abs() < 1e-9, "{k:?}");
+        assert!((k.model_weight - 0.377_540_668_798_145_46).abs() < 1e-12);
+        // With the random walk's model 4 above (weight 0.119 < 0.1585) there is no bound.
+        let mut far = fits.clone();
+        far[1].0.criterion = 4.0;
+        assert!(model_average(&far, 0).left_out.is_empty());
+    }
+
+    /// One normal component: the quantiles are the normal's (Phi^-1(0.975) = 1.959963984540054).
+    #[test]
+    fn one_normal_gives_its_own_quantiles() {
+        let m = Mixture { normals: vec![(1.0, 5.0, 2.0)], points: Vec::new() };
+        assert!((m.quantile(0.975) - (5.0 + 2.0 * 1.959_963_984_540_054)).abs() < 1e-9);
+        assert!((m.quantile(0.5) - 5.0).abs() < 1e-9);
+    }
+
+    /// Weight 0.6 at zero and 0.4 on N(10, 1): the 84.15 % quantile solves 0.6 + 0.4 Phi(x - 10)
+    /// = 0.8415, x = 10 + Phi^-1(0.60375) = 10.263066 (Python's
+    /// statistics.NormalDist().inv_cdf); the 15.85 % quantile is the atom at 0.
+    #[test]
+    fn an_atom_at_zero_and_a_normal_by_hand() {
+        let m = Mixture { normals: vec![(0.4, 10.0, 1.0)], points: vec![(0.6, 0.0)] };
+        assert_eq!(m.quantile(0.1585), 0.0);
+        let x = m.quantile(0.8415);
+        let phi = 0.5 * erfc(-(x - 10.0) / std::f64::consts::SQRT_2);
+        assert!((0.6 + 0.4 * phi - 0.8415).abs() < 1e-12);
+        assert!((x - 10.263_065_622_801_887).abs() < 1e-9, "{x}");
+        // Below the atom's weight the upper quantile is zero: no bound above zero.
+        let m = Mixture { normals: vec![(0.1, 10.0, 1.0)], points: vec![(0.9, 0.0)] };
+        assert_eq!(m.quantile(0.8415), 0.0);
+    }
+}
