@@ -139,8 +139,9 @@ pub struct GmwmJson {
     pub intervals: &'static str,
     /// The parameters of the chosen model.
     pub parameters: Vec<GmwmParameterJson>,
-    /// Processes the chosen model leaves out but candidate models weighing more than (1 -
-    /// confidence) / 2 hold: an upper bound for each (one-sided).
+    /// Processes the chosen model leaves out but candidate models hold, where the model-averaged
+    /// distribution puts more than (1 - confidence) / 2 above zero: an upper bound for each
+    /// (one-sided).
     pub left_out: Vec<GmwmBoundJson>,
     /// Scales (octave taus) used.
     pub scales: usize,

@@ -131,7 +131,7 @@ fn main() {
             ],
         ),
     ];
-    println!("| model | term | slope lines: bias / RMSE (n resolved) | five-term fit: bias / RMSE (n) | GMWM: bias / RMSE (n) | GMWM 68.3 % coverage | coverage where the chosen model holds the term | records leaving it out whose bound covers it |");
+    println!("| model | term | slope lines: bias / RMSE (n resolved) | five-term fit: bias / RMSE (n) | GMWM: bias / RMSE (n) | GMWM 68.3 % coverage | coverage where the chosen model holds the term | left out with a bound: bounds covering the truth of those records |");
     println!("|---|---|---|---|---|---|---|---|");
     for (label, set, terms) in &models {
         let mut model = SensorModel::default();

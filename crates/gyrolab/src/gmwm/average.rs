@@ -6,10 +6,14 @@
 //! criterion, Delta_m its excess over the smallest); D. Turek and D. Fletcher, "Model-averaged
 //! Wald confidence intervals", Computational Statistics & Data Analysis 56(9), 2012 (the MATA-Wald
 //! interval: the limits where the weighted mixture of the candidates' normal sampling distributions
-//! reaches alpha / 2 and 1 - alpha / 2). A candidate without the process holds it at zero, a point
-//! mass there: a term that only some candidates hold gets an interval reaching zero, and a term
-//! the chosen model leaves out an upper bound when the candidates holding it weigh more than
-//! alpha / 2. Intervals after a model choice that ignore it cover less than their level (the
+//! reaches alpha / 2 and 1 - alpha / 2). Both papers average a parameter every candidate holds;
+//! here a candidate without the process enters as a point mass at zero (this project's convention:
+//! the limit of a candidate that fixes the weight at zero with no error), so a term that only some
+//! candidates hold gets an interval reaching zero, and a term the chosen model leaves out an upper
+//! bound when the mixture puts more than alpha / 2 above zero (sum over the candidates holding it of
+//! w_m Phi(weight_m / se_m) > alpha / 2; they must weigh more than alpha / 2 for that). Some zeros
+//! are structural: the flicker floor is not offered beside Gauss-Markov processes, which stand for
+//! it there. Intervals after a model choice that ignore it cover less than their level (the
 //! choice drops a term in some records, and the sampling spread of the chosen model's estimate is
 //! conditional on that choice); the mixture puts the choice's own uncertainty into the interval.
 

@@ -21,7 +21,8 @@
 //! re-evaluated at the fitted model a few times, starting from the chi-squared approximation 2
 //! nu_hat^4_j / edf_j at the estimates; the intervals use the full covariance across scales in a
 //! sandwich with the model's Jacobian; the model is chosen by a wavelet information criterion, the
-//! objective plus its estimated optimism (module `select`).
+//! objective plus its estimated optimism (module `select`), and the linear processes' intervals
+//! are averaged over the candidate models by their criterion weights (module `average`).
 
 mod average;
 mod covariance;
@@ -261,7 +262,8 @@ pub struct GmwmFit {
     /// are not to be used.
     pub quality: crate::noise::FitQuality,
     /// The linear processes the chosen model leaves out whose model-averaged upper bound is
-    /// above zero (candidate models holding them carry weight above (1 - confidence) / 2).
+    /// above zero (the mixture of the candidates puts more than (1 - confidence) / 2 above zero;
+    /// module `average`).
     pub left_out: Vec<GmwmBound>,
 }
 

@@ -105,9 +105,11 @@ pub fn select_model_with_gauss_markov(
     }
     let fits: Vec<_> =
         all.iter().map(|c| finish(wv, &integrals[c.integrals], &c.model, &c.sigma2, confidence, c.search)).collect();
+    // Smallest criterion first; a NaN criterion (none is expected) never stays chosen over a number.
+    let better = |a: f64, b: f64| a < b - 1e-12 || (b.is_nan() && !a.is_nan());
     let mut best: Option<usize> = None;
     for (i, (fit, _)) in fits.iter().enumerate() {
-        if best.is_none_or(|b| fit.criterion < fits[b].0.criterion - 1e-12) {
+        if best.is_none_or(|b| better(fit.criterion, fits[b].0.criterion)) {
             best = Some(i);
         }
     }
