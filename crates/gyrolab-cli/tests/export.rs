@@ -5,14 +5,37 @@ mod common;
 use common::gyrolab;
 
 fn simulate(dir: &std::path::Path) -> std::path::PathBuf {
+    simulate_walk(dir, "20", "36")
+}
+
+/// 2000 s at 50 Hz of N 0.3 deg/sqrt(h) and a random walk K `rrw` deg/h/sqrt(h), seed `seed`.
+fn simulate_walk(dir: &std::path::Path, rrw: &str, seed: &str) -> std::path::PathBuf {
     let p = dir.join("sim.csv");
     gyrolab()
         .args(["simulate", "static", "--duration-s", "2000", "--sample-rate-hz", "50", "--arw-deg-rt-h", "0.3"])
-        .args(["--rrw-deg-h-rt-h", "20", "--seed", "36", "--out"])
+        .args(["--rrw-deg-h-rt-h", rrw, "--seed", seed, "--out"])
         .arg(&p)
         .assert()
         .success();
     p
+}
+
+/// `gyrolab allan RECORD --estimator gmwm --export STACK=FILE`, asserted to succeed; the file's text.
+fn gmwm_export(record: &std::path::Path, stack: &str, file: &std::path::Path) -> String {
+    gyrolab()
+        .arg("allan")
+        .arg(record)
+        .args(["--estimator", "gmwm", "--export"])
+        .arg(format!("{stack}={}", file.display()))
+        .assert()
+        .success();
+    std::fs::read_to_string(file).unwrap()
+}
+
+/// `gyrolab allan RECORD --json`, parsed.
+fn allan_json(record: &std::path::Path) -> serde_json::Value {
+    let json = gyrolab().arg("allan").arg(record).arg("--json").assert().success().get_output().stdout.clone();
+    serde_json::from_slice(&json).unwrap()
 }
 
 fn value(text: &str, key: &str) -> f64 {
@@ -49,22 +72,12 @@ fn simulated_record_is_marked_and_factors_are_recorded() {
 fn gmwm_is_the_basis_when_asked() {
     let dir = tempfile::tempdir().unwrap();
     let sim = simulate(dir.path());
-    let f = dir.path().join("vins.yaml");
-    gyrolab()
-        .arg("allan")
-        .arg(&sim)
-        .args(["--estimator", "gmwm", "--export"])
-        .arg(format!("vins={}", f.display()))
-        .assert()
-        .success();
-    let text = std::fs::read_to_string(&f).unwrap();
+    let text = gmwm_export(&sim, "vins", &dir.path().join("vins.yaml"));
     assert!(text.contains("estimator: gmwm") && text.contains("gmwm: GMWM estimate"), "{text}");
     // N = 0.3 deg/sqrt(h) = 0.005 deg/sqrt(s) = 8.727e-5 rad/s/sqrt(Hz): within 10 %.
     let n = value(&text, "gyr_n");
     assert!((n / (0.005f64.to_radians()) - 1.0).abs() < 0.1, "{n}");
-    let json = gyrolab().arg("allan").arg(&sim).arg("--json").assert().success().get_output().stdout.clone();
-    let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
-    assert_eq!(v["channels"][0]["gmwm"]["sided"], "two-sided");
+    assert_eq!(allan_json(&sim)["channels"][0]["gmwm"]["sided"], "two-sided");
 }
 
 #[test]
@@ -199,16 +212,8 @@ fn gauss_markov_record(dir: &std::path::Path) -> std::path::PathBuf {
 fn a_gauss_markov_process_is_exported_as_the_random_walk_that_bounds_it() {
     let dir = tempfile::tempdir().unwrap();
     let rec = gauss_markov_record(dir.path());
-    let f = dir.path().join("kalibr.yaml");
-    gyrolab()
-        .arg("allan")
-        .arg(&rec)
-        .args(["--estimator", "gmwm", "--export"])
-        .arg(format!("kalibr={}", f.display()))
-        .assert()
-        .success();
-    let json = gyrolab().arg("allan").arg(&rec).arg("--json").assert().success().get_output().stdout.clone();
-    let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
+    let text = gmwm_export(&rec, "kalibr", &dir.path().join("kalibr.yaml"));
+    let v = allan_json(&rec);
     let g = &v["channels"][0]["gmwm"];
     let params = g["parameters"].as_array().unwrap();
     let markov: Vec<&serde_json::Value> = params.iter().filter(|p| p["process"] == "gauss_markov").collect();
@@ -222,7 +227,6 @@ fn a_gauss_markov_process_is_exported_as_the_random_walk_that_bounds_it() {
     // about 380 at 164 s, white noise by about 7.5e5 at 0.01 s).
     let k_rw = params.iter().find(|p| p["process"] == "random_walk").map_or(0.0, |p| p["value"].as_f64().unwrap());
     let want = (k_rw * k_rw + 2.0 * sigma * sigma / t).sqrt().to_radians();
-    let text = std::fs::read_to_string(&f).unwrap();
     let got = value(&text, "gyroscope_random_walk");
     assert!((got / want - 1.0).abs() < 1e-6, "{got} vs {want}\n{text}");
     assert!(text.contains("gmwm_gauss_markov_bound") && text.contains("gauss_markov(sigma"), "{text}");
@@ -235,15 +239,8 @@ fn a_gauss_markov_process_is_exported_as_the_random_walk_that_bounds_it() {
 #[test]
 fn a_random_walk_left_out_by_the_chosen_model_is_exported_as_its_bound() {
     let dir = tempfile::tempdir().unwrap();
-    let sim = dir.path().join("sim.csv");
-    gyrolab()
-        .args(["simulate", "static", "--duration-s", "2000", "--sample-rate-hz", "50", "--arw-deg-rt-h", "0.3"])
-        .args(["--rrw-deg-h-rt-h", "3", "--seed", "6", "--out"])
-        .arg(&sim)
-        .assert()
-        .success();
-    let json = gyrolab().arg("allan").arg(&sim).arg("--json").assert().success().get_output().stdout.clone();
-    let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
+    let sim = simulate_walk(dir.path(), "3", "6");
+    let v = allan_json(&sim);
     let g = &v["channels"][0]["gmwm"];
     assert!(g["parameters"].as_array().unwrap().iter().all(|p| p["process"] != "random_walk"), "{g}");
     let left = g["left_out"].as_array().unwrap();
@@ -255,15 +252,7 @@ fn a_random_walk_left_out_by_the_chosen_model_is_exported_as_its_bound() {
     let text = gyrolab().arg("allan").arg(&sim).assert().success().get_output().stdout.clone();
     let text = String::from_utf8_lossy(&text).to_string();
     assert!(text.contains("left out by the chosen model: random_walk <"), "{text}");
-    let f = dir.path().join("kalibr.yaml");
-    gyrolab()
-        .arg("allan")
-        .arg(&sim)
-        .args(["--estimator", "gmwm", "--export"])
-        .arg(format!("kalibr={}", f.display()))
-        .assert()
-        .success();
-    let yaml = std::fs::read_to_string(&f).unwrap();
+    let yaml = gmwm_export(&sim, "kalibr", &dir.path().join("kalibr.yaml"));
     let got = value(&yaml, "gyroscope_random_walk");
     assert!((got / upper.to_radians() - 1.0).abs() < 1e-6, "{got} vs {upper} deg\n{yaml}");
     assert!(yaml.contains("gmwm_upper_bound") && yaml.contains("84.2 % upper bound"), "{yaml}");

@@ -99,9 +99,22 @@ fn points(
     log: bool,
     scale: f64,
 ) {
+    push_points(out, (a, b), n, log, scale, |f, _, sw| sw * haar_gain(m_lo, f, avg_lo) * haar_gain(m_hi, f, avg_hi));
+}
+
+/// Appends (f, sin^2(pi f), weight(f, sin(pi f), scale x step)) at the midpoints of (a, b] in `n`
+/// steps (uniform, or uniform in log f when `log`): the one loop of [`points`] and [`mean_points`].
+fn push_points(
+    out: &mut Vec<[f64; 3]>,
+    (a, b): (f64, f64),
+    n: usize,
+    log: bool,
+    scale: f64,
+    weight: impl Fn(f64, f64, f64) -> f64,
+) {
     for (f, w) in midpoints(a, b, n, log) {
         let s = (std::f64::consts::PI * f).sin();
-        out.push([f, s * s, scale * w * haar_gain(m_lo, f, avg_lo) * haar_gain(m_hi, f, avg_hi)]);
+        out.push([f, s * s, weight(f, s, scale * w)]);
     }
 }
 
@@ -120,12 +133,11 @@ fn mean_points(
     log: bool,
     scale: f64,
 ) {
-    for (f, w) in midpoints(a, b, n, log) {
-        let s = (std::f64::consts::PI * f).sin();
+    push_points(out, (a, b), n, log, scale, |f, s, sw| {
         let fejer_num = if avg_terms { 0.5 } else { (std::f64::consts::PI * f * terms).sin().powi(2) };
         let fejer = fejer_num / (terms * terms * s * s);
-        out.push([f, s * s, scale * w * haar_gain(m, f, avg_m) * fejer]);
-    }
+        sw * haar_gain(m, f, avg_m) * fejer
+    });
 }
 
 /// The quadrature of the covariance integrals of one set of scales, made once and used for every
