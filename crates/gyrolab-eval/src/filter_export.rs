@@ -261,14 +261,14 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
                 let own = g.parameter(process);
                 let total2 = own.map_or(0.0, |x| x.value * x.value) + extra2;
                 if total2 <= 0.0 {
-                    // A process the chosen model leaves out: its model-averaged upper bound, where
-                    // the candidate models holding it weigh enough to give one.
+                    // A process the chosen model leaves out: its upper bound given that it is
+                    // there, averaged over the candidate models holding it.
                     return g.left_out.iter().find(|b| b.process == process).map(|b| {
                         (
                             b.upper,
                             "gmwm_upper_bound".to_string(),
                             format!(
-                                "GMWM: left out by the chosen model ({model}); one-sided {} % upper bound {} {unit} from the intervals averaged over the candidate models, those holding it weighing {} % (docs/METHODS.md 3.1); {name}",
+                                "GMWM: left out by the chosen model ({model}); one-sided {} % upper bound {} {unit} given that it is there, from the intervals averaged over the candidate models holding it, which weigh {} % (docs/METHODS.md 3.1); {name}",
                                 percent(1.0 - (1.0 - g.confidence) / 2.0),
                                 real_text(b.upper * to_si),
                                 percent(b.model_weight),

@@ -256,7 +256,7 @@ pub fn gmwm_text(a: &ChannelAnalysis) -> Option<String> {
         .iter()
         .map(|b| {
             format!(
-                "; left out by the chosen model: {} < {} {} (one-sided {} %, models holding it weigh {} %)",
+                "; left out by the chosen model: {} < {} {} if present (one-sided {} %, models holding it weigh {} %)",
                 b.process.name(),
                 sig(b.upper, 3),
                 gmwm_unit(b.process, a.quantity),

@@ -222,9 +222,10 @@ pub struct GmwmParameter {
     pub model_weight: f64,
 }
 
-/// A linear process the chosen model leaves out, bounded by the model-averaged distribution: its
-/// coefficient lies below `upper` at the one-sided level 1 - (1 - confidence) / 2 (84.15 % for
-/// 68.3 %), the same as the upper end of the two-sided intervals.
+/// A linear process the chosen model leaves out, bounded given that it is there (the mixture of
+/// the candidate models holding it, their weights renormalised): its coefficient lies below
+/// `upper` at the one-sided level 1 - (1 - confidence) / 2 (84.15 % for 68.3 %), the same as the
+/// upper end of the two-sided intervals.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct GmwmBound {
     /// The process.
@@ -261,9 +262,8 @@ pub struct GmwmFit {
     /// the five-term fit): no model of the processes searched describes the curve, and its values
     /// are not to be used.
     pub quality: crate::noise::FitQuality,
-    /// The linear processes the chosen model leaves out whose model-averaged upper bound is
-    /// above zero (the mixture of the candidates puts more than (1 - confidence) / 2 above zero;
-    /// module `average`).
+    /// The linear processes the chosen model leaves out that some candidate model holds, each
+    /// with its upper bound given that it is there (module `average`).
     pub left_out: Vec<GmwmBound>,
 }
 
