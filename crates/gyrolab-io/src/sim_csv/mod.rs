@@ -194,7 +194,21 @@ fn write_preamble(
 /// With `options.pipelined`, three threads share the work: one simulates (and formats when the
 /// second is busy), one formats, one writes (same bytes as with one thread; see `pipeline`).
 pub fn write_static_csv<W: Write + Send>(
-    out: W,
+    mut out: W,
+    model: &SensorModel,
+    spec: &StaticSpec,
+    seed: u64,
+    options: &SimCsvOptions,
+) -> Result<WriteSummary, SimCsvError> {
+    write_static_csv_to(&mut out, model, spec, seed, options)
+}
+
+/// [`write_static_csv`] to a writer behind a reference: the row loops, compiled once per number
+/// format (17 of them), are compiled here once, not again for each writer type in each calling
+/// crate (51 copies in gyrolab-eval's release build, a quarter of its LLVM IR; docs/PERFORMANCE.md).
+/// The writer is called once per filled buffer, so the dynamic call costs nothing measurable.
+fn write_static_csv_to(
+    out: &mut (dyn Write + Send),
     model: &SensorModel,
     spec: &StaticSpec,
     seed: u64,
@@ -316,7 +330,19 @@ const RATE_TABLE_ROW_ROOM: usize = 3 * NUMBER_ROOM + 16;
 
 /// Simulates a rate-table test and writes it in the long layout; returns rows and bytes written.
 pub fn write_rate_table_csv<W: Write>(
-    out: W,
+    mut out: W,
+    model: &SensorModel,
+    spec: &RateTableSpec,
+    seed: u64,
+    options: &SimCsvOptions,
+) -> Result<WriteSummary, SimCsvError> {
+    write_rate_table_csv_to(&mut out, model, spec, seed, options)
+}
+
+/// [`write_rate_table_csv`] to a writer behind a reference (compiled once; see
+/// [`write_static_csv_to`]).
+fn write_rate_table_csv_to(
+    out: &mut dyn Write,
     model: &SensorModel,
     spec: &RateTableSpec,
     seed: u64,

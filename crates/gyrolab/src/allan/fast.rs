@@ -24,7 +24,7 @@
 //! returned with that error bound, and the caller recomputes directly every m whose bound is not
 //! far below the required accuracy.
 
-use realfft::RealFftPlanner;
+use gyrolab_fft::Correlator;
 
 /// Below this many lags a prefix-limited correlation is summed directly.
 const DIRECT_BELOW: usize = 128;
@@ -186,22 +186,7 @@ fn detrended(s: &[f64]) -> (Vec<f64>, f64) {
 
 /// R(l) = sum_{i<L-l} x_i x_{i+l} for l <= max_lag, from one zero-padded real FFT.
 fn autocorrelation(x: &[f64], max_lag: usize) -> Option<Vec<f64>> {
-    let size = (x.len() + max_lag + 1).next_power_of_two();
-    let mut planner = RealFftPlanner::<f64>::new();
-    let fwd = planner.plan_fft_forward(size);
-    let inv = planner.plan_fft_inverse(size);
-    let mut buf = fwd.make_input_vec();
-    buf[..x.len()].copy_from_slice(x);
-    let mut spec = fwd.make_output_vec();
-    fwd.process(&mut buf, &mut spec).ok()?;
-    for c in spec.iter_mut() {
-        *c = realfft::num_complex::Complex::new(c.norm_sqr(), 0.0);
-    }
-    inv.process(&mut spec, &mut buf).ok()?;
-    let scale = 1.0 / size as f64;
-    buf.truncate(max_lag + 1);
-    buf.iter_mut().for_each(|v| *v *= scale);
-    Some(buf)
+    Correlator::new().autocorrelation(x, max_lag)
 }
 
 /// H(m) = sum_{j<m} x_j x_{j+m} for m <= m_max.
@@ -213,15 +198,14 @@ fn head_sums(x: &[f64], m_max: usize) -> Option<Vec<f64>> {
     let take = x.len().min(2 * size);
     v[..take].copy_from_slice(&x[..take]);
     let mut out = vec![0.0f64; size];
-    let mut planner = RealFftPlanner::<f64>::new();
-    prefix_correlation(&v[..size], &v, &mut out, &mut planner)?;
+    prefix_correlation(&v[..size], &v, &mut out, &mut Correlator::new())?;
     out.truncate(m_max + 1);
     Some(out)
 }
 
 /// out[r] += sum_{i<r} u_i v_{i+r} for r < out.len() = M (a power of two); u.len() >= M,
 /// v.len() >= 2M - 1.
-fn prefix_correlation(u: &[f64], v: &[f64], out: &mut [f64], planner: &mut RealFftPlanner<f64>) -> Option<()> {
+fn prefix_correlation(u: &[f64], v: &[f64], out: &mut [f64], fft: &mut Correlator) -> Option<()> {
     let m = out.len();
     if m <= DIRECT_BELOW {
         for (r, o) in out.iter_mut().enumerate() {
@@ -231,33 +215,13 @@ fn prefix_correlation(u: &[f64], v: &[f64], out: &mut [f64], planner: &mut RealF
     }
     let h = m / 2;
     let (low, high) = out.split_at_mut(h);
-    prefix_correlation(u, v, low, planner)?;
+    prefix_correlation(u, v, low, fft)?;
     // full part: c(r) = sum_{i<h} u_i v_{i+r}, r in [h, m): correlation of a = u[..h] with
     // b = v[h..h + m - 1] at lags 0..h; indices stay below m - 1, so a size-m circle does not wrap
-    let fwd = planner.plan_fft_forward(m);
-    let inv = planner.plan_fft_inverse(m);
-    let mut a = fwd.make_input_vec();
-    a[..h].copy_from_slice(&u[..h]);
-    let mut b = fwd.make_input_vec();
-    b[..m - 1].copy_from_slice(&v[h..h + m - 1]);
-    let mut fa = fwd.make_output_vec();
-    let mut fb = fwd.make_output_vec();
-    fwd.process(&mut a, &mut fa).ok()?;
-    fwd.process(&mut b, &mut fb).ok()?;
-    for (p, q) in fb.iter_mut().zip(&fa) {
-        *p *= q.conj();
-    }
-    if let Some(first) = fb.first_mut() {
-        first.im = 0.0;
-    }
-    if let Some(last) = fb.last_mut() {
-        last.im = 0.0;
-    }
-    inv.process(&mut fb, &mut a).ok()?;
-    let scale = 1.0 / m as f64;
-    for (o, c) in high.iter_mut().zip(&a[..h]) {
-        *o += c * scale;
+    let full = fft.correlation(&u[..h], &v[h..h + m - 1], m, h)?;
+    for (o, c) in high.iter_mut().zip(&full) {
+        *o += c;
     }
     // the rest: sum_{h<=i<r} u_i v_{i+r}, the same problem on u[h..], v[2h..]
-    prefix_correlation(&u[h..], &v[2 * h..], high, planner)
+    prefix_correlation(&u[h..], &v[2 * h..], high, fft)
 }
