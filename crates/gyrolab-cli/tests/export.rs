@@ -233,9 +233,9 @@ fn a_gauss_markov_process_is_exported_as_the_random_walk_that_bounds_it() {
 }
 
 /// A random walk the chosen GMWM model leaves out (white noise + a drift chosen for N 0.3
-/// deg/sqrt(h), K 3 deg/h/sqrt(h), seed 6) is bounded by the model-averaged interval: the text
-/// names it, the JSON lists it under `left_out`, and the Kalibr export writes that bound in rad
-/// with the basis `gmwm_upper_bound`.
+/// deg/sqrt(h), K 3 deg/h/sqrt(h), seed 6) is bounded given that it is there (the candidates
+/// holding it): the text names it, the JSON lists it under `left_out` with the weight of those
+/// candidates, and the Kalibr export writes that bound in rad with the basis `gmwm_upper_bound`.
 #[test]
 fn a_random_walk_left_out_by_the_chosen_model_is_exported_as_its_bound() {
     let dir = tempfile::tempdir().unwrap();
@@ -248,10 +248,13 @@ fn a_random_walk_left_out_by_the_chosen_model_is_exported_as_its_bound() {
     assert_eq!(k["unit"], "deg/s/sqrt(s)");
     assert_eq!(k["confidence_one_sided"], 0.8415);
     let (upper, weight) = (k["upper"].as_f64().unwrap(), k["model_weight"].as_f64().unwrap());
-    assert!(upper > 0.0 && weight > 0.1585 && weight < 1.0, "{k}");
+    assert!(upper > 0.0 && weight > 0.0 && weight < 1.0, "{k}");
     let text = gyrolab().arg("allan").arg(&sim).assert().success().get_output().stdout.clone();
     let text = String::from_utf8_lossy(&text).to_string();
-    assert!(text.contains("left out by the chosen model: random_walk <"), "{text}");
+    assert!(
+        text.contains("left out by the chosen model: random_walk <") && text.contains(" if present (one-sided 84.15 %"),
+        "{text}"
+    );
     let yaml = gmwm_export(&sim, "kalibr", &dir.path().join("kalibr.yaml"));
     let got = value(&yaml, "gyroscope_random_walk");
     assert!((got / upper.to_radians() - 1.0).abs() < 1e-6, "{got} vs {upper} deg\n{yaml}");

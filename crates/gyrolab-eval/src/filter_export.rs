@@ -154,6 +154,15 @@ fn percent(c: f64) -> String {
     ((p * 10.0).round() / 10.0).to_string()
 }
 
+/// A model weight in percent, "below 0.1" where it would round to 0.
+fn weight_percent(w: f64) -> String {
+    if w < 5e-4 {
+        "below 0.1".to_string()
+    } else {
+        percent(w)
+    }
+}
+
 /// A channel's white-noise and random-walk terms by one estimator, in the curve's coefficient
 /// units (deg/sqrt(s), deg/s/sqrt(s) for a gyro in deg/s; m/s/sqrt(s), m/s^2/sqrt(s) for an
 /// accelerometer) with their sources (intervals written in SI units, `to_si` the factor).
@@ -271,7 +280,7 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
                                 "GMWM: left out by the chosen model ({model}); one-sided {} % upper bound {} {unit} given that it is there, from the intervals averaged over the candidate models holding it, which weigh {} % (docs/METHODS.md 3.1); {name}",
                                 percent(1.0 - (1.0 - g.confidence) / 2.0),
                                 real_text(b.upper * to_si),
-                                percent(b.model_weight),
+                                weight_percent(b.model_weight),
                             ),
                         )
                     });

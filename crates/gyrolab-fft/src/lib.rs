@@ -62,8 +62,8 @@ impl Correlator {
 
     /// The correlation c(r) = sum over i < a.len() of a_i b_(i+r) (b taken as zero beyond its
     /// end), for r = 0..lags, by one circular correlation of size `size`, an even number with
-    /// a.len() + lags - 1 <= size and b.len() <= size (so that no product wraps around). `None`
-    /// when those do not hold or a transform fails.
+    /// a.len() + lags - 1 <= size, b.len() <= size and 1 <= lags <= size (so that no product
+    /// wraps around and every lag is a bin). `None` when those do not hold or a transform fails.
     ///
     /// ```
     /// let c = gyrolab_fft::Correlator::new().correlation(&[1.0, 2.0], &[3.0, 4.0, 5.0], 4, 2).unwrap();
@@ -71,7 +71,7 @@ impl Correlator {
     /// assert!((c[0] - 11.0).abs() < 1e-12 && (c[1] - 14.0).abs() < 1e-12);
     /// ```
     pub fn correlation(&mut self, a: &[f64], b: &[f64], size: usize, lags: usize) -> Option<Vec<f64>> {
-        if !size.is_multiple_of(2) || a.len() + lags > size + 1 || b.len() > size {
+        if !size.is_multiple_of(2) || lags == 0 || lags > size || b.len() > size || a.len() + lags - 1 > size {
             return None;
         }
         let fwd = self.planner.plan_fft_forward(size);
@@ -149,6 +149,13 @@ mod tests {
         assert!(c.correlation(&[1.0; 3], &[1.0; 4], 4, 3).is_none());
         assert!(c.correlation(&[1.0; 2], &[1.0; 5], 4, 2).is_none());
         assert!(c.correlation(&[1.0; 2], &[1.0; 3], 3, 1).is_none());
-        assert!(c.correlation(&[1.0; 2], &[1.0; 4], 4, 3).is_some());
+        assert!(c.correlation(&[1.0; 5], &[1.0; 4], 4, 0).is_none());
+        assert!(c.correlation(&[], &[1.0; 4], 4, 5).is_none());
+        // At the boundary (a.len() + lags - 1 = size): 1*1 + 2*2, 1*2 + 2*3, 1*3 + 2*4.
+        let got = c.correlation(&[1.0, 2.0], &[1.0, 2.0, 3.0, 4.0], 4, 3).unwrap();
+        for (g, w) in got.iter().zip([5.0, 8.0, 11.0]) {
+            assert!((g - w).abs() < 1e-12, "{got:?}");
+        }
+        assert_eq!(got.len(), 3);
     }
 }

@@ -112,7 +112,7 @@ pub struct GmwmParameterJson {
     pub model_weight: f64,
 }
 
-/// A process the chosen GMWM model leaves out, with its model-averaged upper bound.
+/// A process the chosen GMWM model leaves out, with its upper bound given that it is there.
 #[derive(Debug, Clone, Serialize)]
 pub struct GmwmBoundJson {
     /// `quantization`, `white`, `flicker`, `random_walk` or `drift`.
@@ -139,9 +139,9 @@ pub struct GmwmJson {
     pub intervals: &'static str,
     /// The parameters of the chosen model.
     pub parameters: Vec<GmwmParameterJson>,
-    /// Processes the chosen model leaves out but candidate models hold, where the model-averaged
-    /// distribution puts more than (1 - confidence) / 2 above zero: an upper bound for each
-    /// (one-sided).
+    /// Processes the chosen model leaves out but candidate models hold: an upper bound for each
+    /// given that it is there (one-sided; the mixture of the candidates holding it, their weights
+    /// renormalised), with the weight of those candidates.
     pub left_out: Vec<GmwmBoundJson>,
     /// Scales (octave taus) used.
     pub scales: usize,
@@ -261,7 +261,7 @@ pub fn gmwm_text(a: &ChannelAnalysis) -> Option<String> {
                 sig(b.upper, 3),
                 gmwm_unit(b.process, a.quantity),
                 short(100.0 * (1.0 - (1.0 - g.confidence) / 2.0), 4),
-                short(100.0 * b.model_weight, 2)
+                if b.model_weight < 5e-5 { "below 0.01".to_string() } else { short(100.0 * b.model_weight, 2) }
             )
         })
         .collect();

@@ -205,7 +205,7 @@ pub fn write_static_csv<W: Write + Send>(
 
 /// [`write_static_csv`] to a writer behind a reference: the row loops, compiled once per number
 /// format (17 of them), are compiled here once, not again for each writer type in each calling
-/// crate (51 copies in gyrolab-eval's release build, a quarter of its LLVM IR; docs/PERFORMANCE.md).
+/// crate (51 copies in gyrolab-eval's release build, about a third of its LLVM IR; docs/PERFORMANCE.md).
 /// The writer is called once per filled buffer, so the dynamic call costs nothing measurable.
 fn write_static_csv_to(
     out: &mut (dyn Write + Send),

@@ -237,8 +237,13 @@ mod tests {
         let k = model_average(&far, 0).left_out[0];
         assert!((k.upper - 2.236_211_490_168_684_7).abs() < 1e-9, "{k:?}");
         assert!(k.model_weight < 0.003, "{k:?}");
-        // A process no candidate holds gets no bound.
-        assert!(model_average(&fits[..1], 0).left_out.is_empty());
+        // A process only candidates of weight 0 hold (criterion not finite) gets no bound.
+        let mut ruled_out = fits.clone();
+        ruled_out[1].0.criterion = f64::INFINITY;
+        ruled_out.push((fit(0.5, &[Process::White]), vec![Moment { process: Process::White, weight: 99.0, se: 2.0 }]));
+        let out = model_average(&ruled_out, 0);
+        assert!(out.left_out.is_empty(), "{out:?}");
+        assert!(out.parameter(Process::White).unwrap().upper > 1.5, "the averaging ran: {out:?}");
     }
 
     /// Three candidates, criteria 0, 1 and 2, the random walk in the second (4 +- 1) and third
@@ -278,7 +283,7 @@ mod tests {
         let phi = 0.5 * erfc(-(x - 10.0) / std::f64::consts::SQRT_2);
         assert!((0.6 + 0.4 * phi - 0.8415).abs() < 1e-12);
         assert!((x - 10.263_065_622_801_887).abs() < 1e-9, "{x}");
-        // Below the atom's weight the upper quantile is zero: no bound above zero.
+        // Below the atom's weight the upper quantile is the atom (an interval's upper end 0).
         let m = Mixture { normals: vec![(0.1, 10.0, 1.0)], points: vec![(0.9, 0.0)] };
         assert_eq!(m.quantile(0.8415), 0.0);
     }

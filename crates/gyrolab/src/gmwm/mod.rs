@@ -262,8 +262,9 @@ pub struct GmwmFit {
     /// the five-term fit): no model of the processes searched describes the curve, and its values
     /// are not to be used.
     pub quality: crate::noise::FitQuality,
-    /// The linear processes the chosen model leaves out that some candidate model holds, each
-    /// with its upper bound given that it is there (module `average`).
+    /// The linear processes the chosen model leaves out that some candidate model of non-zero
+    /// weight holds, each with its upper bound given that it is there when that bound is above
+    /// zero (module `average`); empty when one candidate holds all the weight.
     pub left_out: Vec<GmwmBound>,
 }
 
