@@ -36,7 +36,7 @@ impl Correlator {
     /// eps log2(size) sum x_i^2.
     ///
     /// ```
-    /// let r = gyrolab_fft::Correlator::new().autocorrelation(&[1.0, 2.0, 3.0], 2).unwrap();
+    /// let r = gyrolab_fft::Correlator::new().autocorrelation(&[1.0, 2.0, 3.0], 2).unwrap(); // ok: fixed input, sizes valid
     /// // 1 + 4 + 9, 1*2 + 2*3, 1*3
     /// for (got, want) in r.iter().zip([14.0, 8.0, 3.0]) {
     ///     assert!((got - want).abs() < 1e-12);
@@ -66,7 +66,7 @@ impl Correlator {
     /// wraps around and every lag is a bin). `None` when those do not hold or a transform fails.
     ///
     /// ```
-    /// let c = gyrolab_fft::Correlator::new().correlation(&[1.0, 2.0], &[3.0, 4.0, 5.0], 4, 2).unwrap();
+    /// let c = gyrolab_fft::Correlator::new().correlation(&[1.0, 2.0], &[3.0, 4.0, 5.0], 4, 2).unwrap(); // ok: sizes valid
     /// // 1*3 + 2*4, 1*4 + 2*5
     /// assert!((c[0] - 11.0).abs() < 1e-12 && (c[1] - 14.0).abs() < 1e-12);
     /// ```
