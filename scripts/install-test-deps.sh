@@ -4,10 +4,10 @@
 # (scripts/check_chi2_scipy.py), pytest, matplotlib and maturin for the Python package's tests
 # (python/tests), PyYAML and opencv-python-headless as the readers of the filter exports
 # (scripts/check_exports.py), rosbags, mcap and pyarrow as independent writers of the recordings the readers
-# are tested on (scripts/write_recordings.py, crates/gyrolab-cli/tests/recordings.rs), and
+# are tested on (scripts/write_recordings.py, crates/gyrolab-cli/tests/integration/recordings.rs), and
 # Chromium for the browser test of
-# the HTML report (crates/gyrolab-cli/tests/browser.rs) and the PDF test of `--pdf`
-# (crates/gyrolab-cli/tests/pdf.rs). Does nothing that is already done; says on stderr what it is
+# the HTML report (crates/gyrolab-cli/tests/integration/browser.rs) and the PDF test of `--pdf`
+# (crates/gyrolab-cli/tests/integration/pdf.rs). Does nothing that is already done; says on stderr what it is
 # about to install, and how not to.
 #
 # Opt-outs: GYROLAB_SKIP_PYTHON=1 (no .venv; the checks that need it print SKIPPED:),
@@ -18,7 +18,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# The browser the tests use (crates/gyrolab-cli/tests/browser.rs and pdf.rs): /usr/bin/chromium.
+# The browser the tests use (crates/gyrolab-cli/tests/integration/browser.rs and pdf.rs): /usr/bin/chromium.
 have_browser() {
     [ -x /usr/bin/chromium ]
 }

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Independent reading of the PX4 ULog in examples/recordings (pyulog + numpy) for gyrolab's
-clock-model test (crates/gyrolab-eval/tests/clock.rs, `px4_log_matches_pyulog_and_numpy`).
+clock-model test (crates/gyrolab-eval/tests/integration/clock.rs, `px4_log_matches_pyulog_and_numpy`).
 
 For topic sensor_combined (its `timestamp` is the gyro's sampling time, microseconds):
 - the clock model's rule done here in numpy: base = median interval; the stamps are a sample

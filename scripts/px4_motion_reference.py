@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Independent reading of a REAL PX4 flight log (pyulog + numpy) for gyrolab's stillness check
-(crates/gyrolab-cli/tests/stillness.rs, `a_real_px4_flight_is_found_moving`).
+(crates/gyrolab-cli/tests/integration/stillness.rs, `a_real_px4_flight_is_found_moving`).
 
 For topic sensor_combined (its `timestamp` is the gyro's sampling time, microseconds), each of
 gyro_rad[0..3] (float32 widened, times 180/pi: deg/s), read without gyrolab's clock model:

@@ -10,6 +10,16 @@
 # would resolve other features and build the crates again; docs/PERFORMANCE.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# The time of each step, on stderr (docs/PERFORMANCE.md keeps the figures of fresh clones).
+step_start=$SECONDS
+step_done() {
+    echo "test.sh: $1: $((SECONDS - step_start)) s" >&2
+    step_start=$SECONDS
+}
+# The Python package's native module is linked by the same cargo build as the tests (below), as an
+# extension module: pyo3 leaves the interpreter's symbols to the importing Python (what maturin
+# sets for the wheel). Set for every cargo command here, so the crates are built once.
+export PYO3_BUILD_EXTENSION_MODULE=1
 bash scripts/install-test-deps.sh
 if [ "${GYROLAB_SKIP_BROWSER:-}" != "1" ] && ! bash scripts/install-test-deps.sh --browser; then
     export GYROLAB_SKIP_BROWSER=1
@@ -21,10 +31,13 @@ fi
 # A throw-away PostgreSQL server for the records store tests (exports GYROLAB_TEST_PG_URL; stopped
 # and removed at exit; installs the Debian package postgresql when missing): docs/STORE.md.
 source scripts/pg-test-server.sh start
+step_done "installs and the PostgreSQL server"
 cargo test --workspace --all-targets
+step_done "cargo test (build and run)"
 # The documentation examples (`--all-targets` leaves doctests out): each public formula's example
 # with its published or hand value runs here.
 cargo test --workspace --doc
+step_done "doctests"
 bin=target/debug/gyrolab
 # The binary is built by `cargo test --workspace --all-targets` (should a cargo version not leave it
 # there, build it once).
@@ -32,13 +45,15 @@ if [ ! -x "$bin" ]; then
     echo "test.sh: $bin not left by cargo test: building it" >&2
     cargo build --quiet -p gyrolab-cli
 fi
-# `--all-targets` builds the examples as test harnesses, not their own programs: link the one the
-# scipy check runs. `--workspace` keeps the test build's feature set, so no dependency is compiled
-# again (a `-p gyrolab` build resolves that package's features alone; docs/PERFORMANCE.md).
-cargo build --quiet --workspace --example chi2_quantiles
-# The hostile recordings written by crates/gyrolab-cli/tests/hostile.rs, each read again by
+# `--all-targets` builds the examples as test harnesses, not their own programs, and leaves the
+# Python package's native module (a cdylib) unlinked: link the example the scipy check runs and the
+# module. `--workspace` with an example keeps the test build's feature set, so no dependency is
+# compiled again (a `-p` build resolves that package's features alone; docs/PERFORMANCE.md).
+cargo build --quiet --workspace --lib --example chi2_quantiles
+# The hostile recordings written by crates/gyrolab-cli/tests/integration/hostile.rs, each read again by
 # `allan` and `inspect` under an address-space limit of 2 GiB (issue 31).
 bash scripts/test_hostile_ulimit.sh "$bin"
+step_done "the example, the native module and the hostile recordings under ulimit"
 if [ "$skip_python" = "1" ]; then
     echo "SKIPPED: GYROLAB_SKIP_PYTHON=1: allantools and scipy equality checks, the Python package's tests" >&2
 else
@@ -47,21 +62,38 @@ else
     # Chi-squared quantiles (the confidence bounds) equal to scipy's chi2.ppf from 1 to 1e9 degrees
     # of freedom at relative 1e-9.
     .venv/bin/python scripts/check_chi2_scipy.py target/debug/examples/chi2_quantiles
-    # The clock model's reference for the real PX4 log (crates/gyrolab-eval/tests/clock.rs) read
+    # The clock model's reference for the real PX4 log (crates/gyrolab-eval/tests/integration/clock.rs) read
     # again by pyulog + numpy: the committed JSON must equal a fresh independent reading.
     .venv/bin/python scripts/px4_clock_reference.py --check examples/recordings/px4_sample_log_small.ulg \
         crates/gyrolab-eval/tests/data/px4_clock_reference.json
-    # The stillness check's reference for the real PX4 flight (crates/gyrolab-cli/tests/stillness.rs),
+    # The stillness check's reference for the real PX4 flight (crates/gyrolab-cli/tests/integration/stillness.rs),
     # read again by pyulog + numpy the same way.
     .venv/bin/python scripts/px4_motion_reference.py --check examples/recordings/px4_sample_flight.ulg \
         crates/gyrolab-cli/tests/data/px4_motion_reference.json
     # The filter exports (`allan --export`) read by each stack's reader or the closest one (PyYAML,
     # OpenCV FileStorage, json, a PX4 parameter-file parser) against hand conversions and truth.
     .venv/bin/python scripts/check_exports.py "$bin"
-    # The Python package: built with maturin and installed into .venv, then its pytest suite
+    step_done "the checks against allantools, scipy, pyulog and the stacks' readers"
+    # The Python package laid out from this build (its sources and the native module linked
+    # above, where the wheel puts them: scripts/stage_python_package.py), then its pytest suite
     # (equality with allantools and with the command line, simulated truth, malformed inputs).
-    PATH="$PWD/.venv/bin:$PATH" .venv/bin/pip install --quiet --disable-pip-version-check --no-build-isolation ./python
+    # The release wheel of `pip install ./python` compiles every crate again (about 3 min);
+    # GYROLAB_TEST_WHEEL=1 builds it, installs it into .venv and runs the suite on it too.
+    PYTHONPATH="$(.venv/bin/python scripts/stage_python_package.py target/debug/lib_gyrolab.so target/python-dev)"
+    export PYTHONPATH
+    where=$(.venv/bin/python -c "import gyrolab; print(gyrolab.__file__)")
+    if [ "$where" != "$PYTHONPATH/gyrolab/__init__.py" ]; then
+        echo "test.sh: the Python tests would import gyrolab from $where, not from $PYTHONPATH" >&2
+        exit 1
+    fi
     GYROLAB_BIN="$bin" .venv/bin/python -m pytest -q -rs python/tests
+    if [ "${GYROLAB_TEST_WHEEL:-}" = "1" ]; then
+        PATH="$PWD/.venv/bin:$PATH" .venv/bin/pip install --quiet --disable-pip-version-check --no-build-isolation ./python
+        (unset PYTHONPATH; GYROLAB_BIN="$bin" .venv/bin/python -m pytest -q -rs python/tests)
+    fi
+    step_done "the Python package's tests"
 fi
-# Every example of the README, as written (python blocks SKIPPED without the package).
+# Every example of the README, as written (python blocks SKIPPED without the package; they import
+# the package laid out above).
 GYROLAB_PYTHON="$PWD/.venv/bin/python" bash scripts/readme_examples.sh "$bin"
+step_done "the README's examples"

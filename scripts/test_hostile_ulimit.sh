@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# The hostile recordings of crates/gyrolab-cli/tests/hostile.rs (issue 31), each read by
+# The hostile recordings of crates/gyrolab-cli/tests/integration/hostile.rs (issue 31), each read by
 # `gyrolab allan` and `gyrolab inspect` under an address-space limit of 2 GiB (`ulimit -v`), as on
 # small robots and in containers: every run must end with exit 0 or 2 (never an abort on memory,
 # a panic or a signal) within 60 s. The files are those the test wrote into target/tmp/hostile
-# (run `cargo test -p gyrolab-cli --test hostile` first; scripts/test.sh does).
+# (run `cargo test -p gyrolab-cli --test integration -- hostile::` first; scripts/test.sh does).
 # usage: scripts/test_hostile_ulimit.sh [GYROLAB_BINARY]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,7 +12,7 @@ dir="target/tmp/hostile"
 shopt -s nullglob
 files=("$dir"/*.mcap "$dir"/*.bag "$dir"/*.ulg "$dir"/*.parquet)
 if [ "${#files[@]}" -lt 20 ]; then
-  echo "test_hostile_ulimit: expected the hostile files in $dir (cargo test -p gyrolab-cli --test hostile)" >&2
+  echo "test_hostile_ulimit: expected the hostile files in $dir (cargo test -p gyrolab-cli --test integration -- hostile::)" >&2
   exit 1
 fi
 failed=0

@@ -958,7 +958,7 @@ mod tests {
         assert!(!h.contains("<script"));
         // No ligatures anywhere, the page margins included: "dba4ebff" copies out of the PDF as
         // typed (pypdf read Chromium's "ff" ligature as U+FB00 and the report number failed to
-        // match; crates/gyrolab-cli/tests/pdf.rs).
+        // match; crates/gyrolab-cli/tests/integration/pdf.rs).
         assert!(h.contains("html { font-variant-ligatures: none;"));
         assert!(page_style("GYR-1-ff")
             .contains("Report GYR-1-ff\"; font-size: 8pt; color: #333; font-variant-ligatures: none;"));

@@ -88,7 +88,7 @@ const BUSY_TIMEOUT: Duration = Duration::from_secs(30);
 /// Puts an SQLite store into WAL mode. WAL is a property of the file, so it is read first and
 /// nothing is locked once a store has been converted. The conversion itself needs the file to
 /// itself and SQLite does not run the busy handler for it, so two processes opening a new store
-/// at once (tests/store.rs `two_processes_storing_at_once_both_land`) retry here, with backoff,
+/// at once (tests/integration/store.rs `two_processes_storing_at_once_both_land`) retry here, with backoff,
 /// within the busy timeout.
 fn set_wal(c: &rusqlite::Connection, budget: Duration) -> Result<(), String> {
     let start = std::time::Instant::now();
@@ -658,7 +658,7 @@ pub struct Changes {
     pub test_date: Option<String>,
 }
 
-/// The environment variable of the kill test (crates/gyrolab-cli/tests/store.rs): milliseconds
+/// The environment variable of the kill test (crates/gyrolab-cli/tests/integration/store.rs): milliseconds
 /// to pause inside the transaction of every stored evaluation, after all its rows are written and
 /// before the commit, so that a test can kill the process there. Unset in normal use.
 pub const TEST_PAUSE_ENV: &str = "GYROLAB_STORE_TEST_PAUSE_MS";

@@ -1,0 +1,510 @@
+//! `gyrolab eval --store` and `gyrolab store ...` as processes, every test body on a temporary
+//! SQLite file AND on the real PostgreSQL server of GYROLAB_TEST_PG_URL (one schema per test;
+//! scripts/pg-test-server.sh starts it; without the URL the PostgreSQL half prints `SKIPPED:`,
+//! and fails under CI=true). Checked: the evaluation lands also when a limit fails and queries
+//! read it back (history rows = the report's summary.csv rows; export CSV/Parquet); revisions and
+//! re-evaluation; two processes storing at once both land; a process killed inside the store's
+//! transaction leaves nothing of its evaluation; bad stores exit 2 naming the store, never
+//! printing a password, writing nothing; hostile texts come back verbatim or are refused.
+
+use assert_cmd::Command;
+use std::collections::{BTreeMap, BTreeSet};
+use std::io::BufRead;
+use std::path::{Path, PathBuf};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn gyrolab() -> Command {
+    let mut c = Command::cargo_bin("gyrolab").unwrap();
+    c.env_remove("GYROLAB_STORE").env_remove("GYROLAB_STORE_TEST_PAUSE_MS");
+    c
+}
+
+fn gyrolab_process() -> std::process::Command {
+    let mut c = std::process::Command::new(assert_cmd::cargo::cargo_bin("gyrolab"));
+    c.env_remove("GYROLAB_STORE").env_remove("GYROLAB_STORE_TEST_PAUSE_MS");
+    c
+}
+
+// The back ends of the store's own tests (an SQLite file in a new folder, a new schema of the
+// PostgreSQL test server): one implementation, and the SQL that makes the schema stays in the
+// gyrolab-store crate.
+#[path = "../../../gyrolab-store/tests/integration/common/mod.rs"]
+mod store_backends;
+use store_backends::{backends, mark_newer_schema};
+
+/// A TOML basic string holding `s` exactly.
+fn toml_str(s: &str) -> String {
+    let mut out = String::from("\"");
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if c.is_control() => out.push_str(&format!("\\u{:04X}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+/// The paper plan (its inputs by absolute path) with `serial`, `lot`, `operator` set, in `dir`
+/// as `name`, with `extra` appended (comments).
+fn plan_with(dir: &Path, name: &str, serial: &str, lot: &str, operator: &str, extra: &str) -> PathBuf {
+    let data = repo().join("data/paper/");
+    let text = std::fs::read_to_string(repo().join("examples/paper_plan.toml"))
+        .unwrap()
+        .replace("../data/paper/", &format!("{}/", data.display()))
+        .replace("serial = \"paper-2014\"", &format!("serial = {}\nlot = {}", toml_str(serial), toml_str(lot)))
+        .replace("[test]\n", &format!("[test]\noperator = {}\n", toml_str(operator)));
+    let p = dir.join(name);
+    std::fs::write(&p, text + extra).unwrap();
+    p
+}
+
+fn plan(dir: &Path, serial: &str, lot: &str) -> PathBuf {
+    plan_with(dir, &format!("{serial}.toml"), serial, lot, "A. Operator", "")
+}
+
+/// `gyrolab eval PLAN --out OUT -q` (exit 3: the paper fails its linearity limit), with
+/// `--store LOCATION` when given.
+fn eval(plan: &Path, out: &Path, store: Option<&str>) {
+    let mut c = gyrolab();
+    c.args(["eval", plan.to_str().unwrap(), "--out", out.to_str().unwrap(), "-q"]);
+    if let Some(s) = store {
+        c.args(["--store", s]);
+    }
+    c.assert().code(3);
+}
+
+fn json_of(args: &[&str], store: &str) -> serde_json::Value {
+    let out = gyrolab().args(args).args(["--json", "--store", store]).output().unwrap();
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn history_ids(store: &str, serial: &str) -> BTreeMap<i64, usize> {
+    let rows = json_of(&["store", "history", serial], store);
+    let mut per = BTreeMap::new();
+    for r in rows.as_array().unwrap() {
+        *per.entry(r["evaluation"].as_i64().unwrap()).or_insert(0) += 1;
+    }
+    per
+}
+
+fn summary_rows(out: &Path) -> usize {
+    std::fs::read_to_string(out.join("summary.csv")).unwrap().lines().count() - 1
+}
+
+#[test]
+fn eval_store_then_queries_revisions_and_reevaluation() {
+    for b in backends("queries") {
+        let dir = tempfile::tempdir().unwrap();
+        let loc = b.location.as_str();
+        // Three devices in lot L1, two in L2: evaluated with --store (exit 3 still stores).
+        for (serial, lot) in [("S1", "L1"), ("S2", "L1"), ("S3", "L1"), ("T1", "L2"), ("T2", "L2")] {
+            let p = plan(dir.path(), serial, lot);
+            eval(&p, &dir.path().join(format!("r-{serial}")), Some(loc));
+        }
+        let n = summary_rows(&dir.path().join("r-S1"));
+        let rows = json_of(&["store", "history", "S1"], loc);
+        let rows = rows.as_array().unwrap();
+        assert_eq!(rows.len(), n, "{}: one history row per summary.csv row", b.name);
+        assert!(rows.iter().any(|r| r["verdict"] == "FAIL" && r["figure"] == "linearity_pct"), "{}", b.name);
+        // The stored value equals the report's results.json value, bit for bit.
+        let summary = std::fs::read_to_string(dir.path().join("r-S1/summary.csv")).unwrap();
+        let head: Vec<&str> = summary.lines().next().unwrap().split(',').collect();
+        let col = |k: &str| head.iter().position(|h| *h == k).unwrap();
+        let line = summary.lines().find(|l| l.contains(",scale_factor,")).expect("a scale_factor row");
+        let f: Vec<&str> = line.split(',').collect();
+        let stored = rows
+            .iter()
+            .find(|r| r["figure"] == "scale_factor" && r["axis"] == f[col("axis")])
+            .and_then(|r| r["value"].as_f64())
+            .unwrap();
+        assert_eq!(stored, f[col("value")].parse::<f64>().unwrap(), "{}", b.name);
+
+        // Lot statistics: n = 3 devices, as text, CSV and Parquet.
+        let lot = json_of(&["store", "lot", "L1"], loc);
+        let sf = lot.as_array().unwrap().iter().find(|r| r["figure"] == "scale_factor").unwrap().clone();
+        assert_eq!(sf["statistics"]["n"], 3, "{}", b.name);
+        assert_eq!(sf["statistics"]["mean"].as_f64(), Some(stored), "{}: identical devices", b.name);
+        let pq = dir.path().join("lot.parquet");
+        let out = gyrolab()
+            .args(["store", "lot", "L1", "--csv", "--parquet", pq.to_str().unwrap(), "--store", loc])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let csv = String::from_utf8(out.stdout).unwrap();
+        assert!(csv.starts_with("axis,figure,unit,n,mean,sd,min,max,limit_min,limit_max,yield,Cp,"), "{csv}");
+        assert_eq!(csv.lines().count(), lot.as_array().unwrap().len() + 1);
+        assert_eq!(&std::fs::read(&pq).unwrap()[..4], b"PAR1");
+        let text =
+            String::from_utf8(gyrolab().args(["store", "lot", "L1", "--store", loc]).output().unwrap().stdout).unwrap();
+        assert!(text.lines().next().unwrap().starts_with("axis  figure"), "{text}");
+
+        // Compare and control charts run on the stored lots.
+        let cmp = json_of(&["store", "compare", "L1", "L2"], loc);
+        let row = cmp.as_array().unwrap().iter().find(|r| r["figure"] == "scale_factor").unwrap().clone();
+        assert_eq!((row["n1"].as_i64(), row["n2"].as_i64()), (Some(3), Some(2)), "{}", b.name);
+        let chart = json_of(&["store", "chart", "--axis", "x", "--figure", "scale_factor"], loc);
+        assert_eq!(chart["serials"].as_array().unwrap().len(), 5, "{}", b.name);
+        assert_eq!(chart["lots"], serde_json::json!(["L1", "L2"]), "{}", b.name);
+
+        // History as an SVG trend plot.
+        let svg = dir.path().join("h.svg");
+        gyrolab()
+            .args(["store", "history", "S1", "--figure", "scale_factor", "--plot", svg.to_str().unwrap()])
+            .args(["--store", loc])
+            .assert()
+            .success();
+        let svg = std::fs::read_to_string(&svg).unwrap();
+        assert!(svg.contains("<svg") && svg.contains("History of serial S1"), "{}", b.name);
+
+        // A correction, an approval, a re-evaluation: four revisions of S1, the last current.
+        let id = rows[0]["evaluation"].as_i64().unwrap().to_string();
+        let out = gyrolab()
+            .args(["store", "revise", &id, "--kind", "correction", "--by", "QA", "--reason", "operator misspelt"])
+            .args(["--operator", "B. Tester", "--store", loc])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let corrected = String::from_utf8(out.stdout).unwrap();
+        let corrected = corrected.split("as evaluation ").nth(1).unwrap().split(' ').next().unwrap().to_string();
+        let shown = json_of(&["store", "show", &corrected], loc);
+        assert_eq!(shown["record"]["operator"], "B. Tester");
+        assert_eq!(shown["supersedes"].as_i64().unwrap().to_string(), id);
+        // The superseded one cannot be revised again (exit 2, nothing stored).
+        gyrolab()
+            .args(["store", "revise", &id, "--kind", "approval", "--by", "X", "--reason", "y", "--store", loc])
+            .assert()
+            .code(2)
+            .stderr(predicates::str::contains("already superseded"));
+        gyrolab()
+            .args(["store", "revise", &corrected, "--kind", "approval", "--by", "Dr. A", "--reason", "reviewed"])
+            .args(["--store", loc])
+            .assert()
+            .success();
+        let re = dir.path().join("re");
+        let latest = *history_ids(loc, "S1").keys().last().unwrap();
+        let diff = json_of(
+            &[
+                "store",
+                "reevaluate",
+                &latest.to_string(),
+                "--out",
+                re.to_str().unwrap(),
+                "--by",
+                "CI",
+                "--reason",
+                "new version",
+            ],
+            loc,
+        );
+        assert_eq!(diff["changes"].as_array().unwrap().len(), 0, "{}: same build, same figures", b.name);
+        assert!(re.join("results.json").is_file());
+        let ids = history_ids(loc, "S1");
+        assert_eq!(ids.len(), 4, "{}: {ids:?}", b.name);
+        assert!(ids.values().all(|c| *c == n), "{}: every revision has every figure", b.name);
+        let rows = json_of(&["store", "history", "S1"], loc);
+        let current: BTreeSet<i64> = rows
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|r| r["current"] == true)
+            .map(|r| r["evaluation"].as_i64().unwrap())
+            .collect();
+        assert_eq!(current.len(), 1, "{}", b.name);
+        assert_eq!(current.first(), ids.keys().last(), "{}", b.name);
+        // The lot still counts S1 once.
+        let lot = json_of(&["store", "lot", "L1"], loc);
+        let sf = lot.as_array().unwrap().iter().find(|r| r["figure"] == "scale_factor").unwrap().clone();
+        assert_eq!(sf["statistics"]["n"], 3, "{}", b.name);
+    }
+}
+
+#[test]
+fn the_default_store_is_beside_the_plan_or_gyrolab_store() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = plan(dir.path(), "D1", "L");
+    eval(&p, &dir.path().join("r"), Some(""));
+    gyrolab()
+        .args(["eval", p.to_str().unwrap(), "--out", dir.path().join("r2").to_str().unwrap(), "-q", "--store"])
+        .assert()
+        .code(3);
+    let db = dir.path().join("gyrolab.db");
+    assert!(db.is_file(), "gyrolab.db beside the plan");
+    assert_eq!(history_ids(db.to_str().unwrap(), "D1").len(), 2);
+    // GYROLAB_STORE is the default of eval --store and of the queries.
+    let env_db = dir.path().join("env.db");
+    gyrolab()
+        .env("GYROLAB_STORE", &env_db)
+        .args(["eval", p.to_str().unwrap(), "--out", dir.path().join("r3").to_str().unwrap(), "-q", "--store"])
+        .assert()
+        .code(3);
+    gyrolab().env("GYROLAB_STORE", &env_db).args(["store", "history", "D1"]).assert().success();
+    // store add of an existing folder (the plan named in results.json), into a new store.
+    let other = dir.path().join("other.db");
+    gyrolab()
+        .args(["store", "add", dir.path().join("r").to_str().unwrap(), "--store", other.to_str().unwrap()])
+        .assert()
+        .success()
+        .stdout(predicates::str::contains("as evaluation 1 in"));
+}
+
+#[test]
+fn two_processes_storing_at_once_both_land() {
+    for b in backends("concurrent") {
+        let dir = tempfile::tempdir().unwrap();
+        let mut outs = Vec::new();
+        for serial in ["A", "B"] {
+            let p = plan(dir.path(), serial, "L");
+            let out = dir.path().join(format!("r-{serial}"));
+            eval(&p, &out, None);
+            outs.push((p, out));
+        }
+        // Create the store first for SQLite, so both writers meet an existing file.
+        let children: Vec<_> = outs
+            .iter()
+            .map(|(p, out)| {
+                let mut c = gyrolab_process();
+                c.args(["store", "add", "--plan", p.to_str().unwrap(), "--store", &b.location]);
+                for _ in 0..10 {
+                    c.arg(out);
+                }
+                c.stdout(std::process::Stdio::null()).spawn().unwrap()
+            })
+            .collect();
+        for mut c in children {
+            assert!(c.wait().unwrap().success(), "{}", b.name);
+        }
+        let n = summary_rows(&outs[0].1);
+        for serial in ["A", "B"] {
+            let ids = history_ids(&b.location, serial);
+            assert_eq!(ids.len(), 10, "{} {serial}", b.name);
+            assert!(ids.values().all(|c| *c == n), "{} {serial}: {ids:?}", b.name);
+        }
+    }
+}
+
+#[test]
+fn a_process_killed_inside_the_transaction_leaves_nothing_of_its_evaluation() {
+    for b in backends("kill") {
+        let dir = tempfile::tempdir().unwrap();
+        let p = plan(dir.path(), "K", "L");
+        let out = dir.path().join("r");
+        eval(&p, &out, Some(&b.location));
+        let n = summary_rows(&out);
+        for round in 0..2 {
+            // The store pauses after writing every row of the evaluation, before the commit.
+            let mut child = gyrolab_process()
+                .args(["store", "add", out.to_str().unwrap(), "--store", &b.location])
+                .env("GYROLAB_STORE_TEST_PAUSE_MS", "60000")
+                .stdout(std::process::Stdio::null())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .unwrap();
+            let mut err = std::io::BufReader::new(child.stderr.take().unwrap());
+            let mut line = String::new();
+            err.read_line(&mut line).unwrap();
+            assert!(line.contains("pausing 60000 ms inside the transaction"), "{}: {line}", b.name);
+            child.kill().unwrap(); // SIGKILL: no handler, no rollback by the process
+            child.wait().unwrap();
+            let ids = history_ids(&b.location, "K");
+            assert_eq!(ids.len(), 1, "{} round {round}: the killed evaluation is not visible: {ids:?}", b.name);
+            assert!(ids.values().all(|c| *c == n));
+        }
+        // The store still takes evaluations (no lock left behind).
+        gyrolab().args(["store", "add", out.to_str().unwrap(), "--store", &b.location]).assert().success();
+        assert_eq!(history_ids(&b.location, "K").len(), 2, "{}", b.name);
+    }
+}
+
+#[test]
+fn hostile_texts_come_back_verbatim_or_are_refused_clearly() {
+    // A plan of over 1 MB (1,100 comment lines of 1,000 characters; a plan line may not exceed 1 MiB).
+    let big = format!("# {}\n", "x".repeat(998)).repeat(1100);
+    let texts = [
+        "'; DROP TABLE evaluation; --",
+        "\"quoted\" and 'single' and \\ backslash",
+        "Robert'); DELETE FROM figure WHERE (''='",
+        "Ünïcødé ∮ 漢字 🚀 \u{202e}rtl\u{202c}",
+        "tab\tand newline\nin it",
+    ];
+    for b in backends("hostile") {
+        let dir = tempfile::tempdir().unwrap();
+        for (i, t) in texts.iter().enumerate() {
+            let p = plan_with(dir.path(), &format!("h{i}.toml"), t, t, t, &format!("\n{big}"));
+            let out = dir.path().join(format!("r{i}"));
+            let o = gyrolab()
+                .args(["eval", p.to_str().unwrap(), "--out", out.to_str().unwrap(), "-q", "--store", &b.location])
+                .output()
+                .unwrap();
+            assert_eq!(o.status.code(), Some(3), "{} {t:?}: {}", b.name, String::from_utf8_lossy(&o.stderr));
+            let ids = history_ids(&b.location, t);
+            assert_eq!(ids.len(), 1, "{} {t:?}", b.name);
+            let id = ids.keys().next().unwrap().to_string();
+            let shown = json_of(&["store", "show", &id], &b.location);
+            let r = &shown["record"];
+            assert_eq!(
+                (r["serial"].as_str(), r["lot"].as_str(), r["operator"].as_str()),
+                (Some(*t), Some(*t), Some(*t))
+            );
+            assert!(r["plan_text"].as_str().unwrap().ends_with(&big), "{}: the 1 MB plan comes back", b.name);
+            let lot = json_of(&["store", "lot", t], &b.location);
+            assert!(!lot.as_array().unwrap().is_empty(), "{} {t:?}", b.name);
+        }
+        // Every table is still there and holds every evaluation.
+        assert_eq!(history_ids(&b.location, texts[0]).len(), 1);
+        // A NUL character is refused, naming the field, and nothing is stored.
+        let p = plan_with(dir.path(), "nul.toml", "NUL\u{0}SN", "L", "op", "");
+        let o = gyrolab()
+            .args(["eval", p.to_str().unwrap(), "--out", dir.path().join("rn").to_str().unwrap(), "-q"])
+            .args(["--store", &b.location])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{}", b.name);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("NUL"), "{}: {err}", b.name);
+        gyrolab().args(["store", "history", "NULSN", "--store", &b.location]).assert().code(2);
+    }
+}
+
+#[test]
+fn bad_stores_exit_2_naming_the_store_without_the_password_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = plan(dir.path(), "B1", "L");
+    let report = dir.path().join("r");
+    // Not SQLite: refused before evaluating, the file and the report folder untouched.
+    let junk = dir.path().join("junk.db");
+    std::fs::write(&junk, "not sqlite at all").unwrap();
+    let o = gyrolab()
+        .args(["eval", p.to_str().unwrap(), "--out", report.to_str().unwrap(), "-q", "--store", junk.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("junk.db") && err.contains("not an SQLite database"), "{err}");
+    assert_eq!(std::fs::read_to_string(&junk).unwrap(), "not sqlite at all");
+    assert!(!report.exists(), "nothing written");
+    for args in [vec!["store", "lot", "L"], vec!["store", "history", "B1"]] {
+        gyrolab().args(&args).args(["--store", junk.to_str().unwrap()]).assert().code(2);
+    }
+    gyrolab()
+        .env("GYROLAB_STORE", &junk)
+        .args(["store", "lot", "L"])
+        .assert()
+        .code(2)
+        .stderr(predicates::str::contains("junk.db"));
+    // A query on a missing store does not create it.
+    let missing = dir.path().join("none.db");
+    gyrolab().args(["store", "lot", "L", "--store", missing.to_str().unwrap()]).assert().code(2);
+    assert!(!missing.exists());
+    // A server that is down: exit 2, the URL named with its password masked.
+    let o = gyrolab()
+        .args(["eval", p.to_str().unwrap(), "--out", report.to_str().unwrap(), "--store"])
+        .arg("postgres://lab:hunter2-secret@127.0.0.1:1/db")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let all = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    assert!(all.contains("postgres://lab:***@127.0.0.1:1/db") && !all.contains("hunter2"), "{all}");
+    assert!(!report.exists(), "nothing written");
+    // The real server with a wrong password, and with the right one: never printed.
+    if let Some(pg) = backends("bad_stores").into_iter().find(|b| b.name == "postgres") {
+        let url = pg.location.clone();
+        let right = url.split("://").nth(1).unwrap().split('@').next().unwrap().split(':').nth(1).unwrap().to_string();
+        let wrong = url.replacen(&format!(":{right}@"), ":wrong-Pa55word@", 1);
+        let o = gyrolab().args(["store", "lot", "L", "--store", &wrong]).output().unwrap();
+        assert_eq!(o.status.code(), Some(2));
+        let all = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+        assert!(all.contains(":***@") && !all.contains("wrong-Pa55word") && !all.contains(&right), "{all}");
+        assert!(all.contains("password"), "{all}");
+        let o = gyrolab()
+            .args(["eval", p.to_str().unwrap(), "--out", report.to_str().unwrap(), "--store", &url])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(3));
+        let all = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+        assert!(all.contains("Stored as evaluation") && all.contains(":***@") && !all.contains(&right), "{all}");
+    }
+}
+
+#[test]
+fn a_store_of_a_newer_schema_exits_2_naming_both_versions_and_writes_nothing() {
+    for b in backends("cli_newer_schema") {
+        let dir = tempfile::tempdir().unwrap();
+        let p = plan(dir.path(), "N1", "L");
+        eval(&p, &dir.path().join("first"), Some(&b.location));
+        mark_newer_schema(&b, 9);
+        let report = dir.path().join("second");
+        let o = gyrolab()
+            .args(["eval", p.to_str().unwrap(), "--out", report.to_str().unwrap(), "-q", "--store", &b.location])
+            .output()
+            .unwrap_or_else(|e| panic!("{}: {e}", b.name));
+        assert_eq!(o.status.code(), Some(2), "{}", b.name);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("schema version 9") && err.contains("up to 2"), "{}: {err}", b.name);
+        assert!(!report.exists(), "{}: nothing written", b.name);
+        for args in [vec!["store", "lot", "L"], vec!["store", "history", "N1"]] {
+            gyrolab()
+                .args(&args)
+                .args(["--store", &b.location])
+                .assert()
+                .code(2)
+                .stderr(predicates::str::contains("schema version 9"));
+        }
+    }
+}
+
+/// Every file of folder `a` has the same bytes in folder `b`, and `b` has no other file.
+fn same_folder(a: &Path, b: &Path) {
+    let names = |d: &Path| -> BTreeSet<String> {
+        std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect()
+    };
+    assert_eq!(names(a), names(b), "{} vs {}", a.display(), b.display());
+    for n in names(a) {
+        assert!(std::fs::read(a.join(&n)).unwrap() == std::fs::read(b.join(&n)).unwrap(), "{n} differs");
+    }
+}
+
+#[test]
+fn the_stored_report_folder_is_written_back_byte_for_byte_also_from_a_revision() {
+    for b in backends("cli_report_back") {
+        let dir = tempfile::tempdir().unwrap();
+        let p = plan(dir.path(), "R1", "L");
+        let report = dir.path().join("report");
+        eval(&p, &report, Some(&b.location));
+        let id = *history_ids(&b.location, "R1").keys().next().unwrap();
+        let back = dir.path().join("back");
+        gyrolab()
+            .args(["store", "report", &id.to_string(), "--out", back.to_str().unwrap(), "--store", &b.location])
+            .assert()
+            .success();
+        same_folder(&report, &back);
+        // An approval is a new revision that keeps the same report.
+        gyrolab()
+            .args(["store", "revise", &id.to_string(), "--kind", "approval", "--by", "Q. Manager"])
+            .args(["--reason", "reviewed", "--store", &b.location])
+            .assert()
+            .success();
+        let approved = *history_ids(&b.location, "R1").keys().last().unwrap();
+        assert_ne!(approved, id);
+        let back2 = dir.path().join("back2");
+        gyrolab()
+            .args(["store", "report", &approved.to_string(), "--out", back2.to_str().unwrap(), "--store", &b.location])
+            .assert()
+            .success();
+        same_folder(&report, &back2);
+        // No such evaluation: exit 2, nothing written.
+        let none = dir.path().join("none");
+        gyrolab()
+            .args(["store", "report", "999999", "--out", none.to_str().unwrap(), "--store", &b.location])
+            .assert()
+            .code(2)
+            .stderr(predicates::str::contains("no evaluation 999999"));
+        assert!(!none.exists());
+    }
+}

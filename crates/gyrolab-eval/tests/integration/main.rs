@@ -1,0 +1,19 @@
+//! gyrolab-eval's integration tests, in one test binary (one link instead of one per file: issue 32,
+//! docs/PERFORMANCE.md). Each file is a module; run one with
+//! `cargo test -p gyrolab-eval --test integration -- MODULE::`.
+
+mod allan;
+mod clock;
+mod common;
+mod demo;
+mod plan_g_sensitivity;
+mod plan_power_ups;
+mod plan_temperature;
+mod plan_threshold;
+mod plan_uncertainty;
+mod rate;
+mod raw_log;
+mod static_test;
+mod test_plan;
+mod test_program;
+mod triad;
