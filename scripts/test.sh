@@ -5,9 +5,11 @@
 # it is missing, saying so first (scripts/install-test-deps.sh: opt-outs GYROLAB_SKIP_PYTHON=1,
 # GYROLAB_SKIP_BROWSER=1, each check then printing SKIPPED:).
 #
-# One build: `cargo test --workspace --all-targets` builds the gyrolab binary and the libraries
-# with the workspace's features; the checks below use those files (a `cargo build -p ...` here
-# would resolve other features and build the crates again; docs/PERFORMANCE.md).
+# One build: `cargo test --workspace --lib --bins --tests` builds the gyrolab binary and the
+# libraries with the workspace's features; the checks below use those files (a `cargo build -p ...`
+# here would resolve other features and build the crates again; docs/PERFORMANCE.md). The examples
+# (benchmarks and studies, no tests in them) are not linked here: clippy checks them in CI, and the
+# bench/ scripts build them in release.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # The time of each step, on stderr (docs/PERFORMANCE.md keeps the figures of fresh clones).
@@ -32,23 +34,23 @@ fi
 # and removed at exit; installs the Debian package postgresql when missing): docs/STORE.md.
 source scripts/pg-test-server.sh start
 step_done "installs and the PostgreSQL server"
-cargo test --workspace --all-targets
+cargo test --workspace --lib --bins --tests
 step_done "cargo test (build and run)"
-# The documentation examples (`--all-targets` leaves doctests out): each public formula's example
+# The documentation examples (left out above): each public formula's example
 # with its published or hand value runs here.
 cargo test --workspace --doc
 step_done "doctests"
 bin=target/debug/gyrolab
-# The binary is built by `cargo test --workspace --all-targets` (should a cargo version not leave it
+# The binary is built by `cargo test --workspace` (should a cargo version not leave it
 # there, build it once).
 if [ ! -x "$bin" ]; then
     echo "test.sh: $bin not left by cargo test: building it" >&2
     cargo build --quiet -p gyrolab-cli
 fi
-# `--all-targets` builds the examples as test harnesses, not their own programs, and leaves the
-# Python package's native module (a cdylib) unlinked: link the example the scipy check runs and the
-# module. `--workspace` with an example keeps the test build's feature set, so no dependency is
-# compiled again (a `-p` build resolves that package's features alone; docs/PERFORMANCE.md).
+# Link the example the scipy check runs and the Python package's native module (a cdylib, which
+# `cargo test` leaves unlinked). `--workspace` with an example keeps the test build's feature set
+# (dev-dependencies included), so no dependency is compiled again (a `-p` build resolves that
+# package's features alone; docs/PERFORMANCE.md).
 cargo build --quiet --workspace --lib --example chi2_quantiles
 # The hostile recordings written by crates/gyrolab-cli/tests/integration/hostile.rs, each read again by
 # `allan` and `inspect` under an address-space limit of 2 GiB (issue 31).
