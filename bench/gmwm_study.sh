@@ -4,7 +4,7 @@
 # parameter relative to the truth, and the coverage of the GMWM 68.3 % two-sided intervals. The
 # table goes into docs/METHODS.md section 3.1 ("GMWM study"). Not part of the normal test suite
 # (minutes of CPU); the suite's short version is crates/gyrolab/src/gmwm/tests.rs.
-# Figures of 100 seeds x 10 h, four models: about 29 s in release (one core). Usage: bash bench/gmwm_study.sh [SEEDS] [HOURS]
+# Figures of 100 seeds x 10 h, four models: about 31 s in release (one core), after the build. Usage: bash bench/gmwm_study.sh [SEEDS] [HOURS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --quiet --release -p gyrolab --example gmwm_study

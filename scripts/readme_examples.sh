@@ -51,9 +51,15 @@ for block in "$work"/blocks/*; do
     [ -e "$block" ] || continue
     case "$block" in
     *.python)
-        if ! "$python" -c "import gyrolab" 2>/dev/null; then
+        if ! where=$("$python" -c "import gyrolab; print(gyrolab.__file__)" 2>/dev/null); then
             echo "SKIPPED: README python block $(basename "$block"): $python cannot import gyrolab (pip install ./python)" >&2
             continue
+        fi
+        # Say which package the blocks run on (scripts/test.sh lays one out from its build and puts
+        # it first on PYTHONPATH; run alone, this script uses what .venv holds).
+        if [ -z "${said_where:-}" ]; then
+            echo "readme_examples: python blocks import gyrolab from ${where%/__init__.py}" >&2
+            said_where=1
         fi
         ran=$((ran + 1))
         if ! (cd "$work/copy" && PATH="$work/bin:$PATH" MPLBACKEND=Agg "$python" "$block" >"$work/out" 2>&1); then

@@ -8,8 +8,8 @@
 # One build: `cargo test --workspace --lib --bins --tests` builds the gyrolab binary and the
 # libraries with the workspace's features; the checks below use those files (a `cargo build -p ...`
 # here would resolve other features and build the crates again; docs/PERFORMANCE.md). The examples
-# (benchmarks and studies, no tests in them) are not linked here: clippy checks them in CI, and the
-# bench/ scripts build them in release.
+# (benchmarks and studies, no tests in them) are not linked here: clippy checks them in CI
+# (`--all-targets`), and `cargo build --release --examples` or the bench/ scripts build them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # The time of each step, on stderr (docs/PERFORMANCE.md keeps the figures of fresh clones).
@@ -18,10 +18,24 @@ step_done() {
     echo "test.sh: $1: $((SECONDS - step_start)) s" >&2
     step_start=$SECONDS
 }
-# The Python package's native module is linked by the same cargo build as the tests (below), as an
-# extension module: pyo3 leaves the interpreter's symbols to the importing Python (what maturin
-# sets for the wheel). Set for every cargo command here, so the crates are built once.
-export PYO3_BUILD_EXTENSION_MODULE=1
+# Every integration-test file is a module of its crate's one test binary (docs/LAYOUT.md): a file
+# that main.rs does not name would never run, and a file directly in tests/ would be a binary of
+# its own again.
+for dir in crates/*/tests; do
+    for f in "$dir"/*.rs; do
+        [ -e "$f" ] || continue
+        echo "test.sh: $f: integration tests belong in $dir/integration/ as a module of main.rs" >&2
+        exit 1
+    done
+    [ -d "$dir/integration" ] || continue
+    for f in "$dir"/integration/*.rs; do
+        m=$(basename "$f" .rs)
+        if [ "$m" != main ] && ! grep -q "^mod $m;" "$dir/integration/main.rs"; then
+            echo "test.sh: $f is not a module of $dir/integration/main.rs (add \`mod $m;\`)" >&2
+            exit 1
+        fi
+    done
+done
 bash scripts/install-test-deps.sh
 if [ "${GYROLAB_SKIP_BROWSER:-}" != "1" ] && ! bash scripts/install-test-deps.sh --browser; then
     export GYROLAB_SKIP_BROWSER=1
@@ -58,6 +72,8 @@ bash scripts/test_hostile_ulimit.sh "$bin"
 step_done "the example, the native module and the hostile recordings under ulimit"
 if [ "$skip_python" = "1" ]; then
     echo "SKIPPED: GYROLAB_SKIP_PYTHON=1: allantools and scipy equality checks, the Python package's tests" >&2
+    # The README's python blocks are skipped too (they would import whatever gyrolab .venv holds).
+    export GYROLAB_PYTHON=/nonexistent/python
 else
     # Allan deviations equal to Python allantools (rate data = data_type 'freq') at relative 1e-9.
     .venv/bin/python scripts/check_allantools.py "$bin"
@@ -97,5 +113,5 @@ else
 fi
 # Every example of the README, as written (python blocks SKIPPED without the package; they import
 # the package laid out above).
-GYROLAB_PYTHON="$PWD/.venv/bin/python" bash scripts/readme_examples.sh "$bin"
+GYROLAB_PYTHON="${GYROLAB_PYTHON:-$PWD/.venv/bin/python}" bash scripts/readme_examples.sh "$bin"
 step_done "the README's examples"

@@ -95,16 +95,16 @@ fn main() {
             ],
         ),
         (
-            "B: white + bias instability (flicker from 1 s to 10 h) + random walk (N 0.25, B 4 deg/h, K 6)",
+            "B: white + bias instability (flicker from 1 s to the record's length) + random walk (N 0.25, B 4 deg/h, K 6)",
             |m| {
                 m.arw_deg_rt_h = 0.25;
                 m.bias_instability_dph = 4.0;
-                // Flicker over the widest band the simulator takes at 10 Hz (from 10 sample
-                // intervals to the 10 h record), not its default 10 s to 10^4 s: below its band the
-                // simulated process is no longer 1/f, and the estimator's flicker term (flat at every
-                // tau) then takes variance that belongs to the white noise (docs/METHODS.md 3.1).
+                // Flicker from the shortest tau the simulator takes at 10 Hz (10 sample intervals)
+                // to the record's length (set below from HOURS), not its default 10 s to 10^4 s:
+                // below its band the simulated process is no longer 1/f, and the estimator's flicker
+                // term (flat at every tau) then takes variance that belongs to the white noise
+                // (docs/METHODS.md 3.1).
                 m.flicker_tau_min_s = 1.0;
-                m.flicker_tau_max_s = 36_000.0;
                 m.rrw_deg_h_rt_h = 6.0;
             },
             vec![
@@ -142,6 +142,9 @@ fn main() {
     for (label, set, terms) in &models {
         let mut model = SensorModel::default();
         set(&mut model);
+        if model.bias_instability_dph > 0.0 {
+            model.flicker_tau_max_s = (hours * 3600.0).max(2.0 * model.flicker_tau_min_s);
+        }
         let spec = StaticSpec { sample_rate_hz: rate, duration_s: hours * 3600.0, ..StaticSpec::default() };
         let mut slope = vec![Stats::default(); terms.len()];
         let mut fit = vec![Stats::default(); terms.len()];
