@@ -4,9 +4,8 @@
 The test command (scripts/test.sh) runs the Python package's tests against the native module that
 `cargo build --workspace --lib --example chi2_quantiles` has just linked from the same crates the
 Rust tests ran on (target/debug/lib_gyrolab.so, built with PYO3_BUILD_EXTENSION_MODULE=1 from
-.cargo/config.toml), instead of a separate
-release build by maturin: that build compiled every dependency once more, about 3 minutes on 2
-cores (docs/PERFORMANCE.md, issue 32). The layout follows python/pyproject.toml's [tool.maturin]
+.cargo/config.toml), instead of a separate release build by maturin: that build compiled every
+dependency once more, about 3 minutes on 2 cores (docs/PERFORMANCE.md, issue 32). The layout follows python/pyproject.toml's [tool.maturin]
 table: the packages of `python-packages` copied from `python-source`, the native module placed at
 `module-name` with the abi3 suffix, and a marker file `STAGED_FROM_TEST_BUILD` beside it (the
 package's tests of the wheel itself skip on it). `GYROLAB_TEST_WHEEL=1 bash scripts/test.sh` builds
