@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # GMWM against simulated truth beside the slope readings and the five-term fit: three composite
 # models (and a fourth with a Gauss-Markov process) x SEEDS seeds (default 100) of HOURS hours at 10 Hz (default 10): bias and RMSE of each
-# parameter relative to the truth, and the coverage of the GMWM 68.3 % two-sided intervals. The
+# parameter relative to the truth, the coverage of the GMWM 68.3 % two-sided intervals, and that of
+# the intervals of the true model's processes fitted alone (no model choice) as a yardstick. The
 # table goes into docs/METHODS.md section 3.1 ("GMWM study"). Not part of the normal test suite
 # (minutes of CPU); the suite's short version is crates/gyrolab/src/gmwm/tests.rs.
-# Figures of 100 seeds x 10 h, four models: about 31 s in release (one core), after the build. Usage: bash bench/gmwm_study.sh [SEEDS] [HOURS]
+# Figures of 100 seeds x 10 h, four models: about 18 s in release (one core; 31 s on
+# the machine before 2026-11-30), after the build. Usage: bash bench/gmwm_study.sh [SEEDS] [HOURS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --quiet --release -p gyrolab --example gmwm_study
