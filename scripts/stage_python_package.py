@@ -5,11 +5,11 @@ The test command (scripts/test.sh) runs the Python package's tests against the n
 `cargo build --workspace --lib --example chi2_quantiles` has just linked from the same crates the
 Rust tests ran on (target/debug/lib_gyrolab.so, built with PYO3_BUILD_EXTENSION_MODULE=1 from
 .cargo/config.toml), instead of a separate release build by maturin: that build compiled every
-dependency once more, about 3 minutes on 2 cores (docs/PERFORMANCE.md, issue 32). The layout follows python/pyproject.toml's [tool.maturin]
-table: the packages of `python-packages` copied from `python-source`, the native module placed at
-`module-name` with the abi3 suffix, and a marker file `STAGED_FROM_TEST_BUILD` beside it (the
-package's tests of the wheel itself skip on it). `GYROLAB_TEST_WHEEL=1 bash scripts/test.sh` builds
-and tests the wheel itself.
+dependency once more, about 3 minutes on 2 cores (docs/PERFORMANCE.md, issue 32). The layout
+follows python/pyproject.toml's [tool.maturin] table: the packages of `python-packages` copied from
+`python-source`, the native module placed at `module-name` with the abi3 suffix, and a marker file
+`STAGED_FROM_TEST_BUILD` beside it (the package's tests of the wheel itself skip on it).
+`GYROLAB_TEST_WHEEL=1 bash scripts/test.sh` builds and tests the wheel itself.
 
 usage: stage_python_package.py NATIVE_LIBRARY OUT_DIR
 Prints OUT_DIR's absolute path, for PYTHONPATH. Exit 2 on a missing input or an unreadable table.
