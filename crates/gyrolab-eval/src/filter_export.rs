@@ -229,7 +229,7 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
                 .collect();
             let interval = |x: &gyrolab::gmwm::GmwmParameter, unit: &str| {
                 format!(
-                    "{} % two-sided interval [{}, {}] {unit} (asymptotic sandwich covariance with the scales' covariance under the fitted model, averaged over the candidate models by their criterion weights; coverage in simulation: docs/METHODS.md 3.1)",
+                    "{} % two-sided interval [{}, {}] {unit} (asymptotic sandwich covariance with the scales' covariance under the fitted model, averaged over the candidate models by their criterion weights, a candidate dropped where a simpler one nested in it has a criterion as small; coverage in simulation: docs/METHODS.md 3.1)",
                     percent(g.confidence),
                     real_text(x.lower * to_si),
                     real_text(x.upper * to_si),

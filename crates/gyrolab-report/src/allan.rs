@@ -107,8 +107,10 @@ pub struct GmwmParameterJson {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub correlation_time_at_search_edge: Option<bool>,
     /// The summed weight (0 to 1) of the candidate models holding this process (for
-    /// `gauss_markov`: holding one), exp(-criterion / 2) normalised; the linear processes'
-    /// intervals are averaged over the candidates with these weights (docs/METHODS.md 3.1).
+    /// `gauss_markov`: holding one), exp(-criterion / 2) normalised over the candidates the nesting
+    /// rule leaves (a candidate with a simpler nested one of criterion as small is dropped); the
+    /// linear processes' intervals are averaged over the candidates with these weights
+    /// (docs/METHODS.md 3.1).
     pub model_weight: f64,
 }
 
@@ -161,7 +163,7 @@ pub struct GmwmJson {
 
 /// What the GMWM intervals are (text and JSON).
 pub const GMWM_INTERVALS: &str =
-    "asymptotic: sandwich covariance with the wavelet variances correlated across scales as the fitted model makes them (Percival and Walden 2000, ch. 8), the linear processes' intervals averaged over the candidate models by their criterion weights (MATA-Wald, Turek and Fletcher 2012); simulated coverage in docs/METHODS.md 3.1";
+    "asymptotic: sandwich covariance with the wavelet variances correlated across scales as the fitted model makes them (Percival and Walden 2000, ch. 8), the linear processes' intervals averaged over the candidate models by their criterion weights (MATA-Wald, Turek and Fletcher 2012), a candidate dropped where a simpler one nested in it has a criterion as small (the nesting rule, Richards 2008); simulated coverage in docs/METHODS.md 3.1";
 
 /// The unit of a GMWM coefficient for the curve's quantity.
 pub fn gmwm_unit(process: gyrolab::gmwm::Process, quantity: Quantity) -> &'static str {

@@ -18,6 +18,16 @@
 //! it there. Intervals after a model choice that ignore it cover less than their level (the
 //! choice drops a term in some records, and the sampling spread of the chosen model's estimate is
 //! conditional on that choice); the mixture puts the choice's own uncertainty into the interval.
+//!
+//! The intervals of the terms the chosen model holds average only the candidates the nesting rule
+//! leaves: S. A. Richards, "Dealing with overdispersed data in applied ecology", Journal of Applied
+//! Ecology 45(1), 2008, and T. W. Arnold, "Uninformative parameters and model selection using
+//! Akaike's Information Criterion", Journal of Wildlife Management 74(6), 2010: a candidate is
+//! dropped when a simpler candidate nested in it has a criterion as small or smaller, its extra
+//! terms uninformative (a term that lowers the objective by less than its optimism costs). Without
+//! the rule the candidates holding a spurious term beside the true ones (quantization beside white
+//! noise, a Gauss-Markov process beside a drift) take weight with their wider sampling
+//! distributions, and the intervals over-covered (docs/METHODS.md 3.1).
 
 use super::{GmwmBound, GmwmFit, Process};
 use statrs::function::erf::erfc;
@@ -98,20 +108,26 @@ impl Mixture {
 }
 
 /// The chosen candidate `chosen` of `fits` with its linear processes' intervals replaced by the
-/// model-averaged (MATA-Wald) intervals over every candidate (weights [`model_weights`] of the
-/// criteria), each parameter's [`GmwmParameter::model_weight`](super::GmwmParameter) set, and the
-/// bounds of the processes it leaves out in [`GmwmFit::left_out`]. Gauss-Markov parameters keep the
+/// model-averaged (MATA-Wald) intervals over the candidates the nesting rule leaves (weights
+/// [`model_weights`] of [`nesting_rule`]'s criteria), each parameter's
+/// [`GmwmParameter::model_weight`](super::GmwmParameter) set from those weights, and the bounds of
+/// the processes it leaves out in [`GmwmFit::left_out`] (given that the term is there: every
+/// candidate holding it, the nesting rule not applied, whose judgement is that the term is
+/// not supported). Gauss-Markov parameters keep the
 /// chosen model's intervals (their correlation times differ between candidates, so they are not
 /// one parameter across them). On the weight scale (squared coefficient), then square-rooted, as
 /// the single-model intervals are.
 pub(crate) fn model_average(fits: &[(GmwmFit, Vec<Moment>)], chosen: usize) -> GmwmFit {
     let mut out = fits[chosen].0.clone();
-    let weights = model_weights(&fits.iter().map(|f| f.0.criterion).collect::<Vec<_>>());
+    let criteria: Vec<f64> = fits.iter().map(|f| f.0.criterion).collect();
+    let all_weights = model_weights(&criteria);
     // One candidate with all the weight (the others' criteria more than about 1,490 above): its
     // own intervals, unchanged.
-    if weights.iter().filter(|w| **w > 0.0).count() <= 1 {
+    if all_weights.iter().filter(|w| **w > 0.0).count() <= 1 {
         return out;
     }
+    // The intervals of the terms it holds: the candidates the nesting rule leaves (`nesting_rule`).
+    let weights = model_weights(&nesting_rule(fits));
     let alpha = 1.0 - out.confidence;
     let mut processes: Vec<Process> = Vec::new();
     for m in fits.iter().flat_map(|f| &f.1) {
@@ -130,24 +146,28 @@ pub(crate) fn model_average(fits: &[(GmwmFit, Vec<Moment>)], chosen: usize) -> G
     }
     for process in super::PROCESSES.iter().copied().filter(|p| processes.contains(p)) {
         // `held`: the candidates holding the process, with their model weights.
-        let mut held = Mixture::default();
-        let (mut holding, mut absent) = (0.0, 0.0);
-        for ((_, moments), &w) in fits.iter().zip(&weights) {
-            if w == 0.0 {
-                continue;
-            }
-            match moments.iter().find(|m| m.process == process) {
-                Some(m) if m.se.is_finite() && m.se > 0.0 => held.normals.push((w, m.weight, m.se)),
-                Some(m) => held.points.push((w, m.weight)),
-                None => {
-                    absent += w;
+        let holders = |weights: &[f64]| {
+            let mut held = Mixture::default();
+            let (mut holding, mut absent) = (0.0, 0.0);
+            for ((_, moments), &w) in fits.iter().zip(weights) {
+                if w == 0.0 {
                     continue;
                 }
+                match moments.iter().find(|m| m.process == process) {
+                    Some(m) if m.se.is_finite() && m.se > 0.0 => held.normals.push((w, m.weight, m.se)),
+                    Some(m) => held.points.push((w, m.weight)),
+                    None => {
+                        absent += w;
+                        continue;
+                    }
+                }
+                holding += w;
             }
-            holding += w;
-        }
+            (held, holding, absent)
+        };
         match out.parameters.iter_mut().find(|p| p.process == process) {
             Some(p) => {
+                let (held, holding, absent) = holders(&weights);
                 let mut mixture = Mixture { normals: held.normals.clone(), points: held.points.clone() };
                 if absent > 0.0 {
                     mixture.points.push((absent, 0.0));
@@ -156,7 +176,11 @@ pub(crate) fn model_average(fits: &[(GmwmFit, Vec<Moment>)], chosen: usize) -> G
                 p.upper = mixture.quantile(1.0 - alpha / 2.0).max(0.0).sqrt();
                 p.model_weight = holding;
             }
-            None if holding > 0.0 => {
+            None => {
+                let (held, holding, _) = holders(&all_weights);
+                if holding <= 0.0 {
+                    continue;
+                }
                 // The bound given that the term is there: the candidates holding it, their weights
                 // renormalised to sum 1.
                 let present = Mixture {
@@ -168,10 +192,46 @@ pub(crate) fn model_average(fits: &[(GmwmFit, Vec<Moment>)], chosen: usize) -> G
                     out.left_out.push(GmwmBound { process, upper: upper.sqrt(), model_weight: holding });
                 }
             }
-            None => {}
         }
     }
     out
+}
+
+/// The candidates' criteria with the nesting rule applied (Richards 2008; Arnold 2010): a candidate
+/// that a strictly simpler candidate nested in it matches or beats on the criterion is set to
+/// infinity (weight 0), its extra terms uninformative. The chosen candidate (the smallest
+/// criterion) is never removed.
+///
+/// A candidate `a` is nested in `b` when a's linear processes are a subset of b's and it holds no
+/// more Gauss-Markov processes (b with the extra weights at zero is a), the two not the same.
+pub(crate) fn nesting_rule(fits: &[(GmwmFit, Vec<Moment>)]) -> Vec<f64> {
+    let structures: Vec<(Vec<Process>, usize)> = fits.iter().map(|f| structure(&f.0)).collect();
+    fits.iter()
+        .zip(&structures)
+        .map(|((fit, _), own)| {
+            let c = fit.criterion;
+            let dominated =
+                fits.iter().zip(&structures).any(|((simpler, _), s)| nested_in(s, own) && simpler.criterion <= c);
+            if dominated {
+                f64::INFINITY
+            } else {
+                c
+            }
+        })
+        .collect()
+}
+
+/// A candidate's structure: its linear processes and how many Gauss-Markov processes it holds.
+fn structure(fit: &GmwmFit) -> (Vec<Process>, usize) {
+    let linear = fit.parameters.iter().map(|p| p.process).filter(|p| *p != Process::GaussMarkov).collect();
+    let markov = fit.parameters.iter().filter(|p| p.process == Process::GaussMarkov).count();
+    (linear, markov)
+}
+
+/// Whether structure `a` is a strict simplification of `b`: its linear processes a subset of b's and
+/// no more Gauss-Markov processes, not the same.
+fn nested_in(a: &(Vec<Process>, usize), b: &(Vec<Process>, usize)) -> bool {
+    a.1 <= b.1 && a.0.iter().all(|p| b.0.contains(p)) && (a.0.len() < b.0.len() || a.1 < b.1)
 }
 
 #[cfg(test)]
@@ -202,16 +262,22 @@ mod tests {
         }
     }
 
-    /// Two candidates, criteria 0 and 1 (weights 0.62246 and 0.37754): white noise in both
-    /// (weights 100 +- 2 and 98 +- 3), a random walk only in the second (4 +- 1). The chosen model's
-    /// white-noise interval is the mixture's 15.85 % and 84.15 % quantiles, computed independently
-    /// with Python's statistics.NormalDist (bisection of the mixture); the random walk's bound is
-    /// the 84.15 % quantile given the term is there, the second candidate's alone: sqrt(4 +
-    /// inv_cdf(0.8415)).
+    /// Two candidates, neither nested in the other, criteria 0 and 1 (weights 0.62246 and
+    /// 0.37754): white noise in both (weights 100 +- 2 and 98 +- 3), quantization only in the first,
+    /// a random walk only in the second (4 +- 1). The chosen model's white-noise interval is the
+    /// mixture's 15.85 % and 84.15 % quantiles, computed independently with Python's
+    /// statistics.NormalDist (bisection of the mixture); the random walk's bound is the 84.15 %
+    /// quantile given the term is there, the second candidate's alone: sqrt(4 + inv_cdf(0.8415)).
     #[test]
     fn mixture_intervals_and_bounds_by_an_independent_computation() {
         let fits = vec![
-            (fit(0.0, &[Process::White]), vec![Moment { process: Process::White, weight: 100.0, se: 2.0 }]),
+            (
+                fit(0.0, &[Process::White, Process::Quantization]),
+                vec![
+                    Moment { process: Process::White, weight: 100.0, se: 2.0 },
+                    Moment { process: Process::Quantization, weight: 1.0, se: 0.5 },
+                ],
+            ),
             (
                 fit(1.0, &[Process::White, Process::RandomWalk]),
                 vec![
@@ -262,6 +328,56 @@ mod tests {
         let k = model_average(&fits, 0).left_out[0];
         assert!((k.upper - 2.542_242_150_765_753).abs() < 1e-9, "{k:?}");
         assert!((k.model_weight - 0.493_519_608_944_346).abs() < 1e-12, "{k:?}");
+    }
+
+    /// The nesting rule by hand. Candidates: {white, random walk} chosen (criterion 0; 100 +- 2
+    /// and 4 +- 1), {white, random walk, quantization} (1.5; 95 +- 6, 4 +- 1, 1 +- 1), {white}
+    /// (3; 104 +- 2). The second holds the first, which has the smaller criterion: it is dropped, and
+    /// the weights are exp(0) and exp(-1.5) renormalised (0.81757, 0.18243). White noise's interval
+    /// is the mixture of N(100, 2) and N(104, 2) at 15.85 % and 84.15 % (bisection with Python's
+    /// statistics.NormalDist: sqrt of 98.2691... and 103.2754...; with the second candidate in, the
+    /// lower end would be 9.7774); the random walk's lower end is the atom of {white} (0.18 > alpha
+    /// / 2), its upper end sqrt(4.8637...); quantization, left out, is bounded given that it is there
+    /// from the dropped candidate (the rule does not apply to bounds): sqrt(1 + Phi^-1(0.84150)).
+    #[test]
+    fn the_nesting_rule_drops_a_candidate_whose_extra_term_does_not_pay() {
+        let moment = |process, weight, se| Moment { process, weight, se };
+        let (w, k, q) = (Process::White, Process::RandomWalk, Process::Quantization);
+        let fits = vec![
+            (fit(0.0, &[w, k]), vec![moment(w, 100.0, 2.0), moment(k, 4.0, 1.0)]),
+            (fit(1.5, &[w, k, q]), vec![moment(w, 95.0, 6.0), moment(k, 4.0, 1.0), moment(q, 1.0, 1.0)]),
+            (fit(3.0, &[w]), vec![moment(w, 104.0, 2.0)]),
+        ];
+        let criteria = nesting_rule(&fits);
+        assert_eq!(criteria, vec![0.0, f64::INFINITY, 3.0]);
+        let out = model_average(&fits, 0);
+        let white = out.parameter(w).unwrap();
+        assert!((white.lower - 9.913_079_280_965_471).abs() < 1e-9, "{white:?}");
+        assert!((white.upper - 10.162_450_359_866_316).abs() < 1e-9, "{white:?}");
+        assert!((white.model_weight - 1.0).abs() < 1e-12, "{white:?}");
+        let walk = out.parameter(k).unwrap();
+        assert_eq!(walk.lower, 0.0);
+        assert!((walk.upper - 2.205_388_224_947_014).abs() < 1e-9, "{walk:?}");
+        assert!((walk.model_weight - 0.817_574_476_193_643_7).abs() < 1e-12, "{walk:?}");
+        let bound = out.left_out.iter().find(|b| b.process == q).expect("a bound given presence");
+        assert!((bound.upper - 1.414_440_464_905_628).abs() < 1e-9, "{bound:?}");
+        // Its weight is the one the bound was made with, before the rule (exp(-0.75) of the three).
+        let plain = model_weights(&[0.0, 1.5, 3.0]);
+        assert!((bound.model_weight - plain[1]).abs() < 1e-12, "{bound:?}");
+    }
+
+    /// Nesting counts Gauss-Markov processes: {white, GM} is nested in {white, GM, random walk}
+    /// and in {white, GM, GM}; {white, flicker} is not nested in {white, GM}, nor a model in itself.
+    #[test]
+    fn nesting_counts_gauss_markov_processes() {
+        let (w, gm) = (Process::White, Process::GaussMarkov);
+        let s = |p: &[Process]| structure(&fit(0.0, p));
+        assert!(nested_in(&s(&[w, gm]), &s(&[w, gm, Process::RandomWalk])));
+        assert!(nested_in(&s(&[w, gm]), &s(&[w, gm, gm])));
+        assert!(!nested_in(&s(&[w, gm, gm]), &s(&[w, gm, Process::RandomWalk])));
+        assert!(!nested_in(&s(&[w, Process::Flicker]), &s(&[w, gm])));
+        assert!(!nested_in(&s(&[w, gm]), &s(&[w, gm])));
+        assert!(nested_in(&s(&[w]), &s(&[w, gm])));
     }
 
     /// One normal component: the quantiles are the normal's (Phi^-1(0.975) = 1.959963984540054).

@@ -22,7 +22,8 @@
 //! nu_hat^4_j / edf_j at the estimates; the intervals use the full covariance across scales in a
 //! sandwich with the model's Jacobian; the model is chosen by a wavelet information criterion, the
 //! objective plus its estimated optimism (module `select`), and the linear processes' intervals
-//! are averaged over the candidate models by their criterion weights (module `average`).
+//! are averaged over the candidate models by their criterion weights, the candidates that a
+//! simpler nested candidate matches or beats on the criterion dropped (module `average`).
 
 mod average;
 mod covariance;

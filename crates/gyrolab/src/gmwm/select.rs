@@ -11,8 +11,8 @@
 //! tr(Omega H Sigma), H = D (D' Omega D)^-1 D' Omega the fit's hat matrix and Sigma the wavelet
 //! variances' covariance under the fitted model (2 x parameters when Omega = Sigma^-1, the AIC
 //! penalty). The GMWM authors estimate the same optimism by simulation instead. The chosen
-//! model's intervals of the linear processes are then averaged over every candidate (module
-//! `average`).
+//! model's intervals of the linear processes are then averaged over the candidates the nesting
+//! rule leaves (module `average`).
 
 use super::{average, check, design, finish, fit_estimate, nnls, omega_variances};
 use super::{CovarianceGrid, GmwmError, GmwmFit, Process, Shape, ShapeIntegrals, WaveletVariance, PROCESSES, ROUNDS};
