@@ -277,7 +277,7 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
                             b.upper,
                             "gmwm_upper_bound".to_string(),
                             format!(
-                                "GMWM: left out by the chosen model ({model}); one-sided {} % upper bound {} {unit} given that it is there, from the intervals averaged over the candidate models holding it, which weigh {} % (docs/METHODS.md 3.1); {name}",
+                                "GMWM: left out by the chosen model ({model}); one-sided {} % upper bound {} {unit} given that it is there (nominal: in simulation such bounds held the truth less often), from the intervals averaged over the candidate models holding it, which weigh {} % (docs/METHODS.md 3.1); {name}",
                                 percent(1.0 - (1.0 - g.confidence) / 2.0),
                                 real_text(b.upper * to_si),
                                 weight_percent(b.model_weight),

@@ -123,9 +123,11 @@ pub struct GmwmBoundJson {
     pub upper: f64,
     /// The coefficient's unit.
     pub unit: &'static str,
-    /// One-sided confidence of the bound, 1 - (1 - confidence) / 2 (0.8415 for 0.683).
+    /// One-sided confidence of the bound, 1 - (1 - confidence) / 2 (0.8415 for 0.683), nominal
+    /// (in simulation such bounds held the truth less often; docs/METHODS.md 3.1).
     pub confidence_one_sided: f64,
-    /// The summed weight of the candidate models holding the process.
+    /// The summed weight of the candidate models holding the process, every candidate with its
+    /// plain weight (the nesting rule not applied, as for the bound itself).
     pub model_weight: f64,
 }
 
@@ -258,7 +260,7 @@ pub fn gmwm_text(a: &ChannelAnalysis) -> Option<String> {
         .iter()
         .map(|b| {
             format!(
-                "; left out by the chosen model: {} < {} {} if present (one-sided {} %, models holding it weigh {} %)",
+                "; left out by the chosen model: {} < {} {} if present (one-sided {} % nominal, held less often in simulation; models holding it weigh {} %)",
                 b.process.name(),
                 sig(b.upper, 3),
                 gmwm_unit(b.process, a.quantity),

@@ -5,14 +5,17 @@
 //! Gauss-Markov process of known sigma and correlation time (white + Gauss-Markov + random walk),
 //! generated here as a sampled AR(1), whose sigma and T only the GMWM estimates. As a yardstick, the
 //! coverage of the intervals of the true model's processes fitted alone (`fit_processes`: no choice
-//! among models, no averaging), for the first three models.
+//! among models, no averaging), for the first three models, and on stderr their standardised
+//! errors (value - truth) / (half the interval's width): mean and sd, 0 and 1 for unbiased
+//! estimates with the right standard errors. Model B (flicker) is generated at 100 Hz and averaged
+//! in blocks of 10 to 10 Hz, so that its flicker band starts at the first scale fitted.
 //!
 //! Usage: gmwm_study [SEEDS] [HOURS] (defaults 100 seeds, 10 h at 10 Hz).
 
 use gyrolab::allan::{deviation_from_rate, AllanOptions, DeviationKind, TauList};
 use gyrolab::gmwm::{fit_processes, gmwm, wavelet_variance, Process};
 use gyrolab::noise::{fit_noise_model, slope_line_terms};
-use gyrolab::sim::{SensorModel, StaticBlock, StaticGenerator, StaticSpec};
+use gyrolab::sim::{SensorModel, StaticBlock, StaticGenerator, StaticSpec, FLICKER_MIN_TAU_SAMPLES};
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 
@@ -49,7 +52,8 @@ fn markov_record(seed: u64, rate: f64, hours: f64, n: f64, sigma: f64, t: f64, k
         .collect()
 }
 
-/// Model B's generation rate over the study's rate.
+/// Model B's generation rate over the study's rate (1: generated at the study's rate, its flicker
+/// band then from 1 s, the shortest the simulator takes at 10 Hz).
 const OVERSAMPLE: usize = 10;
 
 #[derive(Default, Clone)]
@@ -104,13 +108,14 @@ fn main() {
             |m| {
                 m.arw_deg_rt_h = 0.25;
                 m.bias_instability_dph = 4.0;
-                // Flicker over every scale the estimator sees: from 0.1 s (set below with the
-                // generation at 100 Hz, the shortest band the simulator takes there, 10 sample
-                // intervals) to the record's length (set below from HOURS), not its default 10 s to
-                // 10^4 s: outside its band the simulated process is no longer 1/f, and the
-                // estimator's flicker term (flat at every tau) then trades variance with the white
-                // noise (docs/METHODS.md 3.1).
-                m.flicker_tau_min_s = 1.0;
+                // Flicker over every scale the estimator sees: from 0.1 s (the shortest band the
+                // simulator takes at the generation's 100 Hz, 10 sample intervals; raised to it
+                // below when OVERSAMPLE is lower)
+                // to the record's length (set below from HOURS), not its default 10 s to 10^4 s:
+                // outside its band the simulated process is no longer 1/f, and the estimator's
+                // flicker term (flat at every tau) then trades variance with the white noise
+                // (docs/METHODS.md 3.1).
+                m.flicker_tau_min_s = 0.1;
                 m.rrw_deg_h_rt_h = 6.0;
             },
             vec![
@@ -148,16 +153,15 @@ fn main() {
     for (label, set, terms) in &models {
         let mut model = SensorModel::default();
         set(&mut model);
-        if model.bias_instability_dph > 0.0 {
-            model.flicker_tau_max_s = (hours * 3600.0).max(2.0 * model.flicker_tau_min_s);
-        }
-        // B is generated at 10 x the rate with its flicker from 10 of those sample intervals, then
-        // averaged to the rate: the simulator's flicker exceeds its plateau below its band (by 24 %,
-        // 11 % and 3 % at 1, 2 and 4 sample intervals when the band starts at 10), so the band must
-        // start at the first scale the estimator sees (docs/METHODS.md 3.1).
+        // B is generated at OVERSAMPLE x the rate with its flicker from 10 of those sample
+        // intervals, then averaged to the rate: the simulator's flicker exceeds its plateau below
+        // its band (by 24 %, 11 % and 3 % at 1, 2 and 4 sample intervals when the band starts at
+        // 10), so the band must start at the first scale the estimator sees (docs/METHODS.md 3.1).
         let oversample = if model.bias_instability_dph > 0.0 { OVERSAMPLE } else { 1 };
-        if oversample > 1 {
-            model.flicker_tau_min_s = 10.0 / (rate * oversample as f64);
+        if model.bias_instability_dph > 0.0 {
+            let shortest = FLICKER_MIN_TAU_SAMPLES / (rate * oversample as f64);
+            model.flicker_tau_min_s = model.flicker_tau_min_s.max(shortest);
+            model.flicker_tau_max_s = (hours * 3600.0).max(2.0 * model.flicker_tau_min_s);
         }
         let spec = StaticSpec {
             sample_rate_hz: rate * oversample as f64,
@@ -177,6 +181,7 @@ fn main() {
         let true_processes: Vec<Process> = terms.iter().map(|t| t.process).collect();
         let mut alone_covered = vec![0usize; terms.len()];
         let mut alone_n = vec![0usize; terms.len()];
+        let mut standardised: Vec<Vec<f64>> = vec![Vec::new(); terms.len()];
         let (mut with_markov, mut poor) = (0usize, 0usize);
         for seed in 0..seeds {
             let rate_samples = if label.starts_with("D:") {
@@ -241,6 +246,7 @@ fn main() {
                     _ => (p.value, p.lower, p.upper),
                 });
                 if let Some(p) = alone.as_ref().and_then(|a| a.parameter(t.process)) {
+                    standardised[i].push((p.value - t.truth) / (0.5 * (p.upper - p.lower)));
                     alone_n[i] += 1;
                     alone_covered[i] += usize::from(p.lower <= t.truth && t.truth <= p.upper);
                 }
@@ -266,6 +272,17 @@ fn main() {
             }
         }
         for (i, t) in terms.iter().enumerate() {
+            let z = &standardised[i];
+            if !z.is_empty() {
+                let mean = z.iter().sum::<f64>() / z.len() as f64;
+                let sd = (z.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / z.len() as f64).sqrt();
+                eprintln!(
+                    "{}: {}: the true model fitted alone: standardised errors mean {mean:+.3}, sd {sd:.3} ({} records)",
+                    &label[..1],
+                    t.name,
+                    z.len()
+                );
+            }
             let held = gm[i].n.max(1) as f64;
             // Over every record, as the GMWM column: a fit that gives the term no weight (or fails)
             // counts as not covering it, and their number is said.

@@ -111,9 +111,9 @@ impl Mixture {
 /// model-averaged (MATA-Wald) intervals over the candidates the nesting rule leaves (weights
 /// [`model_weights`] of [`nesting_rule`]'s criteria), each parameter's
 /// [`GmwmParameter::model_weight`](super::GmwmParameter) set from those weights, and the bounds of
-/// the processes it leaves out in [`GmwmFit::left_out`] (given that the term is there: every
-/// candidate holding it, the nesting rule not applied, whose judgement is that the term is
-/// not supported). Gauss-Markov parameters keep the
+/// the processes it leaves out in [`GmwmFit::left_out`]. A bound is given that the term is there,
+/// so every candidate holding it takes part with its plain weight: the rule is not applied, since
+/// it drops exactly the candidates that judge the term unsupported. Gauss-Markov parameters keep the
 /// chosen model's intervals (their correlation times differ between candidates, so they are not
 /// one parameter across them). On the weight scale (squared coefficient), then square-rooted, as
 /// the single-model intervals are.
@@ -127,7 +127,7 @@ pub(crate) fn model_average(fits: &[(GmwmFit, Vec<Moment>)], chosen: usize) -> G
         return out;
     }
     // The intervals of the terms it holds: the candidates the nesting rule leaves (`nesting_rule`).
-    let weights = model_weights(&nesting_rule(fits));
+    let weights = model_weights(&nesting_rule(fits, chosen));
     let alpha = 1.0 - out.confidence;
     let mut processes: Vec<Process> = Vec::new();
     for m in fits.iter().flat_map(|f| &f.1) {
@@ -199,19 +199,21 @@ pub(crate) fn model_average(fits: &[(GmwmFit, Vec<Moment>)], chosen: usize) -> G
 
 /// The candidates' criteria with the nesting rule applied (Richards 2008; Arnold 2010): a candidate
 /// that a strictly simpler candidate nested in it matches or beats on the criterion is set to
-/// infinity (weight 0), its extra terms uninformative. The chosen candidate (the smallest
-/// criterion) is never removed.
+/// infinity (weight 0), its extra terms uninformative. The chosen candidate `chosen` is never
+/// removed, not even by a simpler one whose criterion ties with it (the model choice keeps the
+/// first of candidates within 1e-12 of the smallest).
 ///
 /// A candidate `a` is nested in `b` when a's linear processes are a subset of b's and it holds no
 /// more Gauss-Markov processes (b with the extra weights at zero is a), the two not the same.
-pub(crate) fn nesting_rule(fits: &[(GmwmFit, Vec<Moment>)]) -> Vec<f64> {
+pub(crate) fn nesting_rule(fits: &[(GmwmFit, Vec<Moment>)], chosen: usize) -> Vec<f64> {
     let structures: Vec<(Vec<Process>, usize)> = fits.iter().map(|f| structure(&f.0)).collect();
     fits.iter()
         .zip(&structures)
-        .map(|((fit, _), own)| {
+        .enumerate()
+        .map(|(i, ((fit, _), own))| {
             let c = fit.criterion;
-            let dominated =
-                fits.iter().zip(&structures).any(|((simpler, _), s)| nested_in(s, own) && simpler.criterion <= c);
+            let dominated = i != chosen
+                && fits.iter().zip(&structures).any(|((simpler, _), s)| nested_in(s, own) && simpler.criterion <= c);
             if dominated {
                 f64::INFINITY
             } else {
@@ -348,7 +350,7 @@ mod tests {
             (fit(1.5, &[w, k, q]), vec![moment(w, 95.0, 6.0), moment(k, 4.0, 1.0), moment(q, 1.0, 1.0)]),
             (fit(3.0, &[w]), vec![moment(w, 104.0, 2.0)]),
         ];
-        let criteria = nesting_rule(&fits);
+        let criteria = nesting_rule(&fits, 0);
         assert_eq!(criteria, vec![0.0, f64::INFINITY, 3.0]);
         let out = model_average(&fits, 0);
         let white = out.parameter(w).unwrap();
@@ -366,8 +368,31 @@ mod tests {
         assert!((bound.model_weight - plain[1]).abs() < 1e-12, "{bound:?}");
     }
 
+    /// A simpler candidate whose criterion ties with the chosen one's does not drop it: both keep
+    /// their weight, 1/2 each (the random walk's weight), and the white noise's interval mixes
+    /// N(100, 2) and N(104, 2) equally (bisection with Python's statistics.NormalDist: sqrt of
+    /// 99.01217 and 104.98783).
+    #[test]
+    fn the_chosen_candidate_is_never_dropped() {
+        let moment = |process, weight, se| Moment { process, weight, se };
+        let (w, k) = (Process::White, Process::RandomWalk);
+        let fits = vec![
+            (fit(0.0, &[w, k]), vec![moment(w, 100.0, 2.0), moment(k, 4.0, 1.0)]),
+            (fit(0.0, &[w]), vec![moment(w, 104.0, 2.0)]),
+        ];
+        assert_eq!(nesting_rule(&fits, 0), vec![0.0, 0.0]);
+        // Were the second chosen, the first would go.
+        assert_eq!(nesting_rule(&fits, 1), vec![f64::INFINITY, 0.0]);
+        let out = model_average(&fits, 0);
+        assert!((out.parameter(k).unwrap().model_weight - 0.5).abs() < 1e-12, "{out:?}");
+        let white = out.parameter(w).unwrap();
+        assert!((white.lower - 9.950_485_851_383_537).abs() < 1e-9, "{white:?}");
+        assert!((white.upper - 10.246_356_978_039_369).abs() < 1e-9, "{white:?}");
+    }
+
     /// Nesting counts Gauss-Markov processes: {white, GM} is nested in {white, GM, random walk}
-    /// and in {white, GM, GM}; {white, flicker} is not nested in {white, GM}, nor a model in itself.
+    /// and in {white, GM, GM}; {white, flicker} is not nested in {white, GM}, and no structure is
+    /// nested in itself.
     #[test]
     fn nesting_counts_gauss_markov_processes() {
         let (w, gm) = (Process::White, Process::GaussMarkov);

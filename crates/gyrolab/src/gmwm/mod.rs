@@ -218,8 +218,8 @@ pub struct GmwmParameter {
     /// The correlation time of a Gauss-Markov process (None for the other processes).
     pub correlation_time: Option<CorrelationTime>,
     /// The summed weight of the candidate models holding this process (for a Gauss-Markov
-    /// process: holding one), exp(-criterion / 2) normalised over the candidates (module
-    /// `average`); 1 for the fit of a single model ([`fit_processes`]).
+    /// process: holding one), exp(-criterion / 2) normalised over the candidates the nesting rule
+    /// leaves (module `average`); 1 for the fit of a single model ([`fit_processes`]).
     pub model_weight: f64,
 }
 
@@ -233,7 +233,9 @@ pub struct GmwmBound {
     pub process: Process,
     /// The upper bound of its coefficient, in the units of [`GmwmParameter::value`].
     pub upper: f64,
-    /// The summed weight of the candidate models holding it.
+    /// The summed weight of the candidate models holding it, with the plain weights (every
+    /// candidate, the nesting rule not applied: those the bound was made with), so it is not
+    /// on the same footing as [`GmwmParameter::model_weight`].
     pub model_weight: f64,
 }
 
