@@ -132,6 +132,10 @@ pub struct ChannelFilterTerms {
     pub fit: [Option<TermEstimate>; 2],
     /// GMWM; [white noise, random walk].
     pub gmwm: [Option<TermEstimate>; 2],
+    /// Terms of the GMWM's chosen model that no stack takes and the GMWM values leave out (its
+    /// flicker floor), one line each.
+    #[serde(default)]
+    pub gmwm_unrepresented: Vec<String>,
 }
 
 impl ChannelFilterTerms {
@@ -348,12 +352,30 @@ pub fn channel_filter_terms(a: &ChannelAnalysis) -> Option<ChannelFilterTerms> {
         }
         out
     };
+    // No stack has a bias-instability (flicker) state, and neither a white noise nor a random
+    // walk can bound a flat Allan deviation over the whole curve without overstating it by the
+    // curve's tau range: the floor is named, not folded in (docs/EXPORTS.md).
+    let gmwm_unrepresented = a
+        .gmwm
+        .as_ref()
+        .and_then(|g| g.parameter(Process::Flicker))
+        .map(|p| {
+            let unit = if accelerometer { "m/s^2" } else { "rad/s" };
+            format!(
+                "{}: the GMWM model holds a flicker floor (bias instability B = {} {unit}) that no stack takes; the exported values leave it out (--overbound raises them until the model lies above the measured curve)",
+                a.channel,
+                real_text(p.value * to_si)
+            )
+        })
+        .into_iter()
+        .collect();
     Some(ChannelFilterTerms {
         channel: a.channel.clone(),
         accelerometer,
         slopes: terms(Estimator::Slopes),
         fit: terms(Estimator::Fit),
         gmwm: terms(Estimator::Gmwm),
+        gmwm_unrepresented,
     })
 }
 
@@ -418,8 +440,12 @@ pub fn combine_terms(
         if t.detail.contains("GMWM POOR FIT") {
             warnings.push(format!("{} is from a GMWM POOR FIT in the exports: {}", what[i], t.detail));
         }
-        if t.basis == "upper_bound" || t.basis == "fit_value" {
-            let kind = if t.basis == "upper_bound" { "an upper bound, not a value," } else { "a five-term fit value" };
+        if t.basis == "upper_bound" || t.basis == "fit_value" || t.basis == "gmwm_upper_bound" {
+            let kind = match t.basis.as_str() {
+                "upper_bound" => "an upper bound, not a value,",
+                "gmwm_upper_bound" => "a GMWM bound given that the term is there (its level nominal), not a value,",
+                _ => "a five-term fit value",
+            };
             warnings.push(format!("{} is {kind} in the exports: {}", what[i], t.detail));
         }
         let f = request.overbound.then(|| factor(t));
@@ -433,6 +459,12 @@ pub fn combine_terms(
             source: TermSource { basis: t.basis.clone(), detail: t.detail.clone() },
         });
     }
+    let unrepresented: Vec<String> = if request.estimator == Estimator::Gmwm {
+        channels.iter().flat_map(|c| c.gmwm_unrepresented.iter().cloned()).collect()
+    } else {
+        Vec::new()
+    };
+    warnings.extend(unrepresented.iter().map(|u| format!("not represented in the exports: {u}")));
     let [gyro_noise, gyro_walk, accel_noise, accel_walk] = combined;
     let export = NoiseExport {
         record: record.record.clone(),
@@ -446,6 +478,7 @@ pub fn combine_terms(
         accel_walk,
         rostopic: record.rostopic.clone(),
         motion: record.motion.clone(),
+        unrepresented,
         writer: env!("CARGO_PKG_VERSION").to_string(),
     };
     Ok((export, warnings))
@@ -503,6 +536,14 @@ pub fn write_exports(
     let mut warnings = Vec::new();
     for outcome in outcomes {
         let (export, mut w) = noise_export(outcome, file, request)?;
+        // A channel without a gyro or accelerometer unit (a typo in its name's unit, say) has no
+        // terms a stack takes: said, not dropped in silence.
+        w.extend(outcome.analyses.iter().filter(|a| channel_filter_terms(a).is_none()).map(|a| {
+            format!(
+                "{}: no gyro or accelerometer unit (analysed in output units), so the exports leave this channel out; give it one with --unit or in its name (gyro_x_dps, accel_x_m_s2)",
+                a.channel
+            )
+        }));
         if several {
             if let Some(t) = &outcome.topic {
                 w.iter_mut().for_each(|x| *x = format!("topic {}: {x}", t.topic));

@@ -53,28 +53,82 @@ pub struct AllanArgs {
     /// header naming the record, rate, basis of each value and factors (docs/EXPORTS.md).
     #[arg(long = "export", value_name = "STACK=FILE")]
     pub exports: Vec<String>,
-    /// Multiply every exported value by X (variances by X^2); recorded in the files.
-    #[arg(long, default_value = "1", value_name = "X")]
-    pub inflate: f64,
+    /// Multiply every exported value by X (variances by X^2; default 1); recorded in the files.
+    /// For the --export files only.
+    #[arg(long, value_name = "X", allow_negative_numbers = true)]
+    pub inflate: Option<f64>,
     /// Overbound each exported value: the smallest factor per parameter that puts the model's
     /// Allan deviation on or above the curve's upper confidence bound at every tau (factors
-    /// recorded in the files and on stderr).
+    /// recorded in the files and on stderr). For the --export files only.
     #[arg(long)]
     pub overbound: bool,
     /// Basis of the exported values: slopes (default: slope readings, else bounds, else the
-    /// five-term fit), fit (five-term fit) or gmwm.
-    #[arg(long, default_value = "slopes", value_name = "NAME")]
-    pub estimator: String,
+    /// five-term fit), fit (five-term fit) or gmwm. For the --export files only (the text and
+    /// JSON report every estimator).
+    #[arg(long, value_name = "NAME")]
+    pub estimator: Option<String>,
 }
 
 impl AllanArgs {
     fn request(&self) -> CliResult<AllanRequest> {
         self.analysis.request(self.file.clone())
     }
+
+    /// The export request (targets checked, before any analysis), or None without --export; the
+    /// export options without --export, or two outputs naming one file, are usage errors.
+    fn export_request(&self) -> CliResult<Option<ExportRequest>> {
+        if self.exports.is_empty() {
+            let given: Vec<&str> = [
+                (self.inflate.is_some(), "--inflate"),
+                (self.overbound, "--overbound"),
+                (self.estimator.is_some(), "--estimator"),
+            ]
+            .into_iter()
+            .filter_map(|(on, name)| on.then_some(name))
+            .collect();
+            if !given.is_empty() {
+                return Err(EvalError::conflict(format!(
+                    "{} applies to the --export files only: add --export STACK=FILE (--kalibr-yaml and --imu-utils-yaml write the slope readings as they are, with no factor)",
+                    given.join(", ")
+                ))
+                .into());
+            }
+            self.check_distinct_outputs(Vec::new())?;
+            return Ok(None);
+        }
+        let targets = self.exports.iter().map(|t| parse_target(t)).collect::<Result<Vec<_>, _>>()?;
+        self.check_distinct_outputs(
+            targets.iter().map(|(stack, path)| (format!("--export {}=", stack.name()), path)).collect(),
+        )?;
+        Ok(Some(ExportRequest {
+            estimator: Estimator::parse(self.estimator.as_deref().unwrap_or("slopes"))?,
+            inflate: self.inflate.unwrap_or(1.0),
+            overbound: self.overbound,
+            targets,
+        }))
+    }
+
+    /// Every output file named once (`outputs`: the exports' option and path, then the YAML
+    /// files'): a second output to the same path would overwrite the first.
+    fn check_distinct_outputs<'a>(&'a self, mut outputs: Vec<(String, &'a PathBuf)>) -> CliResult<()> {
+        outputs.extend(self.kalibr_yaml.iter().map(|p| ("--kalibr-yaml".to_string(), p)));
+        outputs.extend(self.imu_utils_yaml.iter().map(|p| ("--imu-utils-yaml".to_string(), p)));
+        for (i, (first, path)) in outputs.iter().enumerate() {
+            if let Some((second, _)) = outputs[i + 1..].iter().find(|(_, other)| other == path) {
+                return Err(EvalError::conflict(format!(
+                    "{first} and {second} both name {}: each output needs its own file",
+                    path.display()
+                ))
+                .into());
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Runs `gyrolab allan`.
 pub fn run(args: &AllanArgs) -> CliResult {
+    let export = args.export_request()?;
     let mut request = args.request()?;
     if let Some((reference, stated)) = reference_from_headers(std::slice::from_ref(&args.file), &request.reference) {
         eprintln!("note: {}", crate::args::stated_reference_note(&args.file.display().to_string(), &stated));
@@ -123,14 +177,8 @@ pub fn run(args: &AllanArgs) -> CliResult {
             }
         }
     }
-    if !args.exports.is_empty() {
-        let request = ExportRequest {
-            targets: args.exports.iter().map(|t| parse_target(t)).collect::<Result<_, _>>()?,
-            estimator: Estimator::parse(&args.estimator)?,
-            inflate: args.inflate,
-            overbound: args.overbound,
-        };
-        let (written, warnings) = write_exports(&outcomes, &args.file, &request)?;
+    if let Some(request) = &export {
+        let (written, warnings) = write_exports(&outcomes, &args.file, request)?;
         for w in &warnings {
             eprintln!("warning: {w}");
         }

@@ -255,8 +255,120 @@ fn a_random_walk_left_out_by_the_chosen_model_is_exported_as_its_bound() {
         text.contains("left out by the chosen model: random_walk <") && text.contains(" if present (one-sided 84.15 %"),
         "{text}"
     );
-    let yaml = gmwm_export(&sim, "kalibr", &dir.path().join("kalibr.yaml"));
+    let path = dir.path().join("kalibr.yaml");
+    let out = gyrolab()
+        .arg("allan")
+        .arg(&sim)
+        .args(["--estimator", "gmwm", "--export"])
+        .arg(format!("kalibr={}", path.display()))
+        .assert()
+        .success();
+    let stderr = String::from_utf8_lossy(&out.get_output().stderr).to_string();
+    assert!(stderr.contains("gyro random walk is a GMWM bound given that the term is there"), "{stderr}");
+    let yaml = std::fs::read_to_string(&path).unwrap();
     let got = value(&yaml, "gyroscope_random_walk");
     assert!((got / upper.to_radians() - 1.0).abs() < 1e-6, "{got} vs {upper} deg\n{yaml}");
     assert!(yaml.contains("gmwm_upper_bound") && yaml.contains("84.2 % upper bound"), "{yaml}");
+}
+
+/// The export options without --export are usage errors (they would be silently ignored), as
+/// are two outputs naming one file and a negative --inflate written as two arguments; nothing is
+/// analysed or written.
+#[test]
+fn export_options_need_an_export_and_outputs_their_own_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = simulate(dir.path());
+    let stderr = |args: &[&str]| {
+        let out = gyrolab().arg("allan").arg(&sim).args(args).assert().code(2);
+        String::from_utf8_lossy(&out.get_output().stderr).to_string()
+    };
+    for (args, named) in [
+        (vec!["--inflate", "2"], "--inflate"),
+        (vec!["--overbound"], "--overbound"),
+        (vec!["--estimator", "gmwm"], "--estimator"),
+    ] {
+        let err = stderr(&args);
+        assert!(err.contains(&format!("{named} applies to the --export files only")), "{args:?}: {err}");
+    }
+    let k = dir.path().join("k.yaml");
+    let (k_kalibr, k_vins) = (format!("kalibr={}", k.display()), format!("vins={}", k.display()));
+    let err = stderr(&["--export", &k_kalibr, "--export", &k_vins]);
+    assert!(err.contains("--export kalibr= and --export vins= both name") && err.contains("its own file"), "{err}");
+    let err = stderr(&["--export", &k_kalibr, "--kalibr-yaml", k.to_str().unwrap()]);
+    assert!(err.contains("--export kalibr= and --kalibr-yaml both name"), "{err}");
+    assert!(!k.exists());
+    // `--inflate -2` reaches gyrolab's own check, not clap's "use '-- -2'" hint.
+    let err = stderr(&["--inflate", "-2", "--export", &k_kalibr]);
+    assert!(err.contains("inflate") && !err.contains("-- -2"), "{err}");
+    assert!(!k.exists());
+}
+
+/// A GMWM model with a flicker floor (white noise + bias instability, 2 h at 50 Hz): no stack
+/// takes the floor, so every file's header and a `warning:` name it as not represented, with B in
+/// rad/s; a bound of a left-out term is warned about as a bound too.
+#[test]
+fn a_gmwm_flicker_floor_is_named_as_not_represented() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = dir.path().join("flicker.csv");
+    gyrolab()
+        .args(["simulate", "static", "--duration-s", "7200", "--sample-rate-hz", "50", "--arw-deg-rt-h", "0.3"])
+        .args(["--bias-instability-dph", "5", "--seed", "11", "--out"])
+        .arg(&sim)
+        .assert()
+        .success();
+    let v = allan_json(&sim);
+    let g = &v["channels"][0]["gmwm"];
+    let flicker = g["parameters"].as_array().unwrap().iter().find(|p| p["process"] == "flicker");
+    let flicker = flicker.unwrap_or_else(|| panic!("the chosen model holds a flicker floor: {g}"));
+    let b_rad = flicker["value"].as_f64().unwrap().to_radians();
+    let file = dir.path().join("k.yaml");
+    let out = gyrolab()
+        .arg("allan")
+        .arg(&sim)
+        .args(["--estimator", "gmwm", "--export"])
+        .arg(format!("kalibr={}", file.display()))
+        .assert()
+        .success();
+    let text = std::fs::read_to_string(&file).unwrap();
+    let line = text.lines().find(|l| l.starts_with("# NOT REPRESENTED: ")).unwrap_or_else(|| panic!("{text}"));
+    assert!(line.contains("flicker floor") && line.contains("rad/s"), "{line}");
+    let written: f64 = line.split("B = ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    assert!((written / b_rad - 1.0).abs() < 1e-9, "{written} vs {b_rad}");
+    let stderr = String::from_utf8_lossy(&out.get_output().stderr).to_string();
+    assert!(
+        stderr.contains("warning: not represented in the exports: ") && stderr.contains("flicker floor"),
+        "{stderr}"
+    );
+    // The slope readings' export has no such line: it does not come from the GMWM's model.
+    gyrolab().arg("allan").arg(&sim).arg("--export").arg(format!("kalibr={}", file.display())).assert().success();
+    assert!(!std::fs::read_to_string(&file).unwrap().contains("NOT REPRESENTED"));
+}
+
+/// A channel whose name carries no unit gyrolab knows (a typo, `gyro_y_dsp`) is analysed in
+/// output units and left out of the exports, with a `warning:` naming it, not in silence.
+#[test]
+fn a_channel_without_a_unit_is_named_when_the_exports_leave_it_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = simulate(dir.path());
+    let text = std::fs::read_to_string(&sim).unwrap();
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let header = lines.next().unwrap();
+    let rate_column = header.split(',').position(|c| c.starts_with("rate") || c.contains("dps")).unwrap();
+    let mut csv = String::from("time_s,gyro_x_dps,gyro_y_dsp\n");
+    for line in lines.take(50_000) {
+        let cells: Vec<&str> = line.split(',').collect();
+        csv.push_str(&format!("{},{},{}\n", cells[0], cells[rate_column], cells[rate_column]));
+    }
+    let typo = dir.path().join("typo.csv");
+    std::fs::write(&typo, csv).unwrap();
+    let file = dir.path().join("k.yaml");
+    let out =
+        gyrolab().arg("allan").arg(&typo).arg("--export").arg(format!("kalibr={}", file.display())).assert().success();
+    let stderr = String::from_utf8_lossy(&out.get_output().stderr).to_string();
+    assert!(
+        stderr.contains("warning: gyro_y_dsp: no gyro or accelerometer unit")
+            && stderr.contains("leave this channel out"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("warning: gyro_x_dps: no gyro"), "{stderr}");
 }

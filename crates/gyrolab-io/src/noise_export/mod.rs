@@ -147,6 +147,9 @@ pub struct NoiseExport {
     /// One `MOTION: the record is not static: ...` line per channel that moved (the stillness
     /// check; analysed because motion was allowed): each goes into every file's header.
     pub motion: Vec<String>,
+    /// Terms of the model the values come from that no stack takes (a GMWM flicker floor), one
+    /// line each in every file's header: the values do not represent them.
+    pub unrepresented: Vec<String>,
     /// The writer's version, for the header.
     pub writer: String,
 }
@@ -253,6 +256,7 @@ impl NoiseExport {
         h.push(format!("record: {}", one_line(&self.record)));
         h.push(format!("sample rate: {} Hz", rate_text(self.rate_hz)));
         h.push(format!("estimator: {}", self.estimator));
+        h.extend(self.unrepresented.iter().map(|m| format!("NOT REPRESENTED: {}", one_line(m))));
         h.push(if matches!(stack, Stack::Px4 | Stack::Px4Qgc) {
             format!(
                 "time convention: per EKF2 prediction step at {} Hz (density x sqrt(step rate); see below)",

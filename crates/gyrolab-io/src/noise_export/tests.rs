@@ -23,6 +23,7 @@ pub(super) fn sample() -> NoiseExport {
         accel_walk: Some(term(6e-4, "fit_value")),
         rostopic: None,
         motion: Vec::new(),
+        unrepresented: Vec::new(),
         writer: "test".into(),
     }
 }
