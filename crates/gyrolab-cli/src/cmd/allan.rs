@@ -8,7 +8,7 @@ use crate::progress::Bar;
 use clap::Args;
 use gyrolab_eval::allan::AllanRequest;
 use gyrolab_eval::allan_memory::{analyse_records_within, default_memory_bytes, parse_memory, size_text, MemoryPath};
-use gyrolab_eval::filter_export::{parse_target, write_exports, Estimator, ExportRequest};
+use gyrolab_eval::filter_export::{check_inflate, parse_target, same_path, write_exports, Estimator, ExportRequest};
 use gyrolab_eval::simulate::reference_from_headers;
 use gyrolab_eval::EvalError;
 use gyrolab_report::allan::{allan_csv, allan_document, allan_text, imu_utils_yaml, kalibr_yaml};
@@ -97,6 +97,9 @@ impl AllanArgs {
             return Ok(None);
         }
         let targets = self.exports.iter().map(|t| parse_target(t)).collect::<Result<Vec<_>, _>>()?;
+        if let Some(x) = self.inflate {
+            check_inflate(x)?;
+        }
         self.check_distinct_outputs(
             targets.iter().map(|(stack, path)| (format!("--export {}=", stack.name()), path)).collect(),
         )?;
@@ -114,7 +117,7 @@ impl AllanArgs {
         outputs.extend(self.kalibr_yaml.iter().map(|p| ("--kalibr-yaml".to_string(), p)));
         outputs.extend(self.imu_utils_yaml.iter().map(|p| ("--imu-utils-yaml".to_string(), p)));
         for (i, (first, path)) in outputs.iter().enumerate() {
-            if let Some((second, _)) = outputs[i + 1..].iter().find(|(_, other)| other == path) {
+            if let Some((second, _)) = outputs[i + 1..].iter().find(|(_, other)| same_path(other, path)) {
                 return Err(EvalError::conflict(format!(
                     "{first} and {second} both name {}: each output needs its own file",
                     path.display()

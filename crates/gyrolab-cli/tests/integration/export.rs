@@ -296,6 +296,18 @@ fn export_options_need_an_export_and_outputs_their_own_files() {
     assert!(err.contains("--export kalibr= and --export vins= both name") && err.contains("its own file"), "{err}");
     let err = stderr(&["--export", &k_kalibr, "--kalibr-yaml", k.to_str().unwrap()]);
     assert!(err.contains("--export kalibr= and --kalibr-yaml both name"), "{err}");
+    // The same file written two ways, from the record's folder: `k.yaml` and `./k.yaml`.
+    let out = gyrolab()
+        .current_dir(dir.path())
+        .args(["allan", "sim.csv", "--export", "kalibr=k.yaml", "--export", "vins=./k.yaml"])
+        .assert()
+        .code(2);
+    assert!(String::from_utf8_lossy(&out.get_output().stderr).contains("both name"));
+    // A bad --inflate is refused before anything is analysed or written, --kalibr-yaml included.
+    let y = dir.path().join("y.yaml");
+    let err = stderr(&["--kalibr-yaml", y.to_str().unwrap(), "--export", &k_kalibr, "--inflate", "0"]);
+    assert!(err.contains("inflate") && err.contains("not a positive number"), "{err}");
+    assert!(!y.exists());
     assert!(!k.exists());
     // `--inflate -2` reaches gyrolab's own check, not clap's "use '-- -2'" hint.
     let err = stderr(&["--inflate", "-2", "--export", &k_kalibr]);
@@ -366,9 +378,10 @@ fn a_channel_without_a_unit_is_named_when_the_exports_leave_it_out() {
         gyrolab().arg("allan").arg(&typo).arg("--export").arg(format!("kalibr={}", file.display())).assert().success();
     let stderr = String::from_utf8_lossy(&out.get_output().stderr).to_string();
     assert!(
-        stderr.contains("warning: gyro_y_dsp: no gyro or accelerometer unit")
-            && stderr.contains("leave this channel out"),
+        stderr.contains(
+            "warning: gyro_y_dsp: not a gyro or accelerometer channel, so the exports leave it out; it has no unit"
+        ),
         "{stderr}"
     );
-    assert!(!stderr.contains("warning: gyro_x_dps: no gyro"), "{stderr}");
+    assert!(!stderr.contains("warning: gyro_x_dps: not a gyro"), "{stderr}");
 }

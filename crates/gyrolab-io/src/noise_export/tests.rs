@@ -155,3 +155,17 @@ fn stack_names_parse() {
     assert_eq!(Stack::parse("ORBSLAM3"), Some(Stack::Orbslam3));
     assert_eq!(Stack::parse("gtsam"), None);
 }
+
+/// Terms the values do not model are one `NOT REPRESENTED:` header line each, in every stack's file.
+#[test]
+fn unrepresented_terms_are_header_lines() {
+    let mut e = sample();
+    e.unrepresented = vec!["gyro_x: the GMWM model holds a flicker floor (bias instability B = 1.0e-05 rad/s)".into()];
+    for stack in STACKS {
+        let lines = e.header_lines(stack);
+        let hit =
+            lines.iter().filter(|l| l.starts_with("NOT REPRESENTED: gyro_x: the GMWM model holds a flicker")).count();
+        assert_eq!(hit, 1, "{}: {lines:?}", stack.name());
+    }
+    assert!(!sample().header_lines(Stack::Kalibr).iter().any(|l| l.contains("NOT REPRESENTED")));
+}
