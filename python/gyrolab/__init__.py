@@ -212,6 +212,7 @@ def allan(
     names: Optional[Sequence[str]] = None,
     record: Optional[str] = None,
     allow_motion: bool = False,
+    topic: Optional[str] = None,
 ) -> Union[AllanResult, AllanResults]:
     """Allan-family deviation, confidence bounds and noise terms of rate samples.
 
@@ -241,6 +242,8 @@ def allan(
     ``gaps``: "error" (default: a NaN sample or a gap in the time stamps is refused, naming
     the first) or "analyse" (computed over, as ``gyrolab allan --gaps analyse``).
     ``record``: the name results and errors carry (default the path, or ``<array>``).
+    ``topic``: for a recording (ROS 2 MCAP, ROS 1 bag, PX4 ULog) with several IMU topics, the
+    one to analyse, as :func:`read`'s ``topic`` and the CLI's ``--topic``.
 
     Stillness: a gyro (deg/s) or accelerometer (m/s^2) channel whose 1 s window means depart
     from the record's still level (docs/METHODS.md, "Stillness check") moved: the call raises
@@ -251,9 +254,11 @@ def allan(
     Every channel is computed with the interpreter released, on gyrolab's own thread pool
     (safe in fork-based multiprocessing pools).
     """
+    if topic is not None and not isinstance(x, (str, os.PathLike)):
+        raise Error(f"topic={topic!r}: a topic picks one IMU topic of a recording file; x is not a path", keyword="topic")
     if isinstance(x, (str, os.PathLike)):
         path = os.fspath(x)
-        arrays, file_units = _gyrolab.read(path, None, None, None, None)
+        arrays, file_units = _gyrolab.read(path, None, None, None, topic)
         frame = dict(arrays)
         if time is None:
             tcols = [k for k, u in file_units.items() if u == "s"]

@@ -80,3 +80,13 @@ def test_parquet_and_mcap_recordings_are_read_by_content(tmp_path):
     arrays = gyrolab.read(mcap, as_dataframe=False, topic="/imu1")
     np.testing.assert_array_equal(arrays["gyro_x_rad_s"], gx)
     np.testing.assert_allclose(np.diff(arrays["time_s"]), 0.005, rtol=0, atol=1e-12)
+    # allan() takes the topic too (its error above said "topic="), with the same deviations as
+    # reading the topic first; without a path the keyword is refused.
+    with pytest.raises(gyrolab.Error, match="2 IMU topics"):
+        gyrolab.allan(mcap)
+    direct = gyrolab.allan(mcap, topic="/imu1")
+    via_read = gyrolab.allan(gyrolab.read(mcap, topic="/imu1"))
+    np.testing.assert_array_equal(direct["gyro_x_rad_s"].dev, via_read["gyro_x_rad_s"].dev)
+    with pytest.raises(gyrolab.Error) as e:
+        gyrolab.allan(gx, rate_hz=200.0, topic="/imu1")
+    assert e.value.keyword == "topic"
