@@ -14,6 +14,7 @@ Units are part of every name: ``taus_s``, ``arw_deg_rt_h``, ``bias_instability_d
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
@@ -195,7 +196,7 @@ def _factors(taus: Sequence[float], rate_hz: Optional[float], stamps: Optional[n
     return sorted(set(int(v) for v in m)), rounded
 
 
-def allan(
+def _allan(
     x: Any,
     rate_hz: Optional[float] = None,
     kind: str = "oadev",
@@ -325,6 +326,21 @@ def allan(
     if single:
         return next(iter(results.values()))
     return AllanResults(results, record or "<array>")
+
+
+
+@functools.wraps(_allan)
+def allan(x: Any, *args: Any, **kwargs: Any) -> Union[AllanResult, AllanResults]:
+    try:
+        return _allan(x, *args, **kwargs)
+    except Error as e:
+        # A file's errors name the file (and topic), as the CLI's do, unless they already do.
+        if not isinstance(x, (str, os.PathLike)) or e.file is not None:
+            raise
+        where = kwargs.get("record") or os.fspath(x)
+        if kwargs.get("topic"):
+            where = f"{where} topic {kwargs['topic']}"
+        raise Error(f"{where}: {e.message}", file=where, line=e.line, column=e.column, keyword=e.keyword) from None
 
 
 def bias(

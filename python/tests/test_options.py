@@ -96,6 +96,18 @@ def test_gaps_policy():
         gyrolab.allan(X, rate_hz=100.0, gaps="skip")
 
 
+def test_a_files_errors_name_the_file(tmp_path):
+    # The same gap read from a file: the error names the file, as the CLI's does.
+    t = np.arange(X.size) / 100.0
+    t[5000:] += 0.05
+    path = tmp_path / "gap.csv"
+    np.savetxt(path, np.column_stack([t, X]), delimiter=",", header="time_s,rate_dps", comments="", fmt="%.17g")
+    with pytest.raises(gyrolab.Error, match=r"gap\.csv: a gap in the time stamps before time\[5000\]") as e:
+        gyrolab.allan(path)
+    assert e.value.file == str(path) and e.value.keyword == "gaps"
+    assert gyrolab.allan(path, gaps="analyse")["rate_dps"].samples == X.size + 5
+
+
 def test_rate_and_time_must_agree():
     t = np.arange(X.size) / 100.0
     with pytest.raises(gyrolab.Error, match="rate_hz = 50 Hz disagrees"):
