@@ -36,3 +36,15 @@ pub fn to_json<T: serde::Serialize>(value: &T) -> CliResult<String> {
         .map(|s| s + "\n")
         .map_err(|e| CliError::Output(format!("cannot serialise JSON: {e}")))
 }
+
+/// One `SIMULATED: ...` line per input that gyrolab's simulator wrote (empty when none is), for
+/// the head of a text report: a simulated input is marked in every output.
+pub fn simulated_lines(files: &[PathBuf]) -> String {
+    files
+        .iter()
+        .filter(|f| gyrolab_eval::filter_export::is_simulated_record(f))
+        .map(|f| {
+            format!("SIMULATED: {} is a simulated record (gyrolab simulate), not a measured sensor\n", f.display())
+        })
+        .collect()
+}

@@ -132,8 +132,8 @@ pub struct ChannelFilterTerms {
     pub fit: [Option<TermEstimate>; 2],
     /// GMWM; [white noise, random walk].
     pub gmwm: [Option<TermEstimate>; 2],
-    /// Terms of the GMWM's chosen model that no stack takes and the GMWM values leave out (its
-    /// flicker floor), one line each.
+    /// Terms of the GMWM's chosen model that no stack takes and the GMWM values leave out (a
+    /// flicker floor, quantization, drift), one line each.
     #[serde(default)]
     pub gmwm_unrepresented: Vec<String>,
 }

@@ -3,7 +3,7 @@
 
 use crate::args::AnalysisArgs;
 use crate::error::CliResult;
-use crate::output::{print, to_json, write_file};
+use crate::output::{print, simulated_lines, to_json, write_file};
 use crate::progress::Bar;
 use clap::Args;
 use gyrolab_eval::allan::AllanRequest;
@@ -215,11 +215,12 @@ pub fn run(args: &AllanArgs) -> CliResult {
     if args.csv {
         return print(&allan_csv(analyses));
     }
+    let simulated = simulated_lines(std::slice::from_ref(&args.file));
     let mut text: Vec<String> = analyses.iter().map(allan_text).collect();
     if let Some(s) = streamed {
         text.push(format!("memory: {}", streaming_note(&args.file.display().to_string(), s)));
     }
-    print(&(text.join("\n") + "\n"))
+    print(&(simulated + &text.join("\n") + "\n"))
 }
 
 /// The JSON document with the `memory` object (which path; docs/JSON.md) after its keys.

@@ -119,7 +119,8 @@ pub fn run(args: &BiasArgs) -> CliResult {
     if args.json {
         return print(&to_json(&bias_json(tests, outcome.repeatability, &outcome.warmup))?);
     }
-    let mut text = bias_table(&tests, &outcome.repeatability);
+    let mut text = crate::output::simulated_lines(&args.files);
+    text.push_str(&bias_table(&tests, &outcome.repeatability));
     text.push('\n');
     text.push_str(&gyrolab_report::bias::warmup_text(&outcome.warmup));
     if tests.iter().any(|t| t.result.earth_rate_subtracted) {

@@ -22,14 +22,20 @@ fn simulate_walk(dir: &std::path::Path, rrw: &str, seed: &str) -> std::path::Pat
 
 /// `gyrolab allan RECORD --estimator gmwm --export STACK=FILE`, asserted to succeed; the file's text.
 fn gmwm_export(record: &std::path::Path, stack: &str, file: &std::path::Path) -> String {
-    gyrolab()
+    gmwm_export_and_stderr(record, stack, file).0
+}
+
+/// As [`gmwm_export`], with the run's stderr.
+fn gmwm_export_and_stderr(record: &std::path::Path, stack: &str, file: &std::path::Path) -> (String, String) {
+    let out = gyrolab()
         .arg("allan")
         .arg(record)
         .args(["--estimator", "gmwm", "--export"])
         .arg(format!("{stack}={}", file.display()))
         .assert()
         .success();
-    std::fs::read_to_string(file).unwrap()
+    let stderr = String::from_utf8_lossy(&out.get_output().stderr).to_string();
+    (std::fs::read_to_string(file).unwrap(), stderr)
 }
 
 /// `gyrolab allan RECORD --json`, parsed.
@@ -255,17 +261,8 @@ fn a_random_walk_left_out_by_the_chosen_model_is_exported_as_its_bound() {
         text.contains("left out by the chosen model: random_walk <") && text.contains(" if present (one-sided 84.15 %"),
         "{text}"
     );
-    let path = dir.path().join("kalibr.yaml");
-    let out = gyrolab()
-        .arg("allan")
-        .arg(&sim)
-        .args(["--estimator", "gmwm", "--export"])
-        .arg(format!("kalibr={}", path.display()))
-        .assert()
-        .success();
-    let stderr = String::from_utf8_lossy(&out.get_output().stderr).to_string();
+    let (yaml, stderr) = gmwm_export_and_stderr(&sim, "kalibr", &dir.path().join("kalibr.yaml"));
     assert!(stderr.contains("gyro random walk is a GMWM bound given that the term is there"), "{stderr}");
-    let yaml = std::fs::read_to_string(&path).unwrap();
     let got = value(&yaml, "gyroscope_random_walk");
     assert!((got / upper.to_radians() - 1.0).abs() < 1e-6, "{got} vs {upper} deg\n{yaml}");
     assert!(yaml.contains("gmwm_upper_bound") && yaml.contains("84.2 % upper bound"), "{yaml}");
@@ -334,19 +331,11 @@ fn a_gmwm_flicker_floor_is_named_as_not_represented() {
     let flicker = flicker.unwrap_or_else(|| panic!("the chosen model holds a flicker floor: {g}"));
     let b_rad = flicker["value"].as_f64().unwrap().to_radians();
     let file = dir.path().join("k.yaml");
-    let out = gyrolab()
-        .arg("allan")
-        .arg(&sim)
-        .args(["--estimator", "gmwm", "--export"])
-        .arg(format!("kalibr={}", file.display()))
-        .assert()
-        .success();
-    let text = std::fs::read_to_string(&file).unwrap();
+    let (text, stderr) = gmwm_export_and_stderr(&sim, "kalibr", &file);
     let line = text.lines().find(|l| l.starts_with("# NOT REPRESENTED: ")).unwrap_or_else(|| panic!("{text}"));
     assert!(line.contains("flicker floor") && line.contains("rad/s"), "{line}");
     let written: f64 = line.split("B = ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
     assert!((written / b_rad - 1.0).abs() < 1e-9, "{written} vs {b_rad}");
-    let stderr = String::from_utf8_lossy(&out.get_output().stderr).to_string();
     assert!(
         stderr.contains("warning: not represented in the exports: ") && stderr.contains("flicker floor"),
         "{stderr}"
@@ -384,4 +373,24 @@ fn a_channel_without_a_unit_is_named_when_the_exports_leave_it_out() {
         "{stderr}"
     );
     assert!(!stderr.contains("warning: gyro_x_dps: not a gyro"), "{stderr}");
+}
+
+/// A simulated record is marked in the text reports of `allan` and `bias` (a first `SIMULATED:`
+/// line); the same samples without the simulator's header are not.
+#[test]
+fn simulated_inputs_are_marked_in_the_text_reports() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = simulate(dir.path());
+    let stdout = |args: &[&str], file: &std::path::Path| {
+        let out = gyrolab().arg(args[0]).arg(file).args(&args[1..]).assert().success();
+        String::from_utf8_lossy(&out.get_output().stdout).to_string()
+    };
+    assert!(stdout(&["allan"], &sim).starts_with("SIMULATED: "), "allan");
+    assert!(stdout(&["bias"], &sim).starts_with("SIMULATED: "), "bias");
+    // The same samples without the simulator's header lines read as a measured record.
+    let measured = dir.path().join("measured.csv");
+    let text = std::fs::read_to_string(&sim).unwrap();
+    std::fs::write(&measured, text.lines().filter(|l| !l.starts_with('#')).collect::<Vec<_>>().join("\n")).unwrap();
+    assert!(!stdout(&["allan"], &measured).contains("SIMULATED"), "allan, measured");
+    assert!(!stdout(&["bias"], &measured).contains("SIMULATED"), "bias, measured");
 }

@@ -147,8 +147,9 @@ pub struct NoiseExport {
     /// One `MOTION: the record is not static: ...` line per channel that moved (the stillness
     /// check; analysed because motion was allowed): each goes into every file's header.
     pub motion: Vec<String>,
-    /// Terms of the model the values come from that no stack takes (a GMWM flicker floor), one
-    /// line each in every file's header: the values do not represent them.
+    /// Terms of the model the values come from that no stack takes (a GMWM flicker floor,
+    /// quantization or drift), one line each in every file's header: the values do not represent
+    /// them.
     pub unrepresented: Vec<String>,
     /// The writer's version, for the header.
     pub writer: String,
