@@ -301,7 +301,7 @@ def _allan(
             rate_hz = float(rate_hz)
         except (TypeError, ValueError):
             raise Error(f"rate_hz={rate_hz!r}: expected a number of hertz", keyword="rate_hz") from None
-    doc_json, per_channel, filter_terms = _gyrolab.allan_channels(
+    doc_json, per_channel, lazy = _gyrolab.allan_channels(
         arrays,
         cols,
         chan_units,
@@ -318,10 +318,10 @@ def _allan(
         record or "<array>",
         bool(allow_motion),
     )
-    doc = json.loads(doc_json)
+    channels = json.loads(doc_json)
     results = {
-        ch["channel"]: AllanResult._from_json(ch, arrays_of, rounded, terms)
-        for ch, arrays_of, terms in zip(doc["channels"], per_channel, filter_terms)
+        ch["channel"]: AllanResult._from_json(ch, arrays_of, rounded, (lazy, i))
+        for i, (ch, arrays_of) in enumerate(zip(channels, per_channel))
     }
     if single:
         return next(iter(results.values()))

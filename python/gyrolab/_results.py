@@ -36,6 +36,16 @@ _ACCEL_TERMS = {
 _MAX_ERROR_BARS = 60
 
 
+class _Unset:
+    """The value of a lazily computed field before its first use."""
+
+    def __repr__(self) -> str:
+        return "<not yet computed>"
+
+
+_UNSET = _Unset()
+
+
 def _same(a: Any, b: Any) -> bool:
     if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
         a, b = np.asarray(a), np.asarray(b)
@@ -83,16 +93,19 @@ class AllanResult:
     noise: Dict[str, Any] = field(default_factory=dict)
     readings: List[Dict[str, Any]] = field(default_factory=list)
     fit: Optional[Dict[str, Any]] = None
-    gmwm: Optional[Dict[str, Any]] = None
     noise_note: Optional[str] = None
     stillness: Optional[Dict[str, Any]] = None
     taus_rounded: Dict[float, float] = field(default_factory=dict)
     _doc: Dict[str, Any] = field(default_factory=dict)
-    _filter_terms: Optional[str] = None
+    # The GMWM fit and the filter terms are computed by the native module only when first read
+    # (``gmwm``, ``export``, ``to_dict``, pickling): ``_lazy`` is (native analyses, channel index).
+    _gmwm: Any = _UNSET
+    _filter_terms: Any = _UNSET
+    _lazy: Any = None
 
     @classmethod
     def _from_json(
-        cls, ch: Dict[str, Any], arrays: List[np.ndarray], rounded: Dict[float, float], filter_terms: Optional[str] = None
+        cls, ch: Dict[str, Any], arrays: List[np.ndarray], rounded: Dict[float, float], lazy: Any = None
     ) -> "AllanResult":
         accel = ch.get("quantity") == "acceleration"
         terms = (ch.get("accel_noise") if accel else ch.get("noise")) or {}
@@ -115,13 +128,38 @@ class AllanResult:
             noise={k: v for k, v in terms.items() if k not in ("readings", "fit", "kalibr")},
             readings=terms.get("readings", []),
             fit=terms.get("fit"),
-            gmwm=ch.get("gmwm"),
             noise_note=ch.get("noise_note"),
             stillness=ch.get("stillness"),
             taus_rounded=dict(rounded),
             _doc=ch,
-            _filter_terms=filter_terms,
+            _lazy=lazy,
         )
+
+    @property
+    def gmwm(self) -> Optional[Dict[str, Any]]:
+        """The GMWM fit (the ``gmwm`` key of docs/JSON.md), computed on first use; None when
+        not made."""
+        if self._gmwm is _UNSET:
+            text = self._lazy[0].gmwm(self._lazy[1]) if self._lazy is not None else None
+            self._gmwm = None if text is None else json.loads(text)
+        return self._gmwm
+
+    def _terms(self) -> Optional[str]:
+        """The filter terms (JSON for the native ``render_export``), computed on first use."""
+        if self._filter_terms is _UNSET:
+            self._filter_terms = self._lazy[0].filter_terms(self._lazy[1]) if self._lazy is not None else None
+        return self._filter_terms
+
+    def __getstate__(self) -> Dict[str, Any]:
+        # What is computed on first use is computed now: the native analyses do not pickle.
+        state = dict(self.__dict__)
+        state["_gmwm"] = self.gmwm
+        state["_filter_terms"] = self._terms()
+        state["_lazy"] = None
+        return state
+
+    def __setstate__(self, state: Dict[str, Any]) -> None:
+        self.__dict__.update(state)
 
     def __getattr__(self, name: str) -> Any:
         # The noise terms as attributes (r.arw_deg_rt_h); private names and the fields
@@ -142,7 +180,7 @@ class AllanResult:
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, AllanResult):
             return NotImplemented
-        names = [f for f in self.__dataclass_fields__ if f not in ("_doc", "_filter_terms")]
+        names = [f for f in self.__dataclass_fields__ if not f.startswith("_")] + ["gmwm"]
         return all(_same(getattr(self, f), getattr(other, f)) for f in names)
 
     __hash__ = None  # type: ignore[assignment]
@@ -201,7 +239,9 @@ class AllanResult:
 
     def to_dict(self) -> Dict[str, Any]:
         """The channel's result with the keys of ``gyrolab allan --json``."""
-        return json.loads(json.dumps(self._doc))
+        out = json.loads(json.dumps(self._doc))
+        out["gmwm"] = self.gmwm
+        return out
 
     def export(
         self,
@@ -305,7 +345,7 @@ def _export(
 
     from . import _gyrolab
 
-    terms = [r._filter_terms for r in results if r._filter_terms is not None]
+    terms = [t for t in (r._terms() for r in results) if t is not None]
     motion = [r.stillness["motion"] for r in results if r.stillness and r.stillness.get("motion")]
     text, notes = _gyrolab.render_export(
         terms, record, 1.0 / tau0_s, stack, estimator, float(inflate), bool(overbound), motion

@@ -5,8 +5,9 @@ import gyrolab
 
 
 def deviation(seed):
-    """The OADEV of a seeded white-noise record, computed in the worker."""
-    x = np.random.default_rng(seed).standard_normal(20_000) * 0.01
+    """The OADEV of a seeded white-noise record, computed in the worker (long enough, 300,000
+    samples, to run on the package's thread pool rather than on the calling thread)."""
+    x = np.random.default_rng(seed).standard_normal(300_000) * 0.01
     return gyrolab.allan(x, rate_hz=100.0, confidence=None).dev
 
 

@@ -1,6 +1,7 @@
 """gyrolab.allan against allantools (every kind, relative 1e-12), against `gyrolab allan --json`
 on the same file, and against simulated truth."""
 import json
+import pickle
 import subprocess
 
 import allantools
@@ -47,6 +48,26 @@ def test_same_as_the_command_line(cli, tmp_path):
     assert p["noise"] == c["noise"]
     np.testing.assert_array_equal(r.dev, np.array(c["dev"]))
     np.testing.assert_array_equal(r.ci_high, np.array([np.nan if v is None else v for v in c["ci_high"]]))
+
+
+def test_the_gmwm_is_computed_when_first_read_and_equals_the_command_line(cli, tmp_path):
+    # The GMWM is the costliest part of a short record's analysis and most calls never read it:
+    # it is computed on first use (r.gmwm, to_dict, export, pickling), and is then the CLI's.
+    data = np.random.default_rng(8).standard_normal(30_000) * 0.02
+    path = tmp_path / "rate.csv"
+    path.write_text("time_s,rate_dps\n" + "".join(f"{i * 0.01!r},{v!r}\n" for i, v in enumerate(data.tolist())))
+    out = subprocess.run([cli, "allan", str(path), "--json"], check=True, capture_output=True, text=True).stdout
+    want = json.loads(out)["gmwm"]
+    assert want is not None and want["parameters"]
+    r = gyrolab.allan(data, rate_hz=100.0)
+    assert "_gmwm" in r.__dict__ and repr(r.__dict__["_gmwm"]) == "<not yet computed>"
+    assert r.gmwm == want
+    assert r.to_dict()["gmwm"] == want
+    # pickled before first use: computed for the pickle, equal after it
+    fresh = gyrolab.allan(data, rate_hz=100.0)
+    again = pickle.loads(pickle.dumps(fresh))
+    assert again.gmwm == want and again == r
+    assert again.export("kalibr", estimator="gmwm") == r.export("kalibr", estimator="gmwm")
 
 
 def test_simulated_arw_is_recovered():

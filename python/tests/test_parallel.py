@@ -92,3 +92,33 @@ def test_results_pickle_and_compare():
     assert (r == other) is False and r != other
     many = gyrolab.allan({"a": x, "b": x[::-1].copy()}, rate_hz=100.0)
     assert pickle.loads(pickle.dumps(many)) == many
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="threads are counted in /proc/self/task")
+def test_a_short_record_is_computed_on_the_calling_thread_and_starts_no_thread():
+    # Below gyrolab.allan's parallel size (2^18 samples in all) the call runs on the caller's
+    # thread with no thread pool (issue 56): no rayon pool is started, the package's nor rayon's
+    # global one, so nothing waits on threads a fork would lose. A long record starts the
+    # package's pool. In a fresh interpreter, so that no earlier test has started a pool.
+    import subprocess
+    import textwrap
+
+    code = textwrap.dedent(
+        """
+        import os, numpy as np, gyrolab
+        count = lambda: len(os.listdir("/proc/self/task"))
+        x = np.random.default_rng(1).standard_normal(60_000) * 0.01
+        before = count()
+        for _ in range(3):
+            r = gyrolab.allan(x, rate_hz=100.0)
+        gyrolab.allan({"a": x, "b": x, "c": x}, rate_hz=100.0)
+        short = count()
+        gyrolab.allan(np.random.default_rng(2).standard_normal(300_000) * 0.01, rate_hz=100.0)
+        print(before, short, count(), r.dev[0] > 0)
+        """
+    )
+    out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True, timeout=TIMEOUT_S)
+    before, short, long, ok = out.stdout.split()
+    assert ok == "True"
+    assert int(short) == int(before), out.stdout
+    assert int(long) > int(short), out.stdout

@@ -19,7 +19,7 @@ use gyrolab_io::recording::{read_records, TopicMeta};
 use gyrolab_io::series::{ChannelInfo, SeriesData, SeriesOptions};
 use gyrolab_io::series::{LineMap, RowKind, SkipReason, SkippedColumn, UnitSource};
 use gyrolab_io::DataError;
-use gyrolab_report::allan::ChannelAnalysis;
+use gyrolab_report::allan::{ChannelAnalysis, LazyGmwm};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -842,9 +842,9 @@ pub(crate) fn channel_analysis(
     };
     let allan_kind = matches!(setup.options.kind, DeviationKind::Oadev | DeviationKind::Adev);
     let gmwm = if calibrated && allan_kind {
-        gyrolab::gmwm::gmwm(&curve, curve.confidence.unwrap_or(DEFAULT_GMWM_CONFIDENCE)).ok()
+        LazyGmwm::at_confidence(curve.confidence.unwrap_or(DEFAULT_GMWM_CONFIDENCE))
     } else {
-        None
+        LazyGmwm::none()
     };
     let (slope_lines, model_fit, noise_note) = if quantity == Quantity::Unitless {
         (

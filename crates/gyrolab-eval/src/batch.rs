@@ -4,7 +4,7 @@
 //! noise terms of `gyrolab allan --json`, their units in the column names), as CSV or Parquet.
 //!
 //! The figures are those of [`crate::allan::analyse_records`] and
-//! [`gyrolab_report::allan::allan_json`] (docs/METHODS.md section 3); this module adds no
+//! [`gyrolab_report::allan::allan_json_with`] (without the GMWM, which the table does not hold) (docs/METHODS.md section 3); this module adds no
 //! formula, only the bookkeeping (docs/METHODS.md, "Batches").
 //!
 //! Nothing is written here: the front end receives each finished input through [`BatchSink`]
@@ -15,7 +15,7 @@ use crate::allan::{analyse_records, AllanRequest};
 use crate::error::{EvalError, EvalResult};
 use crate::progress::Progress;
 use gyrolab_io::DataError;
-use gyrolab_report::allan::{allan_json, AllanJson};
+use gyrolab_report::allan::{allan_json_with, AllanJson};
 use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 use std::collections::{BTreeMap, HashMap};
@@ -400,7 +400,7 @@ pub fn evaluate_input(
     let mut rows = Vec::new();
     for outcome in &outcomes {
         for a in &outcome.analyses {
-            rows.push(result_row(&allan_json(a), file, sha256, simulated));
+            rows.push(result_row(&allan_json_with(a, false), file, sha256, simulated));
         }
     }
     if rows.is_empty() {

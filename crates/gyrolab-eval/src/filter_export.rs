@@ -217,7 +217,7 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
             ]
         }
         Estimator::Gmwm => {
-            let Some(g) = &a.gmwm else { return [None, None] };
+            let Some(g) = a.gmwm() else { return [None, None] };
             let model: Vec<String> = g
                 .parameters
                 .iter()
@@ -356,8 +356,7 @@ pub fn channel_filter_terms(a: &ChannelAnalysis) -> Option<ChannelFilterTerms> {
     // or a random walk bounds none of them over the whole curve without overstating it at its
     // other end: they are named, not folded in (docs/EXPORTS.md).
     let gmwm_unrepresented = a
-        .gmwm
-        .as_ref()
+        .gmwm()
         .map(|g| {
             [
                 (Process::Flicker, "a flicker floor (bias instability B", "rad/s", "m/s^2"),

@@ -176,9 +176,10 @@ enum Samples<'a> {
 }
 
 /// Allan analysis of channels of one record in one native call, the channels in parallel on
-/// the package's pool: returns (JSON document as `gyrolab allan --json`, per channel the arrays
-/// taus_s, m, dev, ci_low, ci_high, n_terms, alpha; bounds NaN where none exists, per channel
-/// the JSON of its filter terms or None: what `result.export(...)` renders). `rate_hz`
+/// the package's pool: returns (JSON list of the channels of `gyrolab allan --json` (its
+/// `channels` key, each `gmwm` null: the GMWM is computed when asked for), per channel the
+/// arrays taus_s, m, dev, ci_low, ci_high, n_terms, alpha; bounds NaN where none exists, and the
+/// [`AllanChannels`] that computes each channel's GMWM fit and filter terms). `rate_hz`
 /// or `time_s` (seconds, one per sample) gives the sampling; gaps in `time_s` and NaN samples
 /// follow `gaps` (`error` or `analyse`). `factors` replaces `taus` by averaging factors.
 #[pyfunction]
@@ -201,7 +202,7 @@ fn allan_channels<'py>(
     gaps: &str,
     record: &str,
     allow_motion: bool,
-) -> PyResult<(String, Vec<Vec<Bound<'py, PyArray1<f64>>>>, Vec<Option<String>>)> {
+) -> PyResult<(String, Vec<Vec<Bound<'py, PyArray1<f64>>>>, AllanChannels)> {
     let policy = GapPolicy::parse(gaps).map_err(|e| err(e.into()))?;
     if let Some(f) = rate_hz {
         gyrolab::validate::positive("sample_rate_hz", f).map_err(|e| err(e.into()))?;
@@ -352,25 +353,29 @@ fn allan_channels<'py>(
     };
     // Missing samples in the record (NaN or gaps) are computed over only when asked for.
     let missing_policy = if policy == GapPolicy::Analyse { GapPolicy::Analyse } else { GapPolicy::Error };
-    let analyses = run(py, || {
-        samples
-            .par_iter()
-            .zip(infos.par_iter())
-            .map(|(s, info)| {
-                let values: &[f64] = match s {
-                    Samples::Borrowed(s) => s,
-                    Samples::Owned(v) => v,
-                };
-                let mut buffer = Vec::with_capacity(values.len() + 1);
-                gyrolab_io::pages::advise_huge_pages(&mut buffer);
-                analyse_channel_borrowed(&setup, info, values, buffer, missing_policy)
-            })
-            .collect::<Result<Vec<_>, _>>()
-    })?
+    let one = |(s, info): (&Samples<'_>, &ChannelInfo)| {
+        let values: &[f64] = match s {
+            Samples::Borrowed(s) => s,
+            Samples::Owned(v) => v,
+        };
+        let mut buffer = Vec::with_capacity(values.len() + 1);
+        gyrolab_io::pages::advise_huge_pages(&mut buffer);
+        analyse_channel_borrowed(&setup, info, values, buffer, missing_policy)
+    };
+    let analyses = if n * columns.len() < gyrolab::allan::PARALLEL_MIN_POINTS {
+        // A short record on the calling thread, the interpreter released: the hand-off to a pool
+        // thread cost a 10 min record at 100 Hz a fifth of its call (issue 56). Below this size
+        // the core calls no rayon function, so no pool is used or started.
+        py.detach(|| samples.iter().zip(infos.iter()).map(one).collect::<Result<Vec<_>, _>>())
+    } else {
+        run(py, || samples.par_iter().zip(infos.par_iter()).map(one).collect::<Result<Vec<_>, _>>())?
+    }
     .map_err(err)?;
     gyrolab_eval::allan::refuse_motion(&analyses, path, allow_motion).map_err(err)?;
-    let doc = gyrolab_report::allan::allan_document(&analyses).ok_or_else(|| error("no channel"))?;
-    let json = serde_json::to_string(&doc).map_err(json_err)?;
+    // The GMWM and the filter terms (which hold it) are left to the first call that needs them
+    // (`AllanChannels`): most calls read the curve and the slope terms only (issue 56).
+    let doc = gyrolab_report::allan::allan_document_with(&analyses, false).ok_or_else(|| error("no channel"))?;
+    let json = serde_json::to_string(&doc.channels).map_err(json_err)?;
     let arrays = analyses
         .iter()
         .map(|a| {
@@ -388,16 +393,43 @@ fn allan_channels<'py>(
             ]
         })
         .collect();
-    let filter_terms = analyses
-        .iter()
-        .map(|a| {
-            gyrolab_eval::filter_export::channel_filter_terms(a)
-                .map(|t| serde_json::to_string(&t))
-                .transpose()
-                .map_err(json_err)
-        })
-        .collect::<PyResult<_>>()?;
-    Ok((json, arrays, filter_terms))
+    Ok((json, arrays, AllanChannels { analyses }))
+}
+
+/// The analyses of one `allan_channels` call, kept for what is computed only when asked for:
+/// each channel's GMWM fit and its filter terms (JSON texts, the keys of docs/JSON.md).
+#[pyclass(frozen, module = "gyrolab._gyrolab")]
+struct AllanChannels {
+    analyses: Vec<gyrolab_report::allan::ChannelAnalysis>,
+}
+
+impl AllanChannels {
+    fn channel(&self, index: usize) -> PyResult<&gyrolab_report::allan::ChannelAnalysis> {
+        self.analyses.get(index).ok_or_else(|| error(format!("no channel {index}")))
+    }
+}
+
+#[pymethods]
+impl AllanChannels {
+    /// The GMWM fit of channel `index` as JSON (the `gmwm` key of docs/JSON.md), `None` when the
+    /// channel has none; computed on the first call, with the interpreter released.
+    fn gmwm(&self, py: Python<'_>, index: usize) -> PyResult<Option<String>> {
+        let a = self.channel(index)?;
+        run(py, || gyrolab_report::allan::gmwm_json(a))?
+            .map(|g| serde_json::to_string(&g))
+            .transpose()
+            .map_err(json_err)
+    }
+
+    /// The filter terms of channel `index` as JSON (what `render_export` takes), `None` when the
+    /// channel has none (the GMWM computed first if it was not).
+    fn filter_terms(&self, py: Python<'_>, index: usize) -> PyResult<Option<String>> {
+        let a = self.channel(index)?;
+        run(py, || gyrolab_eval::filter_export::channel_filter_terms(a))?
+            .map(|t| serde_json::to_string(&t))
+            .transpose()
+            .map_err(json_err)
+    }
 }
 
 /// The text of one filter stack's noise-parameter file from the filter terms `allan_channels`
@@ -720,6 +752,7 @@ fn apply<'py>(
 fn _gyrolab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(allan_channels, m)?)?;
+    m.add_class::<AllanChannels>()?;
     m.add_function(wrap_pyfunction!(render_export, m)?)?;
     m.add_function(wrap_pyfunction!(bias, m)?)?;
     m.add_function(wrap_pyfunction!(rate_table, m)?)?;

@@ -38,8 +38,10 @@ pub struct ChannelAnalysis {
     pub model_fit: Option<ModelFitResult>,
     /// Why noise terms are missing, if they are.
     pub noise_note: Option<String>,
-    /// The GMWM fit (model chosen by its criterion), beside the slope lines and the five-term fit.
-    pub gmwm: Option<gyrolab::gmwm::GmwmFit>,
+    /// The GMWM fit (model chosen by its criterion), beside the slope lines and the five-term
+    /// fit: computed when first asked for ([`ChannelAnalysis::gmwm`]), so that outputs without it
+    /// (batch tables, Python calls that read no GMWM attribute) do not pay for it.
+    pub gmwm: LazyGmwm,
     /// The stillness check of the channel (`None`: no rule for its quantity: not a gyro in
     /// deg/s nor an accelerometer in m/s^2).
     pub stillness: Option<gyrolab::stillness::StillnessCheck>,
@@ -50,7 +52,41 @@ pub struct ChannelAnalysis {
     pub gravity: Option<gyrolab::stillness::GravityCheck>,
 }
 
+/// A channel's GMWM fit, computed from its curve the first time it is asked for and kept
+/// (thread-safe): the GMWM is the costliest part of an analysis of a short record (issue 56).
+#[derive(Debug, Clone, Default)]
+pub struct LazyGmwm {
+    /// The confidence of its intervals; `None`: no GMWM for this channel (not a calibrated
+    /// rate or acceleration, or not an Allan deviation).
+    confidence: Option<f64>,
+    fit: std::sync::OnceLock<Option<gyrolab::gmwm::GmwmFit>>,
+}
+
+impl LazyGmwm {
+    /// A GMWM to compute with intervals at `confidence` when asked for.
+    pub fn at_confidence(confidence: f64) -> LazyGmwm {
+        LazyGmwm { confidence: Some(confidence), fit: std::sync::OnceLock::new() }
+    }
+
+    /// No GMWM for this channel.
+    pub fn none() -> LazyGmwm {
+        LazyGmwm::default()
+    }
+
+    /// The fit of `curve` (computed on the first call), `None` when the channel has no GMWM or
+    /// the fit failed.
+    pub fn get(&self, curve: &AllanCurve) -> Option<&gyrolab::gmwm::GmwmFit> {
+        let confidence = self.confidence?;
+        self.fit.get_or_init(|| gyrolab::gmwm::gmwm(curve, confidence).ok()).as_ref()
+    }
+}
+
 impl ChannelAnalysis {
+    /// The GMWM fit of the channel's curve, computed on the first call ([`LazyGmwm`]).
+    pub fn gmwm(&self) -> Option<&gyrolab::gmwm::GmwmFit> {
+        self.gmwm.get(&self.curve)
+    }
+
     /// The line marking a channel that moved: `MOTION: the record is not static: FILE (CHANNEL)
     /// moved in ...: noise terms are not a still sensor's`; `None` when it did not move.
     pub fn motion_line(&self) -> Option<String> {
@@ -189,7 +225,7 @@ pub fn gmwm_unit(process: gyrolab::gmwm::Process, quantity: Quantity) -> &'stati
 
 /// The GMWM fit of a channel in JSON.
 pub fn gmwm_json(a: &ChannelAnalysis) -> Option<GmwmJson> {
-    let g = a.gmwm.as_ref()?;
+    let g = a.gmwm()?;
     Some(GmwmJson {
         confidence: g.confidence,
         sided: "two-sided",
@@ -232,7 +268,7 @@ pub fn gmwm_json(a: &ChannelAnalysis) -> Option<GmwmJson> {
 
 /// The GMWM line of the text report.
 pub fn gmwm_text(a: &ChannelAnalysis) -> Option<String> {
-    let g = a.gmwm.as_ref()?;
+    let g = a.gmwm()?;
     let parts: Vec<String> = g
         .parameters
         .iter()
@@ -538,6 +574,12 @@ fn readings(s: &SlopeLineResult, quantity: Quantity) -> Vec<ReadingJson> {
 
 /// Builds the JSON of one channel.
 pub fn allan_json(a: &ChannelAnalysis) -> AllanJson {
+    allan_json_with(a, true)
+}
+
+/// [`allan_json`] with or without the `gmwm` key's fit (`with_gmwm = false` leaves it `null`
+/// and the GMWM uncomputed: for outputs that do not show it, such as batch tables).
+pub fn allan_json_with(a: &ChannelAnalysis, with_gmwm: bool) -> AllanJson {
     let c = &a.curve;
     let accel = a.quantity == Quantity::Acceleration;
     let accel_noise = a.slope_lines.as_ref().filter(|_| accel).map(|s| {
@@ -606,7 +648,7 @@ pub fn allan_json(a: &ChannelAnalysis) -> AllanJson {
         noise,
         accel_noise,
         noise_note: a.noise_note.clone(),
-        gmwm: gmwm_json(a),
+        gmwm: if with_gmwm { gmwm_json(a) } else { None },
         stillness: a.stillness.clone().map(|check| StillnessJson {
             check,
             allow_motion: a.allow_motion,
@@ -618,7 +660,12 @@ pub fn allan_json(a: &ChannelAnalysis) -> AllanJson {
 
 /// Builds the JSON document of several channels (at least one).
 pub fn allan_document(channels: &[ChannelAnalysis]) -> Option<AllanDocument> {
-    let all: Vec<AllanJson> = channels.iter().map(allan_json).collect();
+    allan_document_with(channels, true)
+}
+
+/// [`allan_document`] with or without the channels' GMWM fits ([`allan_json_with`]).
+pub fn allan_document_with(channels: &[ChannelAnalysis], with_gmwm: bool) -> Option<AllanDocument> {
+    let all: Vec<AllanJson> = channels.iter().map(|a| allan_json_with(a, with_gmwm)).collect();
     Some(AllanDocument {
         gyrolab_version: env!("CARGO_PKG_VERSION").into(),
         first: all.first()?.clone(),
@@ -1104,7 +1151,7 @@ mod tests {
             quantity: Quantity::AngularRate,
             slope_lines: slope_line_terms(&curve).ok(),
             model_fit: fit_noise_model(&curve, None).ok(),
-            gmwm: gyrolab::gmwm::gmwm(&curve, 0.683).ok(),
+            gmwm: LazyGmwm::at_confidence(0.683),
             curve,
             noise_note: None,
             stillness: None,

@@ -158,7 +158,37 @@ fn normal_quantile(p: f64) -> f64 {
 /// p = 0 gives 0, p = 1 infinity. Relative accuracy about 1e-14 (checked against scipy's
 /// `chi2.ppf` to 1e-9 by `scripts/check_chi2_scipy.py`, and CDF(quantile(p)) = p to 1e-12 by the
 /// unit tests). `None` when `dof` is not a positive finite number or p is outside [0, 1].
+///
+/// Each (p, dof) is solved once per process and kept (a small table shared by every thread,
+/// emptied when full): the same curves ask for the same quantiles again and again (a batch of
+/// records of one length, a notebook's repeated calls, the stillness check's windows), and a
+/// solve costs microseconds where a look-up costs nanoseconds (issue 56). The kept value is the
+/// solved one, bit for bit.
 pub fn chi_squared_quantile(p: f64, dof: f64) -> Option<f64> {
+    use std::collections::HashMap;
+    use std::sync::Mutex;
+    /// Most (p, dof) pairs kept.
+    const KEPT: usize = 1 << 14;
+    /// Solved quantiles by the bits of (p, dof).
+    type Table = HashMap<(u64, u64), Option<f64>>;
+    static SOLVED: Mutex<Option<Table>> = Mutex::new(None);
+    let key = (p.to_bits(), dof.to_bits());
+    if let Some(v) = SOLVED.lock().ok().and_then(|t| t.as_ref().and_then(|t| t.get(&key).copied())) {
+        return v;
+    }
+    let v = solve_quantile(p, dof);
+    if let Ok(mut table) = SOLVED.lock() {
+        let table = table.get_or_insert_with(HashMap::new);
+        if table.len() >= KEPT {
+            table.clear();
+        }
+        table.insert(key, v);
+    }
+    v
+}
+
+/// [`chi_squared_quantile`] solved (no table).
+fn solve_quantile(p: f64, dof: f64) -> Option<f64> {
     if !(dof.is_finite() && dof > 0.0 && (0.0..=1.0).contains(&p)) {
         return None;
     }
@@ -227,6 +257,20 @@ pub fn chi_squared_quantile(p: f64, dof: f64) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_kept_quantile_is_the_solved_one_bit_for_bit() {
+        for &dof in &[1.0, 7.5, 123.25, 59_999.0, 2.5e6] {
+            for &p in &[1e-9, 0.1585, 0.5, 0.8415, 1.0 - 1e-9] {
+                let solved = solve_quantile(p, dof).map(f64::to_bits);
+                // the first call solves and keeps, the second reads the table
+                assert_eq!(chi_squared_quantile(p, dof).map(f64::to_bits), solved);
+                assert_eq!(chi_squared_quantile(p, dof).map(f64::to_bits), solved);
+            }
+        }
+        assert_eq!(chi_squared_quantile(0.5, -1.0), None);
+        assert_eq!(chi_squared_quantile(0.5, -1.0), None);
+    }
 
     const PS: [f64; 7] = [0.0005, 0.025, 0.1587, 0.5, 0.8413, 0.975, 0.9995];
     const DOFS: [f64; 12] = [1.0, 2.0, 3.7, 10.0, 100.0, 1e3, 1e4, 2.709e5, 1e6, 1e7, 1e8, 1e9];

@@ -68,10 +68,15 @@ pub(crate) fn overlapping_allan_sums_fft(s: &[f64], ms: &[usize]) -> Option<Vec<
     }
     let energy = hi + lo;
     let reversed: Vec<f64> = x.iter().rev().copied().collect();
-    let ((r, head), tail) = rayon::join(
-        || rayon::join(|| autocorrelation(&x, 2 * m_max), || head_sums(&x, m_max)),
-        || head_sums(&reversed, m_max),
-    );
+    let ((r, head), tail) = if len < super::PARALLEL_MIN_POINTS {
+        // a short record: on the calling thread (see PARALLEL_MIN_POINTS)
+        ((autocorrelation(&x, 2 * m_max), head_sums(&x, m_max)), head_sums(&reversed, m_max))
+    } else {
+        rayon::join(
+            || rayon::join(|| autocorrelation(&x, 2 * m_max), || head_sums(&x, m_max)),
+            || head_sums(&reversed, m_max),
+        )
+    };
     let (r, head, tail) = (r?, head?, tail?);
     let fft_len = (len + 2 * m_max).next_power_of_two() as f64;
     let bound = ERROR_FACTOR * f64::EPSILON * fft_len.log2() * energy;

@@ -19,7 +19,6 @@ use super::{
     attach_bounds, averaging_factors, compute, rate_to_sample_angle_in_place, rate_to_sample_angle_into,
     validate_parameters, AllanCurve, AllanError, AllanOptions, AllanPoint, DeviationKind,
 };
-use rayon::prelude::*;
 
 /// [`deviation_from_rate_with_gaps`] of borrowed samples: a complete record is read where it is
 /// and its angle series built in `buffer` (see [`super::deviation_from_rate_into`]); a record
@@ -108,49 +107,50 @@ pub fn deviation_from_rate_with_gaps(
     rate_to_sample_angle_in_place(&mut rate)?;
     let s = rate;
     let ms = averaging_factors(options, n, tau0_s)?;
-    let mut points: Vec<AllanPoint> = ms
-        .par_iter()
-        .filter_map(|&m| {
-            let window = span_factor * m;
-            if window > n {
-                return None;
+    let mut points: Vec<AllanPoint> = super::map_indices(s.len(), ms.len(), |i| {
+        let m = ms[i];
+        let window = span_factor * m;
+        if window > n {
+            return None;
+        }
+        let stride = if overlapping { 1 } else { m };
+        let mut sum = 0.0f64;
+        let mut terms = 0usize;
+        let mut k = 0usize;
+        while k + window <= n {
+            if missing[k + window] == missing[k] {
+                let d = if span_factor == 2 {
+                    (s[k + 2 * m] - s[k + m]) - (s[k + m] - s[k])
+                } else {
+                    let d1 = (s[k + 3 * m] - s[k + 2 * m]) - (s[k + 2 * m] - s[k + m]);
+                    let d0 = (s[k + 2 * m] - s[k + m]) - (s[k + m] - s[k]);
+                    d1 - d0
+                };
+                sum += d * d;
+                terms += 1;
             }
-            let stride = if overlapping { 1 } else { m };
-            let mut sum = 0.0f64;
-            let mut terms = 0usize;
-            let mut k = 0usize;
-            while k + window <= n {
-                if missing[k + window] == missing[k] {
-                    let d = if span_factor == 2 {
-                        (s[k + 2 * m] - s[k + m]) - (s[k + m] - s[k])
-                    } else {
-                        let d1 = (s[k + 3 * m] - s[k + 2 * m]) - (s[k + 2 * m] - s[k + m]);
-                        let d0 = (s[k + 2 * m] - s[k + m]) - (s[k + m] - s[k]);
-                        d1 - d0
-                    };
-                    sum += d * d;
-                    terms += 1;
-                }
-                k += stride;
-            }
-            if terms == 0 {
-                return None;
-            }
-            let mf = m as f64;
-            let norm = if span_factor == 2 { 2.0 } else { 6.0 };
-            Some(AllanPoint {
-                m,
-                tau_s: mf * tau0_s,
-                deviation: (sum / (norm * mf * mf * terms as f64)).sqrt(),
-                terms,
-                alpha: None,
-                noise_id: None,
-                edf: None,
-                lower: None,
-                upper: None,
-            })
+            k += stride;
+        }
+        if terms == 0 {
+            return None;
+        }
+        let mf = m as f64;
+        let norm = if span_factor == 2 { 2.0 } else { 6.0 };
+        Some(AllanPoint {
+            m,
+            tau_s: mf * tau0_s,
+            deviation: (sum / (norm * mf * mf * terms as f64)).sqrt(),
+            terms,
+            alpha: None,
+            noise_id: None,
+            edf: None,
+            lower: None,
+            upper: None,
         })
-        .collect();
+    })
+    .into_iter()
+    .flatten()
+    .collect();
     if points.is_empty() {
         return Err(AllanError::TooShort { n: valid, kind: kind.name() });
     }

@@ -612,7 +612,6 @@ const RUN_MAX: usize = 8;
 /// is fused up to the run's common end and finished alone. Blocks are grouped and combined in a
 /// fixed order, so the sums do not depend on the number of threads.
 pub(crate) fn overlapping_allan_sums(s: &[f64], ms: &[usize]) -> Vec<f64> {
-    use rayon::prelude::*;
     const BLOCK: usize = 1024;
     let len = s.len();
     // groups: (first index into ms, count, octave run?)
@@ -639,16 +638,13 @@ pub(crate) fn overlapping_allan_sums(s: &[f64], ms: &[usize]) -> Vec<f64> {
     const GROUP_BUDGET: usize = 1 << 22;
     let groups = (GROUP_BUDGET / ms.len().max(1)).clamp(1, GROUPS_MAX).min(blocks.max(1));
     let per_group = blocks.div_ceil(groups).max(1);
-    let partial: Vec<Vec<f64>> = (0..groups)
-        .into_par_iter()
-        .map(|g| {
-            let mut acc = vec![0.0f64; ms.len()];
-            for b in g * per_group..((g + 1) * per_group).min(blocks) {
-                sum_block(s, ms, &runs, b * BLOCK, BLOCK, &mut acc);
-            }
-            acc
-        })
-        .collect();
+    let partial: Vec<Vec<f64>> = super::map_indices(len, groups, |g| {
+        let mut acc = vec![0.0f64; ms.len()];
+        for b in g * per_group..((g + 1) * per_group).min(blocks) {
+            sum_block(s, ms, &runs, b * BLOCK, BLOCK, &mut acc);
+        }
+        acc
+    });
     let mut total = vec![0.0f64; ms.len()];
     for acc in &partial {
         total.iter_mut().zip(acc).for_each(|(t, v)| *t += v);

@@ -25,11 +25,12 @@
 //! rounding of 0.25 or 0.75.
 
 use super::confidence::{lag1_alpha, lag1_noise_id, LAG1_MIN_AVERAGES};
-use rayon::prelude::*;
 
-/// Factors with at least this many averages are swept; shorter series are summed one by one
-/// (they are at most 1/16384 of the record each).
-const SWEEP_MIN_AVERAGES: usize = 1 << 14;
+/// Factors with at least this many averages are swept; shorter series are summed one by one.
+/// Every factor the rule identifies by lag 1 (at least [`LAG1_MIN_AVERAGES`] averages) is
+/// swept: the sweep's levels above the first cost a pairwise sum each, less than a factor's
+/// own two passes (a 10 min record at 100 Hz spent a sixth of its analysis in those; issue 56).
+const SWEEP_MIN_AVERAGES: usize = LAG1_MIN_AVERAGES;
 
 /// Angle points per block of a sweep (256 KiB of f64: stays in the 1 MiB L2 cache while every
 /// factor reads its averages from it).
@@ -59,8 +60,9 @@ fn lag1_noise_ids_with(s: &[f64], ms: &[usize], dmax: usize, min_averages: usize
         order0_r1(s, &swept, block).into_iter().map(|order0| SweptR1 { order0, diffs: None }).collect()
     };
     let differences = dmax.saturating_sub(1).min(2);
-    ms.par_iter()
-        .map(|&m| match swept.binary_search(&m) {
+    super::map_indices(s.len(), ms.len(), |i| {
+        let m = ms[i];
+        match swept.binary_search(&m) {
             Ok(i) => {
                 let delta = r1[i].order0.map(|r| r / (1.0 + r))?;
                 if delta < 0.25 || differences == 0 {
@@ -73,8 +75,8 @@ fn lag1_noise_ids_with(s: &[f64], ms: &[usize], dmax: usize, min_averages: usize
                 }
             }
             Err(_) => lag1_noise_id(s, m, dmax),
-        })
-        .collect()
+        }
+    })
 }
 
 /// A factor's r1 from a sweep: of the detrended averages (`None`: no spread), and, from the
@@ -166,13 +168,10 @@ fn octave_r1(s: &[f64], ms: &[usize], block: usize, differences: usize) -> Vec<S
     let ns: Vec<usize> = (0..levels).map(|k| n_rate >> k).collect();
     let cs: Vec<f64> = ns.iter().map(|&n| (n as f64 - 1.0) / 2.0).collect();
     let sweep = |raw: &[bool], diff: &[bool]| -> Vec<Vec<RawSums>> {
-        (0..PARTS)
-            .into_par_iter()
-            .map(|p| {
-                let (lo, hi) = bounds(p);
-                octave_part(s, raw, diff, &cs, lo, hi, block)
-            })
-            .collect()
+        super::map_indices(s.len(), PARTS, |p| {
+            let (lo, hi) = bounds(p);
+            octave_part(s, raw, diff, &cs, lo, hi, block)
+        })
     };
     // The sweep of the averages (order 0) at every wanted factor.
     let raw: Vec<bool> = wanted.iter().map(Option::is_some).collect();
@@ -251,8 +250,55 @@ fn octave_part_body(
     // Levels up to the last one summed (the pair sums stop there).
     let levels = raw.iter().zip(diff).rposition(|(&r, &d)| r || d).map_or(0, |k| k + 1);
     let mut acc = vec![RawSums::default(); raw.len()];
-    let mut cur = vec![0.0f64; block];
-    let mut next = vec![0.0f64; block];
+    // Work buffers no longer than the part (a short record's part is a fraction of a block:
+    // zeroing whole blocks cost it more than its sums, issue 56).
+    let span = block.min(hi.saturating_sub(lo));
+    let mut scratch = take_scratch(4 * span + 4);
+    octave_part_blocks(s, raw, diff, cs, (lo, hi), block, span, levels, &mut acc, &mut scratch[..4 * span + 4]);
+    give_back_scratch(scratch);
+    acc
+}
+
+thread_local! {
+    /// The work buffer of this thread's sweeps, kept between calls: a new zeroed buffer per
+    /// call cost a short record more in page faults and zeroing than its sums (issue 56).
+    static SCRATCH: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// This thread's work buffer, at least `len` values long (contents unspecified: its users write
+/// each value before they read it); give it back with [`give_back_scratch`].
+fn take_scratch(len: usize) -> Vec<f64> {
+    let mut buf = SCRATCH.with(|cell| cell.take());
+    if buf.len() < len {
+        buf.resize(len, 0.0);
+    }
+    buf
+}
+
+/// Keeps `buf` as this thread's work buffer for the next sweep.
+fn give_back_scratch(buf: Vec<f64>) {
+    SCRATCH.with(|cell| cell.replace(buf));
+}
+
+/// The blocks of one part of [`octave_part_body`], its work buffers cut from `scratch`
+/// (4 `span` + 4 values, each written before it is read).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn octave_part_blocks(
+    s: &[f64],
+    raw: &[bool],
+    diff: &[bool],
+    cs: &[f64],
+    (lo, hi): (usize, usize),
+    block: usize,
+    span: usize,
+    levels: usize,
+    acc: &mut [RawSums],
+    scratch: &mut [f64],
+) {
+    let (mut cur, rest) = scratch.split_at_mut(span);
+    let (mut next, rest) = rest.split_at_mut(span);
+    let (d1, d2) = rest.split_at_mut(span + 2);
     // Per level: the two averages before the block (read straight from the angle at the start
     // of a part after the first), and how many of them there are.
     let mut carry: Vec<([f64; 2], usize)> = (0..levels)
@@ -266,8 +312,6 @@ fn octave_part_body(
             }
         })
         .collect();
-    let mut d1 = vec![0.0f64; block + 2];
-    let mut d2 = vec![0.0f64; block + 2];
     let mut b0 = lo;
     while b0 < hi {
         let b1 = (b0 + block).min(hi);
@@ -285,7 +329,7 @@ fn octave_part_body(
                 raw_sums(w, (b0 >> k) as f64 - cs[k], &mut acc[k]);
             }
             if diff[k] {
-                difference_sums(w, &mut carry[k], &mut d1, &mut d2, &mut acc[k].diffs);
+                difference_sums(w, &mut carry[k], d1, d2, &mut acc[k].diffs);
             }
             if k + 1 < levels {
                 let half = count_k / 2;
@@ -297,7 +341,6 @@ fn octave_part_body(
         }
         b0 = b1;
     }
-    acc
 }
 
 /// Adds one block's averages `w` (the first at position t with t - c = `p0`) to the raw sums.
@@ -475,15 +518,12 @@ fn order0_r1(s: &[f64], ms: &[usize], block: usize) -> Vec<Option<f64>> {
     let last_point = s.len() - 1;
     let bounds = |p: usize| (last_point * p / PARTS, last_point * (p + 1) / PARTS);
     // sweep 1: the lines
-    let trend: Vec<Vec<TrendSums>> = (0..PARTS)
-        .into_par_iter()
-        .map(|p| {
-            let (lo, hi) = bounds(p);
-            let mut acc = vec![TrendSums::default(); ms.len()];
-            for_each_block(s, ms, &ns, lo, hi, block, |i, j0, w| trend_sums(w, j0 as f64 - cs[i], &mut acc[i]));
-            acc
-        })
-        .collect();
+    let trend: Vec<Vec<TrendSums>> = super::map_indices(s.len(), PARTS, |p| {
+        let (lo, hi) = bounds(p);
+        let mut acc = vec![TrendSums::default(); ms.len()];
+        for_each_block(s, ms, &ns, lo, hi, block, |i, j0, w| trend_sums(w, j0 as f64 - cs[i], &mut acc[i]));
+        acc
+    });
     let lines: Vec<(f64, f64)> = (0..ms.len())
         .map(|i| {
             let (mut s0, mut s1) = ([0.0f64; LANES], [0.0f64; LANES]);
@@ -499,18 +539,15 @@ fn order0_r1(s: &[f64], ms: &[usize], block: usize) -> Vec<Option<f64>> {
         })
         .collect();
     // sweep 2: the residuals' sums
-    let resid: Vec<Vec<ResidualSums>> = (0..PARTS)
-        .into_par_iter()
-        .map(|p| {
-            let (lo, hi) = bounds(p);
-            let mut acc = vec![ResidualSums::default(); ms.len()];
-            for_each_block(s, ms, &ns, lo, hi, block, |i, j0, w| {
-                let (a0, a1) = lines[i];
-                residual_sums(w, j0 as f64 - cs[i], a0, a1, &mut acc[i])
-            });
-            acc
-        })
-        .collect();
+    let resid: Vec<Vec<ResidualSums>> = super::map_indices(s.len(), PARTS, |p| {
+        let (lo, hi) = bounds(p);
+        let mut acc = vec![ResidualSums::default(); ms.len()];
+        for_each_block(s, ms, &ns, lo, hi, block, |i, j0, w| {
+            let (a0, a1) = lines[i];
+            residual_sums(w, j0 as f64 - cs[i], a0, a1, &mut acc[i])
+        });
+        acc
+    });
     (0..ms.len()).map(|i| moment_r1(&combine(resid.iter().map(|part| &part[i])), ns[i], false).ok().flatten()).collect()
 }
 
@@ -525,7 +562,9 @@ fn for_each_block(
     block: usize,
     mut f: impl FnMut(usize, usize, &mut [f64]),
 ) {
-    let mut buf = vec![0.0f64; block + 1];
+    let len = block.min(hi.saturating_sub(lo)) + 1;
+    let mut scratch = take_scratch(len);
+    let buf = &mut scratch[..len];
     let mut b0 = lo;
     while b0 < hi {
         let b1 = (b0 + block).min(hi);
@@ -554,6 +593,7 @@ fn for_each_block(
         }
         b0 = b1;
     }
+    give_back_scratch(scratch);
 }
 
 /// Position ramps t - c of the lanes, starting at `p0`.

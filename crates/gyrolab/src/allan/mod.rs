@@ -338,6 +338,30 @@ fn two_sum(a: f64, b: f64) -> (f64, f64) {
 /// Elements per chunk of the parallel angle conversion (128 KiB of f64).
 const PHASE_CHUNK: usize = 1 << 14;
 
+/// Records shorter than this many points are computed on the calling thread alone: their
+/// parallel pieces take tens of microseconds, about what waking another thread costs (a 10 min
+/// record at 100 Hz spent more time in the scheduler than in its sums; issue 56). Every
+/// parallel sum has a fixed partition, so the results do not depend on it.
+pub const PARALLEL_MIN_POINTS: usize = 1 << 18;
+
+/// Whether a record of `points` points is computed in parallel ([`PARALLEL_MIN_POINTS`]).
+/// Below it no rayon function is called at all (not even to ask a pool's size): a caller may
+/// run a short record on its own thread, outside any pool (the Python package does: handing a
+/// 10 min record to a pool thread cost a fifth of its call), and no global pool is started.
+pub(crate) fn parallel(points: usize) -> bool {
+    points >= PARALLEL_MIN_POINTS
+}
+
+/// `f` of each index `0..n`, in order: in parallel (the current rayon pool) for a record of
+/// `points` points that is [`parallel`], else on the calling thread.
+pub(crate) fn map_indices<R: Send>(points: usize, n: usize, f: impl Fn(usize) -> R + Sync + Send) -> Vec<R> {
+    if parallel(points) {
+        (0..n).into_par_iter().map(f).collect()
+    } else {
+        (0..n).map(f).collect()
+    }
+}
+
 /// Double-double sum (hi, lo) of one chunk, 8 compensated lanes (vectorisable, branch-free),
 /// and whether every value is finite (x * 0 is 0 for finite x, NaN otherwise).
 fn chunk_sum_dd(values: &[f64]) -> (f64, f64, bool) {
@@ -386,9 +410,15 @@ fn chunk_sum_dd(values: &[f64]) -> (f64, f64, bool) {
 /// units of rounding.
 fn rate_to_sample_angle_in_place(data: &mut Vec<f64>) -> Result<(), AllanError> {
     let plan = angle_plan(data)?;
-    data.par_chunks_mut(PHASE_CHUNK)
-        .zip(plan.starts)
-        .for_each(|(chunk, start)| cumulative_chunk(chunk, plan.mean, start));
+    if parallel(data.len()) {
+        data.par_chunks_mut(PHASE_CHUNK)
+            .zip(plan.starts)
+            .for_each(|(chunk, start)| cumulative_chunk(chunk, plan.mean, start));
+    } else {
+        data.chunks_mut(PHASE_CHUNK)
+            .zip(plan.starts)
+            .for_each(|(chunk, start)| cumulative_chunk(chunk, plan.mean, start));
+    }
     data.push(plan.end);
     Ok(())
 }
@@ -401,11 +431,18 @@ fn rate_to_sample_angle_into(rate: &[f64], out: &mut Vec<f64>) -> Result<(), All
     let plan = angle_plan(rate)?;
     out.clear();
     out.reserve_exact(rate.len() + 1);
-    out.spare_capacity_mut()[..rate.len()]
-        .par_chunks_mut(PHASE_CHUNK)
-        .zip(rate.par_chunks(PHASE_CHUNK))
-        .zip(plan.starts)
-        .for_each(|((dst, src), start)| cumulative_chunk_into(src, dst, plan.mean, start));
+    let dst = &mut out.spare_capacity_mut()[..rate.len()];
+    if parallel(rate.len()) {
+        dst.par_chunks_mut(PHASE_CHUNK)
+            .zip(rate.par_chunks(PHASE_CHUNK))
+            .zip(plan.starts)
+            .for_each(|((dst, src), start)| cumulative_chunk_into(src, dst, plan.mean, start));
+    } else {
+        dst.chunks_mut(PHASE_CHUNK)
+            .zip(rate.chunks(PHASE_CHUNK))
+            .zip(plan.starts)
+            .for_each(|((dst, src), start)| cumulative_chunk_into(src, dst, plan.mean, start));
+    }
     // SAFETY: the loop above wrote every one of the first rate.len() elements (the chunks of
     // the spare capacity and of `rate` pair one to one and have equal lengths).
     unsafe { out.set_len(rate.len()) };
@@ -430,7 +467,11 @@ fn angle_plan(data: &[f64]) -> Result<AnglePlan, AllanError> {
     if n == 0 {
         return Ok(AnglePlan { mean: 0.0, starts: Vec::new(), end: 0.0 });
     }
-    let sums: Vec<(f64, f64, bool)> = data.par_chunks(PHASE_CHUNK).map(chunk_sum_dd).collect();
+    let sums: Vec<(f64, f64, bool)> = if parallel(n) {
+        data.par_chunks(PHASE_CHUNK).map(chunk_sum_dd).collect()
+    } else {
+        data.chunks(PHASE_CHUNK).map(chunk_sum_dd).collect()
+    };
     if sums.iter().any(|s| !s.2) {
         check_finite(data)?;
     }
@@ -677,34 +718,31 @@ fn compute(s: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve,
     let ms = averaging_factors(options, n_rate, tau0_s)?;
     // OADEV, the common case, is summed for all taus in one cache-blocked sweep
     let oadev_sums = (kind == DeviationKind::Oadev).then(|| oadev_sums(s, &ms));
-    let mut points: Vec<AllanPoint> = ms
-        .par_iter()
-        .enumerate()
-        .map(|(i, &m)| {
-            let (variance, terms) = match &oadev_sums {
-                Some(sums) => {
-                    let n = s.len() - 2 * m;
-                    (sums[i] / (2.0 * (m as f64).powi(2) * n as f64), n)
-                }
-                None => variance_at(s, kind, m),
-            };
-            let mut deviation = variance.sqrt();
-            if kind == DeviationKind::Tdev {
-                deviation *= m as f64 * tau0_s / 3f64.sqrt();
+    let mut points: Vec<AllanPoint> = map_indices(s.len(), ms.len(), |i| {
+        let m = ms[i];
+        let (variance, terms) = match &oadev_sums {
+            Some(sums) => {
+                let n = s.len() - 2 * m;
+                (sums[i] / (2.0 * (m as f64).powi(2) * n as f64), n)
             }
-            AllanPoint {
-                m,
-                tau_s: m as f64 * tau0_s,
-                deviation,
-                terms,
-                alpha: None,
-                noise_id: None,
-                edf: None,
-                lower: None,
-                upper: None,
-            }
-        })
-        .collect();
+            None => variance_at(s, kind, m),
+        };
+        let mut deviation = variance.sqrt();
+        if kind == DeviationKind::Tdev {
+            deviation *= m as f64 * tau0_s / 3f64.sqrt();
+        }
+        AllanPoint {
+            m,
+            tau_s: m as f64 * tau0_s,
+            deviation,
+            terms,
+            alpha: None,
+            noise_id: None,
+            edf: None,
+            lower: None,
+            upper: None,
+        }
+    });
     attach_bounds(&mut points, s, kind, options.confidence, |_| s.len());
     Ok(AllanCurve { kind, tau0_s, n_rate, confidence: options.confidence, points })
 }
@@ -722,8 +760,10 @@ fn attach_bounds(
     if let Some(confidence) = confidence {
         let ms: Vec<usize> = points.iter().map(|p| p.m).collect();
         let lag1 = lag1_sweep::lag1_noise_ids(s, &ms, kind.difference_order() as usize);
-        let ids: Vec<Option<(i32, NoiseIdMethod)>> =
-            points.par_iter().zip(lag1).map(|(p, lag1)| identify_noise(s, p.m, kind, p.terms, lag1)).collect();
+        let ids: Vec<Option<(i32, NoiseIdMethod)>> = {
+            let points = &*points;
+            map_indices(s.len(), points.len(), |i| identify_noise(s, points[i].m, kind, points[i].terms, lag1[i]))
+        };
         let mut previous: Option<i32> = None;
         for (p, id) in points.iter_mut().zip(ids) {
             match id {
