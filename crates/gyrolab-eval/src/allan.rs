@@ -976,6 +976,17 @@ pub(crate) fn gravity_of(analyses: &mut [ChannelAnalysis]) -> Option<gyrolab::st
     Some(g)
 }
 
+/// Computes the GMWM fit of every channel that has one (each is otherwise computed when first
+/// asked for, [`ChannelAnalysis::gmwm`]), the channels in parallel: for an output that shows
+/// them all (a record's six IMU channels fitted one after another as they are rendered took
+/// a seventh of an MCAP recording's analysis; issue 56).
+pub fn prepare_gmwm<'a>(analyses: impl IntoIterator<Item = &'a ChannelAnalysis>) {
+    let all: Vec<&ChannelAnalysis> = analyses.into_iter().collect();
+    all.par_iter().for_each(|a| {
+        a.gmwm();
+    });
+}
+
 /// Refuses records whose gyro or accelerometer channels moved (the stillness check), unless
 /// motion is allowed: the error names each channel that moved, its episodes and {allow_motion}.
 pub fn refuse_motion<'a>(

@@ -145,6 +145,10 @@ pub fn run(args: &AllanArgs) -> CliResult {
     let outcomes = analyse_records_within(&request, memory);
     spinner.finish();
     let (outcomes, path) = outcomes?;
+    if !args.csv || export.is_some() {
+        // The text, the JSON and the exports show the GMWM: the channels' fits made side by side.
+        gyrolab_eval::allan::prepare_gmwm(outcomes.iter().flat_map(|o| &o.analyses));
+    }
     let streamed = match &path {
         MemoryPath::Streaming(s) => {
             eprintln!("note: {}", streaming_note(&args.file.display().to_string(), s));

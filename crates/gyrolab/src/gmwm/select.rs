@@ -17,6 +17,40 @@
 use super::{average, check, design, finish, fit_estimate, nnls, omega_variances};
 use super::{CovarianceGrid, GmwmError, GmwmFit, Process, Shape, ShapeIntegrals, WaveletVariance, PROCESSES, ROUNDS};
 use crate::allan::AllanCurve;
+use rayon::prelude::*;
+use std::sync::{Arc, Mutex};
+
+/// The quadrature of a set of scales and the integrals of the linear processes on it: data
+/// independent (they depend on the sample interval, each scale's averaging factor and number of
+/// terms, and the processes), so made once per process and shared by every curve of that
+/// shape: the channels of one record, the records of one length in a batch, a notebook's
+/// repeated calls (issue 56). The last [`KEPT_TABLES`] sets are kept.
+type Tables = (Arc<CovarianceGrid>, Arc<ShapeIntegrals>);
+
+/// Sets of scales whose [`Tables`] are kept.
+const KEPT_TABLES: usize = 8;
+
+/// The [`Tables`] of `wv` and the linear processes `linear`, made or found.
+fn linear_tables(wv: &[WaveletVariance], linear: &[Process]) -> Tables {
+    type Key = (u64, Vec<(u64, u64)>, Vec<Process>);
+    static KEPT: Mutex<Vec<(Key, Tables)>> = Mutex::new(Vec::new());
+    let tau0 = wv.first().map_or(1.0, |w| w.tau_s / w.m as f64);
+    let key: Key = (tau0.to_bits(), wv.iter().map(|w| (w.m, w.terms)).collect(), linear.to_vec());
+    if let Some((_, t)) = KEPT.lock().ok().and_then(|k| k.iter().find(|(k, _)| *k == key).cloned()) {
+        return t;
+    }
+    let grid = CovarianceGrid::new(wv);
+    let shapes: Vec<Shape> = linear.iter().map(|&p| Shape::Linear(p)).collect();
+    let integrals = ShapeIntegrals::new(&grid, &shapes);
+    let made: Tables = (Arc::new(grid), Arc::new(integrals));
+    if let Ok(mut kept) = KEPT.lock() {
+        if kept.len() >= KEPT_TABLES {
+            kept.remove(0);
+        }
+        kept.push((key, made.clone()));
+    }
+    made
+}
 
 /// The most first-order Gauss-Markov processes a model holds in [`gmwm`].
 pub const MAX_GAUSS_MARKOV: usize = 2;
@@ -59,10 +93,22 @@ fn linear_candidates(
 ) -> Option<GmwmError> {
     let mut last_err = None;
     let mut seen: Vec<Vec<Process>> = Vec::new();
-    for mask in 1u32..(1u32 << linear.len()) {
-        let set: Vec<Shape> =
-            linear.iter().enumerate().filter(|(i, _)| mask & (1 << i) != 0).map(|(_, &p)| Shape::Linear(p)).collect();
-        match fit_estimate(wv, grid, &set, confidence) {
+    // Every subset fitted in parallel, then taken in mask order (the same candidates, in the
+    // same order, as one after another).
+    let fitted: Vec<_> = (1u32..(1u32 << linear.len()))
+        .into_par_iter()
+        .map(|mask| {
+            let set: Vec<Shape> = linear
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| mask & (1 << i) != 0)
+                .map(|(_, &p)| Shape::Linear(p))
+                .collect();
+            fit_estimate(wv, grid, &set, confidence)
+        })
+        .collect();
+    for fit in fitted {
+        match fit {
             Ok((model, sigma2)) => {
                 let kept: Vec<Process> = model.iter().map(|m| m.0.process()).collect();
                 if kept.is_empty() || seen.contains(&kept) {
@@ -93,18 +139,44 @@ pub fn select_model_with_gauss_markov(
     max_gauss_markov: usize,
     confidence: f64,
 ) -> Result<GmwmFit, GmwmError> {
-    let grid = CovarianceGrid::new(wv);
     let linear: Vec<Process> = candidates.iter().copied().filter(|p| *p != Process::GaussMarkov).collect();
-    let mut integrals = vec![ShapeIntegrals::new(&grid, &linear.iter().map(|&p| Shape::Linear(p)).collect::<Vec<_>>())];
+    let (grid, linear_integrals) = linear_tables(wv, &linear);
+    let grid = &*grid;
+    let mut integrals = vec![linear_integrals];
     let mut all = Vec::new();
-    let last_err = linear_candidates(wv, &grid, &linear, confidence, 0, &mut all);
     let max_gauss_markov = max_gauss_markov.min(MAX_GAUSS_MARKOV);
     let without_flicker: Vec<Process> = linear.iter().copied().filter(|p| *p != Process::Flicker).collect();
-    for k in 1..=max_gauss_markov {
-        gauss_markov_candidates(wv, &grid, &without_flicker, k, confidence, &mut integrals, &mut all);
+    // The linear models and the searches with 1 and 2 Gauss-Markov processes are independent:
+    // made in parallel, then taken in that order.
+    let (last_err, searched) = rayon::join(
+        || {
+            let mut linear_all = Vec::new();
+            let err = linear_candidates(wv, grid, &linear, confidence, 0, &mut linear_all);
+            (err, linear_all)
+        },
+        || {
+            (1..=max_gauss_markov)
+                .into_par_iter()
+                .map(|k| {
+                    let mut found = Vec::new();
+                    let tables = gauss_markov_candidates(wv, grid, &without_flicker, k, confidence, &mut found);
+                    (tables, found)
+                })
+                .collect::<Vec<_>>()
+        },
+    );
+    let (last_err, linear_all) = last_err;
+    all.extend(linear_all);
+    for (tables, found) in searched {
+        let Some(tables) = tables else { continue };
+        integrals.push(Arc::new(tables));
+        let index = integrals.len() - 1;
+        all.extend(found.into_iter().map(|c| Candidate { integrals: index, ..c }));
     }
-    let fits: Vec<_> =
-        all.iter().map(|c| finish(wv, &integrals[c.integrals], &c.model, &c.sigma2, confidence, c.search)).collect();
+    let fits: Vec<_> = all
+        .par_iter()
+        .map(|c| finish(wv, &integrals[c.integrals], &c.model, &c.sigma2, confidence, c.search))
+        .collect();
     // Smallest criterion first; a NaN criterion (none is expected) never stays chosen over a number.
     let better = |a: f64, b: f64| a < b - 1e-12 || (b.is_nan() && !a.is_nan());
     let mut best: Option<usize> = None;
@@ -142,19 +214,18 @@ fn profile(wv: &[WaveletVariance], linear: &[Shape], ts: &[f64], nu: &[f64], sig
 }
 
 /// The models with `k` Gauss-Markov processes (correlation times searched) and each subset of
-/// the linear processes `linear`, added to `out` (their shapes' integrals to `integrals`);
-/// nothing when the record has too few scales or the search's fit does not keep all `k`
-/// processes. A subset is offered only when the scales outnumber its parameters (weights and
-/// correlation times).
+/// the linear processes `linear`, added to `out` (their `integrals` index left to the caller),
+/// and their shapes' integrals returned; nothing when the record has too few scales or the
+/// search's fit does not keep all `k` processes. A subset is offered only when the scales
+/// outnumber its parameters (weights and correlation times).
 fn gauss_markov_candidates(
     wv: &[WaveletVariance],
     grid: &CovarianceGrid,
     linear: &[Process],
     k: usize,
     confidence: f64,
-    integrals: &mut Vec<ShapeIntegrals>,
     out: &mut Vec<Candidate>,
-) -> Option<()> {
+) -> Option<ShapeIntegrals> {
     let n = wv.len();
     check(wv, 2 * k + 1, confidence).ok()?;
     let (lo, hi) = (wv.first()?.tau_s, wv.last()?.tau_s);
@@ -213,8 +284,7 @@ fn gauss_markov_candidates(
     let markov: Vec<Shape> = model.iter().map(|m| m.0).filter(|s| matches!(s, Shape::GaussMarkov(_))).collect();
     let mut all = lin.clone();
     all.extend(&markov);
-    integrals.push(ShapeIntegrals::new(grid, &all));
-    let index = integrals.len() - 1;
+    let integrals = ShapeIntegrals::new(grid, &all);
     let mut seen: Vec<Vec<Shape>> = Vec::new();
     for mask in 0u32..(1u32 << lin.len()) {
         let mut shapes: Vec<Shape> =
@@ -229,9 +299,9 @@ fn gauss_markov_candidates(
             continue;
         }
         seen.push(kept);
-        out.push(Candidate { model: m, sigma2: s2, search: (lo, hi), integrals: index });
+        out.push(Candidate { model: m, sigma2: s2, search: (lo, hi), integrals: usize::MAX });
     }
-    Some(())
+    Some(integrals)
 }
 
 /// Every k-tuple of increasing grid indices from `first` to `last`, at least [`MIN_GAP_STEPS`]
