@@ -19,15 +19,7 @@ PY="$VENV/bin/python"
 cargo build --release -q -p gyrolab-cli
 BIN=target/release/gyrolab
 mkdir -p "$DATA"
-if [ ! -f "$DATA/rate_10m.csv" ]; then
-    "$PY" - "$DATA/rate_10m.csv" <<'PYEOF'
-import sys, numpy as np
-rng = np.random.default_rng(1); n = 10_000_000
-t = np.arange(n) * 0.01
-x = rng.standard_normal(n) * 1e-2 + np.cumsum(rng.standard_normal(n)) * 3e-6 + 0.5
-np.savetxt(sys.argv[1], np.column_stack([t, x]), fmt=["%.2f", "%.7e"], delimiter=",", header="time_s,rate_dps", comments="")
-PYEOF
-fi
+bash bench/make_data.sh rate_10m "$PY" "$DATA/rate_10m.csv"
 if [ ! -f "$DATA/imu_8h_400hz.csv" ]; then
     "$PY" - "$DATA/imu_8h_400hz.csv" <<'PYEOF'
 import sys, numpy as np

@@ -22,12 +22,7 @@ fi
 PY="$VENV/bin/python"
 if [ -z "${GYROLAB_BIN:-}" ]; then cargo build --release -q -p gyrolab-cli; fi
 BIN=${GYROLAB_BIN:-target/release/gyrolab}
-mkdir -p "$DATA/records"
-for i in $(seq 1 "$COUNT"); do
-    f=$(printf "%s/records/r%04d.csv" "$DATA" "$i")
-    [ -f "$f" ] || "$BIN" simulate static --duration-s 600 --sample-rate-hz 100 --arw-deg-rt-h 0.3 \
-        --bias-instability-dph 5 --rrw-deg-h-rt-h 2 --seed "$i" --out "$f"
-done
+bash bench/make_data.sh batch "$BIN" "$DATA/records" "$COUNT"
 FILES=("$DATA"/records/*.csv)
 CORES=$(nproc)
 

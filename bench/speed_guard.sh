@@ -75,26 +75,13 @@ ratio() { awk -v a="$1" -v b="$2" 'BEGIN{printf "%.2f", a / b}'; }
 
 # The 10 M-line CSV (bench/allan_csv_vs_pandas.sh's case 1).
 CSV=$DATA/rate_10m.csv
-if [ ! -f "$CSV" ]; then
-    "$PY" - "$CSV" <<'PY'
-import sys, numpy as np
-rng = np.random.default_rng(1); n = 10_000_000
-t = np.arange(n) * 0.01
-x = rng.standard_normal(n) * 1e-2 + np.cumsum(rng.standard_normal(n)) * 3e-6 + 0.5
-np.savetxt(sys.argv[1], np.column_stack([t, x]), fmt=["%.2f", "%.7e"], delimiter=",", header="time_s,rate_dps", comments="")
-PY
-fi
+bash bench/make_data.sh rate_10m "$PY" "$CSV"
 csv_g=$(best 3 "$BIN" allan "$CSV" --json)
 csv_p=$(best 3 "$PY" bench/pandas_allan_csv.py "$CSV" 100)
 
 # The batch (bench/batch_speed.sh's records).
 REC=$DATA/batch_$COUNT/records
-mkdir -p "$REC"
-for i in $(seq 1 "$COUNT"); do
-    f=$(printf "%s/r%04d.csv" "$REC" "$i")
-    [ -f "$f" ] || "$BIN" simulate static --duration-s 600 --sample-rate-hz 100 --arw-deg-rt-h 0.3 \
-        --bias-instability-dph 5 --rrw-deg-h-rt-h 2 --seed "$i" --out "$f"
-done
+bash bench/make_data.sh batch "$BIN" "$REC" "$COUNT"
 batch() { rm -rf "$DATA/guard_batch"; "$BIN" batch "$REC" --out "$DATA/guard_batch" --quiet "$@"; }
 b1=$(best 3 batch --jobs 1)
 bn=$(best 3 batch)

@@ -415,21 +415,20 @@ impl AllanChannels {
     /// channel has none; computed on the first call, with the interpreter released.
     fn gmwm(&self, py: Python<'_>, index: usize) -> PyResult<Option<String>> {
         let a = self.channel(index)?;
-        run(py, || gyrolab_report::allan::gmwm_json(a))?
-            .map(|g| serde_json::to_string(&g))
-            .transpose()
-            .map_err(json_err)
+        json_or_none(run(py, || gyrolab_report::allan::gmwm_json(a))?)
     }
 
     /// The filter terms of channel `index` as JSON (what `render_export` takes), `None` when the
     /// channel has none (the GMWM computed first if it was not).
     fn filter_terms(&self, py: Python<'_>, index: usize) -> PyResult<Option<String>> {
         let a = self.channel(index)?;
-        run(py, || gyrolab_eval::filter_export::channel_filter_terms(a))?
-            .map(|t| serde_json::to_string(&t))
-            .transpose()
-            .map_err(json_err)
+        json_or_none(run(py, || gyrolab_eval::filter_export::channel_filter_terms(a))?)
     }
+}
+
+/// A value as JSON text, `None` as `None`.
+fn json_or_none<T: serde::Serialize>(value: Option<T>) -> PyResult<Option<String>> {
+    value.map(|v| serde_json::to_string(&v)).transpose().map_err(json_err)
 }
 
 /// The text of one filter stack's noise-parameter file from the filter terms `allan_channels`

@@ -136,17 +136,7 @@ pub fn deviation_from_rate_with_gaps(
         }
         let mf = m as f64;
         let norm = if span_factor == 2 { 2.0 } else { 6.0 };
-        Some(AllanPoint {
-            m,
-            tau_s: mf * tau0_s,
-            deviation: (sum / (norm * mf * mf * terms as f64)).sqrt(),
-            terms,
-            alpha: None,
-            noise_id: None,
-            edf: None,
-            lower: None,
-            upper: None,
-        })
+        Some(AllanPoint::unidentified(m, mf * tau0_s, (sum / (norm * mf * mf * terms as f64)).sqrt(), terms))
     })
     .into_iter()
     .flatten()

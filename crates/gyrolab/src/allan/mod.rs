@@ -247,6 +247,13 @@ pub struct AllanPoint {
     pub upper: Option<f64>,
 }
 
+impl AllanPoint {
+    /// A point whose noise is not identified yet (no alpha, EDF or bounds).
+    pub fn unidentified(m: usize, tau_s: f64, deviation: f64, terms: usize) -> AllanPoint {
+        AllanPoint { m, tau_s, deviation, terms, alpha: None, noise_id: None, edf: None, lower: None, upper: None }
+    }
+}
+
 /// A deviation curve with the context needed to interpret it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AllanCurve {
@@ -731,17 +738,7 @@ fn compute(s: &[f64], tau0_s: f64, options: &AllanOptions) -> Result<AllanCurve,
         if kind == DeviationKind::Tdev {
             deviation *= m as f64 * tau0_s / 3f64.sqrt();
         }
-        AllanPoint {
-            m,
-            tau_s: m as f64 * tau0_s,
-            deviation,
-            terms,
-            alpha: None,
-            noise_id: None,
-            edf: None,
-            lower: None,
-            upper: None,
-        }
+        AllanPoint::unidentified(m, m as f64 * tau0_s, deviation, terms)
     });
     attach_bounds(&mut points, s, kind, options.confidence, |_| s.len());
     Ok(AllanCurve { kind, tau0_s, n_rate, confidence: options.confidence, points })
