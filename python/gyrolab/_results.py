@@ -159,6 +159,12 @@ class AllanResult:
         return state
 
     def __setstate__(self, state: Dict[str, Any]) -> None:
+        # A result pickled before the GMWM was computed on first use held it as `gmwm`.
+        if "gmwm" in state:
+            state = dict(state)
+            state["_gmwm"] = state.pop("gmwm")
+            state.setdefault("_filter_terms", state.get("_filter_terms"))
+        state.setdefault("_lazy", None)
         self.__dict__.update(state)
 
     def __getattr__(self, name: str) -> Any:

@@ -68,6 +68,13 @@ def test_the_gmwm_is_computed_when_first_read_and_equals_the_command_line(cli, t
     again = pickle.loads(pickle.dumps(fresh))
     assert again.gmwm == want and again == r
     assert again.export("kalibr", estimator="gmwm") == r.export("kalibr", estimator="gmwm")
+    # copies of a result not read yet work (the native analyses are shared, never copied)
+    import copy
+    import dataclasses
+
+    unread = gyrolab.allan(data, rate_hz=100.0)
+    assert copy.deepcopy(unread) == r and copy.copy(unread).gmwm == want
+    assert dataclasses.asdict(gyrolab.allan(data, rate_hz=100.0))["kind"] == "oadev"
 
 
 def test_simulated_arw_is_recovered():

@@ -113,12 +113,23 @@ def test_a_short_record_is_computed_on_the_calling_thread_and_starts_no_thread()
             r = gyrolab.allan(x, rate_hz=100.0)
         gyrolab.allan({"a": x, "b": x, "c": x}, rate_hz=100.0)
         short = count()
+        # 200,000 stamped samples with a gap of 100,000: padded to 300,000 on the grid, so not
+        # short: computed on the package's pool, and no thread of rayon's global pool started
+        # (only threads named gyrolab-N are new)
+        t = np.arange(200_000) * 0.01
+        t[100_000:] += 1000.0
+        others = lambda: sum(1 for d in os.listdir("/proc/self/task")
+                             if not open(f"/proc/self/task/{d}/comm").read().startswith("gyrolab-"))
+        y = np.random.default_rng(3).standard_normal(200_000) * 0.01
+        gyrolab.allan(y, time=t, gaps="analyse", confidence=None)
+        padded_others = others()
         gyrolab.allan(np.random.default_rng(2).standard_normal(300_000) * 0.01, rate_hz=100.0)
-        print(before, short, count(), r.dev[0] > 0)
+        print(before, short, count(), padded_others, r.dev[0] > 0)
         """
     )
     out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True, timeout=TIMEOUT_S)
-    before, short, long, ok = out.stdout.split()
+    before, short, long, padded_others, ok = out.stdout.split()
     assert ok == "True"
     assert int(short) == int(before), out.stdout
+    assert int(padded_others) == int(before), out.stdout
     assert int(long) > int(short), out.stdout

@@ -362,7 +362,17 @@ fn allan_channels<'py>(
         gyrolab_io::pages::advise_huge_pages(&mut buffer);
         analyse_channel_borrowed(&setup, info, values, buffer, missing_policy)
     };
-    let analyses = if n * columns.len() < gyrolab::allan::PARALLEL_MIN_POINTS {
+    // The lengths as they reach the analysis (a record with gaps is padded to its grid), the
+    // channels one after another: all of them together below the core's parallel size.
+    let analysed: usize = samples
+        .iter()
+        .map(|s| match s {
+            Samples::Borrowed(v) => v.len(),
+            Samples::Owned(v) => v.len(),
+        })
+        .map(|len| len.saturating_add(1))
+        .sum();
+    let analyses = if gyrolab::allan::runs_serially(analysed.saturating_sub(1)) {
         // A short record on the calling thread, the interpreter released: the hand-off to a pool
         // thread cost a 10 min record at 100 Hz a fifth of its call (issue 56). Below this size
         // the core calls no rayon function, so no pool is used or started.
@@ -411,6 +421,16 @@ impl AllanChannels {
 
 #[pymethods]
 impl AllanChannels {
+    /// The handle itself (it never changes): `copy.copy` of a result.
+    fn __copy__(slf: Py<Self>) -> Py<Self> {
+        slf
+    }
+
+    /// The handle itself (it never changes): `copy.deepcopy` and `dataclasses.asdict` of a result.
+    fn __deepcopy__(slf: Py<Self>, _memo: &Bound<'_, PyAny>) -> Py<Self> {
+        slf
+    }
+
     /// The GMWM fit of channel `index` as JSON (the `gmwm` key of docs/JSON.md), `None` when the
     /// channel has none; computed on the first call, with the interpreter released.
     fn gmwm(&self, py: Python<'_>, index: usize) -> PyResult<Option<String>> {

@@ -77,7 +77,16 @@ impl LazyGmwm {
     /// the fit failed.
     pub fn get(&self, curve: &AllanCurve) -> Option<&gyrolab::gmwm::GmwmFit> {
         let confidence = self.confidence?;
-        self.fit.get_or_init(|| gyrolab::gmwm::gmwm(curve, confidence).ok()).as_ref()
+        if let Some(fit) = self.fit.get() {
+            return fit.as_ref();
+        }
+        // Computed outside the cell: the fit runs rayon work, and a rayon worker waiting in it
+        // may take up another caller's request for this same fit (a `get_or_init` would then
+        // re-enter the cell it is filling). Two callers at once both compute it (the same fit,
+        // deterministically); the first stored is kept.
+        let fit = gyrolab::gmwm::gmwm(curve, confidence).ok();
+        let _ = self.fit.set(fit);
+        self.fit.get().and_then(Option::as_ref)
     }
 }
 

@@ -26,11 +26,17 @@
 
 use super::confidence::{lag1_alpha, lag1_noise_id, LAG1_MIN_AVERAGES};
 
-/// Factors with at least this many averages are swept; shorter series are summed one by one.
-/// Every factor the rule identifies by lag 1 (at least [`LAG1_MIN_AVERAGES`] averages) is
-/// swept: the sweep's levels above the first cost a pairwise sum each, less than a factor's
-/// own two passes (a 10 min record at 100 Hz spent a sixth of its analysis in those; issue 56).
-const SWEEP_MIN_AVERAGES: usize = LAG1_MIN_AVERAGES;
+/// Factors with at least this many averages are swept; shorter series are summed one by one
+/// (they are at most 1/16384 of the record each).
+const SWEEP_MIN_AVERAGES: usize = 1 << 14;
+
+/// In an octave list (every factor a power of two) every factor the rule identifies by lag 1
+/// (at least [`LAG1_MIN_AVERAGES`] averages) is swept: the octave sweep's levels above the first
+/// cost a pairwise sum each, less than a factor's own two passes (a 10 min record at 100 Hz
+/// spent a sixth of its analysis in those; issue 56). Other lists keep
+/// [`SWEEP_MIN_AVERAGES`]: their sweep keeps sums per factor and part, which for every factor
+/// of a long all-tau list would hold hundreds of MB.
+const OCTAVE_SWEEP_MIN_AVERAGES: usize = LAG1_MIN_AVERAGES;
 
 /// Angle points per block of a sweep (256 KiB of f64: stays in the 1 MiB L2 cache while every
 /// factor reads its averages from it).
@@ -45,7 +51,9 @@ const PARTS: usize = 4;
 /// Lag-1 noise identification at every factor of `ms`, equal to `lag1_noise_id(s, m, dmax)` at
 /// each (up to the rounding of r1, see the module documentation).
 pub(crate) fn lag1_noise_ids(s: &[f64], ms: &[usize], dmax: usize) -> Vec<Option<i32>> {
-    lag1_noise_ids_with(s, ms, dmax, SWEEP_MIN_AVERAGES, BLOCK)
+    let octave = ms.iter().all(|m| m.is_power_of_two());
+    let min_averages = if octave { OCTAVE_SWEEP_MIN_AVERAGES } else { SWEEP_MIN_AVERAGES };
+    lag1_noise_ids_with(s, ms, dmax, min_averages, BLOCK)
 }
 
 fn lag1_noise_ids_with(s: &[f64], ms: &[usize], dmax: usize, min_averages: usize, block: usize) -> Vec<Option<i32>> {

@@ -351,6 +351,14 @@ const PHASE_CHUNK: usize = 1 << 14;
 /// parallel sum has a fixed partition, so the results do not depend on it.
 pub const PARALLEL_MIN_POINTS: usize = 1 << 18;
 
+/// Whether the analysis of `rate_samples` rate samples (the angle series has one point more)
+/// runs on the calling thread without any rayon call ([`PARALLEL_MIN_POINTS`]): a caller that
+/// runs it outside a thread pool asks this of the samples as they reach the analysis (after
+/// any gap filling or padding to the sample grid).
+pub fn runs_serially(rate_samples: usize) -> bool {
+    !parallel(rate_samples.saturating_add(1))
+}
+
 /// Whether a record of `points` points is computed in parallel ([`PARALLEL_MIN_POINTS`]).
 /// Below it no rayon function is called at all (not even to ask a pool's size): a caller may
 /// run a short record on its own thread, outside any pool (the Python package does: handing a

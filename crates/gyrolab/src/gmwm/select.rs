@@ -33,23 +33,34 @@ const KEPT_TABLES: usize = 8;
 /// The [`Tables`] of `wv` and the linear processes `linear`, made or found.
 fn linear_tables(wv: &[WaveletVariance], linear: &[Process]) -> Tables {
     type Key = (u64, Vec<(u64, u64)>, Vec<Process>);
-    static KEPT: Mutex<Vec<(Key, Tables)>> = Mutex::new(Vec::new());
+    type Cell = Arc<std::sync::OnceLock<Tables>>;
+    static KEPT: Mutex<Vec<(Key, Cell)>> = Mutex::new(Vec::new());
     let tau0 = wv.first().map_or(1.0, |w| w.tau_s / w.m as f64);
     let key: Key = (tau0.to_bits(), wv.iter().map(|w| (w.m, w.terms)).collect(), linear.to_vec());
-    if let Some((_, t)) = KEPT.lock().ok().and_then(|k| k.iter().find(|(k, _)| *k == key).cloned()) {
-        return t;
-    }
-    let grid = CovarianceGrid::new(wv);
-    let shapes: Vec<Shape> = linear.iter().map(|&p| Shape::Linear(p)).collect();
-    let integrals = ShapeIntegrals::new(&grid, &shapes);
-    let made: Tables = (Arc::new(grid), Arc::new(integrals));
-    if let Ok(mut kept) = KEPT.lock() {
-        if kept.len() >= KEPT_TABLES {
-            kept.remove(0);
-        }
-        kept.push((key, made.clone()));
-    }
-    made
+    // The key's cell, found or added under the list's lock; filled outside it, once: the
+    // channels of one record fitted side by side wait for the first to make it (no rayon work
+    // runs inside, so a waiting worker cannot be asked for it again).
+    let cell: Cell = match KEPT.lock() {
+        Ok(mut kept) => match kept.iter().find(|(k, _)| *k == key) {
+            Some((_, c)) => c.clone(),
+            None => {
+                if kept.len() >= KEPT_TABLES {
+                    kept.remove(0);
+                }
+                let c: Cell = Arc::default();
+                kept.push((key, c.clone()));
+                c
+            }
+        },
+        Err(_) => Arc::default(),
+    };
+    cell.get_or_init(|| {
+        let grid = CovarianceGrid::new(wv);
+        let shapes: Vec<Shape> = linear.iter().map(|&p| Shape::Linear(p)).collect();
+        let integrals = ShapeIntegrals::new(&grid, &shapes);
+        (Arc::new(grid), Arc::new(integrals))
+    })
+    .clone()
 }
 
 /// The most first-order Gauss-Markov processes a model holds in [`gmwm`].
