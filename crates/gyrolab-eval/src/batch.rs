@@ -4,8 +4,9 @@
 //! noise terms of `gyrolab allan --json`, their units in the column names), as CSV or Parquet.
 //!
 //! The figures are those of [`crate::allan::analyse_records`] and
-//! [`gyrolab_report::allan::allan_json_with`] (without the GMWM, which the table does not hold) (docs/METHODS.md section 3); this module adds no
-//! formula, only the bookkeeping (docs/METHODS.md, "Batches").
+//! [`gyrolab_report::allan::allan_json_with`] without the GMWM, which the table does not hold
+//! (docs/METHODS.md section 3); this module adds no formula, only the bookkeeping
+//! (docs/METHODS.md, "Batches").
 //!
 //! Nothing is written here: the front end receives each finished input through [`BatchSink`]
 //! (to append it to its journal, [`journal_line`]) and renders the combined table with

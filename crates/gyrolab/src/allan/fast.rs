@@ -68,7 +68,7 @@ pub(crate) fn overlapping_allan_sums_fft(s: &[f64], ms: &[usize]) -> Option<Vec<
     }
     let energy = hi + lo;
     let reversed: Vec<f64> = x.iter().rev().copied().collect();
-    let ((r, head), tail) = if len < super::PARALLEL_MIN_POINTS {
+    let ((r, head), tail) = if !super::parallel(len) {
         // a short record: on the calling thread (see PARALLEL_MIN_POINTS)
         ((autocorrelation(&x, 2 * m_max), head_sums(&x, m_max)), head_sums(&reversed, m_max))
     } else {
