@@ -17,7 +17,7 @@ use std::path::Path;
 /// folder stays written, an older report.pdf (which shows an earlier report) is removed, and the
 /// run ends with exit code 1 and a message saying how to get the PDF.
 pub fn write_and_finish(out: &Path, folder: &ReportFolder, quiet: bool, pdf: bool) -> CliResult {
-    let files = write_folder(out, &folder.outputs)?;
+    let files = write_folder(out, &folder.outputs, &folder.inputs)?;
     if !quiet {
         let mut s = format!("Wrote {} files to {}:\n", files.len(), out.display());
         for f in &files {

@@ -16,18 +16,26 @@ pub fn print(text: &str) -> CliResult {
     }
 }
 
-/// Writes a file whole or not at all.
-pub fn write_file(path: &Path, bytes: &[u8]) -> CliResult {
-    gyrolab_io::atomic::write_atomic(path, bytes)
-        .map_err(|e| CliError::Output(format!("{}: cannot write the file: {e}", path.display())))
+/// Writes a file whole or not at all, never over one of `inputs`.
+pub fn write_file(path: &Path, bytes: &[u8], inputs: &[&Path]) -> CliResult {
+    gyrolab_io::atomic::write_outputs(vec![gyrolab_io::atomic::OutputFile::bytes(path, bytes)], inputs)
+        .map(drop)
+        .map_err(output_error)
 }
 
 /// Writes a report folder: every output to a temporary file first, then all renamed into place,
-/// so that a failure leaves the folder as it was. Returns the paths written, in order.
-pub fn write_folder(dir: &Path, outputs: &[NamedOutput]) -> CliResult<Vec<PathBuf>> {
+/// so that a failure leaves the folder as it was, and never over one of `inputs` (exit 2).
+/// Returns the paths written, in order.
+pub fn write_folder(dir: &Path, outputs: &[NamedOutput], inputs: &[PathBuf]) -> CliResult<Vec<PathBuf>> {
     let files: Vec<(&str, &[u8])> = outputs.iter().map(|o| (o.name.as_str(), &o.bytes[..])).collect();
-    gyrolab_io::atomic::write_folder(dir, &files)
-        .map_err(|(path, e)| CliError::Output(format!("{}: cannot write the file: {e}", path.display())))
+    let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+    gyrolab_io::atomic::write_folder(dir, &files, &inputs).map_err(output_error)
+}
+
+/// The error of a set of outputs not written: bad usage (exit 2) when the request put an input
+/// or a folder in the way, else an output failure (exit 1); the message says what is on disk.
+pub fn output_error(e: gyrolab_io::atomic::OutputError) -> CliError {
+    CliError::Eval(gyrolab_eval::EvalError::from(e))
 }
 
 /// Serialises a value as pretty JSON with a final newline.

@@ -51,6 +51,18 @@ impl EvalError {
     }
 }
 
+impl From<gyrolab_io::atomic::OutputError> for EvalError {
+    /// An output refused for the request's sake (an input or a folder in the way, a file named
+    /// twice) is a conflict (bad usage); a write the system refused is an output failure.
+    fn from(e: gyrolab_io::atomic::OutputError) -> Self {
+        if e.is_usage() {
+            EvalError::conflict(e.to_string())
+        } else {
+            EvalError::Output(e.to_string())
+        }
+    }
+}
+
 /// Replaces `{field}` in `message` by `spell(field)` for each of `fields`.
 fn render_fields(message: &str, fields: &[&'static str], spell: &dyn Fn(&str) -> String) -> String {
     let mut out = message.to_string();

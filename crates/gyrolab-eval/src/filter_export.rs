@@ -538,13 +538,14 @@ pub fn noise_export(
     combine_terms(&record, &channels, request)
 }
 
-/// Writes the exports of every record of a run (one file per topic when there are several:
-/// imu.yaml -> imu_<topic>.yaml), all or none; returns the files written and the warnings.
-pub fn write_exports(
+/// The export files of every record of a run (one file per topic when there are several:
+/// imu.yaml -> imu_<topic>.yaml), made and checked but not written, and the warnings.
+#[allow(clippy::type_complexity)]
+pub fn export_files(
     outcomes: &[AllanOutcome],
     file: &Path,
     request: &ExportRequest,
-) -> EvalResult<(Vec<PathBuf>, Vec<String>)> {
+) -> EvalResult<(Vec<(PathBuf, Vec<u8>)>, Vec<String>)> {
     let several = outcomes.len() > 1;
     let mut files = Vec::new();
     let mut warnings = Vec::new();
@@ -585,9 +586,7 @@ pub fn write_exports(
             )));
         }
     }
-    let written = gyrolab_io::atomic::write_files(&files)
-        .map_err(|(path, e)| EvalError::Output(format!("{}: {e} (no export file was written)", path.display())))?;
-    Ok((written, warnings))
+    Ok((files, warnings))
 }
 
 #[cfg(test)]

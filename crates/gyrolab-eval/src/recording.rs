@@ -150,19 +150,21 @@ pub fn convert(path: &Path, topics: &[String], out: &Path) -> EvalResult<Convert
     }
     let rec = opened.read_recording(&RecordingOptions { topics: topics.to_vec(), ..Default::default() })?;
     let several = rec.imu.len() > 1;
+    // Every topic's file written together (all or none), never over the recording.
     let mut files = Vec::new();
+    let mut outputs = Vec::new();
     for t in &rec.imu {
         let target = if several { per_topic_path(out, &t.topic) } else { out.to_path_buf() };
-        let written = match format {
+        outputs.push(match format {
             ConvertFormat::Csv => {
-                gyrolab_io::atomic::write_atomic_with(&target, |w| gyrolab_io::recording::write_topic_csv(w, t))
+                gyrolab_io::atomic::OutputFile::stream(&target, |w| gyrolab_io::recording::write_topic_csv(w, t))
             }
             ConvertFormat::Parquet => {
-                gyrolab_io::atomic::write_atomic_with(&target, |w| gyrolab_io::recording::write_topic_parquet(w, t))
+                gyrolab_io::atomic::OutputFile::stream(&target, |w| gyrolab_io::recording::write_topic_parquet(w, t))
             }
-        };
-        written.map_err(|e| EvalError::Output(format!("{}: cannot write the file: {e}", target.display())))?;
+        });
         files.push((t.topic.clone(), target, t.stamps_ns.len()));
     }
+    gyrolab_io::atomic::write_outputs(outputs, &[path])?;
     Ok(Converted { files, truncated: rec.truncated })
 }

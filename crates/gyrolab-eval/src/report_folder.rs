@@ -37,6 +37,8 @@ pub struct ReportFolder {
     pub undecided: Vec<String>,
     /// Some results come from simulated records (results.json `simulated`).
     pub simulated: bool,
+    /// The files the evaluation read (the plan and its inputs), which no output may overwrite.
+    pub inputs: Vec<std::path::PathBuf>,
 }
 
 /// The mark a CSV of a report folder with simulated inputs starts with, unless the file's own
@@ -202,5 +204,5 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
     if simulated {
         mark_simulated_csvs(&mut outputs, inputs.simulated_rate.as_deref());
     }
-    Ok(ReportFolder { outputs, verdict, failures, undecided, simulated })
+    Ok(ReportFolder { outputs, verdict, failures, undecided, simulated, inputs: Vec::new() })
 }

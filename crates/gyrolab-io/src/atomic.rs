@@ -84,51 +84,203 @@ fn write_and_persist(
     Ok(())
 }
 
-/// Writes a folder of files all or nothing as far as a file system allows: creates `dir`, writes
-/// every file to a temporary file inside it (fsynced), and only when all are written renames
-/// them into place, in order. A failure before the renames leaves the folder as it was (the
-/// temporaries are removed); the error names the file it is about. A target that cannot be
-/// replaced (a folder of that name) is found before any rename; should a rename still fail, the
-/// files already replaced are put back from hard links kept of them (and the new ones removed),
-/// so that the folder never mixes files of two runs. Other files in `dir` are not touched.
-pub fn write_folder(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>, (PathBuf, std::io::Error)> {
-    std::fs::create_dir_all(dir).map_err(|e| (dir.to_path_buf(), e))?;
-    let mut staged = Vec::with_capacity(files.len());
-    for (name, bytes) in files {
-        let path = dir.join(name);
-        if Path::new(name).file_name() != Some(std::ffi::OsStr::new(name)) {
-            return Err((path, std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a plain file name")));
+/// One file of a set of outputs ([`write_outputs`]): its target and its bytes, given whole or
+/// written by a function into the temporary file (for outputs too large to hold in memory).
+pub struct OutputFile<'a> {
+    /// Where the file goes.
+    pub path: PathBuf,
+    /// Its content.
+    content: Content<'a>,
+}
+
+/// The content of an [`OutputFile`].
+enum Content<'a> {
+    /// The bytes, whole.
+    Bytes(std::borrow::Cow<'a, [u8]>),
+    /// A function that writes them.
+    Stream(Box<dyn FnOnce(&mut (dyn Write + Send)) -> std::io::Result<()> + 'a>),
+}
+
+impl<'a> OutputFile<'a> {
+    /// A file of these bytes.
+    pub fn bytes(path: impl Into<PathBuf>, bytes: impl Into<std::borrow::Cow<'a, [u8]>>) -> OutputFile<'a> {
+        OutputFile { path: path.into(), content: Content::Bytes(bytes.into()) }
+    }
+
+    /// A file whose bytes `fill` writes (into a buffered temporary file).
+    pub fn stream(
+        path: impl Into<PathBuf>,
+        fill: impl FnOnce(&mut (dyn Write + Send)) -> std::io::Result<()> + 'a,
+    ) -> OutputFile<'a> {
+        OutputFile { path: path.into(), content: Content::Stream(Box::new(fill)) }
+    }
+}
+
+/// Why a set of outputs was not written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutputRefusal {
+    /// The target is a file the run reads (an output never overwrites an input).
+    IsAnInput,
+    /// Two outputs of the run name one file.
+    NamedTwice,
+    /// A folder (or something else that is not a file) is where the file goes.
+    NotAFile,
+    /// A file name with a folder in it where a plain name is needed.
+    NotAPlainName,
+    /// Writing or renaming failed (a full disk, a missing folder, no permission).
+    Io,
+}
+
+/// A set of outputs not written: which target, why, and what is on disk afterwards. Every
+/// target is then as it was before the run (see [`write_outputs`]).
+#[derive(Debug)]
+pub struct OutputError {
+    /// The target the failure is about.
+    pub path: PathBuf,
+    /// Why.
+    pub refusal: OutputRefusal,
+    /// The system's error, for [`OutputRefusal::Io`].
+    pub source: Option<std::io::Error>,
+    /// Every target of the run, with whether a file is there afterwards (as it was before).
+    pub targets: Vec<(PathBuf, bool)>,
+}
+
+impl OutputError {
+    /// Whether the failure is the request's (an input or a folder in the way, a file named
+    /// twice, a bad name): bad usage, not a failure of the system.
+    pub fn is_usage(&self) -> bool {
+        self.refusal != OutputRefusal::Io
+    }
+
+    /// What is on disk afterwards, in words: "no file of this run was written; k.yaml is as it
+    /// was, v.yaml does not exist".
+    pub fn aftermath(&self) -> String {
+        let (kept, absent): (Vec<_>, Vec<_>) = self.targets.iter().partition(|(_, there)| *there);
+        let names =
+            |v: &[&(PathBuf, bool)]| v.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>().join(", ");
+        let mut s = String::from("no file of this run was written");
+        if !kept.is_empty() {
+            s.push_str(&format!("; left as they were: {}", names(&kept)));
         }
-        match stage_in(dir, bytes) {
-            Ok(tmp) => staged.push((tmp, path)),
+        if !absent.is_empty() {
+            s.push_str(&format!("; not there: {}", names(&absent)));
+        }
+        s
+    }
+}
+
+impl std::fmt::Display for OutputError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let why = match (self.refusal, &self.source) {
+            (OutputRefusal::IsAnInput, _) => {
+                "this file is an input of the run, and an output never overwrites an input: choose another output path or folder".to_string()
+            }
+            (OutputRefusal::NamedTwice, _) => "two outputs of the run name this file: each output needs its own file".to_string(),
+            (OutputRefusal::NotAFile, _) => "a folder (or something else that is not a file) is in the way".to_string(),
+            (OutputRefusal::NotAPlainName, _) => "not a plain file name".to_string(),
+            (OutputRefusal::Io, Some(e)) => format!("cannot write the file: {e}"),
+            (OutputRefusal::Io, None) => "cannot write the file".to_string(),
+        };
+        write!(f, "{}: {why} ({})", self.path.display(), self.aftermath())
+    }
+}
+
+impl std::error::Error for OutputError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.source.as_ref().map(|e| e as _)
+    }
+}
+
+/// Whether `target`, written by rename, would replace `input`: the same directory entry (the
+/// same folder, canonically, and name) or, both existing, the same file (a hard link: the output
+/// would take the input's name away from it).
+fn replaces(target: &Path, input: &Path) -> bool {
+    let entry = |p: &Path| -> Option<(PathBuf, std::ffi::OsString)> {
+        let dir = match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        Some((std::fs::canonicalize(dir).ok()?, p.file_name()?.to_os_string()))
+    };
+    if let (Some(a), Some(b)) = (entry(target), entry(input)) {
+        if a == b {
+            return true;
+        }
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(t), Ok(i)) = (std::fs::symlink_metadata(target), std::fs::metadata(input)) {
+            return t.is_file() && t.dev() == i.dev() && t.ino() == i.ino();
+        }
+    }
+    false
+}
+
+/// Writes a set of files, each anywhere, all or none as far as a file system allows, and never
+/// over one of `inputs`:
+/// 1. every target is checked first: not an input (nor a hard link of one), not named twice,
+///    not a folder;
+/// 2. every file is written to a temporary file beside its target (mode 0644, fsynced);
+/// 3. only when all are written are they renamed into place, in order; the files being replaced
+///    are kept as hard links until then, so that should a rename still fail, the ones already
+///    replaced are put back (and new ones removed): the targets never mix files of two runs.
+///
+/// A failure leaves every target as it was; the error names the file it is about and what is
+/// on disk afterwards ([`OutputError::aftermath`]). No temporary file is left behind.
+pub fn write_outputs(files: Vec<OutputFile<'_>>, inputs: &[&Path]) -> Result<Vec<PathBuf>, OutputError> {
+    let targets: Vec<PathBuf> = files.iter().map(|f| f.path.clone()).collect();
+    let fail = |path: &Path, refusal: OutputRefusal, source: Option<std::io::Error>| OutputError {
+        path: path.to_path_buf(),
+        refusal,
+        source,
+        targets: targets.iter().map(|t| (t.clone(), std::fs::symlink_metadata(t).is_ok())).collect(),
+    };
+    for (i, path) in targets.iter().enumerate() {
+        if inputs.iter().any(|input| replaces(path, input)) {
+            return Err(fail(path, OutputRefusal::IsAnInput, None));
+        }
+        if targets[..i].iter().any(|other| replaces(path, other) || same_written_path(path, other)) {
+            return Err(fail(path, OutputRefusal::NamedTwice, None));
+        }
+        if std::fs::symlink_metadata(path).is_ok_and(|m| !m.is_file() && !m.file_type().is_symlink()) {
+            return Err(fail(path, OutputRefusal::NotAFile, None));
+        }
+    }
+    let mut staged: Vec<(tempfile::NamedTempFile, PathBuf)> = Vec::with_capacity(files.len());
+    let release = |staged: &[(tempfile::NamedTempFile, PathBuf)]| staged.iter().for_each(|(t, _)| unregister(t.path()));
+    for file in files {
+        let dir = match file.path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        match stage_in(&dir, file.content) {
+            Ok(tmp) => staged.push((tmp, file.path)),
             Err(e) => {
-                staged.iter().for_each(|(t, _)| unregister(t.path()));
-                return Err((path, e));
+                release(&staged);
+                drop(staged);
+                return Err(fail(&file.path, OutputRefusal::Io, Some(e)));
             }
         }
     }
     let temporaries: Vec<PathBuf> = staged.iter().map(|(t, _)| t.path().to_path_buf()).collect();
     let unregister_all = || temporaries.iter().for_each(|t| unregister(t));
-    // Targets that a rename could not replace, found before the first rename.
-    for (_, path) in &staged {
-        if std::fs::symlink_metadata(path).is_ok_and(|m| m.is_dir()) {
-            unregister_all();
-            return Err((
-                path.clone(),
-                std::io::Error::new(std::io::ErrorKind::IsADirectory, "a folder of this name is in the way"),
-            ));
-        }
-    }
-    // The files being replaced, kept as hard links until every rename is done.
+    // The files being replaced, kept as hard links beside them until every rename is done.
     let mut kept: Vec<(PathBuf, PathBuf)> = Vec::new();
-    for (_, path) in &staged {
-        if std::fs::symlink_metadata(path).is_ok_and(|m| m.is_file()) {
-            let keep = dir.join(format!(".gyrolab-old-{}-{}.tmp", std::process::id(), kept.len()));
+    for (n, (_, path)) in staged.iter().enumerate() {
+        if std::fs::symlink_metadata(path).is_ok_and(|m| m.is_file() || m.file_type().is_symlink()) {
+            let dir = match path.parent() {
+                Some(p) if !p.as_os_str().is_empty() => p,
+                _ => Path::new("."),
+            };
+            let keep = dir.join(format!(".gyrolab-old-{}-{n}.tmp", std::process::id()));
             let _ = std::fs::remove_file(&keep);
             if let Err(e) = std::fs::hard_link(path, &keep) {
                 kept.iter().for_each(|(k, _)| drop(std::fs::remove_file(k)));
                 unregister_all();
-                return Err((path.clone(), e));
+                let path = path.clone();
+                drop(staged);
+                return Err(fail(&path, OutputRefusal::Io, Some(e)));
             }
             register(&keep);
             kept.push((keep, path.clone()));
@@ -136,7 +288,7 @@ pub fn write_folder(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>,
     }
     let (written, result) = persist_in_order(staged);
     if result.is_err() {
-        // Put the folder back as it was: the new files out, the old ones in.
+        // Put every target back as it was: the new files out, the old ones in.
         for path in &written {
             match kept.iter().find(|(_, p)| p == path) {
                 Some((keep, _)) => drop(std::fs::rename(keep, path)),
@@ -149,7 +301,44 @@ pub fn write_folder(dir: &Path, files: &[(&str, &[u8])]) -> Result<Vec<PathBuf>,
         unregister(keep);
     }
     unregister_all();
-    result.map(|()| written)
+    match result {
+        Ok(()) => Ok(written),
+        Err((path, e)) => Err(fail(&path, OutputRefusal::Io, Some(e))),
+    }
+}
+
+/// Whether two output paths name one file as written (relative to the working folder, `.`
+/// components dropped), for targets that do not exist yet.
+fn same_written_path(a: &Path, b: &Path) -> bool {
+    let norm = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    norm(a) == norm(b)
+}
+
+/// Writes a folder of files all or none ([`write_outputs`]): creates `dir`, then writes every
+/// `(name, bytes)` into it; `inputs` are never overwritten. Other files in `dir` are not touched.
+pub fn write_folder(dir: &Path, files: &[(&str, &[u8])], inputs: &[&Path]) -> Result<Vec<PathBuf>, OutputError> {
+    let targets = || files.iter().map(|(n, _)| (dir.join(n), false)).collect::<Vec<_>>();
+    for (name, _) in files {
+        if Path::new(name).file_name() != Some(std::ffi::OsStr::new(name)) {
+            let mut targets = targets();
+            targets.iter_mut().for_each(|(p, there)| *there = std::fs::symlink_metadata(p).is_ok());
+            return Err(OutputError {
+                path: dir.join(name),
+                refusal: OutputRefusal::NotAPlainName,
+                source: None,
+                targets,
+            });
+        }
+    }
+    if let Err(e) = std::fs::create_dir_all(dir) {
+        return Err(OutputError {
+            path: dir.to_path_buf(),
+            refusal: OutputRefusal::Io,
+            source: Some(e),
+            targets: targets(),
+        });
+    }
+    write_outputs(files.iter().map(|(name, bytes)| OutputFile::bytes(dir.join(name), *bytes)).collect(), inputs)
 }
 
 /// Renames each staged file onto its target, in order, stopping at the first failure: (the
@@ -168,45 +357,38 @@ fn persist_in_order(
     (written, Ok(()))
 }
 
-/// A temporary file in `dir` holding `bytes` (mode 0644, synced to disk), registered for
+/// A temporary file in `dir` holding `content` (mode 0644, synced to disk), registered for
 /// removal on a signal until it is persisted or dropped.
-fn stage_in(dir: &Path, bytes: &[u8]) -> std::io::Result<tempfile::NamedTempFile> {
-    let mut tmp = tempfile::Builder::new().prefix(".gyrolab-").suffix(".tmp").tempfile_in(dir)?;
+fn stage_in(dir: &Path, content: Content<'_>) -> std::io::Result<tempfile::NamedTempFile> {
+    let tmp = tempfile::Builder::new().prefix(".gyrolab-").suffix(".tmp").tempfile_in(dir)?;
     register(tmp.path());
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        tmp.as_file().set_permissions(std::fs::Permissions::from_mode(0o644))?;
+    let filled = (|| {
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            tmp.as_file().set_permissions(std::fs::Permissions::from_mode(0o644))?;
+        }
+        {
+            let file = EarlyWriteback::new(tmp.as_file(), WRITEBACK_CHUNK, start_writeback);
+            let mut w = std::io::BufWriter::with_capacity(1 << 16, file);
+            match content {
+                Content::Bytes(b) => w.write_all(&b)?,
+                Content::Stream(fill) => fill(&mut w)?,
+            }
+            w.flush()?;
+        }
+        tmp.as_file().sync_all()
+    })();
+    if let Err(e) = filled {
+        unregister(tmp.path());
+        return Err(e);
     }
-    tmp.write_all(bytes)?;
-    tmp.as_file().sync_all()?;
     Ok(tmp)
 }
 
-/// Writes several files, each anywhere, all or nothing as far as a file system allows: every
-/// file is first written to a temporary file beside its target (fsynced); only when all are
-/// written are they renamed into place, in order. A failure before the renames leaves every
-/// target as it was; the error names the file it is about.
-pub fn write_files(files: &[(PathBuf, Vec<u8>)]) -> Result<Vec<PathBuf>, (PathBuf, std::io::Error)> {
-    let mut staged: Vec<(tempfile::NamedTempFile, PathBuf)> = Vec::with_capacity(files.len());
-    let release = |staged: &[(tempfile::NamedTempFile, PathBuf)]| staged.iter().for_each(|(t, _)| unregister(t.path()));
-    for (path, bytes) in files {
-        let dir = match path.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p,
-            _ => Path::new("."),
-        };
-        match stage_in(dir, bytes) {
-            Ok(tmp) => staged.push((tmp, path.clone())),
-            Err(e) => {
-                release(&staged);
-                return Err((path.clone(), e));
-            }
-        }
-    }
-    let temporaries: Vec<PathBuf> = staged.iter().map(|(t, _)| t.path().to_path_buf()).collect();
-    let (written, result) = persist_in_order(staged);
-    temporaries.iter().for_each(|t| unregister(t));
-    result.map(|()| written)
+/// Writes several files, each anywhere, all or none ([`write_outputs`] with no inputs named).
+pub fn write_files(files: &[(PathBuf, Vec<u8>)]) -> Result<Vec<PathBuf>, OutputError> {
+    write_outputs(files.iter().map(|(p, b)| OutputFile::bytes(p.clone(), &b[..])).collect(), &[])
 }
 
 /// A file written from its start that asks for write-back of every finished `chunk` bytes by
@@ -348,12 +530,12 @@ mod tests {
     fn a_folder_is_written_whole_or_left_as_it_was() {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("report");
-        let written = super::write_folder(&out, &[("a.txt", b"one"), ("b.txt", b"two")]).unwrap();
+        let written = super::write_folder(&out, &[("a.txt", b"one"), ("b.txt", b"two")], &[]).unwrap();
         assert_eq!(written, [out.join("a.txt"), out.join("b.txt")]);
         assert_eq!(std::fs::read(out.join("b.txt")).unwrap(), b"two");
         // A bad name among the files: nothing is replaced, no temporary is left.
-        let e = super::write_folder(&out, &[("a.txt", b"new"), ("x/y.txt", b"bad")]).unwrap_err();
-        assert_eq!(e.0, out.join("x/y.txt"));
+        let e = super::write_folder(&out, &[("a.txt", b"new"), ("x/y.txt", b"bad")], &[]).unwrap_err();
+        assert_eq!(e.path, out.join("x/y.txt"));
         assert_eq!(std::fs::read(out.join("a.txt")).unwrap(), b"one");
         let names: Vec<_> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name()).collect();
         assert_eq!(names.len(), 2, "{names:?}");
@@ -361,8 +543,9 @@ mod tests {
         // first two keep the earlier run's content; nothing else is left in the folder.
         std::fs::create_dir(out.join("c.txt")).unwrap();
         std::fs::write(out.join("mine.txt"), b"user").unwrap();
-        let e = super::write_folder(&out, &[("a.txt", b"new"), ("b.txt", b"new"), ("c.txt", b"new")]).unwrap_err();
-        assert_eq!(e.0, out.join("c.txt"));
+        let e = super::write_folder(&out, &[("a.txt", b"new"), ("b.txt", b"new"), ("c.txt", b"new")], &[]).unwrap_err();
+        assert_eq!(e.path, out.join("c.txt"));
+        assert_eq!(e.refusal, OutputRefusal::NotAFile);
         assert_eq!(std::fs::read(out.join("a.txt")).unwrap(), b"one");
         assert_eq!(std::fs::read(out.join("b.txt")).unwrap(), b"two");
         let mut names: Vec<_> =
@@ -371,11 +554,94 @@ mod tests {
         assert_eq!(names, ["a.txt", "b.txt", "c.txt", "mine.txt"]);
         // Replaced whole: the old content is gone, the user's file stays, no link is left.
         std::fs::remove_dir(out.join("c.txt")).unwrap();
-        super::write_folder(&out, &[("a.txt", b"new"), ("b.txt", b"new"), ("c.txt", b"new")]).unwrap();
+        super::write_folder(&out, &[("a.txt", b"new"), ("b.txt", b"new"), ("c.txt", b"new")], &[]).unwrap();
         for f in ["a.txt", "b.txt", "c.txt"] {
             assert_eq!(std::fs::read(out.join(f)).unwrap(), b"new");
         }
         assert_eq!(std::fs::read(out.join("mine.txt")).unwrap(), b"user");
         assert_eq!(std::fs::read_dir(&out).unwrap().count(), 4);
+    }
+
+    /// An input is never overwritten: named as it is, through another spelling of its folder, or
+    /// as a hard link of it; nothing of the set is written and the message says what is there.
+    #[test]
+    fn an_input_is_never_overwritten() {
+        let dir = tempfile::tempdir().unwrap();
+        let input = dir.path().join("allan_x.csv");
+        std::fs::write(&input, b"time_s,rate_dps\n").unwrap();
+        let out = dir.path().join("table.csv");
+        for target in [input.clone(), dir.path().join("sub/../allan_x.csv"), dir.path().join("link.csv")] {
+            if target.ends_with("link.csv") {
+                std::fs::hard_link(&input, &target).unwrap();
+            } else {
+                std::fs::create_dir_all(dir.path().join("sub")).unwrap();
+            }
+            let e = write_outputs(
+                vec![OutputFile::bytes(&out, &b"a"[..]), OutputFile::bytes(&target, &b"b"[..])],
+                &[&input],
+            )
+            .unwrap_err();
+            assert_eq!(e.refusal, OutputRefusal::IsAnInput, "{target:?}");
+            assert!(e.is_usage());
+            assert_eq!(std::fs::read(&input).unwrap(), b"time_s,rate_dps\n");
+            assert!(!out.exists());
+            let text = e.to_string();
+            assert!(text.contains("never overwrites an input") && text.contains("not there: "), "{text}");
+        }
+        // A file named twice in one set.
+        let e = write_outputs(
+            vec![OutputFile::bytes(&out, &b"a"[..]), OutputFile::bytes(dir.path().join("./table.csv"), &b"b"[..])],
+            &[],
+        )
+        .unwrap_err();
+        assert_eq!(e.refusal, OutputRefusal::NamedTwice);
+        assert!(!out.exists());
+    }
+
+    /// A rename that fails after others succeeded (the third target's folder made read-only
+    /// between staging and renaming cannot be arranged portably, so a staged file's folder is
+    /// removed): the files already replaced get their old content back, new ones are removed.
+    #[test]
+    fn a_failed_write_part_way_leaves_every_target_as_it_was() {
+        let dir = tempfile::tempdir().unwrap();
+        let a = dir.path().join("a.yaml");
+        let b = dir.path().join("b.yaml");
+        std::fs::write(&a, b"old a").unwrap();
+        // The last output streams and fails: nothing is renamed, every target as it was.
+        let e = write_outputs(
+            vec![
+                OutputFile::bytes(&a, &b"new a"[..]),
+                OutputFile::bytes(&b, &b"new b"[..]),
+                OutputFile::stream(dir.path().join("c.yaml"), |w| {
+                    w.write_all(b"partial")?;
+                    Err(std::io::Error::other("disk full"))
+                }),
+            ],
+            &[],
+        )
+        .unwrap_err();
+        assert_eq!(e.refusal, OutputRefusal::Io);
+        assert_eq!(std::fs::read(&a).unwrap(), b"old a");
+        assert!(!b.exists());
+        assert_eq!(e.targets.iter().filter(|(_, there)| *there).count(), 1);
+        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names, ["a.yaml"], "no temporary left");
+        // A folder whose parent does not exist: refused at staging, before any rename.
+        let e = write_outputs(
+            vec![OutputFile::bytes(&a, &b"new a"[..]), OutputFile::bytes(dir.path().join("no/such/c.yaml"), &b"c"[..])],
+            &[],
+        )
+        .unwrap_err();
+        assert_eq!(e.path, dir.path().join("no/such/c.yaml"));
+        assert_eq!(std::fs::read(&a).unwrap(), b"old a");
+        // The rollback itself: the renames stop at a target that became a folder after the
+        // checks (simulated by persisting onto a folder), earlier targets get their old bytes.
+        let staged = vec![
+            (stage_in(dir.path(), Content::Bytes(b"new a"[..].into())).unwrap(), a.clone()),
+            (stage_in(dir.path(), Content::Bytes(b"x"[..].into())).unwrap(), dir.path().to_path_buf()),
+        ];
+        let (written, result) = persist_in_order(staged);
+        assert_eq!(written, [a.clone()]);
+        assert!(result.is_err());
     }
 }

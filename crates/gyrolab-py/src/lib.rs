@@ -734,8 +734,13 @@ fn evaluate_plan(
     })?
     .map_err(err)?;
     let files: Vec<(&str, &[u8])> = folder.outputs.iter().map(|o| (o.name.as_str(), &o.bytes[..])).collect();
-    let written = gyrolab_io::atomic::write_folder(&out, &files).map_err(|(p, e)| {
-        pyo3::exceptions::PyOSError::new_err(format!("{}: cannot write the file: {e}", p.display()))
+    let inputs: Vec<&std::path::Path> = folder.inputs.iter().map(PathBuf::as_path).collect();
+    let written = gyrolab_io::atomic::write_folder(&out, &files, &inputs).map_err(|e| {
+        if e.is_usage() {
+            pyo3::exceptions::PyValueError::new_err(e.to_string())
+        } else {
+            pyo3::exceptions::PyOSError::new_err(e.to_string())
+        }
     })?;
     Ok((folder.verdict.map(|v| v.text().to_string()), written, folder.failures, folder.undecided))
 }

@@ -633,8 +633,6 @@ fn read_report_files(store: &mut Store, id: i64) -> StoreResult<Vec<(String, Opt
 pub fn write_report(store: &mut Store, id: i64, out: &std::path::Path) -> StoreResult<Vec<std::path::PathBuf>> {
     let files = report_files(store, id)?;
     let refs: Vec<(&str, &[u8])> = files.iter().map(|(n, b)| (n.as_str(), b.as_slice())).collect();
-    gyrolab_io::atomic::write_folder(out, &refs).map_err(|(p, e)| StoreError::Input {
-        path: p.display().to_string(),
-        message: format!("cannot write the file: {e}"),
-    })
+    gyrolab_io::atomic::write_folder(out, &refs, &[])
+        .map_err(|e| StoreError::Input { path: e.path.display().to_string(), message: e.to_string() })
 }

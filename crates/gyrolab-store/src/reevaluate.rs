@@ -72,8 +72,9 @@ pub fn reevaluate(store: &mut Store, id: i64, by: &str, reason: &str, out: &Path
     let folder = evaluate_test_plan(&plan, &rec.plan_path, &gyrolab_eval::Silent)
         .map_err(|e| StoreError::Input { path: rec.plan_path.clone(), message: e.to_string() })?;
     let files: Vec<(&str, &[u8])> = folder.outputs.iter().map(|o| (o.name.as_str(), o.bytes.as_slice())).collect();
-    gyrolab_io::atomic::write_folder(out, &files)
-        .map_err(|(p, e)| StoreError::Input { path: p.display().to_string(), message: format!("cannot write: {e}") })?;
+    let inputs: Vec<&Path> = folder.inputs.iter().map(PathBuf::as_path).collect();
+    gyrolab_io::atomic::write_folder(out, &files, &inputs)
+        .map_err(|e| StoreError::Input { path: e.path.display().to_string(), message: e.to_string() })?;
     let mut new = from_report_folder(out, Some(&plan_path))?;
     // The facts recorded about the device stay those of the revision superseded (corrections
     // included); the figures are the new ones.

@@ -3,12 +3,12 @@
 
 use crate::args::AnalysisArgs;
 use crate::error::CliResult;
-use crate::output::{print, simulated_lines, to_json, write_file};
+use crate::output::{print, simulated_lines, to_json};
 use crate::progress::Bar;
 use clap::Args;
 use gyrolab_eval::allan::AllanRequest;
 use gyrolab_eval::allan_memory::{analyse_records_within, default_memory_bytes, parse_memory, size_text, MemoryPath};
-use gyrolab_eval::filter_export::{check_inflate, parse_target, same_path, write_exports, Estimator, ExportRequest};
+use gyrolab_eval::filter_export::{check_inflate, export_files, parse_target, same_path, Estimator, ExportRequest};
 use gyrolab_eval::simulate::reference_from_headers;
 use gyrolab_eval::EvalError;
 use gyrolab_report::allan::{allan_csv, allan_document, allan_text, imu_utils_yaml, kalibr_yaml};
@@ -163,6 +163,9 @@ pub fn run(args: &AllanArgs) -> CliResult {
             eprintln!("{level}: {}", n.render(&crate::error::flag));
         }
     }
+    // Every file of the run made first, then written together: all or none, never over the record.
+    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+    let mut warnings: Vec<String> = Vec::new();
     for (path, imu_utils) in [(&args.kalibr_yaml, false), (&args.imu_utils_yaml, true)] {
         let Some(path) = path else { continue };
         let writer = if imu_utils { imu_utils_yaml } else { kalibr_yaml };
@@ -173,19 +176,21 @@ pub fn run(args: &AllanArgs) -> CliResult {
                 _ => path.clone(),
             };
             let file = writer(&outcome.analyses, 1.0 / outcome.sample_interval_s).ok_or_else(|| {
-                EvalError::conflict("no noise terms could be read from the curves (give the gyro channels a unit such as --unit rad/s, or calibrate outputs with --cal or --scale-factor, and use --kind oadev)")
+                let whose = outcome.topic.as_ref().map_or(String::new(), |t| format!("topic {}: ", t.topic));
+                EvalError::conflict(format!("{whose}no noise terms could be read from the curves (give the gyro channels a unit such as --unit rad/s, or calibrate outputs with --cal or --scale-factor, and use --kind oadev); no output file was written"))
             })?;
-            write_file(&target, file.text.as_bytes())?;
-            if several {
-                eprintln!("note: wrote {}", target.display());
-            }
-            for w in &file.warnings {
-                eprintln!("warning: {w}");
-            }
+            files.push((target, file.text.into_bytes()));
+            warnings.extend(file.warnings);
         }
     }
     if let Some(request) = &export {
-        let (written, warnings) = write_exports(&outcomes, &args.file, request)?;
+        let (export_files, export_warnings) = export_files(&outcomes, &args.file, request)?;
+        files.extend(export_files);
+        warnings.extend(export_warnings);
+    }
+    if !files.is_empty() {
+        let outputs = files.iter().map(|(p, b)| gyrolab_io::atomic::OutputFile::bytes(p.clone(), &b[..])).collect();
+        let written = gyrolab_io::atomic::write_outputs(outputs, &[args.file.as_path()]).map_err(EvalError::from)?;
         for w in &warnings {
             eprintln!("warning: {w}");
         }

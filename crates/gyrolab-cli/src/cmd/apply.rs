@@ -4,6 +4,7 @@ use crate::error::{CliError, CliResult};
 use clap::Args;
 use gyrolab_eval::apply::{apply_to, prepare_apply, stage_input, ApplyRequest};
 use gyrolab_io::apply_csv::{ApplySummary, StreamError};
+use gyrolab_io::atomic::{write_outputs, OutputFile};
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 
@@ -58,7 +59,9 @@ pub fn run(args: &ApplyArgs) -> CliResult {
     let summary = match &args.out {
         Some(path) => {
             let (mut data_error, mut done) = (None, None);
-            let r = gyrolab_io::atomic::write_atomic_with(path, |w| match apply_to(&input, &plan, w, &mut progress) {
+            // Never over the record or the calibration file it applies.
+            let inputs = [args.input.as_path(), args.cal.as_path()];
+            let output = OutputFile::stream(path, |w| match apply_to(&input, &plan, w, &mut progress) {
                 Ok(s) => {
                     done = Some(s);
                     Ok(())
@@ -69,11 +72,12 @@ pub fn run(args: &ApplyArgs) -> CliResult {
                     Err(std::io::Error::other("bad input"))
                 }
             });
+            let r = write_outputs(vec![output], &inputs);
             bar.finish_and_clear();
             if let Some(d) = data_error {
                 return Err(d.into());
             }
-            r.map_err(|e| CliError::Output(format!("{}: cannot write the file: {e}", path.display())))?;
+            r.map_err(crate::output::output_error)?;
             done.unwrap_or_default()
         }
         None => {

@@ -188,6 +188,16 @@ pub fn run(args: &BatchArgs) -> CliResult {
     let file = sink.file.into_inner().unwrap_or_else(|p| p.into_inner());
     file.sync_data().map_err(|e| CliError::Output(format!("{}: {e}", args.out.join(JOURNAL).display())))?;
     let now = outcome.evaluated.len();
+    // The batch's inputs, which no table may overwrite (`--out .` among the records).
+    let input_files: Vec<PathBuf> = outcome
+        .evaluated
+        .iter()
+        .map(|d| d.file.clone())
+        .chain(outcome.failures.iter().map(|f| f.file.clone()))
+        .chain(outcome.skipped.iter().map(|s| match s {
+            Skipped::AlreadyDone { file } | Skipped::SameAs { file, .. } => file.clone(),
+        }))
+        .collect();
     for d in outcome.evaluated {
         journal.entries.insert(d.sha256.clone(), d);
     }
@@ -207,8 +217,8 @@ pub fn run(args: &BatchArgs) -> CliResult {
     if let Some(f) = &failures_csv {
         files.push(("failures.csv", f.as_bytes()));
     }
-    gyrolab_io::atomic::write_folder(&args.out, &files)
-        .map_err(|(path, e)| CliError::Output(format!("{}: cannot write the file: {e}", path.display())))?;
+    let inputs: Vec<&std::path::Path> = input_files.iter().map(PathBuf::as_path).collect();
+    gyrolab_io::atomic::write_folder(&args.out, &files, &inputs).map_err(crate::output::output_error)?;
     if failures_csv.is_none() {
         // A list of failures from an earlier run would no longer be true.
         let _ = std::fs::remove_file(args.out.join("failures.csv"));

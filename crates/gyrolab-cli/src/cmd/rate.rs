@@ -2,17 +2,19 @@
 //! per output column), or a three-axis set (`--triad`).
 
 use crate::error::{CliError, CliResult};
-use crate::output::{print, to_json, write_file};
+use crate::output::{output_error, print, to_json, write_file};
 use clap::Args;
 use gyrolab::triad::TableAxis;
 use gyrolab::units::{OutputUnit, RateUnit};
 use gyrolab_eval::rate::{calibration_file, evaluate_rates, EvaluatedAxis, RateRequest, RateSettings};
 use gyrolab_eval::raw_log::SegmentationRequest;
 use gyrolab_eval::triad::{evaluate_triad, TriadRequest};
+use gyrolab_io::atomic::{write_outputs, OutputFile};
 use gyrolab_io::rate_table::RateColumns;
 use gyrolab_report::rate::{rate_json, rate_points_table, rate_summary_table, AxisReport};
 use gyrolab_report::segments::{segmentation_text, SegmentationJson, SegmentationReport};
 use gyrolab_report::triad::{triad_json, triad_text};
+use std::path::Path;
 use std::path::PathBuf;
 
 /// Options of `gyrolab rate`.
@@ -156,11 +158,17 @@ pub fn run(args: &RateArgs) -> CliResult {
         return run_triad(args);
     }
     let outcome = evaluate_rates(&args.request())?;
+    // The segments and the calibration written together (all or none), never over a record.
+    let mut files = Vec::new();
     if let (Some(out), Some(log)) = (&args.segments_out, outcome.logs.first()) {
-        write_file(out, log.segments_csv().as_bytes())?;
+        files.push(OutputFile::bytes(out, log.segments_csv().into_bytes()));
     }
     if let Some(cal) = &args.cal_out {
-        write_file(cal, cal_toml(&calibration_file(&outcome.axes))?.as_bytes())?;
+        files.push(OutputFile::bytes(cal, cal_toml(&calibration_file(&outcome.axes))?.into_bytes()));
+    }
+    if !files.is_empty() {
+        let inputs: Vec<&Path> = args.files.iter().map(PathBuf::as_path).collect();
+        write_outputs(files, &inputs).map_err(output_error)?;
     }
     let reports: Vec<AxisReport<'_>> = outcome.axes.iter().map(EvaluatedAxis::report).collect();
     let seg_reports: Vec<SegmentationReport<'_>> = outcome.logs.iter().map(|l| l.report()).collect();
@@ -208,7 +216,8 @@ fn run_triad(args: &RateArgs) -> CliResult {
     };
     let t = evaluate_triad(&request)?;
     if let Some(cal) = &args.cal_out {
-        write_file(cal, cal_toml(&t.calibration_file())?.as_bytes())?;
+        let inputs: Vec<&Path> = args.triad.iter().map(|(_, f)| f.as_path()).collect();
+        write_file(cal, cal_toml(&t.calibration_file())?.as_bytes(), &inputs)?;
     }
     let report = t.report();
     if args.json {

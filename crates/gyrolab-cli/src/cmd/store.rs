@@ -299,7 +299,7 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
 /// file of `--parquet` first (whole or not at all).
 fn emit(table: &Table, output: &QueryOutput, json: impl FnOnce() -> CliResult<String>) -> CliResult {
     if let Some(path) = &output.parquet {
-        write_file(path, &to_parquet(table)?)?;
+        write_file(path, &to_parquet(table)?, &[])?;
     }
     if output.json {
         print(&json()?)
@@ -353,7 +353,7 @@ fn history(a: &HistoryArgs) -> CliResult {
         rows.retain(|r| &r.figure.figure == f);
     }
     if let Some(path) = &a.svg {
-        write_file(path, history_svg(&a.serial, &rows)?.as_bytes())?;
+        write_file(path, history_svg(&a.serial, &rows)?.as_bytes(), &[])?;
     }
     emit(&history_table(&rows), &a.format, || to_json(&rows))
 }

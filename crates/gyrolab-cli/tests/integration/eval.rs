@@ -579,3 +579,27 @@ fn plan_exports_write_filter_files_from_the_static_allan_analysis() {
     assert!(err.contains("plan.toml:7:") && err.contains("options.exports") && err.contains("gtsam"), "{err}");
     assert!(!dir.path().join("o2").exists());
 }
+
+/// An output never overwrites an input (issue 53): a rate-table record named like a file of the
+/// report (`points_x.csv`) in the folder given as `--out` is refused with exit 2 before anything
+/// is written; the record is unchanged and the folder holds no file of the report.
+#[test]
+fn eval_never_overwrites_an_input_in_its_out_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = read(&example_plan());
+    let mut text = text.replace("../data/paper/", "");
+    for axis in ["x", "y", "z"] {
+        let name = format!("paper_rate_table_{axis}.csv");
+        let local = if axis == "x" { "points_x.csv".to_string() } else { name.clone() };
+        std::fs::copy(common::paper(&name), dir.path().join(&local)).unwrap();
+        text = text.replace(&name, &local);
+    }
+    let plan = write(dir.path(), "plan.toml", &text);
+    let before = std::fs::read(dir.path().join("points_x.csv")).unwrap();
+    let o = gyrolab().arg("eval").arg(&plan).arg("--out").arg(dir.path()).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("points_x.csv") && err.contains("never overwrites an input"), "{err}");
+    assert_eq!(std::fs::read(dir.path().join("points_x.csv")).unwrap(), before);
+    assert!(!dir.path().join("results.json").exists() && !dir.path().join("report.html").exists());
+}

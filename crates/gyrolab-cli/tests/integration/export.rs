@@ -394,3 +394,94 @@ fn simulated_inputs_are_marked_in_the_text_reports() {
     assert!(!stdout(&["allan"], &measured).contains("SIMULATED"), "allan, measured");
     assert!(!stdout(&["bias"], &measured).contains("SIMULATED"), "bias, measured");
 }
+
+/// The names of the files in `dir`, sorted.
+fn names_in(dir: &std::path::Path) -> Vec<String> {
+    let mut v: Vec<String> =
+        std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    v.sort();
+    v
+}
+
+/// Every output of `allan` all or none (issue 54): four exports with a folder where the px4 file
+/// goes, the Kalibr and imu_utils files beside them, existing files of an earlier run. Nothing
+/// is replaced, nothing new appears, no temporary is left, and the message says what is there.
+#[test]
+fn allan_outputs_are_written_all_or_none() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = simulate(dir.path());
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("k.yaml"), "earlier run\n").unwrap();
+    std::fs::create_dir(out.join("px4.params")).unwrap();
+    let run = |px4: &str| {
+        let mut c = gyrolab();
+        c.current_dir(&out).arg("allan").arg(&sim);
+        for t in ["kalibr=k.yaml", "openvins=ov.yaml", px4, "vins=v.yaml"] {
+            c.args(["--export", t]);
+        }
+        c.args(["--kalibr-yaml", "kalibr_plain.yaml", "--imu-utils-yaml", "imu_utils.yaml"]);
+        c
+    };
+    let before = names_in(&out);
+    let err = run("px4=px4.params").assert().code(2).get_output().stderr.clone();
+    let err = String::from_utf8_lossy(&err);
+    assert!(err.contains("px4.params") && err.contains("a folder"), "{err}");
+    assert!(err.contains("no file of this run was written") && err.contains("left as they were: k.yaml"), "{err}");
+    assert!(err.contains("not there: ") && err.contains("v.yaml"), "{err}");
+    assert_eq!(names_in(&out), before);
+    assert_eq!(std::fs::read_to_string(out.join("k.yaml")).unwrap(), "earlier run\n");
+    // The same run with a file target: all six files, the earlier k.yaml replaced.
+    run("px4=px4.txt").assert().success();
+    assert_eq!(
+        names_in(&out),
+        ["imu_utils.yaml", "k.yaml", "kalibr_plain.yaml", "ov.yaml", "px4.params", "px4.txt", "v.yaml"]
+    );
+    assert!(std::fs::read_to_string(out.join("k.yaml")).unwrap().contains("gyroscope_noise_density"));
+}
+
+/// A full disk (a file-size limit of 1 KiB, below a Kalibr file's size, with SIGXFSZ ignored so
+/// that a write fails with EFBIG as on a full file system): no output is left behind, the
+/// earlier file stays, no temporary is left, exit 1 with the file named.
+#[cfg(unix)]
+#[test]
+fn a_full_disk_leaves_every_output_as_it_was() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = simulate(dir.path());
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("k.yaml"), "earlier run\n").unwrap();
+    let bin = assert_cmd::cargo::cargo_bin("gyrolab");
+    let script = format!(
+        "trap '' XFSZ; ulimit -f 1; exec '{}' allan '{}' --export kalibr=k.yaml --export openvins=ov.yaml --kalibr-yaml big.yaml",
+        bin.display(),
+        sim.display()
+    );
+    let o = std::process::Command::new("sh").arg("-c").arg(&script).current_dir(&out).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("cannot write the file") && err.contains("no file of this run was written"), "{err}");
+    assert_eq!(names_in(&out), ["k.yaml"], "{err}");
+    assert_eq!(std::fs::read_to_string(out.join("k.yaml")).unwrap(), "earlier run\n");
+}
+
+/// An output never overwrites an input: an export named as the record itself is refused (exit
+/// 2) before anything is written, and the record is unchanged.
+#[test]
+fn an_export_never_overwrites_the_record() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = simulate(dir.path());
+    let before = std::fs::read(&sim).unwrap();
+    let err = gyrolab()
+        .current_dir(dir.path())
+        .args(["allan", "sim.csv", "--export", "kalibr=k.yaml", "--export", "vins=./sim.csv"])
+        .assert()
+        .code(2)
+        .get_output()
+        .stderr
+        .clone();
+    let err = String::from_utf8_lossy(&err);
+    assert!(err.contains("never overwrites an input"), "{err}");
+    assert_eq!(std::fs::read(&sim).unwrap(), before);
+    assert!(!dir.path().join("k.yaml").exists());
+}

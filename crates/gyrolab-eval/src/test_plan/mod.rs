@@ -337,7 +337,9 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         temperature_models: thermal.compensation,
         simulated_rate: plan.device.simulated.clone(),
     };
-    assemble_report(inputs, progress)
+    let mut folder = assemble_report(inputs, progress)?;
+    folder.inputs = std::iter::once(plan.file.clone()).chain(plan.input_files()).collect();
+    Ok(folder)
 }
 
 /// The report's test conditions and equipment rows: each piece of equipment's calibration status

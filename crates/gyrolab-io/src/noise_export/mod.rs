@@ -21,7 +21,6 @@
 //!   `orientation_covariance[0] = -1` when no orientation is given (the message's comment).
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
 
 /// A filter stack gyrolab writes noise parameters for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -524,26 +523,6 @@ impl NoiseExport {
         let _ = writeln!(s, "linear_acceleration_covariance: {}   # (m/s^2)^2", matrix(slots[2].term));
         s
     }
-}
-
-/// Why the export files could not be written.
-#[derive(Debug, thiserror::Error)]
-pub enum ExportError {
-    /// A file could not be written; no file of the run was (see [`crate::atomic::write_files`]).
-    #[error("{}: {source} (no export file was written)", .path.display())]
-    Write {
-        /// The file.
-        path: PathBuf,
-        /// The error.
-        source: std::io::Error,
-    },
-}
-
-/// Writes every (stack, file) of a run, all or none.
-pub fn write_exports(noise: &NoiseExport, targets: &[(Stack, PathBuf)]) -> Result<Vec<PathBuf>, ExportError> {
-    let files: Vec<(PathBuf, Vec<u8>)> =
-        targets.iter().map(|(stack, path)| (path.clone(), noise.render(*stack).into_bytes())).collect();
-    crate::atomic::write_files(&files).map_err(|(path, source)| ExportError::Write { path, source })
 }
 
 /// Whether a file was written by gyrolab's simulator (its first line says so), for the

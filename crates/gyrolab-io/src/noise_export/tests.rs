@@ -132,22 +132,6 @@ fn a_missing_term_is_named_not_invented() {
 }
 
 #[test]
-fn exports_are_written_all_or_none() {
-    let dir = tempfile::tempdir().unwrap();
-    let n = sample();
-    let good = dir.path().join("kalibr.yaml");
-    let bad = dir.path().join("no_such_folder").join("px4.params");
-    let err = write_exports(&n, &[(Stack::Kalibr, good.clone()), (Stack::Px4, bad)]).unwrap_err();
-    assert!(err.to_string().contains("no_such_folder"), "{err}");
-    assert!(!good.exists());
-    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "a temporary was left");
-    let written =
-        write_exports(&n, &[(Stack::Kalibr, good.clone()), (Stack::Basalt, dir.path().join("b.json"))]).unwrap();
-    assert_eq!(written.len(), 2);
-    assert_eq!(std::fs::read_to_string(&good).unwrap(), n.render(Stack::Kalibr));
-}
-
-#[test]
 fn stack_names_parse() {
     for s in STACKS {
         assert_eq!(Stack::parse(s.name()), Some(s));

@@ -33,7 +33,7 @@ fn evaluated_copy(dir: &Path) -> (PathBuf, PathBuf) {
             .unwrap();
     let out = dir.join("report");
     let files: Vec<(&str, &[u8])> = folder.outputs.iter().map(|o| (o.name.as_str(), o.bytes.as_slice())).collect();
-    gyrolab_io::atomic::write_folder(&out, &files).unwrap();
+    gyrolab_io::atomic::write_folder(&out, &files, &[]).unwrap();
     (plan, out)
 }
 
