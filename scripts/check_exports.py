@@ -127,16 +127,21 @@ def main():
 
         vins = yaml_without_directive(paths["vins"])
         vins_fs = cv2.FileStorage(paths["vins"], cv2.FILE_STORAGE_READ)
-        for key, want in [("gyr_n", ng), ("gyr_w", kg), ("acc_n", na), ("acc_w", ka)]:
+        # Per IMU sample, as VINS-Fusion's integration_base.h propagates them: N sqrt(2 f), K sqrt(f).
+        for key, want in [("gyr_n", ng * math.sqrt(2 * RATE)), ("gyr_w", kg * math.sqrt(RATE)),
+                          ("acc_n", na * math.sqrt(2 * RATE)), ("acc_w", ka * math.sqrt(RATE))]:
             check(close(vins[key], want), f"vins (PyYAML) {key}")
             check(close(vins_fs.getNode(key).real(), want, 1e-9), f"vins (OpenCV) {key}")
 
         orb = cv2.FileStorage(paths["orbslam3"], cv2.FILE_STORAGE_READ)
         for key, want in [("IMU.NoiseGyro", ng), ("IMU.GyroWalk", kg), ("IMU.NoiseAcc", na),
-                          ("IMU.AccWalk", ka), ("IMU.Frequency", RATE)]:
+                          ("IMU.AccWalk", ka)]:
             node = orb.getNode(key)
-            check(node.isReal(), f"orbslam3 {key} is a real (ORB-SLAM3 refuses other types)")
+            check(node.isReal(), f"orbslam3 {key} is a real (ORB-SLAM3's ParseIMUParamFile refuses other types)")
             check(close(node.real(), want), f"orbslam3 {key}")
+        node = orb.getNode("IMU.Frequency")
+        check(node.isInt(), "orbslam3 IMU.Frequency is an integer (ParseIMUParamFile refuses a real)")
+        check(node.real() == round(RATE), "orbslam3 IMU.Frequency")
 
         basalt = json.load(open(paths["basalt"], encoding="utf-8"))["value0"]
         check(close(basalt["imu_update_rate"], RATE), "basalt imu_update_rate")

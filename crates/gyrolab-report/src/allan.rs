@@ -1008,8 +1008,10 @@ fn filter_file(channels: &[ChannelAnalysis], update_rate_hz: f64, imu_utils: boo
     let name = |i: usize| format!("{} ({})", channels[i].file, channels[i].channel);
     let mut text = if imu_utils {
         format!(
-            "%YAML:1.0\n---\n# imu_utils / VINS-Mono style IMU noise parameters written by gyrolab {}\n\
-             # Continuous-time values (the convention of imu_utils, VINS and Kalibr):\n\
+            "%YAML:1.0\n---\n# imu_utils style IMU noise parameters written by gyrolab {}\n\
+             # Continuous-time values, as imu_utils prints them. VINS-Fusion's propagation takes its gyr_n,\n\
+             # gyr_w, acc_n, acc_w per IMU sample instead (density x sqrt(2 rate), walk x sqrt(rate)):\n\
+             # `--export vins=FILE` writes those (docs/EXPORTS.md).\n\
              # gyr_n: gyro white noise density, rad/s/sqrt(Hz); gyr_w: gyro random walk, rad/s^2/sqrt(Hz);\n\
              # acc_n: accelerometer white noise density, m/s^2/sqrt(Hz); acc_w: accelerometer random walk, m/s^3/sqrt(Hz).\n",
             env!("CARGO_PKG_VERSION")
@@ -1114,7 +1116,8 @@ pub fn kalibr_yaml(channels: &[ChannelAnalysis], update_rate_hz: f64) -> Option<
     filter_file(channels, update_rate_hz, false)
 }
 
-/// imu_utils / VINS-style YAML (`gyr_n`, `gyr_w`, `acc_n`, `acc_w`, continuous time) for the
+/// imu_utils-style YAML (`gyr_n`, `gyr_w`, `acc_n`, `acc_w`, continuous time, as imu_utils prints
+/// them; VINS-Fusion's per-sample values are the `vins` export's) for the
 /// analysed channels. `None` when no channel has noise terms.
 pub fn imu_utils_yaml(channels: &[ChannelAnalysis], update_rate_hz: f64) -> Option<KalibrFile> {
     filter_file(channels, update_rate_hz, true)

@@ -38,7 +38,9 @@ pub struct AllanArgs {
     /// `warning:` on stderr.
     #[arg(long, value_name = "FILE.yaml")]
     pub kalibr_yaml: Option<PathBuf>,
-    /// Write an imu_utils / VINS-style YAML (gyr_n, gyr_w, acc_n, acc_w), by the same rule.
+    /// Write an imu_utils-style YAML (gyr_n, gyr_w, acc_n, acc_w as continuous-time densities, as
+    /// imu_utils prints them), by the same rule; for VINS-Fusion's per-sample values use
+    /// `--export vins=FILE`.
     #[arg(long, value_name = "FILE.yaml")]
     pub imu_utils_yaml: Option<PathBuf>,
     /// Memory ceiling (such as 1GiB, 512MiB, 2GB; default: half the machine's memory): a

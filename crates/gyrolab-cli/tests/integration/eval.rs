@@ -563,7 +563,7 @@ fn plan_exports_write_filter_files_from_the_static_allan_analysis() {
     // By hand: N deg/sqrt(h) / 60 = deg/sqrt(s), x pi/180 = rad/s/sqrt(Hz).
     let want = arw / 60.0 * std::f64::consts::PI / 180.0;
     assert!((density / want - 1.0).abs() < 1e-9, "{density} vs {want}\n{kalibr}");
-    assert!(kalibr.contains("update_rate: 100.0") && kalibr.contains("long.csv"), "{kalibr}");
+    assert!(kalibr.contains("update_rate: 100\n") && kalibr.contains("long.csv"), "{kalibr}");
     let px4 = read(&out.join("noise_px4.txt"));
     let gyr = px4
         .lines()

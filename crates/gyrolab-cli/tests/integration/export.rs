@@ -80,9 +80,10 @@ fn gmwm_is_the_basis_when_asked() {
     let sim = simulate(dir.path());
     let text = gmwm_export(&sim, "vins", &dir.path().join("vins.yaml"));
     assert!(text.contains("estimator: gmwm") && text.contains("gmwm: GMWM estimate"), "{text}");
-    // N = 0.3 deg/sqrt(h) = 0.005 deg/sqrt(s) = 8.727e-5 rad/s/sqrt(Hz): within 10 %.
+    // N = 0.3 deg/sqrt(h) = 0.005 deg/sqrt(s) = 8.727e-5 rad/s/sqrt(Hz), and VINS's gyr_n per
+    // sample at 50 Hz N sqrt(2 x 50): within 10 %.
     let n = value(&text, "gyr_n");
-    assert!((n / (0.005f64.to_radians()) - 1.0).abs() < 0.1, "{n}");
+    assert!((n / (0.005f64.to_radians() * 100f64.sqrt()) - 1.0).abs() < 0.1, "{n}");
     assert_eq!(allan_json(&sim)["channels"][0]["gmwm"]["sided"], "two-sided");
 }
 

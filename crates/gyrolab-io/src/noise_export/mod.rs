@@ -5,10 +5,16 @@
 //!   white noise, sigma_bd = sigma_b / sqrt(rate) for a random walk);
 //! - OpenVINS: `kalibr_imu_chain.yaml` of its configs (`%YAML:1.0`, `imu0:` with Kalibr's keys,
 //!   read with OpenCV FileStorage);
-//! - VINS-Fusion / VINS-Mono: `acc_n`, `gyr_n`, `acc_w`, `gyr_w` in the `%YAML:1.0` config
-//!   (continuous-time, the imu_utils convention);
+//! - VINS-Fusion / VINS-Mono: `acc_n`, `gyr_n`, `acc_w`, `gyr_w` in the `%YAML:1.0` config,
+//!   per IMU sample as VINS-Fusion's midpoint propagation takes them
+//!   (`vins_estimator/src/factor/integration_base.h` at be55a937, lines 30-36 and 118-134: the
+//!   noise matrix holds GYR_N^2 twice and GYR_W^2 without dt, V has 0.5 dt on both gyro noises
+//!   and dt on the walks, so the angle variance grows by 0.5 GYR_N^2 dt^2 a sample and the bias
+//!   variance by GYR_W^2 dt^2): GYR_N = N sqrt(2 f), GYR_W = K sqrt(f), f the sample rate;
 //! - ORB-SLAM3: `IMU.NoiseGyro`, `IMU.NoiseAcc`, `IMU.GyroWalk`, `IMU.AccWalk` (continuous,
-//!   Tracking.cc multiplies the noises by sqrt(IMU.Frequency) and divides the walks by it);
+//!   Tracking.cc `ParseIMUParamFile` and Settings.cc `readIMU` multiply the noises by
+//!   sqrt(IMU.Frequency) and divide the walks by it); `IMU.Frequency` an integer (the parser
+//!   before 1.0 refuses a real);
 //! - Basalt: calibration JSON `gyro_noise_std`, `accel_noise_std` (continuous; its
 //!   `dicrete_time_*_noise_std()` multiply by sqrt(imu_update_rate)), `gyro_bias_std`,
 //!   `accel_bias_std` (continuous random-walk densities);
@@ -175,13 +181,20 @@ pub fn real_text(v: f64) -> String {
     format!("{mantissa}e{sign}{digits:0>2}")
 }
 
-/// The rate as text with a decimal point (an OpenCV real, a YAML float).
+/// A rate whole to within 1e-9 of itself (200.00000000635782 from a clock's stamps), as that
+/// whole number; `None` for any other rate.
+pub fn whole_rate(v: f64) -> Option<i64> {
+    let r = v.round();
+    (v.is_finite() && r >= 1.0 && r < 1e15 && (v - r).abs() <= 1e-9 * v.abs()).then_some(r as i64)
+}
+
+/// The rate as text: a whole rate as an integer (`200`, as Kalibr's and ORB-SLAM3's own files
+/// write it; every reader of these files takes an integer where it reads a real), any other as
+/// the shortest decimal that reads back to it.
 fn rate_text(v: f64) -> String {
-    let s = format!("{v}");
-    if s.contains('.') || s.contains('e') {
-        s
-    } else {
-        format!("{s}.0")
+    match whole_rate(v) {
+        Some(n) => n.to_string(),
+        None => format!("{v}"),
     }
 }
 
@@ -257,7 +270,13 @@ impl NoiseExport {
         h.push(format!("sample rate: {} Hz", rate_text(self.rate_hz)));
         h.push(format!("estimator: {}", self.estimator));
         h.extend(self.unrepresented.iter().map(|m| format!("NOT REPRESENTED: {}", one_line(m))));
-        h.push(if matches!(stack, Stack::Px4 | Stack::Px4Qgc) {
+        h.push(if stack == Stack::Vins {
+            format!(
+                "time convention: per IMU sample at {} Hz, as VINS-Fusion's midpoint propagation takes them \
+                 (integration_base.h): gyr_n = N sqrt(2 rate), gyr_w = K sqrt(rate), acc_n and acc_w likewise",
+                rate_text(self.rate_hz)
+            )
+        } else if matches!(stack, Stack::Px4 | Stack::Px4Qgc) {
             format!(
                 "time convention: per EKF2 prediction step at {} Hz (density x sqrt(step rate); see below)",
                 rate_text(PX4_DEFAULT_EKF_HZ)
@@ -402,12 +421,37 @@ impl NoiseExport {
         s
     }
 
+    /// VINS-Fusion's values per IMU sample (see the module documentation): white noise
+    /// N sqrt(2 f), random walk K sqrt(f), f the sample rate.
+    pub fn vins_values(&self) -> [Option<f64>; 4] {
+        let f = self.rate_hz;
+        let factors = [(2.0 * f).sqrt(), f.sqrt(), (2.0 * f).sqrt(), f.sqrt()];
+        let slots = self.slots();
+        std::array::from_fn(|i| slots[i].term.map(|t| t.value * factors[i]))
+    }
+
     fn vins(&self) -> String {
         let mut s = String::from("%YAML:1.0\n");
         s.push_str(&self.comment_header(Stack::Vins, "# "));
-        s.push_str("# The IMU entries of a VINS-Fusion / VINS-Mono config: paste them into yours (its other keys are\n# the cameras'); VINS's own EuRoC config uses values 50 to 60 times the sensor's densities.\n");
+        s.push_str(
+            "# The IMU entries of a VINS-Fusion / VINS-Mono config: paste them into yours (its other keys are\n\
+             # the cameras'). Per IMU sample, as vins_estimator/src/factor/integration_base.h propagates them\n\
+             # (midpoint step: angle variance + 0.5 gyr_n^2 dt^2, bias variance + gyr_w^2 dt^2 a sample), so\n\
+             # gyr_n = density x sqrt(2 x rate) and gyr_w = random walk x sqrt(rate); the densities are in the\n\
+             # header above. One value for every axis (VINS takes one): the largest of the axes.\n",
+        );
         let keys = ["gyr_n", "gyr_w", "acc_n", "acc_w"];
-        s.push_str(&self.yaml_entries(keys, ""));
+        let units = ["rad/s", "rad/s^2", "m/s^2", "m/s^3"];
+        for (((key, value), slot), unit) in keys.iter().zip(self.vins_values()).zip(self.slots()).zip(units) {
+            match (value, slot.term) {
+                (Some(v), Some(t)) => {
+                    let _ = writeln!(s, "{key}: {}   # {unit} per sample, {}", real_text(v), t.source.basis);
+                }
+                _ => {
+                    let _ = writeln!(s, "# {key}: not written ({} not estimated)", slot.what);
+                }
+            }
+        }
         s.push_str("# g_norm: your local gravity, m/s^2 (not estimated by gyrolab)\n");
         s
     }
@@ -417,7 +461,16 @@ impl NoiseExport {
         s.push_str(&self.comment_header(Stack::Orbslam3, "# "));
         s.push_str("# The IMU entries of an ORB-SLAM3 settings file (continuous time: ORB-SLAM3 multiplies the\n# noises by sqrt(IMU.Frequency) and divides the walks by it).\n");
         s.push_str(&self.yaml_entries(["IMU.NoiseGyro", "IMU.GyroWalk", "IMU.NoiseAcc", "IMU.AccWalk"], ""));
-        let _ = writeln!(s, "IMU.Frequency: {}", rate_text(self.rate_hz));
+        // An integer: ORB-SLAM3's parser before 1.0 (Tracking.cc ParseIMUParamFile) refuses a real.
+        let whole = self.rate_hz.round().max(1.0);
+        if whole_rate(self.rate_hz).is_none() {
+            let _ = writeln!(
+                s,
+                "# the record's rate is {} Hz; IMU.Frequency is the nearest integer (ORB-SLAM3 before 1.0 reads an integer only)",
+                self.rate_hz
+            );
+        }
+        let _ = writeln!(s, "IMU.Frequency: {}", whole as i64);
         s
     }
 
@@ -538,3 +591,6 @@ pub fn is_gyrolab_simulation(path: &std::path::Path) -> bool {
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod propagation;

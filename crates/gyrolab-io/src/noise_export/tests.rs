@@ -29,7 +29,7 @@ pub(super) fn sample() -> NoiseExport {
 }
 
 /// The value of `key` in `key: value` or `param set key value` or tab-separated lines.
-fn value_of(text: &str, key: &str) -> Option<f64> {
+pub(super) fn value_of(text: &str, key: &str) -> Option<f64> {
     for line in text.lines() {
         let l = line.trim();
         if l.starts_with('#') {
@@ -74,7 +74,6 @@ fn continuous_stacks_write_the_densities_under_their_keys() {
                 "accelerometer_random_walk",
             ],
         ),
-        (Stack::Vins, ["gyr_n", "gyr_w", "acc_n", "acc_w"]),
         (Stack::Orbslam3, ["IMU.NoiseGyro", "IMU.GyroWalk", "IMU.NoiseAcc", "IMU.AccWalk"]),
     ] {
         let text = n.render(stack);
@@ -84,8 +83,48 @@ fn continuous_stacks_write_the_densities_under_their_keys() {
         assert!(text.contains("SIMULATED"), "{text}");
         assert!(text.contains("upper_bound"), "{text}");
     }
-    assert_eq!(value_of(&n.render(Stack::Orbslam3), "IMU.Frequency"), Some(400.0));
-    assert_eq!(value_of(&n.render(Stack::Kalibr), "update_rate"), Some(400.0));
+    assert!(n.render(Stack::Orbslam3).contains("\nIMU.Frequency: 400\n"));
+    assert!(n.render(Stack::Kalibr).contains("\nupdate_rate: 400\n"));
+}
+
+/// VINS-Fusion's values per sample at 400 Hz, by hand: gyr_n = 1e-3 x sqrt(800) =
+/// 2.8284271e-2 rad/s, gyr_w = 2e-5 x sqrt(400) = 4e-4 rad/s^2, acc_n = 4e-3 x sqrt(800) =
+/// 1.1313708e-1 m/s^2, acc_w = 6e-4 x 20 = 1.2e-2 m/s^3 (the propagation test proves the rule).
+#[test]
+fn vins_values_are_per_sample() {
+    let text = sample().render(Stack::Vins);
+    for (k, want) in
+        [("gyr_n", 2.8284271247461903e-2), ("gyr_w", 4e-4), ("acc_n", 1.1313708498984761e-1), ("acc_w", 1.2e-2)]
+    {
+        let got = value_of(&text, k).unwrap();
+        assert!((got / want - 1.0).abs() < 1e-12, "{k}: {got}\n{text}");
+    }
+    assert!(text.contains("SIMULATED") && text.contains("per IMU sample at 400 Hz"), "{text}");
+}
+
+/// A rate whole to 1e-9 is written as an integer everywhere (Kalibr, OpenVINS, ORB-SLAM3,
+/// Basalt); another rate as its shortest decimal, and ORB-SLAM3's IMU.Frequency as the nearest
+/// integer with a comment giving the rate.
+#[test]
+fn whole_rates_are_integers() {
+    let mut n = sample();
+    n.rate_hz = 200.00000000635782;
+    for stack in [Stack::Kalibr, Stack::Openvins, Stack::Orbslam3, Stack::Basalt] {
+        let text = n.render(stack);
+        assert!(!text.contains("200.0000"), "{stack:?}\n{text}");
+    }
+    assert!(n.render(Stack::Kalibr).contains("\nupdate_rate: 200\n"));
+    assert!(n.render(Stack::Basalt).contains("\"imu_update_rate\": 200,"));
+    n.rate_hz = 204.58265139116196;
+    assert!(n.render(Stack::Kalibr).contains("\nupdate_rate: 204.58265139116196\n"));
+    let orb = n.render(Stack::Orbslam3);
+    assert!(
+        orb.contains("\nIMU.Frequency: 205\n") && orb.contains("the record's rate is 204.58265139116196 Hz"),
+        "{orb}"
+    );
+    assert_eq!(whole_rate(199.9999), None);
+    assert_eq!(whole_rate(199.99999999), Some(200));
+    assert_eq!(whole_rate(0.2), None);
 }
 
 #[test]
