@@ -280,6 +280,9 @@ pub enum ReadNote {
     Topic(TopicMeta),
     /// The recording ends early or is damaged: what was read is analysed.
     Truncated(String),
+    /// An IMU topic left out because no topic was named and it is no sensor's own sample
+    /// stream (a snapshot, an integrated or a too-short topic).
+    TopicSkipped(gyrolab_io::recording::SkippedTopic),
 }
 
 impl std::fmt::Display for ReadNote {
@@ -402,6 +405,12 @@ impl std::fmt::Display for ReadNote {
                 Ok(())
             }
             ReadNote::Truncated(what) => f.write_str(what),
+            ReadNote::TopicSkipped(s) => write!(
+                f,
+                "topic {} skipped: {}; name it with {{topics}} to analyse it anyway",
+                gyrolab_io::text::excerpt(&s.topic),
+                s.reason
+            ),
             ReadNote::SampleRateEstimated { hz } => {
                 write!(f, "sample rate {hz:.6} Hz, estimated from the time stamps (mean interval)")
             }
@@ -442,7 +451,7 @@ impl ReadNote {
     /// The note with its option placeholders (`{units}`) spelled by the front end.
     pub fn render(&self, spell: &dyn Fn(&str) -> String) -> String {
         let mut t = self.to_string();
-        for f in ["units", "gaps", "sample_rate_hz", "columns"] {
+        for f in ["units", "gaps", "sample_rate_hz", "columns", "topics"] {
             t = t.replace(&format!("{{{f}}}"), &spell(f));
         }
         t
@@ -935,12 +944,14 @@ pub fn analyse_records(request: &AllanRequest) -> EvalResult<Vec<AllanOutcome>> 
     })?;
     let records = read_records(path, &options, &request.topics)?;
     let mut outcomes = Vec::with_capacity(records.records.len());
+    let mut skipped: Vec<ReadNote> = records.skipped.iter().cloned().map(ReadNote::TopicSkipped).collect();
     for record in records.records {
         let rows = record.data.header.rows;
         let topic = record.topic;
         let mut outcome = analyse_data(request, &reference, record.data, topic.as_ref())
             .map_err(|e| located_in(e, rows, topic.as_ref()))?;
-        let mut notes = Vec::new();
+        // The topics skipped, said once, before the first topic analysed.
+        let mut notes = std::mem::take(&mut skipped);
         if let Some(t) = &topic {
             notes.push(ReadNote::Topic(t.clone()));
         }

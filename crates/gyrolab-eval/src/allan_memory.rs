@@ -220,7 +220,21 @@ pub fn analyse_records_within(
             return Ok((analyse_records(request)?, in_memory(Some(estimate))));
         }
         refuse_other_estimators(request, path, estimate, memory_bytes)?;
-        let (outcomes, summary) = recording::analyse_recording_streaming(request, memory_bytes, estimate, &counts)?;
+        // No topic named: the sensors at their own rate, as the in-memory path chooses them.
+        let (named, skipped) = if request.topics.is_empty() {
+            let reasons = counts.iter().map(|t| (t.topic.clone(), t.snapshot_reason()));
+            let (kept, skipped) = gyrolab_io::recording::sensor_topics(path, reasons)?;
+            (AllanRequest { topics: kept, ..request.clone() }, skipped)
+        } else {
+            (request.clone(), Vec::new())
+        };
+        let counts: Vec<_> = counts.into_iter().filter(|t| named.topics.contains(&t.topic)).collect();
+        let estimate = recording::counted_size(&counts);
+        let (mut outcomes, summary) = recording::analyse_recording_streaming(&named, memory_bytes, estimate, &counts)?;
+        if let Some(first) = outcomes.first_mut() {
+            let notes = skipped.into_iter().map(ReadNote::TopicSkipped).chain(std::mem::take(&mut first.notes));
+            first.notes = notes.collect();
+        }
         return Ok((outcomes, MemoryPath::Streaming(summary)));
     }
     if format == FileFormat::Parquet && request.topics.is_empty() {

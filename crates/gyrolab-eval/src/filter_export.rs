@@ -538,6 +538,12 @@ pub fn noise_export(
     combine_terms(&record, &channels, request)
 }
 
+/// The `MOTION: ...` lines of every channel of every topic of a recording that moved (the
+/// stillness check), for every output of the recording: one recording moved or did not.
+pub fn recording_motion(outcomes: &[AllanOutcome]) -> Vec<String> {
+    outcomes.iter().flat_map(|o| o.analyses.iter().filter_map(|a| a.motion_line())).collect()
+}
+
 /// The export files of every record of a run (one file per topic when there are several:
 /// imu.yaml -> imu_<topic>.yaml), made and checked but not written, and the warnings.
 #[allow(clippy::type_complexity)]
@@ -549,8 +555,11 @@ pub fn export_files(
     let several = outcomes.len() > 1;
     let mut files = Vec::new();
     let mut warnings = Vec::new();
+    // Motion is the recording's: every topic's file carries every channel that moved.
+    let motion = recording_motion(outcomes);
     for outcome in outcomes {
-        let (export, mut w) = noise_export(outcome, file, request)?;
+        let (mut export, mut w) = noise_export(outcome, file, request)?;
+        export.motion = motion.clone();
         // A channel that is neither a gyro's rate nor an accelerometer's specific force (no unit,
         // a typo in its name's unit, or a sensor output without a scale factor) has no terms a
         // stack takes: said, not dropped in silence.

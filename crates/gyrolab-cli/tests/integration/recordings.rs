@@ -529,3 +529,48 @@ fn recordings_beyond_the_ceiling_are_streamed_and_agree_with_memory() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("octave OADEV only") && err.contains("--memory"), "{err}");
 }
+
+/// Snapshot topics skipped (issue 54): on pyulog's sample_log_small.ulg (BSD-3-Clause) the
+/// default analysis takes sensor_combined only (250 Hz sensor samples); the three vehicle_imu
+/// (2 Hz, integrated) and six sensor_gyro / sensor_accel copies (1 Hz, 6 messages) are named
+/// with their reason, the Kalibr file is one file, exit 0; named with --topic, a snapshot is
+/// analysed as asked.
+#[test]
+fn snapshot_topics_are_skipped_unless_named() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let ulg = root.join("examples/recordings/px4_sample_log_small.ulg");
+    let dir = tempfile::tempdir().unwrap();
+    let out = gyrolab()
+        .current_dir(dir.path())
+        .arg("allan")
+        .arg(&ulg)
+        .args(["--kalibr-yaml", "imu.yaml", "--json"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let channels = doc["channels"].as_array().unwrap();
+    assert_eq!(channels.len(), 6, "sensor_combined's six channels only");
+    assert!(
+        channels
+            .iter()
+            .all(|c| c["topic"] == "sensor_combined" || c["file"].as_str().unwrap().contains("sensor_combined")),
+        "{channels:?}"
+    );
+    for t in ["vehicle_imu", "vehicle_imu.1", "vehicle_imu.2"] {
+        assert!(err.contains(&format!("topic {t} skipped: PX4's vehicle_imu")), "{t}: {err}");
+    }
+    for t in ["sensor_gyro", "sensor_gyro.2", "sensor_accel.1"] {
+        assert!(err.contains(&format!("topic {t} skipped: 6 messages at 1.000 Hz")), "{t}: {err}");
+    }
+    assert!(err.contains("name it with --topic to analyse it anyway"), "{err}");
+    let names: Vec<String> =
+        std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert_eq!(names, ["imu.yaml"]);
+    // Named, a snapshot is analysed (its curve as short as its record).
+    let out = gyrolab().arg("allan").arg(&ulg).args(["--topic", "vehicle_imu", "--json"]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["channels"].as_array().unwrap().len(), 6);
+}

@@ -154,6 +154,99 @@ pub struct TopicInfo {
     pub stamps_ns: Vec<i64>,
 }
 
+/// Fewer messages than this make no Allan curve worth a filter's parameters: such an IMU topic
+/// is skipped unless named.
+pub const MIN_CURVE_MESSAGES: u64 = 100;
+
+/// An IMU topic slower than this (mean rate over its span) is a snapshot or status copy, not a
+/// sensor's own sample stream (every MEMS IMU samples at tens of hertz or more): skipped unless
+/// named.
+pub const MIN_SENSOR_RATE_HZ: f64 = 10.0;
+
+/// An IMU topic left out of an analysis where no topic was named, and why.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct SkippedTopic {
+    /// The topic.
+    pub topic: String,
+    /// Why it is not a sensor's own sample stream.
+    pub reason: String,
+}
+
+/// Why an IMU topic is not a sensor's own samples at their rate, or `None` when it is: PX4's
+/// `vehicle_imu` (delta angles and velocities integrated over each publication interval), a
+/// topic of fewer than [`MIN_CURVE_MESSAGES`] messages, or one whose typical rate (`rate_hz`:
+/// from the median interval of its stamps, which a stray stamp does not move) is below
+/// [`MIN_SENSOR_RATE_HZ`] (PX4's 1 Hz `sensor_gyro` / `sensor_accel` copies of a default log).
+pub fn snapshot_reason(message_type: &str, messages: u64, rate_hz: Option<f64>) -> Option<String> {
+    let at = rate_hz.map_or(String::new(), |r| format!(" at {r:.3} Hz"));
+    if message_type == "vehicle_imu" {
+        return Some(format!(
+            "PX4's vehicle_imu ({messages} messages{at}): delta angles and velocities integrated over each interval, not the sensor's samples (sensor_combined, or sensor_gyro / sensor_accel logged at rate, hold those)"
+        ));
+    }
+    if let Some(r) = rate_hz.filter(|&r| r < MIN_SENSOR_RATE_HZ) {
+        return Some(format!(
+            "{messages} messages at {r:.3} Hz: slower than {MIN_SENSOR_RATE_HZ} Hz, a snapshot or status copy, not a sensor's own sample stream"
+        ));
+    }
+    (messages < MIN_CURVE_MESSAGES)
+        .then(|| format!("{messages} messages{at}: fewer than {MIN_CURVE_MESSAGES}, too few for an Allan curve"))
+}
+
+/// The rate of the median interval between successive stamps (ns, in order), Hz; `None` for
+/// fewer than two stamps or a median of zero.
+pub fn median_rate_hz(stamps_ns: &[i64]) -> Option<f64> {
+    let mut d: Vec<i64> = stamps_ns.windows(2).map(|w| w[1].saturating_sub(w[0])).collect();
+    if d.is_empty() {
+        return None;
+    }
+    let mid = d.len() / 2;
+    let (_, &mut median, _) = d.select_nth_unstable(mid);
+    (median > 0).then(|| 1e9 / median as f64)
+}
+
+impl TopicInfo {
+    /// [`snapshot_reason`] of this topic, its rate from its stamps when they were kept, else
+    /// from its span (a stray stamp can make that look slow: the decoded topics of an analysis
+    /// are judged by [`ImuTopic::snapshot_reason`]).
+    pub fn snapshot_reason(&self) -> Option<String> {
+        let rate = median_rate_hz(&self.stamps_ns).or_else(|| {
+            self.span_ns.and_then(|(a, b)| {
+                (b > a && self.messages > 1).then(|| (self.messages - 1) as f64 / ((b - a) as f64 * 1e-9))
+            })
+        });
+        snapshot_reason(&self.message_type, self.messages, rate)
+    }
+}
+
+/// The IMU topics analysed when none is named, from `(topic, why it is no sensor stream)`: the
+/// sensors at their own rate; the others are skipped, each with its reason. An error naming
+/// every IMU topic and its reason when none is left.
+pub fn sensor_topics(
+    path: &Path,
+    reasons: impl IntoIterator<Item = (String, Option<String>)>,
+) -> Result<(Vec<String>, Vec<SkippedTopic>), DataError> {
+    let (mut kept, mut skipped) = (Vec::new(), Vec::new());
+    for (topic, reason) in reasons {
+        match reason {
+            Some(reason) => skipped.push(SkippedTopic { topic, reason }),
+            None => kept.push(topic),
+        }
+    }
+    if kept.is_empty() && !skipped.is_empty() {
+        let list: Vec<String> =
+            skipped.iter().map(|s| format!("{} ({})", crate::text::excerpt(&s.topic), s.reason)).collect();
+        return Err(DataError::new(
+            path,
+            format!(
+                "no IMU topic is a sensor's own sample stream: {}; name a topic to analyse it anyway",
+                list.join("; ")
+            ),
+        ));
+    }
+    Ok((kept, skipped))
+}
+
 /// A decoded IMU topic.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImuTopic {
@@ -175,6 +268,12 @@ pub struct ImuTopic {
 }
 
 impl ImuTopic {
+    /// [`snapshot_reason`] of this decoded topic, its rate from the median interval of its
+    /// stamps.
+    pub fn snapshot_reason(&self) -> Option<String> {
+        snapshot_reason(&self.message_type, self.stamps_ns.len() as u64, median_rate_hz(&self.stamps_ns))
+    }
+
     /// The topic as a time series: `time_s` (seconds from the first stamp) and the channels,
     /// read by the header rules of a delimited file (units from the names, `options` for the
     /// rest); rows are messages.
@@ -237,10 +336,14 @@ pub struct FileRecords {
     pub records: Vec<FileRecord>,
     /// Where a recording ends early or is damaged (the messages before it are read).
     pub truncated: Option<String>,
+    /// IMU topics left out because none was named and they are no sensor's own sample stream
+    /// ([`sensor_topics`]).
+    pub skipped: Vec<SkippedTopic>,
 }
 
 /// Reads any file gyrolab reads, by its content: delimited text and Parquet as one table,
-/// MCAP, ROS 1 bags and ULog as one record per IMU topic (`topics` selects; empty: all).
+/// MCAP, ROS 1 bags and ULog as one record per IMU topic (`topics` selects; empty: every IMU
+/// topic that is a sensor's own sample stream, [`sensor_topics`]).
 pub fn read_records(path: &Path, options: &SeriesOptions, topics: &[String]) -> Result<FileRecords, DataError> {
     if path.as_os_str() == "-" {
         return read_stdin_records(path, options, topics);
@@ -297,14 +400,27 @@ impl OpenedFile {
                 ),
             ));
         }
-        let table = |data| FileRecords { format, records: vec![FileRecord { topic: None, data }], truncated: None };
+        let table = |data| FileRecords {
+            format,
+            records: vec![FileRecord { topic: None, data }],
+            truncated: None,
+            skipped: Vec::new(),
+        };
         match format {
             FileFormat::Sqlite => Err(sqlite_refused(path)),
             FileFormat::Text => Ok(table(crate::series::read_series_opened(path, file, size, options)?)),
             FileFormat::Parquet => Ok(table(crate::parquet_table::read_parquet_file(path, file, options)?)),
             _ => {
                 let opened = OpenedFile { path: path.to_path_buf(), file, format, size };
-                let rec = opened.read_recording(&RecordingOptions { topics: topics.to_vec(), ..Default::default() })?;
+                let mut rec =
+                    opened.read_recording(&RecordingOptions { topics: topics.to_vec(), ..Default::default() })?;
+                let mut skipped = Vec::new();
+                if topics.is_empty() {
+                    let (kept, left_out) =
+                        sensor_topics(path, rec.imu.iter().map(|t| (t.topic.clone(), t.snapshot_reason())))?;
+                    rec.imu.retain(|t| kept.contains(&t.topic));
+                    skipped = left_out;
+                }
                 let mut records = Vec::with_capacity(rec.imu.len());
                 for t in rec.imu {
                     let topic = t.topic.clone();
@@ -314,7 +430,7 @@ impl OpenedFile {
                     })?;
                     records.push(FileRecord { topic: Some(meta), data });
                 }
-                Ok(FileRecords { format, records, truncated: rec.truncated })
+                Ok(FileRecords { format, records, truncated: rec.truncated, skipped })
             }
         }
     }
@@ -415,7 +531,12 @@ fn read_stdin_records(path: &Path, options: &SeriesOptions, topics: &[String]) -
         ));
     }
     let data = crate::series::read_series_all(path, options)?;
-    Ok(FileRecords { format: FileFormat::Text, records: vec![FileRecord { topic: None, data }], truncated: None })
+    Ok(FileRecords {
+        format: FileFormat::Text,
+        records: vec![FileRecord { topic: None, data }],
+        truncated: None,
+        skipped: Vec::new(),
+    })
 }
 
 /// What [`read_recording`] reads.
