@@ -257,15 +257,18 @@ class AllanResult:
         estimator: str = "slopes",
         inflate: float = 1.0,
         overbound: bool = False,
+        allow_poor_fit: bool = False,
     ) -> str:
         """This channel's noise parameters as one filter stack's file (the text of ``gyrolab
         allan --export STACK=FILE``; docs/EXPORTS.md): ``stack`` one of kalibr, openvins, vins,
         orbslam3, basalt, px4, px4-qgc, ros-covariance. Returns the text; with ``path``, also
         writes it (whole or not at all). ``estimator``: slopes (default), fit or gmwm;
         ``inflate``: every value x this factor; ``overbound``: each value raised until its
-        model lies on or above the curve's upper confidence bounds. Warnings (bounds written,
-        terms not estimated) are issued as :class:`UserWarning`."""
-        return _export([self], self.record, self.tau0_s, stack, path, estimator, inflate, overbound)
+        model lies on or above the curve's upper confidence bounds; ``allow_poor_fit``: write
+        values from a GMWM fit flagged POOR FIT (refused by default with a
+        :class:`gyrolab.Error` whose ``keyword`` is ``allow_poor_fit``, as the command line exits 7).
+        Warnings (bounds written, terms not estimated) are issued as :class:`UserWarning`."""
+        return _export([self], self.record, self.tau0_s, stack, path, estimator, inflate, overbound, allow_poor_fit)
 
     def to_dataframe(self) -> Any:
         """The curve as a tidy pandas DataFrame: ``channel``, ``tau_s``, ``m``, ``dev``,
@@ -346,6 +349,7 @@ def _export(
     estimator: str,
     inflate: float,
     overbound: bool,
+    allow_poor_fit: bool = False,
 ) -> str:
     import warnings
 
@@ -354,7 +358,8 @@ def _export(
     terms = [t for t in (r._terms() for r in results) if t is not None]
     motion = [r.stillness["motion"] for r in results if r.stillness and r.stillness.get("motion")]
     text, notes = _gyrolab.render_export(
-        terms, record, 1.0 / tau0_s, stack, estimator, float(inflate), bool(overbound), motion
+        terms, record, 1.0 / tau0_s, stack, estimator, float(inflate), bool(overbound), motion,
+        bool(allow_poor_fit),
     )
     for n in notes:
         warnings.warn(n, UserWarning, stacklevel=3)
@@ -431,12 +436,16 @@ class AllanResults(Mapping[str, AllanResult]):
         estimator: str = "slopes",
         inflate: float = 1.0,
         overbound: bool = False,
+        allow_poor_fit: bool = False,
     ) -> str:
         """The record's noise parameters as one filter stack's file, gyro and accelerometer
         channels combined by the largest value per entry, as ``gyrolab allan --export`` does
         (see :meth:`AllanResult.export`)."""
         first = next(iter(self._results.values()))
-        return _export(list(self._results.values()), self.record, first.tau0_s, stack, path, estimator, inflate, overbound)
+        return _export(
+            list(self._results.values()), self.record, first.tau0_s, stack, path, estimator, inflate, overbound,
+            allow_poor_fit,
+        )
 
     def plot(self, ax: Any = None, asymptotes: bool = False, terms: Optional["AllanResults"] = None) -> Any:
         """Every channel's curve on one axes (one colour each; a gyro and an accelerometer have

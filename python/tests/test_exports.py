@@ -134,3 +134,20 @@ def test_gmwm_gauss_markov_process_from_python():
         warnings.simplefilter("ignore")
         kalibr = yaml.safe_load(r.export("kalibr", estimator="gmwm"))
     assert kalibr["gyroscope_random_walk"] == pytest.approx(want, rel=1e-6)
+
+
+def test_a_gmwm_poor_fit_is_refused_unless_allowed():
+    # White noise and a 0.2 Hz sine: a curve no GMWM model describes (POOR FIT), as the CLI's
+    # test; the export names allow_poor_fit, as `gyrolab allan` exits 7.
+    rng = np.random.default_rng(3)
+    t = np.arange(60_000) / 100.0
+    x = 0.05 * rng.standard_normal(t.size) + 0.5 * np.sin(2 * np.pi * 0.2 * t)
+    r = gyrolab.allan(x, rate_hz=100.0, units="deg/s")
+    with pytest.raises(gyrolab.Error) as e:
+        r.export("kalibr", estimator="gmwm")
+    assert e.value.keyword == "allow_poor_fit" and "GMWM POOR FIT" in str(e.value)
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        text = r.export("kalibr", estimator="gmwm", allow_poor_fit=True)
+    assert "GMWM POOR FIT" in text
+    assert any("POOR FIT" in str(x.message) for x in w)

@@ -5,7 +5,9 @@
 //! 4 some inputs of a batch failed (`gyrolab batch`: the others were evaluated and written);
 //! 5 the result is INCOMPLETE (`gyrolab eval`: no limit failed, but a required check could not be
 //! evaluated: a check not evaluated never counts as passed); 6 the result is CONDITIONAL (no
-//! limit failed, every check evaluated, at least one inside the guard band of its decision rule).
+//! limit failed, every check evaluated, at least one inside the guard band of its decision rule);
+//! 7 filter parameters would come from a GMWM fit flagged POOR FIT (`gyrolab allan --export
+//! --estimator gmwm`: nothing written; `--allow-poor-fit` writes them).
 
 use gyrolab_eval::EvalError;
 use std::process::ExitCode;
@@ -50,6 +52,7 @@ impl CliError {
     pub fn exit_code(&self) -> ExitCode {
         match self {
             CliError::Eval(EvalError::Output(_)) | CliError::Output(_) => ExitCode::from(1),
+            CliError::Eval(EvalError::PoorFit(_)) => ExitCode::from(7),
             CliError::Eval(_) => ExitCode::from(2),
             CliError::LimitFailed(_) | CliError::Changed(_) => ExitCode::from(3),
             CliError::SomeFailed(_) => ExitCode::from(4),

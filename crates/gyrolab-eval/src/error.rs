@@ -28,6 +28,11 @@ pub enum EvalError {
     /// An output (a plot, a serialised document, a simulated record) could not be produced.
     #[error("{0}")]
     Output(String),
+    /// Filter parameters would come from a fit flagged POOR FIT and that was not allowed
+    /// (front ends give it its own exit code or exception); the message names the field that
+    /// allows it as `{allow_poor_fit}`.
+    #[error("{}", .0.replace("{allow_poor_fit}", "`allow_poor_fit`"))]
+    PoorFit(String),
 }
 
 impl EvalError {
@@ -36,6 +41,7 @@ impl EvalError {
         match self {
             EvalError::Invalid(e) => e.render(&spell(e.field)),
             EvalError::Conflict { message, fields } => render_fields(message, fields, spell),
+            EvalError::PoorFit(message) => render_fields(message, &["allow_poor_fit"], spell),
             other => other.to_string(),
         }
     }

@@ -61,6 +61,9 @@ pub struct ExportRequest {
     pub inflate: f64,
     /// Overbound each value on its channel's curve (the factors are recorded).
     pub overbound: bool,
+    /// Write values from a GMWM fit flagged POOR FIT (its model does not describe the curve);
+    /// without it such an export is refused ([`EvalError::PoorFit`]).
+    pub allow_poor_fit: bool,
 }
 
 /// Parses a stack name.
@@ -445,6 +448,12 @@ pub fn combine_terms(
             continue;
         };
         if t.detail.contains("GMWM POOR FIT") {
+            if !request.allow_poor_fit {
+                return Err(EvalError::PoorFit(format!(
+                    "{}: the {} would come from a GMWM POOR FIT ({}): a filter would take values of a model that does not describe the curve; no export file was written (allow it with {{allow_poor_fit}}, or export the slope readings)",
+                    record.record, what[i], t.detail
+                )));
+            }
             warnings.push(format!("{} is from a GMWM POOR FIT in the exports: {}", what[i], t.detail));
         }
         if t.basis == "upper_bound" || t.basis == "fit_value" || t.basis == "gmwm_upper_bound" {

@@ -92,6 +92,7 @@ fn err(e: EvalError) -> PyErr {
             Location { keyword: fields.first().map(|f| keyword(f)), ..Location::default() }
         }
         EvalError::Output(_) => Location::default(),
+        EvalError::PoorFit(_) => Location { keyword: Some(keyword("allow_poor_fit")), ..Location::default() },
     };
     raise(message, at)
 }
@@ -455,7 +456,7 @@ fn json_or_none<T: serde::Serialize>(value: Option<T>) -> PyResult<Option<String
 /// returned (JSON, one per channel): returns (text, warnings). `stack`: kalibr, openvins,
 /// vins, orbslam3, basalt, px4, px4-qgc, ros-covariance; `estimator`: slopes, fit or gmwm.
 #[pyfunction]
-#[pyo3(signature = (terms, record, rate_hz, stack, estimator="slopes", inflate=1.0, overbound=false, motion=Vec::new()))]
+#[pyo3(signature = (terms, record, rate_hz, stack, estimator="slopes", inflate=1.0, overbound=false, motion=Vec::new(), allow_poor_fit=false))]
 #[allow(clippy::too_many_arguments)]
 fn render_export(
     terms: Vec<String>,
@@ -466,6 +467,7 @@ fn render_export(
     inflate: f64,
     overbound: bool,
     motion: Vec<String>,
+    allow_poor_fit: bool,
 ) -> PyResult<(String, Vec<String>)> {
     use gyrolab_eval::filter_export::{ChannelFilterTerms, Estimator, ExportRecord, ExportRequest};
     let channels: Vec<ChannelFilterTerms> =
@@ -475,6 +477,7 @@ fn render_export(
         estimator: Estimator::parse(estimator).map_err(|e| keyword_error("estimator", e.to_string()))?,
         inflate,
         overbound,
+        allow_poor_fit,
     };
     let export_record = ExportRecord {
         record: record.to_string(),

@@ -839,10 +839,14 @@ pub fn stillness_text(a: &ChannelAnalysis) -> String {
             c.not_evaluated_reason.as_deref().unwrap_or("no reason given")
         );
     }
+    // The window used: its samples at the record's interval (a slow record's windows hold at
+    // least the rule's minimum of samples, so they can be longer than the rule's nominal 1 s).
+    let window_s = c.window_samples as f64 * a.curve.tau0_s;
     format!(
-        "stillness: still: no window of {} s departed from the still level {} {u} by more than {} sigma and {} {u} \
+        "stillness: still: no window of {} s ({} samples) departed from the still level {} {u} by more than {} sigma and {} {u} \
          ({} windows; docs/METHODS.md, stillness check)\n",
-        short(r.window_s, 4),
+        short(window_s, 4),
+        c.window_samples,
         sig(c.still_level, 4),
         short(r.k_sigma, 3),
         sig(r.floor, 3),

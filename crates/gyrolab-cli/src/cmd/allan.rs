@@ -69,6 +69,11 @@ pub struct AllanArgs {
     /// JSON report every estimator).
     #[arg(long, value_name = "NAME")]
     pub estimator: Option<String>,
+    /// Write the --export files even when their values come from a GMWM fit flagged POOR FIT
+    /// (its model does not describe the curve); without it such a run writes nothing and exits
+    /// with code 7.
+    #[arg(long)]
+    pub allow_poor_fit: bool,
 }
 
 impl AllanArgs {
@@ -84,6 +89,7 @@ impl AllanArgs {
                 (self.inflate.is_some(), "--inflate"),
                 (self.overbound, "--overbound"),
                 (self.estimator.is_some(), "--estimator"),
+                (self.allow_poor_fit, "--allow-poor-fit"),
             ]
             .into_iter()
             .filter_map(|(on, name)| on.then_some(name))
@@ -109,6 +115,7 @@ impl AllanArgs {
             estimator: Estimator::parse(self.estimator.as_deref().unwrap_or("slopes"))?,
             inflate: self.inflate.unwrap_or(1.0),
             overbound: self.overbound,
+            allow_poor_fit: self.allow_poor_fit,
             targets,
         }))
     }

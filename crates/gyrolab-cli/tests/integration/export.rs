@@ -486,3 +486,46 @@ fn an_export_never_overwrites_the_record() {
     assert_eq!(std::fs::read(&sim).unwrap(), before);
     assert!(!dir.path().join("k.yaml").exists());
 }
+
+/// A GMWM POOR FIT is not exported in silence (issue 54): a record whose curve no model
+/// describes (white noise and a 0.2 Hz sine of 0.5 deg/s: a bump at 1 to 3 s) with
+/// `--estimator gmwm --export` writes nothing and exits 7 naming `--allow-poor-fit`; with it
+/// the file is written with a warning, exit 0.
+#[test]
+fn a_gmwm_poor_fit_export_exits_7_unless_allowed() {
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+    let dir = tempfile::tempdir().unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    let mut text = String::from("time_s,gyro_x [deg/s]\n");
+    for i in 0..60_000 {
+        let t = i as f64 / 100.0;
+        let w: f64 = StandardNormal.sample(&mut rng);
+        text.push_str(&format!("{t:.2},{:.9e}\n", 0.05 * w + 0.5 * (2.0 * std::f64::consts::PI * 0.2 * t).sin()));
+    }
+    let record = common::write(dir.path(), "sine.csv", &text);
+    let k = dir.path().join("k.yaml");
+    let run = |allow: bool| {
+        let mut c = gyrolab();
+        c.arg("allan").arg(&record).args(["--estimator", "gmwm", "--export"]).arg(format!("kalibr={}", k.display()));
+        if allow {
+            c.arg("--allow-poor-fit");
+        }
+        c.output().unwrap()
+    };
+    let out = run(false);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(7), "{err}");
+    assert!(
+        err.contains("GMWM POOR FIT") && err.contains("--allow-poor-fit") && err.contains("no export file was written"),
+        "{err}"
+    );
+    assert!(!k.exists());
+    let out = run(true);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("is from a GMWM POOR FIT in the exports"), "{err}");
+    assert!(std::fs::read_to_string(&k).unwrap().contains("GMWM POOR FIT"));
+    // --allow-poor-fit without --export is a usage error, as the other export options.
+    gyrolab().arg("allan").arg(&record).arg("--allow-poor-fit").assert().code(2);
+}

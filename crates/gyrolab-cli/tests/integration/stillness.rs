@@ -366,3 +366,23 @@ fn a_plan_refuses_a_power_up_record_that_moved_unless_the_plan_allows_it() {
     let html = std::fs::read_to_string(r.join("report.html")).unwrap();
     assert!(html.contains("MOTION: up2.csv"), "the section prints the note");
 }
+
+/// The stillness text states the window it used (issue 54): at 100 Hz the rule's 1 s (100
+/// samples); at 2 Hz a window holds the minimum of 10 samples, 5 s, and the text says 5 s.
+#[test]
+fn the_stillness_text_states_the_window_used() {
+    let dir = tempfile::tempdir().unwrap();
+    for (rate, want) in [(100.0, "no window of 1 s (100 samples)"), (2.0, "no window of 5 s (10 samples)")] {
+        let mut text = String::from("time_s,gyro_x [deg/s]\n");
+        let mut x: u64 = 7;
+        for i in 0..2000 {
+            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let u = (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            text.push_str(&format!("{},{}\n", i as f64 / rate, 0.01 * u));
+        }
+        let p = write(dir.path(), "r.csv", &text);
+        let out = gyrolab().arg("allan").arg(&p).output().unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(stdout.contains(want), "{rate} Hz: {stdout}");
+    }
+}

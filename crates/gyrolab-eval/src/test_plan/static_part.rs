@@ -474,6 +474,7 @@ fn filter_exports(reports: &[StaticAxisReport], ctx: &StaticContext<'_>) -> Eval
         estimator: crate::filter_export::Estimator::Slopes,
         inflate: 1.0,
         overbound: false,
+        allow_poor_fit: false,
     };
     let (export, _warnings) = combine_terms(&record, &channels, &request)
         .map_err(|e| EvalError::conflict(format!("options.exports: {e}")))?;
