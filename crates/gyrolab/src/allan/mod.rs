@@ -34,9 +34,11 @@ pub mod gap_fill;
 mod gaps;
 mod kernels;
 mod lag1_sweep;
+pub mod present;
 pub mod streaming;
 
 pub use gaps::{deviation_from_rate_with_gaps, deviation_from_rate_with_gaps_into};
+pub use present::{analyse_rate_present, deviation_from_rate_present};
 
 pub use chi2::{chi_squared_cdf, chi_squared_quantile};
 use rayon::prelude::*;
@@ -297,6 +299,9 @@ pub enum AllanError {
         /// Short name of the deviation.
         kind: &'static str,
     },
+    /// The least share of present samples a window needs is not in (0, 1].
+    #[error("least share of present samples in a window {0} must lie in (0, 1]")]
+    BadPresentShare(f64),
     /// Unknown deviation name.
     #[error("unknown deviation kind '{0}' (expected adev, oadev, mdev, tdev, hdev, ohdev, totdev)")]
     UnknownKind(String),
