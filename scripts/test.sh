@@ -88,6 +88,10 @@ else
     # read again by pyulog + numpy the same way.
     .venv/bin/python scripts/px4_motion_reference.py --check examples/recordings/px4_sample_flight.ulg \
         crates/gyrolab-cli/tests/data/px4_motion_reference.json
+    # The dense drops of pyulog's tagged log, time-binned by pyulog + numpy the same way.
+    .venv/bin/python scripts/px4_dense_drops_reference.py --check \
+        examples/recordings/px4_sample_logging_tagged_and_default_params.ulg \
+        crates/gyrolab-eval/tests/data/px4_dense_drops_reference.json
     # The filter exports (`allan --export`) read by each stack's reader or the closest one (PyYAML,
     # OpenCV FileStorage, json, a PX4 parameter-file parser) against hand conversions and truth.
     .venv/bin/python scripts/check_exports.py "$bin"

@@ -194,6 +194,9 @@ pub enum ReadNote {
         rows: RowKind,
         /// What was done with them.
         policy: GapPolicy,
+        /// Too many were missing for `fill`: the deviations are window averages of the samples
+        /// present ([`ReadNote::FillDeclined`]).
+        present: bool,
     },
     /// The clock model of the time stamps and the evidence it was decided on.
     Clock(ClockModel),
@@ -222,7 +225,8 @@ pub enum ReadNote {
         samples: usize,
     },
     /// Gap policy `fill` declined: more samples missing than the fill rule is checked for
-    /// ([`MAX_FILLED_SHARE`]); the record is analysed with the gaps left out.
+    /// ([`MAX_FILLED_SHARE`]); each tau's windows are averaged over the samples present
+    /// (`gyrolab::allan::present`), which keeps the long taus.
     FillDeclined {
         /// Samples missing on the record's grid.
         missing: usize,
@@ -309,10 +313,11 @@ impl std::fmt::Display for ReadNote {
                 1.0 / step,
                 1000.0 / step
             ),
-            ReadNote::Gaps { count, missing, first, rows, policy } => {
+            ReadNote::Gaps { count, missing, first, rows, policy, present } => {
                 let shown: Vec<String> =
                     first.iter().map(|(l, m)| format!("{} {l} ({m} missing)", rows.word())).collect();
                 let done = match policy {
+                    _ if *present => "too many for filling: each window averaged over the samples present (below)",
                     GapPolicy::Contiguous => "closed up ({gaps} contiguous: the samples taken as consecutive)",
                     GapPolicy::Fill => "runs of up to 3 filled by linear interpolation, longer ones computed over (terms that touch a missing sample are left out)",
                     _ => "computed over them (terms that touch a missing sample are left out)",
@@ -357,7 +362,7 @@ impl std::fmt::Display for ReadNote {
             ),
             ReadNote::FillDeclined { missing, samples } => write!(
                 f,
-                "{missing} missing sample(s), {:.2} % of the record: more than the {:.0} % the fill rule is checked for, so none is filled and the terms that touch them are left out (as {{gaps}} analyse)",
+                "{missing} missing sample(s), {:.2} % of the record: more than the {:.0} % the fill rule is checked for, so none is filled; each tau's windows are averaged over the samples present (a window with fewer than half its samples is not used) and the white-noise excess of the missing samples is removed, which keeps the long taus (docs/METHODS.md, present-sample estimator); {{gaps}} analyse leaves out every term that touches a missing sample instead",
                 100.0 * *missing as f64 / (*samples).max(1) as f64,
                 100.0 * MAX_FILLED_SHARE
             ),
@@ -770,6 +775,27 @@ pub fn analyse_channel(
     Ok(channel_analysis(setup, info, quantity, curve, stillness))
 }
 
+/// [`analyse_channel`] of a record with more samples missing than filling is safe for: each
+/// tau's windows averaged over the samples present, the white-noise excess of the missing ones
+/// removed ([`gyrolab::allan::present`]; windows with fewer than half their samples not used).
+pub fn analyse_channel_present(
+    setup: &ChannelSetup<'_>,
+    info: &ChannelInfo,
+    mut values: Vec<f64>,
+) -> EvalResult<ChannelAnalysis> {
+    let (quantity, conversion) = physical_conversion(setup, info)?;
+    conversion.apply(&mut values);
+    let stillness = check_channel(&values, setup.tau0_s, quantity);
+    let curve = gyrolab::allan::present::deviation_from_rate_present(
+        &values,
+        setup.tau0_s,
+        setup.options,
+        gyrolab::allan::present::DEFAULT_MIN_PRESENT_SHARE,
+    )
+    .map_err(|e| curve_error(setup.path, info, setup.lines, e))?;
+    Ok(channel_analysis(setup, info, quantity, curve, stillness))
+}
+
 /// [`analyse_channel`] of borrowed samples: samples that need no unit conversion are read where
 /// they are and the angle series is built in `buffer` (no copy of the record); others are
 /// copied into `buffer` and converted there. Give `buffer` capacity N + 1 (on the pages you
@@ -1101,6 +1127,7 @@ pub fn analyse_data(
             first,
             rows,
             policy: request.gaps,
+            present: false,
         });
     }
     if data.quality.missing_cells > 0 {
@@ -1170,14 +1197,17 @@ pub fn analyse_data(
         allow_motion: request.allow_motion,
     };
     let mut policy = request.gaps;
+    // Too many missing for `fill`: the present-sample estimator (its long taus kept).
+    let mut present = false;
     if policy == GapPolicy::Fill {
         let samples = channels.first().map_or(0, |c| c.len() + timing.missing);
         if timing.missing as f64 > MAX_FILLED_SHARE * samples as f64 {
             notes.push(ReadNote::FillDeclined { missing: timing.missing, samples });
             policy = GapPolicy::Analyse;
+            present = true;
             for n in notes.iter_mut() {
-                if let ReadNote::Gaps { policy: said, .. } = n {
-                    *said = GapPolicy::Analyse;
+                if let ReadNote::Gaps { present: said, .. } = n {
+                    *said = true;
                 }
             }
         }
@@ -1192,7 +1222,12 @@ pub fn analyse_data(
             };
             let fill = if policy == GapPolicy::Fill { fill_isolated(&mut values) } else { FillCount::default() };
             let n = values.len();
-            Ok((analyse_channel(&setup, &info, values)?, fill, n))
+            let analysis = if present {
+                analyse_channel_present(&setup, &info, values)?
+            } else {
+                analyse_channel(&setup, &info, values)?
+            };
+            Ok((analysis, fill, n))
         })
         .collect();
     let results = results.into_iter().collect::<Result<Vec<_>, _>>()?;

@@ -285,3 +285,51 @@ fn px4_log_matches_pyulog_and_numpy() {
     }
     assert!(compared >= 18, "{compared} points compared");
 }
+
+/// Dense drops of a REAL PX4 log (issue 54): pyulog's sample_logging_tagged_and_default_params.ulg
+/// steps 4 and 8 ms on `sensor_combined`, 665 of 2,693 samples missing (24.7 %), too many to
+/// fill. The default policy's present-sample estimator keeps the long taus: the curve passes
+/// 1 s (the gap rule's stopped at 0.032 s), N is a value, and every deviation from m = 16 to 512
+/// has the term count of pyulog + numpy's time-binned reading of the same messages
+/// (tests/data/px4_dense_drops_reference.json, scripts/px4_dense_drops_reference.py) and lies
+/// within 5 % below it (gyrolab removes the white excess of the missing samples, which the
+/// time-binned means keep).
+#[test]
+fn dense_drops_keep_the_long_taus_of_a_real_px4_log() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let ulg = root.join("examples/recordings/px4_sample_logging_tagged_and_default_params.ulg");
+    let text =
+        std::fs::read_to_string(root.join("crates/gyrolab-eval/tests/data/px4_dense_drops_reference.json")).unwrap();
+    let want: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let o = analyse_file(&AllanRequest { topics: vec!["sensor_combined".into()], ..AllanRequest::new(&ulg) }).unwrap();
+    assert!(o.notes.iter().any(|n| matches!(n, ReadNote::FillDeclined { missing: 665, samples: 2693 })));
+    let mut compared = 0;
+    for (name, points) in want["oadev_dps"].as_object().unwrap() {
+        let a = o.analyses.iter().find(|a| &a.channel == name).unwrap_or_else(|| panic!("channel {name}"));
+        assert!(
+            a.curve.points.last().unwrap().tau_s > 1.0,
+            "{name}: the curve stops at {}",
+            a.curve.points.last().unwrap().tau_s
+        );
+        let n = a.slope_lines.as_ref().and_then(|s| s.coefficients.arw_deg_rt_h);
+        assert!(n.is_some_and(|n| n > 0.5 && n < 5.0), "{name}: N = {n:?}");
+        for p in points.as_array().unwrap() {
+            let (m, terms, dev) =
+                (p[0].as_u64().unwrap() as usize, p[1].as_u64().unwrap() as usize, p[2].as_f64().unwrap());
+            let q = a.curve.points.iter().find(|q| q.m == m).unwrap_or_else(|| panic!("{name}: no point at m = {m}"));
+            assert_eq!(q.terms, terms, "{name} m = {m}");
+            let r = q.deviation / dev;
+            assert!(r <= 1.0 + 1e-12 && r > 0.95, "{name} m = {m}: {} vs time-binned {dev}", q.deviation);
+            compared += 1;
+        }
+    }
+    assert!(compared >= 18, "{compared} points compared");
+    // The gap rule (`--gaps analyse`) on the same record: the long taus are lost.
+    let gaps = analyse_file(&AllanRequest {
+        topics: vec!["sensor_combined".into()],
+        gaps: GapPolicy::Analyse,
+        ..AllanRequest::new(&ulg)
+    })
+    .unwrap();
+    assert!(gaps.analyses[0].curve.points.last().unwrap().tau_s < 0.1);
+}
