@@ -284,6 +284,9 @@ pub enum ReadNote {
     Topic(TopicMeta),
     /// The recording ends early or is damaged: what was read is analysed.
     Truncated(String),
+    /// The record's temperature moved by more than
+    /// [`gyrolab::record_temperature::MOVED_SPAN_C`] (a warning).
+    TemperatureMoved(gyrolab::record_temperature::RecordTemperature),
     /// An IMU topic left out because no topic was named and it is no sensor's own sample
     /// stream (a snapshot, an integrated or a too-short topic).
     TopicSkipped(gyrolab_io::recording::SkippedTopic),
@@ -410,6 +413,16 @@ impl std::fmt::Display for ReadNote {
                 Ok(())
             }
             ReadNote::Truncated(what) => f.write_str(what),
+            ReadNote::TemperatureMoved(t) => write!(
+                f,
+                "the temperature ({}) moved by {:.3} degC during the record ({:.3} to {:.3} degC, drift {:.3} degC/h), more than {} degC: slow terms (bias instability, rate random walk, rate ramp) may be the temperature's; test at a stabilised temperature",
+                t.column,
+                t.span_c,
+                t.min_c,
+                t.max_c,
+                t.slope_c_per_h,
+                gyrolab::record_temperature::MOVED_SPAN_C
+            ),
             ReadNote::TopicSkipped(s) => write!(
                 f,
                 "topic {} skipped: {}; name it with {{topics}} to analyse it anyway",
@@ -445,6 +458,7 @@ impl ReadNote {
             _ => matches!(
                 self,
                 ReadNote::Truncated(_)
+                    | ReadNote::TemperatureMoved(_)
                     | ReadNote::Gravity(gyrolab::stillness::GravityCheck { outside_windows: 1.., .. })
                     | ReadNote::TimeUnitDoubt { .. }
                     | ReadNote::Reset { .. }
@@ -911,6 +925,7 @@ pub(crate) fn channel_analysis(
         stillness,
         allow_motion: setup.allow_motion,
         gravity: None,
+        temperature: None,
     }
 }
 
@@ -1175,6 +1190,19 @@ pub fn analyse_data(
     }
     data.time = None;
     data.time_compact = None;
+    // The record's temperature column (rows up to a reset), carried into every channel.
+    let temperature = data.temperature.take().and_then(|t| {
+        let n = data.channels.first().map_or(t.len(), Vec::len).min(t.len());
+        let column = data
+            .header
+            .temperature_column
+            .and_then(|c| data.header.columns.get(c - 1))
+            .map_or_else(|| "temperature".to_string(), |c| c.name.clone());
+        gyrolab::record_temperature::record_temperature(&column, &t[..n], tau0)
+    });
+    if let Some(t) = temperature.as_ref().filter(|t| t.moved) {
+        notes.push(ReadNote::TemperatureMoved(t.clone()));
+    }
     let opts = AllanOptions {
         kind: request.kind,
         taus: request.taus.clone(),
@@ -1243,7 +1271,10 @@ pub fn analyse_data(
         (complete && longest_s < quarter_s / 2.0).then_some(ReadNote::LongTausLost { longest_s, quarter_s })
     });
     notes.extend(lost);
-    let analyses = results.into_iter().map(|r| r.0).collect();
+    let mut analyses: Vec<ChannelAnalysis> = results.into_iter().map(|r| r.0).collect();
+    for a in &mut analyses {
+        a.temperature = temperature.clone();
+    }
     Ok(AllanOutcome { topic: None, analyses, sample_interval_s: tau0, notes })
 }
 

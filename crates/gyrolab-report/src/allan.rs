@@ -50,6 +50,9 @@ pub struct ChannelAnalysis {
     /// The gravity check of the three accelerometer axes this channel is one of (the same on
     /// each of them; `None` unless a record has exactly three accelerometer channels in m/s^2).
     pub gravity: Option<gyrolab::stillness::GravityCheck>,
+    /// The record's temperature (the same on every channel of the record), when it has a
+    /// temperature column.
+    pub temperature: Option<gyrolab::record_temperature::RecordTemperature>,
 }
 
 /// A channel's GMWM fit, computed from its curve the first time it is asked for and kept
@@ -499,6 +502,10 @@ pub struct AllanJson {
     /// vector against 1 g; absent for other channels).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub gravity: Option<gyrolab::stillness::GravityCheck>,
+    /// The record's temperature column (mean, range, drift; `moved` above 1 degC of range),
+    /// absent without one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub temperature: Option<gyrolab::record_temperature::RecordTemperature>,
 }
 
 /// The JSON document: the first channel's keys at the top level, every channel in `channels`.
@@ -664,6 +671,7 @@ pub fn allan_json_with(a: &ChannelAnalysis, with_gmwm: bool) -> AllanJson {
             motion: a.motion_line(),
         }),
         gravity: a.gravity.clone(),
+        temperature: a.temperature.clone(),
     }
 }
 
@@ -821,7 +829,32 @@ pub fn allan_text(a: &ChannelAnalysis) -> String {
         (None, None) => {}
     }
     s.push_str(&stillness_text(a));
+    if let Some(t) = &a.temperature {
+        s.push_str(&temperature_text(t));
+    }
     s
+}
+
+/// The temperature line of a channel's text: mean, range and drift of the record's
+/// temperature column; a warning when it moved.
+pub fn temperature_text(t: &gyrolab::record_temperature::RecordTemperature) -> String {
+    let line = format!(
+        "temperature ({}): mean {} degC, range {} to {} degC ({} degC), drift {} degC/h",
+        t.column,
+        sig(t.mean_c, 4),
+        sig(t.min_c, 4),
+        sig(t.max_c, 4),
+        sig(t.span_c, 3),
+        sig(t.slope_c_per_h, 3)
+    );
+    if t.moved {
+        format!(
+            "warning: {line}: the temperature moved by more than {} degC during the record, so slow terms (bias instability, rate random walk, rate ramp) may be the temperature's\n",
+            gyrolab::record_temperature::MOVED_SPAN_C
+        )
+    } else {
+        format!("{line}\n")
+    }
 }
 
 /// The stillness lines of a channel's text: a `warning:` naming what moved and when, the rule
@@ -1173,6 +1206,7 @@ mod tests {
             stillness: None,
             allow_motion: false,
             gravity: None,
+            temperature: None,
         }
     }
 

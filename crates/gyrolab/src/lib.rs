@@ -11,6 +11,7 @@
 //! - [`rate_test`]: rate-table (scale-factor) test figures;
 //! - [`static_test`]: static (bias) test figures, accumulated block by block;
 //! - [`record_length`]: test planning: record length for a noise term's precision;
+//! - [`record_temperature`]: a static record's temperature: mean, range, drift, moved or not;
 //! - [`published`]: comparison with figures printed in a publication;
 //! - [`sim`]: gyro simulator with known truth (static records, rate-table tests);
 //! - [`segment`]: plateaus, strokes and runs found in raw rate-table logs;
@@ -40,6 +41,7 @@ pub mod process_capability;
 pub mod published;
 pub mod rate_test;
 pub mod record_length;
+pub mod record_temperature;
 pub mod sampling;
 pub mod segment;
 pub mod sim;

@@ -219,3 +219,32 @@ fn fit_range_takes_low_comma_high_as_the_readme_writes_it() {
     let e = allan_error("time_s,rate_dps\n0,1\n0.1,2\n0.2,1\n0.3,2\n", &["--fit-range", "10,1"]);
     assert!(e.contains("--fit-range needs two increasing positive taus"), "{e}");
 }
+
+/// A record's temperature column is carried into the JSON and the text (issue 54): a simulated
+/// ramp of 12 degC/h from 25 degC over 600 s reads mean 26, range 2 degC, drift 12 degC/h (the
+/// simulator's truth) and warns that it moved; a constant 25 degC does not warn.
+#[test]
+fn the_temperature_column_is_reported_with_its_drift() {
+    let dir = tempfile::tempdir().unwrap();
+    for (ramp, moved) in [("12", true), ("0", false)] {
+        let p = dir.path().join(format!("t{ramp}.csv"));
+        gyrolab()
+            .args(["simulate", "static", "--duration-s", "600", "--sample-rate-hz", "100", "--arw-deg-rt-h", "0.3"])
+            .args(["--temp-c", "25", "--temp-ramp-c-per-h", ramp, "--record-temperature", "--seed", "4", "--out"])
+            .arg(&p)
+            .assert()
+            .success();
+        let out = gyrolab().arg("allan").arg(&p).arg("--json").output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{err}");
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let t = &doc["channels"][0]["temperature"];
+        assert_eq!(t["column"], "temp_c");
+        assert_eq!(t["moved"], moved, "{t}");
+        let slope = t["slope_c_per_h"].as_f64().unwrap();
+        let want: f64 = ramp.parse().unwrap();
+        assert!((slope - want).abs() < 1e-6, "{slope}");
+        assert!((t["mean_c"].as_f64().unwrap() - (25.0 + want * 300.0 / 3600.0)).abs() < 1e-3, "{t}");
+        assert_eq!(err.contains("the temperature (temp_c) moved"), moved, "{err}");
+    }
+}
