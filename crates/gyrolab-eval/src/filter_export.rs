@@ -481,6 +481,7 @@ pub fn combine_terms(
         Vec::new()
     };
     warnings.extend(unrepresented.iter().map(|u| format!("not represented in the exports: {u}")));
+    let per_axis = per_axis_values(channels, request);
     let [gyro_noise, gyro_walk, accel_noise, accel_walk] = combined;
     let export = NoiseExport {
         record: record.record.clone(),
@@ -496,8 +497,57 @@ pub fn combine_terms(
         motion: record.motion.clone(),
         unrepresented,
         writer: env!("CARGO_PKG_VERSION").to_string(),
+        per_axis,
     };
     Ok((export, warnings))
+}
+
+/// The axis (0 x, 1 y, 2 z) a channel's name names: a token `x`, `y`, `z` (`gyro_x_rad_s`,
+/// `accel_y [m/s^2]`, a Vector3Stamped's `z`) or a two-letter token ending in one (`gx`, `ay`,
+/// `wz`); `None` otherwise.
+pub fn axis_of(name: &str) -> Option<usize> {
+    let axis = |c: char| match c {
+        'x' | 'X' => Some(0),
+        'y' | 'Y' => Some(1),
+        'z' | 'Z' => Some(2),
+        _ => None,
+    };
+    name.split(|c: char| !c.is_ascii_alphanumeric()).find_map(|token| {
+        let mut chars = token.chars();
+        match (chars.next(), chars.next(), chars.next()) {
+            (Some(c), None, None) => axis(c),
+            (Some(_), Some(c), None) => axis(c),
+            _ => None,
+        }
+    })
+}
+
+/// The per-axis values of each term (gyro noise, gyro walk, accelerometer noise and walk), each
+/// with its overbound factor when overbounding and the inflation, where exactly one channel of
+/// that kind names each of x, y and z.
+fn per_axis_values(channels: &[ChannelFilterTerms], request: &ExportRequest) -> [Option<[f64; 3]>; 4] {
+    let mut out = [None; 4];
+    for (accelerometer, base) in [(false, 0), (true, 2)] {
+        let of_kind: Vec<&ChannelFilterTerms> = channels.iter().filter(|c| c.accelerometer == accelerometer).collect();
+        for term in 0..2 {
+            let mut values: [Option<f64>; 3] = [None; 3];
+            let mut ok = of_kind.len() == 3;
+            for c in &of_kind {
+                let (Some(axis), Some(t)) = (axis_of(&c.channel), &c.of(request.estimator)[term]) else {
+                    ok = false;
+                    break;
+                };
+                let f = if request.overbound { t.overbound_factor.unwrap_or(1.0) } else { 1.0 };
+                if values[axis].replace(t.value * f * request.inflate).is_some() {
+                    ok = false;
+                }
+            }
+            if let (true, [Some(x), Some(y), Some(z)]) = (ok, values) {
+                out[base + term] = Some([x, y, z]);
+            }
+        }
+    }
+    out
 }
 
 /// The text of one stack's file (by its name: kalibr, openvins, vins, orbslam3, basalt, px4,
@@ -629,6 +679,68 @@ mod tests {
             assert_eq!(back.value.to_bits(), value.to_bits(), "{value:e}");
             assert_eq!(back.overbound_factor.map(f64::to_bits), Some(value.to_bits()));
         }
+    }
+
+    /// Axis names as channels are named (issue 54, per-axis values for Basalt).
+    #[test]
+    fn axes_are_read_from_channel_names() {
+        for (name, axis) in [
+            ("gyro_x_rad_s", Some(0)),
+            ("accel_y [m/s^2]", Some(1)),
+            ("z", Some(2)),
+            ("gz", Some(2)),
+            ("wx", Some(0)),
+            ("rate_dps", None),
+            ("temp_c", None),
+            ("gyro", None),
+        ] {
+            assert_eq!(axis_of(name), axis, "{name}");
+        }
+    }
+
+    /// Three gyro channels give per-axis values whose largest is the combined one; two
+    /// channels, or two on one axis, give none.
+    #[test]
+    fn per_axis_values_need_the_three_axes_once() {
+        let term = |v: f64| {
+            Some(TermEstimate { value: v, basis: "value".into(), detail: String::new(), overbound_factor: Some(2.0) })
+        };
+        let ch = |name: &str, n: f64| ChannelFilterTerms {
+            channel: name.into(),
+            accelerometer: false,
+            slopes: [term(n), term(n / 10.0)],
+            fit: [None, None],
+            gmwm: [None, None],
+            gmwm_unrepresented: Vec::new(),
+        };
+        let request = ExportRequest {
+            targets: Vec::new(),
+            estimator: Estimator::Slopes,
+            inflate: 3.0,
+            overbound: false,
+            allow_poor_fit: false,
+        };
+        let three = [ch("gyro_z", 3.0), ch("gyro_x", 1.0), ch("gyro_y", 2.0)];
+        let v = per_axis_values(&three, &request);
+        assert_eq!(v[0], Some([3.0, 6.0, 9.0]));
+        assert_eq!(v[1], Some([0.30000000000000004, 0.6000000000000001, 0.8999999999999999]));
+        assert_eq!((v[2], v[3]), (None, None));
+        let record =
+            ExportRecord { record: "r".into(), rate_hz: 100.0, simulated: false, rostopic: None, motion: Vec::new() };
+        let (export, _) = combine_terms(&record, &three, &request).unwrap();
+        assert_eq!(export.gyro_noise.as_ref().unwrap().value, 9.0);
+        let basalt = export.per_axis[0].unwrap();
+        assert!(export.render(Stack::Basalt).contains(&format!(
+            "\"gyro_noise_std\": [{}, {}, {}]",
+            real_text(basalt[0]),
+            real_text(basalt[1]),
+            real_text(basalt[2])
+        )));
+        assert_eq!(per_axis_values(&three[..2], &request)[0], None);
+        assert_eq!(per_axis_values(&[ch("gyro_x", 1.0), ch("gx", 1.0), ch("gyro_z", 1.0)], &request)[0], None);
+        // Overbounding multiplies each axis by its own factor.
+        let over = ExportRequest { overbound: true, ..request };
+        assert_eq!(per_axis_values(&three, &over)[0], Some([6.0, 12.0, 18.0]));
     }
 
     /// Paths that name one file as written: `./k.yaml` and `k.yaml`, a folder's `.`; not `..`.

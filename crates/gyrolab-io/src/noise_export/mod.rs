@@ -158,6 +158,11 @@ pub struct NoiseExport {
     pub unrepresented: Vec<String>,
     /// The writer's version, for the header.
     pub writer: String,
+    /// Per-axis values (x, y, z; same unit and factors as the combined term) of gyro noise,
+    /// gyro walk, accelerometer noise and accelerometer walk, where the record has that term on
+    /// all three axes: written by the stacks that take one value per axis (Basalt); the others
+    /// take the combined (largest) value.
+    pub per_axis: [Option<[f64; 3]>; 4],
 }
 
 /// Per-step rate of PX4's EKF2 prediction by default (EKF2_PREDICT_US = 10000 us).
@@ -480,14 +485,19 @@ impl NoiseExport {
         for (i, l) in lines.iter().enumerate() {
             let _ = writeln!(s, "    {}{}", json_string(l), if i + 1 < lines.len() { "," } else { "" });
         }
-        s.push_str("  ],\n  \"value0\": {\n");
+        s.push_str("  ],\n  \"gyrolab_merge\": \"a fragment of Basalt's calibration: copy the keys of value0 into the value0 of your full calib JSON (cereal reads them by name); per-axis values [x, y, z] where the record has all three axes, else the largest on each\",\n");
+        s.push_str("  \"value0\": {\n");
         let mut entries = vec![format!("    \"imu_update_rate\": {}", rate_text(self.rate_hz))];
-        for (key, slot) in
-            ["gyro_noise_std", "gyro_bias_std", "accel_noise_std", "accel_bias_std"].iter().zip(self.slots())
+        for ((key, slot), axes) in ["gyro_noise_std", "gyro_bias_std", "accel_noise_std", "accel_bias_std"]
+            .iter()
+            .zip(self.slots())
+            .zip(self.per_axis)
         {
             if let Some(t) = slot.term {
-                let v = real_text(t.value);
-                entries.push(format!("    \"{key}\": [{v}, {v}, {v}]"));
+                // One value per axis (Basalt's Vec3) where the record has all three, else the
+                // combined (largest) value on each.
+                let [x, y, z] = axes.unwrap_or([t.value; 3]).map(real_text);
+                entries.push(format!("    \"{key}\": [{x}, {y}, {z}]"));
             }
         }
         s.push_str(&entries.join(",\n"));

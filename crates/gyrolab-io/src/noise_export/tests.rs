@@ -25,6 +25,7 @@ pub(super) fn sample() -> NoiseExport {
         motion: Vec::new(),
         unrepresented: Vec::new(),
         writer: "test".into(),
+        per_axis: [None; 4],
     }
 }
 
