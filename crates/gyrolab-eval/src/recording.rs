@@ -38,13 +38,26 @@ pub fn inspect(path: &Path) -> EvalResult<Inventory> {
         let record = &data.records[0].data;
         let names: Vec<String> =
             record.header.channels.iter().map(|c| format!("{} [{}]", c.name, c.unit.symbol())).collect();
+        // The clock model of every command: a stamp going back to or before the first (a
+        // clock reset, a trailer of zeros) ends the record, as `allan` and `bias` read it.
+        let reset = record.time.as_deref().and_then(|t| estimate_interval(t).ok()).and_then(|e| e.reset);
+        let kept = reset.map_or(record.lines.len(), |r| r.index);
         let (start, duration, rate, gaps, missing) = match &record.time {
             Some(t) => {
-                let ns: Vec<i64> = t.iter().map(|&x| (x * 1e9) as i64).collect();
+                let ns: Vec<i64> = t[..kept.min(t.len())].iter().map(|&x| (x * 1e9) as i64).collect();
                 timing_of(&ns)
             }
             None => (None, None, None, 0, 0),
         };
+        let truncated = reset.map(|r| {
+            format!(
+                "the time stamps go back at line {} (from {} s to {} s: a clock reset or a trailer of zeros): the record ends before it, {} row(s) from there left out",
+                record.lines.get(r.index).unwrap_or(0),
+                r.from_s,
+                r.to_s,
+                record.lines.len() - kept
+            )
+        });
         return Ok(Inventory {
             gyrolab_version: version,
             file,
@@ -52,7 +65,7 @@ pub fn inspect(path: &Path) -> EvalResult<Inventory> {
             topics: vec![TopicInventory {
                 topic: "(table)".into(),
                 message_type: names.join(", "),
-                messages: record.lines.len() as u64,
+                messages: kept as u64,
                 imu: !record.header.channels.is_empty(),
                 start_s: start,
                 duration_s: duration,
@@ -62,7 +75,7 @@ pub fn inspect(path: &Path) -> EvalResult<Inventory> {
                 out_of_order: 0,
                 stamps: if record.time.is_some() { "time column".into() } else { "no time column".into() },
             }],
-            truncated: None,
+            truncated,
         });
     }
     let again = opened.try_clone()?;

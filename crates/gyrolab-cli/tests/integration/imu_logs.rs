@@ -338,3 +338,54 @@ fn mpu6050_bursty_log_with_dropouts() {
     let mean = t["mean_output"].as_f64().unwrap();
     assert!((mean - gx_sum / kept as f64).abs() < 1e-9, "{mean} vs {}", gx_sum / kept as f64);
 }
+
+/// One clock model in every command (issue 54): an MPU6050 logger's CSV (millisecond stamps,
+/// 100 Hz, 6,280 rows) ending with 720 rows of zeros, the stamps included. `inspect`, `allan`
+/// and `bias` each end the record before the trailer with the same words, read 100 Hz and
+/// 6,280 samples; none refuses it.
+#[test]
+fn a_zero_trailer_ends_the_record_in_every_command() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::from("timestamp_ms,gx_dps,gy_dps,gz_dps,ax_g,ay_g,az_g\n");
+    let mut x: u64 = 11;
+    let mut noise = || {
+        x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    for i in 0..6280 {
+        let t = 1010 + 10 * i;
+        text.push_str(&format!(
+            "{t},{:.4},{:.4},{:.4},{:.5},{:.5},{:.5}\n",
+            0.1 + 0.1 * noise(),
+            -0.2 + 0.1 * noise(),
+            0.05 + 0.1 * noise(),
+            0.004 * noise(),
+            0.004 * noise(),
+            1.0 + 0.004 * noise()
+        ));
+    }
+    for _ in 0..720 {
+        text.push_str("0,0,0,0,0,0,0\n");
+    }
+    let p = common::write(dir.path(), "mpu.csv", &text);
+    let said = "the time stamps go back at line 6282 (from";
+    let out = gyrolab().arg("inspect").arg(&p).arg("--json").output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(out.status.success(), "{err}");
+    let inv: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(inv["topics"][0]["messages"], 6280, "{inv}");
+    assert!((inv["topics"][0]["rate_hz"].as_f64().unwrap() - 100.0).abs() < 1e-6, "{inv}");
+    assert!(inv["truncated"].as_str().unwrap().contains(said), "{inv}");
+    let out = gyrolab().arg("allan").arg(&p).arg("--json").output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(out.status.success() && err.contains(said), "{err}");
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!((doc["channels"][0]["tau0_s"].as_f64().unwrap() - 0.01).abs() < 1e-12, "{}", doc["channels"][0]["tau0_s"]);
+    let out = gyrolab().arg("bias").arg(&p).arg("--json").output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(out.status.success() && err.contains(said), "{err}");
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let test = &doc["tests"][0];
+    assert_eq!(test["samples"], 6280, "{test}");
+    assert_eq!(test["sample_rate_hz"], 100.0, "{test}");
+}

@@ -263,6 +263,12 @@ pub struct StaticTestAccumulator {
     pub(super) scratch_d: Vec<f64>,
     pub(super) extremes: Vec<ChunkExtremes>,
     pub(super) chunk_slope: ChunkSlope,
+    /// A stamp went back to or before the record's first (a clock reset, a trailer of zeros):
+    /// (sample index, line, from s, to s); the record ends before it and later samples are
+    /// counted in `left_out`, not analysed (the Allan analysis's rule, `crate::sampling`).
+    pub(super) reset: Option<(u64, Option<u64>, f64, f64)>,
+    /// Samples after a reset, left out.
+    pub(super) left_out: u64,
 }
 
 impl StaticTestAccumulator {
@@ -294,6 +300,8 @@ impl StaticTestAccumulator {
             scratch_d: Vec::new(),
             extremes: Vec::new(),
             chunk_slope: ChunkSlope::default(),
+            reset: None,
+            left_out: 0,
             config,
         };
         match acc.config.sample_rate_hz {
@@ -361,8 +369,47 @@ impl StaticTestAccumulator {
         Ok(())
     }
 
-    /// Adds a block of consecutive samples.
+    /// Adds a block of consecutive samples. A time stamp going back to or before the record's
+    /// first (a clock reset, a trailer of zeros) ends the record: the samples before it are
+    /// analysed, the rest counted and left out, and the figures' notes say so.
     pub fn push(&mut self, block: &SampleBlock) -> Result<(), StaticTestError> {
+        if self.reset.is_some() {
+            self.left_out += block.output.len() as u64;
+            return Ok(());
+        }
+        if let Some(ts) = block.time_s {
+            let first = match (&self.probe, self.reference) {
+                (Some(p), _) if !p.time.is_empty() => Some(p.time[0]),
+                (None, Some((_, t0))) => Some(t0),
+                _ => ts.first().copied(),
+            };
+            let seen = self.samples + self.probe.as_ref().map_or(0, |p| p.output.len() as u64);
+            let before = |i: usize| {
+                if i == 0 {
+                    self.probe.as_ref().and_then(|p| p.time.last().copied()).or(self.prev_time)
+                } else {
+                    Some(ts[i - 1])
+                }
+            };
+            let cut = first.and_then(|t0| ts.iter().enumerate().position(|(i, &t)| (i > 0 || seen > 0) && t <= t0));
+            if let Some(i) = cut {
+                let from = before(i).unwrap_or(f64::NAN);
+                self.reset = Some((seen + i as u64, block.lines.map(|l| l[i]), from, ts[i]));
+                self.left_out = (block.output.len() - i) as u64;
+                let head = SampleBlock {
+                    output: &block.output[..i],
+                    time_s: Some(&ts[..i]),
+                    temperature_c: block.temperature_c.map(|c| &c[..i]),
+                    lines: block.lines.map(|l| &l[..i]),
+                };
+                return if i > 0 { self.push_checked(&head) } else { Ok(()) };
+            }
+        }
+        self.push_checked(block)
+    }
+
+    /// [`Self::push`] of a block with no reset in it.
+    fn push_checked(&mut self, block: &SampleBlock) -> Result<(), StaticTestError> {
         self.check_block(block)?;
         if let Some(probe) = self.probe.as_mut() {
             probe.output.extend_from_slice(block.output);
@@ -664,6 +711,13 @@ impl StaticTestAccumulator {
         let fs = self.fs.unwrap_or(1.0); // ok: set once samples exist
         let cfg = &self.config;
         let mut notes = Vec::new();
+        if let Some((sample, line, from, to)) = self.reset {
+            let at = line.map_or(format!("sample {}", sample + 1), |l| format!("line {l}"));
+            notes.push(format!(
+                "the time stamps go back at {at} (from {from} s to {to} s: a clock reset or a trailer of zeros): the record ends before it, {} sample(s) from there left out",
+                self.left_out
+            ));
+        }
         let (x0, t0) = self.reference.unwrap_or((0.0, 0.0)); // ok: valid >= 2
         let mo = self.moments;
         let mean_output = x0 + mo.mean_d;
