@@ -943,6 +943,36 @@ mod tests {
         acc.finish().unwrap().result
     }
 
+    /// A stamp going back to or before the first ends the record (issue 54, the Allan
+    /// analysis's rule): the figures equal those of the record cut there, however the blocks
+    /// fall, and a note says where and how many samples were left out.
+    #[test]
+    fn a_reset_ends_the_record() {
+        let n = 500;
+        let x: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7919) % 101) as f64 * 1e-3).collect();
+        let mut t: Vec<f64> = (0..n).map(|i| 10.0 + i as f64 * 0.01).collect();
+        for v in t.iter_mut().skip(400) {
+            *v = 0.0; // a trailer of zeros
+        }
+        let lines: Vec<u64> = (2..n as u64 + 2).collect();
+        let config = StaticTestConfig { smoothing_times_s: vec![0.1], min_windows: 2, ..StaticTestConfig::default() };
+        let run = |x: &[f64], t: &[f64], l: &[u64], split: usize| {
+            let mut acc = StaticTestAccumulator::new(config.clone()).unwrap();
+            for ((o, ts), l) in x.chunks(split).zip(t.chunks(split)).zip(l.chunks(split)) {
+                acc.push(&SampleBlock { output: o, time_s: Some(ts), temperature_c: None, lines: Some(l) }).unwrap();
+            }
+            acc.finish().unwrap().result
+        };
+        let cut = run(&x[..400], &t[..400], &lines[..400], 64);
+        for split in [1, 7, 64, 399, 400, 401, 500] {
+            let r = run(&x, &t, &lines, split);
+            assert_eq!(r.valid_samples, 400, "split {split}");
+            assert_eq!(r.mean_output.to_bits(), cut.mean_output.to_bits(), "split {split}");
+            let note = r.notes.iter().find(|n| n.contains("go back")).unwrap_or_else(|| panic!("{:?}", r.notes));
+            assert!(note.contains("at line 402") && note.contains("100 sample(s) from there left out"), "{note}");
+        }
+    }
+
     proptest! {
         /// The block path (slice loops, rail runs by pieces, interval extremes first) finds the same
         /// quality findings and figures as the sample-by-sample path, on records with long runs at
@@ -957,7 +987,9 @@ mod tests {
             let n = x.len();
             let mut t: Vec<f64> = (0..n).map(|i| i as f64 * 0.5).collect();
             for &(kind, at) in &stamps {
-                if at > 0 && at < n {
+                // From the 10th sample on: the six shifts (at most -3.6 s) never take a stamp back
+                // to the first, which would end the record (a reset, tested on its own below).
+                if at >= 10 && at < n {
                     // A repeated stamp, a decreasing one, a gap; each followed by regular stamps.
                     let shift = match kind {
                         0 => -0.5,
