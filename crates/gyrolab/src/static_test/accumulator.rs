@@ -373,6 +373,7 @@ impl StaticTestAccumulator {
     /// first (a clock reset, a trailer of zeros) ends the record: the samples before it are
     /// analysed, the rest counted and left out, and the figures' notes say so.
     pub fn push(&mut self, block: &SampleBlock) -> Result<(), StaticTestError> {
+        self.check_block(block)?;
         if self.reset.is_some() {
             self.left_out += block.output.len() as u64;
             return Ok(());
@@ -391,7 +392,13 @@ impl StaticTestAccumulator {
                     Some(ts[i - 1])
                 }
             };
-            let cut = first.and_then(|t0| ts.iter().enumerate().position(|(i, &t)| (i > 0 || seen > 0) && t <= t0));
+            // As `crate::sampling` decides a reset: from the third stamp on, one that goes back
+            // (below the stamp before it) to or before the first.
+            let cut = first.and_then(|t0| {
+                ts.iter()
+                    .enumerate()
+                    .position(|(i, &t)| seen + i as u64 >= 2 && t <= t0 && before(i).is_some_and(|p| t < p))
+            });
             if let Some(i) = cut {
                 let from = before(i).unwrap_or(f64::NAN);
                 self.reset = Some((seen + i as u64, block.lines.map(|l| l[i]), from, ts[i]));
