@@ -41,6 +41,49 @@ pub struct ReportFolder {
     pub inputs: Vec<std::path::PathBuf>,
 }
 
+/// The name of a report folder's manifest: every other file of the folder with its SHA-256 and
+/// size, written last; `gyrolab verify` checks the folder against it.
+pub const MANIFEST: &str = "manifest.json";
+
+/// One file of a report folder's manifest.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct ManifestEntry {
+    /// The file's name in the folder.
+    pub name: String,
+    /// SHA-256 of its bytes, lower-case hex.
+    pub sha256: String,
+    /// Its size, bytes.
+    pub size_bytes: u64,
+}
+
+/// A report folder's manifest ([`MANIFEST`]).
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Manifest {
+    /// What it is, for a reader who finds the file alone.
+    pub about: String,
+    /// The hash function: `SHA-256`.
+    pub algorithm: String,
+    /// Every file of the report but the manifest itself, in writing order.
+    pub files: Vec<ManifestEntry>,
+}
+
+/// The manifest of `outputs` as pretty JSON with a final newline.
+pub fn manifest_json(outputs: &[NamedOutput]) -> EvalResult<String> {
+    let manifest = Manifest {
+        about: "the files of this gyrolab report folder with their SHA-256, written with them; `gyrolab verify` checks the folder against it (an edited, missing or added file is found; a manifest rewritten with the files is found only by the signature of an issued report)".into(),
+        algorithm: "SHA-256".into(),
+        files: outputs
+            .iter()
+            .map(|o| ManifestEntry {
+                name: o.name.clone(),
+                sha256: gyrolab_io::input_file::sha256_hex(&o.bytes),
+                size_bytes: o.bytes.len() as u64,
+            })
+            .collect(),
+    };
+    json(&manifest).map(|s| s + "\n")
+}
+
 /// The mark a CSV of a report folder with simulated inputs starts with, unless the file's own
 /// rows are simulated (it then starts with `# SIMULATED DATA: ...`).
 pub const SIMULATED_INPUTS_LINE: &str = "# SIMULATED INPUTS: some results of this report folder come from simulated \
@@ -204,5 +247,7 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
     if simulated {
         mark_simulated_csvs(&mut outputs, inputs.simulated_rate.as_deref());
     }
+    let manifest = manifest_json(&outputs)?;
+    outputs.push(NamedOutput { name: MANIFEST.into(), bytes: manifest.into_bytes() });
     Ok(ReportFolder { outputs, verdict, failures, undecided, simulated, inputs: Vec::new() })
 }

@@ -1,7 +1,9 @@
 //! `gyrolab verify DIR`: a report folder's integrity record (results.json `integrity`: the plan's
 //! SHA-256 and copy, every input with its SHA-256, written by `gyrolab eval`) checked against
 //! the files as they are now, so that an input or plan edited after the report was issued is
-//! found (ISO/IEC 17025:2017 7.5 technical records, 7.11.3 integrity of data).
+//! found (ISO/IEC 17025:2017 7.5 technical records, 7.11.3 integrity of data); and the
+//! folder's own files against its manifest (manifest.json: every output with its SHA-256), so
+//! that an edited, deleted or added output is found too.
 
 use crate::error::EvalResult;
 use gyrolab_io::input_file::sha256_file;
@@ -63,6 +65,17 @@ pub struct FileCheck {
     pub state: FileState,
 }
 
+/// One output of the report folder against the manifest.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputCheck {
+    /// The file's name in the folder.
+    pub name: String,
+    /// The SHA-256 in the manifest.
+    pub recorded_sha256: String,
+    /// What was found.
+    pub state: FileState,
+}
+
 /// The result of verifying a report folder.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Verification {
@@ -70,13 +83,69 @@ pub struct Verification {
     pub report_number: String,
     /// Every file checked: the plan copy, the plan (when found), the inputs in plan order.
     pub checks: Vec<FileCheck>,
+    /// Every output in the manifest, checked; `None` when the folder has no manifest (written
+    /// by a gyrolab before 0.3): the outputs were NOT checked, which never counts as passed.
+    pub outputs: Option<Vec<OutputCheck>>,
+    /// Files in the folder that the manifest does not list (an added file, a leftover of an
+    /// interrupted run), besides the manifest itself and a `report.pdf` printed from
+    /// report.html afterwards (listed in `uncovered`).
+    pub extra: Vec<String>,
+    /// Files the manifest cannot cover, by design: `report.pdf`, printed from report.html after
+    /// the folder was written (`--pdf`).
+    pub uncovered: Vec<String>,
 }
 
 impl Verification {
-    /// True when every file checked has its recorded hash.
+    /// True when every file checked has its recorded hash, every output its manifest's, and no
+    /// file was added (the outputs checked; see [`Verification::outputs_checked`]).
     pub fn all_unchanged(&self) -> bool {
         self.checks.iter().all(|c| c.state == FileState::Unchanged)
+            && self.outputs.iter().flatten().all(|c| c.state == FileState::Unchanged)
+            && self.extra.is_empty()
     }
+
+    /// Whether the outputs were checked (the folder has a manifest).
+    pub fn outputs_checked(&self) -> bool {
+        self.outputs.is_some()
+    }
+}
+
+/// The outputs of `dir` against its manifest: (checks, extra files, uncovered files); `None`
+/// without a manifest. A manifest that cannot be read is an error naming it.
+#[allow(clippy::type_complexity)]
+fn check_outputs(dir: &Path) -> EvalResult<Option<(Vec<OutputCheck>, Vec<String>, Vec<String>)>> {
+    use crate::report_folder::{Manifest, MANIFEST};
+    let path = dir.join(MANIFEST);
+    if !path.exists() {
+        return Ok(None);
+    }
+    let text = gyrolab_io::text::read_text_file(&path, gyrolab_io::text::MAX_TABLE_BYTES, "a manifest")?;
+    let manifest: Manifest = serde_json::from_str(&text)
+        .map_err(|e| DataError::new(&path, format!("not a gyrolab manifest: {e}")).at_line(e.line() as u64))?;
+    let mut checks = Vec::with_capacity(manifest.files.len());
+    for f in &manifest.files {
+        if Path::new(&f.name).file_name() != Some(std::ffi::OsStr::new(&f.name)) {
+            return Err(DataError::new(&path, format!("'{}' is not a plain file name", f.name)).into());
+        }
+        let c = check(Role::PlanCopy, dir.join(&f.name), &f.sha256);
+        checks.push(OutputCheck { name: f.name.clone(), recorded_sha256: f.sha256.clone(), state: c.state });
+    }
+    let (mut extra, mut uncovered) = (Vec::new(), Vec::new());
+    let entries = std::fs::read_dir(dir).map_err(|e| DataError::io(dir, &e))?;
+    for entry in entries {
+        let entry = entry.map_err(|e| DataError::io(dir, &e))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if name == MANIFEST || manifest.files.iter().any(|f| f.name == name) {
+            continue;
+        }
+        if name == "report.pdf" {
+            uncovered.push(name);
+        } else {
+            extra.push(name);
+        }
+    }
+    extra.sort();
+    Ok(Some((checks, extra, uncovered)))
 }
 
 fn check(role: Role, path: PathBuf, recorded: &str) -> FileCheck {
@@ -124,5 +193,9 @@ pub fn verify_folder(dir: &Path, plan_dir: Option<&Path>) -> EvalResult<Verifica
     for i in &integrity.inputs {
         checks.push(check(Role::Input, base.join(&i.file), &i.sha256));
     }
-    Ok(Verification { report_number, checks })
+    let (outputs, extra, uncovered) = match check_outputs(dir)? {
+        Some((o, e, u)) => (Some(o), e, u),
+        None => (None, Vec::new(), Vec::new()),
+    };
+    Ok(Verification { report_number, checks, outputs, extra, uncovered })
 }

@@ -81,7 +81,12 @@ fn verify_names_every_changed_or_missing_input_and_the_report_has_an_identity() 
     let a = gyrolab().arg("verify").arg(&out).current_dir(dir.path()).assert().code(0);
     let stdout = String::from_utf8_lossy(&a.get_output().stdout).into_owned();
     assert!(stdout.starts_with("Report LAB-2026-0042"), "{stdout}");
-    assert_eq!(stdout.matches("unchanged").count(), 5, "plan copy, plan, three inputs: {stdout}");
+    assert_eq!(
+        stdout.matches("unchanged").count() - stdout.matches("unchanged output").count(),
+        5,
+        "plan copy, plan, three inputs: {stdout}"
+    );
+    assert!(stdout.matches("unchanged output").count() >= 8, "every output of the manifest: {stdout}");
 
     // One byte of an input changed, another input gone, the plan copy edited: exit 3, each named.
     let y = dir.path().join("paper_rate_table_y.csv");
@@ -100,7 +105,10 @@ fn verify_names_every_changed_or_missing_input_and_the_report_has_an_identity() 
     assert!(stdout.contains("MISSING   input") && stdout.contains("paper_rate_table_z.csv"), "{stdout}");
     assert!(stdout.contains("CHANGED   plan copy"), "{stdout}");
     assert!(stdout.contains("unchanged input") && stdout.contains("paper_rate_table_x.csv"), "{stdout}");
-    assert!(stderr.starts_with("FAIL: 3 of 5 files of report LAB-2026-0042 changed or missing"), "{stderr}");
+    // The plan copy is also an output of the manifest: found twice (as the plan's copy and as
+    // an output), 4 of the 5 plan and input files and 9 outputs.
+    assert!(stderr.starts_with("FAIL: 4 of 14 files of report LAB-2026-0042 changed, missing or added"), "{stderr}");
+    assert!(stderr.contains("output plan_copy.toml"), "{stderr}");
 }
 
 #[test]
@@ -125,4 +133,64 @@ fn verify_refuses_folders_without_an_integrity_record() {
     std::fs::write(out.join("results.json"), "{\"gyrolab_version\": \"0.1.0\"}").unwrap();
     let a = gyrolab().arg("verify").arg(&out).assert().code(2);
     assert!(String::from_utf8_lossy(&a.get_output().stderr).contains("no integrity record"));
+}
+
+/// `verify` checks the outputs too (issue 53): every file of the folder against manifest.json,
+/// whose hashes equal coreutils' sha256sum; an edited report.html (PASS to FAIL), an edited
+/// results.json, a deleted summary.csv and an added file each give exit 3 naming them; a
+/// report.pdf printed afterwards is listed as not covered, not as a change; a folder without a
+/// manifest has its outputs NOT CHECKED (exit 5), never passed.
+#[test]
+fn verify_checks_every_output_against_the_manifest() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = plan(dir.path());
+    let out = dir.path().join("report");
+    gyrolab().arg("eval").arg(&p).arg("--out").arg(&out).arg("-q").assert().code(0);
+    let manifest: serde_json::Value = serde_json::from_str(&read(&out.join("manifest.json"))).unwrap();
+    let files = manifest["files"].as_array().unwrap();
+    let mut names: Vec<&str> = files.iter().map(|f| f["name"].as_str().unwrap()).collect();
+    names.sort();
+    let mut on_disk: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n != "manifest.json")
+        .collect();
+    on_disk.sort();
+    assert_eq!(names, on_disk);
+    for f in files {
+        if let Some(sum) = sha256sum(&out.join(f["name"].as_str().unwrap())) {
+            assert_eq!(f["sha256"].as_str().unwrap(), sum, "{f}");
+        }
+    }
+    let verify = || gyrolab().arg("verify").arg(&out).arg("--plan-dir").arg(dir.path()).output().unwrap();
+    assert_eq!(verify().status.code(), Some(0));
+    std::fs::write(out.join("report.pdf"), b"%PDF").unwrap();
+    let o = verify();
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("report.pdf (printed from report.html after the manifest"));
+    let original = read(&out.join("report.html"));
+    for (edit, word) in [("report.html", "output report.html"), ("results.json", "output results.json")] {
+        let path = out.join(edit);
+        let before = std::fs::read(&path).unwrap();
+        let mut text = String::from_utf8(before.clone()).unwrap();
+        text = if text.contains("PASS") { text.replacen("PASS", "FAIL", 1) } else { text.replacen('1', "2", 1) };
+        std::fs::write(&path, text).unwrap();
+        let o = verify();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(3), "{err}");
+        assert!(err.contains(word), "{err}");
+        std::fs::write(&path, before).unwrap();
+    }
+    assert_eq!(read(&out.join("report.html")), original);
+    std::fs::remove_file(out.join("summary.csv")).unwrap();
+    std::fs::write(out.join(".gyrolab-x.tmp"), b"leftover").unwrap();
+    let o = verify();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    assert!(err.contains("output summary.csv") && err.contains("added .gyrolab-x.tmp"), "{err}");
+    std::fs::remove_file(out.join("manifest.json")).unwrap();
+    std::fs::remove_file(out.join(".gyrolab-x.tmp")).unwrap();
+    let o = verify();
+    assert_eq!(o.status.code(), Some(5), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("NOT CHECKED"));
 }
