@@ -127,6 +127,13 @@ pub struct AnalysisArgs {
     /// (exit 2); with it every output (text, JSON, Kalibr and export files) is marked MOTION.
     #[arg(long)]
     pub allow_motion: bool,
+    /// Analyse the record from this many seconds after its first sample (each topic of a
+    /// recording from its own first sample).
+    #[arg(long, value_name = "SECONDS")]
+    pub start: Option<f64>,
+    /// Analyse the record up to (not including) this many seconds after its first sample.
+    #[arg(long, value_name = "SECONDS")]
+    pub end: Option<f64>,
 }
 
 impl AnalysisArgs {
@@ -147,6 +154,7 @@ impl AnalysisArgs {
             gaps: GapPolicy::parse(&self.gaps)?,
             topics: record.topics.clone(),
             allow_motion: self.allow_motion,
+            window_s: (self.start, self.end),
         })
     }
 }

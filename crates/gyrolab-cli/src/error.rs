@@ -95,6 +95,8 @@ pub fn flag(field: &str) -> String {
         "triad_x" => "--triad x=FILE".into(),
         "triad_y" => "--triad y=FILE".into(),
         "triad_z" => "--triad z=FILE".into(),
+        "start_s" => "--start".into(),
+        "end_s" => "--end".into(),
         other => format!("--{}", other.replace('_', "-")),
     }
 }

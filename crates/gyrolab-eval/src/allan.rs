@@ -69,6 +69,10 @@ pub struct AllanRequest {
     /// Analyse a record whose gyro or accelerometer channels moved (the stillness check,
     /// docs/METHODS.md): its outputs are marked; without it such a record is refused.
     pub allow_motion: bool,
+    /// The part of the record analysed, seconds from its first sample: samples at or after
+    /// the start and before the end (`None`: from the first, to the last). Each topic of a
+    /// recording counts from its own first sample.
+    pub window_s: (Option<f64>, Option<f64>),
 }
 
 /// What the Allan analysis does with missing samples (docs/METHODS.md, "Gap policies").
@@ -128,8 +132,109 @@ impl AllanRequest {
             gaps: GapPolicy::default(),
             topics: Vec::new(),
             allow_motion: false,
+            window_s: (None, None),
         }
     }
+
+    /// Whether a part of the record is asked for (`window_s`).
+    pub fn has_window(&self) -> bool {
+        self.window_s.0.is_some() || self.window_s.1.is_some()
+    }
+}
+
+/// Keeps the samples of `data` whose time from the first sample lies in `[start, end)` (the
+/// stamps, else the sample index over `rate_hz`); a note says what was kept. An empty or
+/// inverted window, or one holding fewer than two samples, is an error naming the record's
+/// length.
+pub fn trim_to_window(
+    data: &mut SeriesData,
+    path: &Path,
+    (start, end): (Option<f64>, Option<f64>),
+    rate_hz: Option<f64>,
+) -> EvalResult<Option<ReadNote>> {
+    if start.is_none() && end.is_none() {
+        return Ok(None);
+    }
+    for (name, v) in [("start_s", start), ("end_s", end)] {
+        if let Some(v) = v {
+            if !v.is_finite() || v < 0.0 {
+                return Err(EvalError::conflict_on(
+                    &[name],
+                    format!("{{{name}}} must be a number of seconds >= 0, got {v}"),
+                ));
+            }
+        }
+    }
+    if let (Some(a), Some(b)) = (start, end) {
+        if b <= a {
+            return Err(EvalError::conflict_on(
+                &["start_s", "end_s"],
+                format!("{{end_s}} {b} s is not after {{start_s}} {a} s"),
+            ));
+        }
+    }
+    let n = data.channels.first().map_or(0, Vec::len);
+    let offset = |i: usize| -> Option<f64> {
+        match (&data.time, rate_hz) {
+            (Some(t), _) => Some(t[i] - t[0]),
+            (None, Some(f)) => Some(i as f64 / f),
+            _ => None,
+        }
+    };
+    if n == 0 || offset(0).is_none() {
+        return Err(EvalError::conflict_on(
+            &["start_s", "end_s", "sample_rate_hz"],
+            format!(
+                "{}: {{start_s}} and {{end_s}} need the record's time stamps or {{sample_rate_hz}}",
+                path.display()
+            ),
+        ));
+    }
+    let keep = |i: usize| offset(i).is_some_and(|s| start.is_none_or(|a| s >= a) && end.is_none_or(|b| s < b));
+    let first = (0..n).find(|&i| keep(i));
+    let last = (0..n).rev().find(|&i| keep(i));
+    let length = offset(n - 1).unwrap_or(0.0);
+    let (Some(from), Some(to)) = (first, last) else {
+        return Err(EvalError::conflict_on(
+            &["start_s", "end_s"],
+            format!("{}: no sample between {{start_s}} and {{end_s}}: the record is {length} s long", path.display()),
+        ));
+    };
+    if to <= from {
+        return Err(EvalError::conflict_on(
+            &["start_s", "end_s"],
+            format!(
+                "{}: fewer than two samples between {{start_s}} and {{end_s}}: the record is {length} s long",
+                path.display()
+            ),
+        ));
+    }
+    let range = from..to + 1;
+    let (from_s, to_s) = (offset(from).unwrap_or(0.0), offset(to).unwrap_or(0.0));
+    let first_line = data.lines.get(from).unwrap_or(0);
+    let last_line = data.lines.get(to).unwrap_or(0);
+    for c in &mut data.channels {
+        *c = c[range.clone()].to_vec();
+    }
+    if let Some(t) = &mut data.time {
+        *t = t[range.clone()].to_vec();
+    }
+    if let Some(t) = &mut data.temperature {
+        if t.len() >= range.end {
+            *t = t[range.clone()].to_vec();
+        }
+    }
+    if let Some(t) = &mut data.table_rate {
+        if t.len() >= range.end {
+            *t = t[range.clone()].to_vec();
+        }
+    }
+    let mut lines = gyrolab_io::series::LineMap::default();
+    for i in range.clone() {
+        lines.push(data.lines.get(i).unwrap_or(0));
+    }
+    data.lines = lines;
+    Ok(Some(ReadNote::Window { from_s, to_s, samples: range.len(), of: n, first_line, last_line }))
 }
 
 /// The analyses of a file (or of one topic of a recording).
@@ -287,6 +392,21 @@ pub enum ReadNote {
     /// The record's temperature moved by more than
     /// [`gyrolab::record_temperature::MOVED_SPAN_C`] (a warning).
     TemperatureMoved(gyrolab::record_temperature::RecordTemperature),
+    /// The part of the record analysed (`window_s`).
+    Window {
+        /// Its first sample, s from the record's first.
+        from_s: f64,
+        /// Its last sample, s from the record's first.
+        to_s: f64,
+        /// Samples kept.
+        samples: usize,
+        /// Samples of the record.
+        of: usize,
+        /// Line (message) of its first sample.
+        first_line: u64,
+        /// Line (message) of its last sample.
+        last_line: u64,
+    },
     /// An IMU topic left out because no topic was named and it is no sensor's own sample
     /// stream (a snapshot, an integrated or a too-short topic).
     TopicSkipped(gyrolab_io::recording::SkippedTopic),
@@ -423,6 +543,10 @@ impl std::fmt::Display for ReadNote {
                 t.slope_c_per_h,
                 gyrolab::record_temperature::MOVED_SPAN_C
             ),
+            ReadNote::Window { from_s, to_s, samples, of, first_line, last_line } => write!(
+                f,
+                "analysed from {from_s} s to {to_s} s of the record ({{start_s}}, {{end_s}}): {samples} of {of} samples, rows {first_line} to {last_line}"
+            ),
             ReadNote::TopicSkipped(s) => write!(
                 f,
                 "topic {} skipped: {}; name it with {{topics}} to analyse it anyway",
@@ -470,7 +594,7 @@ impl ReadNote {
     /// The note with its option placeholders (`{units}`) spelled by the front end.
     pub fn render(&self, spell: &dyn Fn(&str) -> String) -> String {
         let mut t = self.to_string();
-        for f in ["units", "gaps", "sample_rate_hz", "columns", "topics"] {
+        for f in ["units", "gaps", "sample_rate_hz", "columns", "topics", "start_s", "end_s"] {
             t = t.replace(&format!("{{{f}}}"), &spell(f));
         }
         t
@@ -979,8 +1103,9 @@ pub fn analyse_records(request: &AllanRequest) -> EvalResult<Vec<AllanOutcome>> 
         sample_rate_hz: request.sample_rate_hz,
         channels: if request.columns.is_empty() { None } else { Some(request.columns.clone()) },
         tolerant: true,
-        // Only the interval and gap search reads the stamps: kept compactly.
-        compact_time: true,
+        // Only the interval and gap search reads the stamps: kept compactly (whole when a part
+        // of the record is asked for, to cut it by them).
+        compact_time: !request.has_window(),
         ..SeriesOptions::default()
     })?;
     let records = read_records(path, &options, &request.topics)?;
@@ -1110,6 +1235,7 @@ pub fn analyse_data(
     let path = &request.file;
     let rows = data.header.rows;
     let mut notes = read_notes(&data.header);
+    notes.extend(trim_to_window(&mut data, path, request.window_s, request.sample_rate_hz)?);
     let timing = record_timing(&data, path, request.sample_rate_hz, request.gaps)?;
     let tau0 = timing.tau0_s;
     // A stamp going back ends the record: the rows before it are analysed.

@@ -279,6 +279,18 @@ pub fn analyse_records_within(
 /// A record beyond the ceiling is streamed, which computes octave OADEV only: another kind or
 /// tau list is refused, naming the options.
 fn refuse_other_estimators(request: &AllanRequest, path: &Path, estimate: u64, memory_bytes: u64) -> EvalResult<()> {
+    if request.has_window() {
+        return Err(EvalError::conflict_on(
+            &["memory", "start_s", "end_s"],
+            format!(
+                "{}: about {} in memory, above the ceiling {{memory}} {}: {{start_s}} and {{end_s}} cut a record read in memory (raise {{memory}} above {}, or cut the record first with `gyrolab convert`)",
+                path.display(),
+                size_text(estimate),
+                size_text(memory_bytes),
+                size_text(estimate)
+            ),
+        ));
+    }
     if request.kind == DeviationKind::Oadev && request.taus == TauList::Octave {
         return Ok(());
     }

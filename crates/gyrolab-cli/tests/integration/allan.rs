@@ -248,3 +248,63 @@ fn the_temperature_column_is_reported_with_its_drift() {
         assert_eq!(err.contains("the temperature (temp_c) moved"), moved, "{err}");
     }
 }
+
+/// `--start`/`--end` (issue 54): the part of a record analysed equals the same rows cut by hand
+/// into their own file (every deviation to the last bit), the note names the rows kept; an
+/// inverted or empty window is a usage error naming the record's length.
+#[test]
+fn start_and_end_cut_the_record_as_a_hand_cut_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("r.csv");
+    gyrolab()
+        .args(["simulate", "static", "--duration-s", "300", "--sample-rate-hz", "100", "--arw-deg-rt-h", "0.3"])
+        .args(["--rrw-deg-h-rt-h", "5", "--seed", "9", "--out"])
+        .arg(&p)
+        .assert()
+        .success();
+    let text = std::fs::read_to_string(&p).unwrap();
+    let mut cut = String::new();
+    let mut rows = 0;
+    for line in text.lines() {
+        let t = line.split(',').next().and_then(|x| x.parse::<f64>().ok());
+        match t {
+            Some(t) if !(50.0..200.0).contains(&t) => continue,
+            Some(_) => rows += 1,
+            None => {}
+        }
+        cut.push_str(line);
+        cut.push('\n');
+    }
+    // The cut file's stamps start at 50 s; the tool counts from the record's first sample, 0 s.
+    let q = common::write(dir.path(), "cut.csv", &cut);
+    let run = |file: &std::path::Path, extra: &[&str]| -> (serde_json::Value, String) {
+        let out = gyrolab().arg("allan").arg(file).args(extra).arg("--json").output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(out.status.success(), "{err}");
+        (serde_json::from_slice(&out.stdout).unwrap(), err)
+    };
+    let (windowed, err) = run(&p, &["--start", "50", "--end", "200"]);
+    let (by_hand, _) = run(&q, &[]);
+    assert!(
+        err.contains(&format!(
+            "analysed from 50 s to 199.99 s of the record (--start, --end): {rows} of 30000 samples"
+        )),
+        "{err}"
+    );
+    assert_eq!(rows, 15000);
+    for key in ["dev", "taus_s", "n_terms", "ci_low", "ci_high"] {
+        let (a, b) = (&windowed["channels"][0][key], &by_hand["channels"][0][key]);
+        assert!(a.as_array().is_some_and(|v| v.len() >= 8), "{key}: {a}");
+        assert_eq!(a, b, "{key}");
+    }
+    assert_eq!(windowed["channels"][0]["samples"], 15000);
+    for (args, word) in [
+        (["--start", "200", "--end", "50"], "is not after"),
+        (["--start", "400", "--end", "500"], "the record is 299.99 s long"),
+    ] {
+        let out = gyrolab().arg("allan").arg(&p).args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains(word), "{err}");
+    }
+}
