@@ -38,6 +38,23 @@ pub struct EvalArgs {
     pub store: Option<String>,
 }
 
+/// Whether an SQLite store can be created at `location` (a path): its folder exists and takes a
+/// new file. A usage error (exit 2) naming the folder otherwise.
+fn creatable(location: &str) -> CliResult<()> {
+    let path = std::path::Path::new(location);
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => std::path::Path::new("."),
+    };
+    tempfile::Builder::new().prefix(".gyrolab-store-check-").tempfile_in(dir).map(drop).map_err(|e| {
+        CliError::Usage(format!(
+            "{}: the store does not exist and cannot be created in its folder: {}; nothing was written",
+            gyrolab_store::mask_location(location),
+            e.kind()
+        ))
+    })
+}
+
 /// Runs `gyrolab eval`.
 pub fn run(args: &EvalArgs) -> CliResult {
     let plan = read_test_plan(&args.plan)?;
@@ -55,8 +72,10 @@ pub fn run(args: &EvalArgs) -> CliResult {
             scope.spawn(move || {
                 let store = match Store::open(l, false) {
                     Ok(s) => Ok(Some(s)),
-                    Err(StoreError::NotFound { .. }) => Ok(None),
-                    Err(e) => Err(e),
+                    // Created once the folder is written: its folder must take a new file now,
+                    // so that a store that cannot be made ends the run before anything is written.
+                    Err(StoreError::NotFound { .. }) => creatable(l).map(|()| None),
+                    Err(e) => Err(CliError::from(e)),
                 };
                 (store, hash_plan_inputs(&args.plan))
             })

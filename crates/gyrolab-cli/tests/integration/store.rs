@@ -508,3 +508,21 @@ fn the_stored_report_folder_is_written_back_byte_for_byte_also_from_a_revision()
         assert!(!none.exists());
     }
 }
+
+/// A store that cannot be made (its folder missing) ends `eval --store` with exit 2 before the
+/// report folder is written (issue 53: exit 2 means nothing written), the password of a
+/// mistyped URL not echoed.
+#[test]
+fn an_unusable_store_is_refused_before_the_folder_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let plan = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper_plan.toml");
+    let out = dir.path().join("report");
+    for store in [dir.path().join("no/such/folder/g.db").display().to_string(), "postgress://u:s3cr3t@h/db".to_string()]
+    {
+        let o = gyrolab().arg("eval").arg(&plan).arg("--out").arg(&out).arg("--store").arg(&store).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(!out.exists(), "{err}");
+        assert!(!err.contains("s3cr3t"), "{err}");
+    }
+}
