@@ -316,7 +316,7 @@ pub struct CheckReport {
     pub links: i64,
     /// Links re-verified against their rows.
     pub links_checked: i64,
-    /// Rows per chained table (table, rows).
+    /// Rows per chained table (table, rows); full check only.
     pub rows: Vec<(String, i64)>,
     /// Report files whose stored bytes were re-hashed and found equal to their SHA-256 and size.
     pub files_checked: i64,
@@ -446,7 +446,10 @@ fn verify_link(
     if unhex(&l.hash).is_some_and(|h| h == link_hash(prev, l.seq, &digest)) {
         return Ok(None);
     }
-    let row = read_row(x, t, l.row_id)?.unwrap_or_default();
+    let row = match read_row(x, t, l.row_id) {
+        Ok(r) => r.unwrap_or_default(),
+        Err(e) => return Ok(Some(unreadable(t, l.row_id, Some(l.seq), &e))),
+    };
     let now = field_digests(t, &row);
     let differ: Vec<&str> = t
         .columns
@@ -483,58 +486,82 @@ fn verify_link(
     }))
 }
 
+/// A row that cannot be read as its columns' types (SQLite keeps any value in any column: a text
+/// written into a REAL column behind the store's back).
+fn unreadable(t: &ChainedTable, row_id: i64, link: Option<i64>, e: &str) -> Problem {
+    Problem {
+        table: t.name.into(),
+        row_id: Some(row_id),
+        link,
+        what: format!("cannot be read as its columns' types ({e}): a value of another type was written into it"),
+    }
+}
+
+/// The digest of one row for the checks: `None` when it is gone, a digest of nothing (which
+/// matches no link) with a problem when it cannot be read.
+fn digest_of(
+    x: &mut dyn Exec,
+    t: &ChainedTable,
+    id: i64,
+    problems: &mut Vec<Problem>,
+) -> Result<Option<[u8; 32]>, String> {
+    match read_row(x, t, id) {
+        Ok(r) => Ok(r.map(|r| row_digest(t, &r))),
+        Err(e) => {
+            problems.push(unreadable(t, id, None, &e));
+            Ok(Some([0u8; 32]))
+        }
+    }
+}
+
 fn count(x: &mut dyn Exec, sql: &str, params: &[Val]) -> Result<i64, String> {
     Ok(x.query(sql, params, &[Kind::I])?.first().map_or(0, |r| r[0].int()))
 }
 
-/// Row counts per table against the links per table, and rows without an id.
-fn check_counts(x: &mut dyn Exec, report: &mut CheckReport) -> Result<(), String> {
+/// Rows past the end of the chain: per table, a row whose id is above the last chained one, or a
+/// row without an id (index look-ups only, whatever the size of the store).
+fn check_tails(x: &mut dyn Exec, report: &mut CheckReport) -> Result<(), String> {
     for t in &CHAINED {
-        let rows = count(x, &format!("SELECT COUNT(*) FROM {}", t.name), &[])?;
-        let links = count(x, "SELECT COUNT(*) FROM chain WHERE tbl = $1", &[Val::T(Some(t.name.into()))])?;
-        let no_id = count(x, &format!("SELECT COUNT(*) FROM {} WHERE id IS NULL", t.name), &[])?;
-        report.rows.push((t.name.to_string(), rows));
-        if no_id > 0 {
+        let max = |x: &mut dyn Exec, sql: &str, p: &[Val]| -> Result<Option<i64>, String> {
+            Ok(x.query(sql, p, &[Kind::IOpt])?.first().and_then(|r| match r[0] {
+                Val::IOpt(v) => v,
+                _ => None,
+            }))
+        };
+        let last_row = max(x, &format!("SELECT MAX(id) FROM {}", t.name), &[])?;
+        let last_link = max(x, "SELECT MAX(row_id) FROM chain WHERE tbl = $1", &[Val::T(Some(t.name.to_string()))])?;
+        if let Some(id) = last_row.filter(|id| last_link.is_none_or(|l| id > &l)) {
             report.problems.push(Problem {
                 table: t.name.into(),
-                row_id: None,
+                row_id: Some(id),
                 link: None,
-                what: format!("{no_id} row(s) without an id: inserted outside the store"),
+                what: "not in the chain (past its last row of this table): inserted outside the store".into(),
             });
         }
-        if rows != links {
+        let no_id = x.query(&format!("SELECT 1 FROM {} WHERE id IS NULL LIMIT 1", t.name), &[], &[Kind::I])?;
+        if !no_id.is_empty() {
             report.problems.push(Problem {
                 table: t.name.into(),
                 row_id: None,
                 link: None,
-                what: format!(
-                    "{rows} row(s) but {links} chain link(s): {}",
-                    if rows > links { "rows inserted outside the store" } else { "rows deleted" }
-                ),
+                what: "row(s) without an id: inserted outside the store".into(),
             });
         }
     }
     Ok(())
 }
 
-/// The quick check run before every write: triggers present, row counts equal to link counts,
-/// the chain without gaps, and the last [`QUICK_LINKS`] links against their rows.
+/// The quick check run before every write, in index look-ups and [`QUICK_LINKS`] row reads
+/// whatever the size of the store: triggers present, no row past the chain's end or without an
+/// id, and the last [`QUICK_LINKS`] links, without gaps, against their rows. A row changed,
+/// deleted or inserted deeper in the store is found by [`full_check`] only.
 pub fn quick_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, String> {
     let mut report = CheckReport { quick: true, ..CheckReport::default() };
     check_triggers(x, postgres, &mut report)?;
-    check_counts(x, &mut report)?;
+    check_tails(x, &mut report)?;
     let (n, h) = head(x)?;
     report.links = n;
     report.head = (n > 0).then(|| hex(&h));
-    let in_chain = count(x, "SELECT COUNT(*) FROM chain", &[])?;
-    if in_chain != n {
-        report.problems.push(Problem {
-            table: "chain".into(),
-            row_id: None,
-            link: None,
-            what: format!("{in_chain} link(s) but the head is link {n}: links deleted or inserted"),
-        });
-    }
     let from = (n - QUICK_LINKS).max(0);
     let links: Vec<Link> = x
         .query(
@@ -546,8 +573,17 @@ pub fn quick_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, Stri
         .map(|r| link_of(r))
         .collect();
     let mut prev: Option<Link> = None;
-    for l in links {
-        if l.seq == 0 || l.seq == from && from > 0 {
+    for (i, l) in links.into_iter().enumerate() {
+        let expected = from.max(1) + i as i64;
+        if l.seq != expected {
+            report.problems.push(Problem {
+                table: "chain".into(),
+                row_id: None,
+                link: Some(expected),
+                what: format!("link {expected} is missing (the next stored link is {})", l.seq),
+            });
+        }
+        if l.seq == from && from > 0 {
             prev = Some(l);
             continue;
         }
@@ -555,14 +591,16 @@ pub fn quick_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, Stri
             Some(p) => unhex(&p.hash).unwrap_or_default(),
             None => [0u8; 32],
         };
+        let mut unread = Vec::new();
         let digest = match table(&l.tbl) {
-            Some(t) => read_row(x, t, l.row_id)?.map(|r| row_digest(t, &r)),
+            Some(t) => digest_of(x, t, l.row_id, &mut unread)?,
             None => Some([0u8; 32]),
         };
         report.links_checked += 1;
         if let Some(p) = verify_link(x, &l, &prev_hash, digest, prev.as_ref())? {
             report.problems.push(p);
         }
+        report.problems.extend(unread);
         prev = Some(l);
     }
     Ok(report)
@@ -582,18 +620,43 @@ pub fn full_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, Strin
         let sql = format!("SELECT {} FROM {} WHERE id > $1 ORDER BY id LIMIT 256", columns_sql(t), t.name);
         let mut last = i64::MIN;
         let mut seen = 0;
+        let ids_sql = format!("SELECT id FROM {} WHERE id > $1 ORDER BY id LIMIT 256", t.name);
         loop {
-            let page = x.query(&sql, &[Val::I(last)], &kinds(t))?;
+            // (id, the row or why it cannot be read as its columns' types)
+            let page: Vec<(i64, Result<Vec<Val>, String>)> = match x.query(&sql, &[Val::I(last)], &kinds(t)) {
+                Ok(p) => p.into_iter().map(|r| (r[0].int(), Ok(r))).collect(),
+                Err(_) => {
+                    // A row of this page cannot be read (SQLite keeps any value in any column):
+                    // the page row by row.
+                    let ids = x.query(&ids_sql, &[Val::I(last)], &[Kind::I])?;
+                    let mut rows = Vec::new();
+                    for id in ids.iter().map(|r| r[0].int()) {
+                        match read_row(x, t, id) {
+                            Ok(Some(r)) => rows.push((id, Ok(r))),
+                            Ok(None) => {}
+                            Err(e) => rows.push((id, Err(e))),
+                        }
+                    }
+                    rows
+                }
+            };
             if page.is_empty() {
                 break;
             }
-            for row in &page {
-                let id = row[0].int();
-                last = id;
+            for (id, row) in &page {
+                last = last.max(*id);
                 seen += 1;
-                digests.insert((t.name, id), row_digest(t, row));
-                if t.name == "report_file" {
-                    check_file(row, &mut report, &mut file_problems);
+                match row {
+                    Ok(row) => {
+                        digests.insert((t.name, *id), row_digest(t, row));
+                        if t.name == "report_file" {
+                            check_file(row, &mut report, &mut file_problems);
+                        }
+                    }
+                    Err(e) => {
+                        report.problems.push(unreadable(t, *id, None, e));
+                        digests.insert((t.name, *id), [0u8; 32]);
+                    }
                 }
             }
         }

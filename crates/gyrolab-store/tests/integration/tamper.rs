@@ -428,3 +428,18 @@ fn a_version_2_store_gets_its_chain_on_migration() {
         assert_eq!(r.triggers_ok.len(), r.triggers_expected);
     }
 }
+
+#[test]
+fn a_value_of_another_type_written_on_sqlite_is_named_not_a_failure() {
+    // SQLite keeps any value in any column: a text in the REAL column `value`.
+    let b = backends("tamper_types").into_iter().next().unwrap();
+    let mut s = two_evaluations(&b);
+    let mut raw = Raw::open(&b);
+    let fid = first_figure_id(&mut raw);
+    raw.behind_the_triggers(&["figure"], &format!("UPDATE figure SET value = 'ten' WHERE id = {fid};"));
+    let r = s.check().unwrap();
+    let p = r.problems.iter().find(|p| p.what.contains("another type")).unwrap_or_else(|| panic!("{:?}", r.problems));
+    assert_eq!((p.table.as_str(), p.row_id), ("figure", Some(fid)));
+    assert!(r.problems.iter().all(|p| p.row_id == Some(fid)), "{:?}", r.problems);
+    assert!(matches!(Store::open_for_writing(&b.location, false), Err(StoreError::Tampered { .. })));
+}
