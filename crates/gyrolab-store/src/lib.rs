@@ -195,7 +195,9 @@ pub struct Store {
 const SQLITE_HEADER: &[u8; 16] = b"SQLite format 3\0";
 
 impl Store {
-    /// Opens the store at `location` (a file path or a `postgres://` URL). `create`: a missing
+    /// Opens the store at `location` (a file path, `sqlite://PATH`, a `postgres://` URL or a
+    /// libpq keyword string, read by [`parse_location`]; a refused location is an
+    /// [`StoreError::Open`] naming only what may be shown). `create`: a missing
     /// SQLite file is created (else it is an error). The schema is created or migrated on first
     /// use; a store of a newer schema, a file that is not SQLite, or an SQLite file with tables
     /// but no gyrolab schema is refused with nothing written.
@@ -203,64 +205,74 @@ impl Store {
         let parsed = parse_location(location)
             .map_err(|e| StoreError::Open { store: e.shown.clone(), message: e.message.clone() })?;
         let name = parsed.shown().to_string();
-        let mut store = if let Location::Postgres { connect, .. } = &parsed {
-            let mask = |m: String| parsed.mask(&m);
-            let mut config: postgres::Config = connect
-                .parse()
-                .map_err(|e: postgres::Error| StoreError::Open { store: name.clone(), message: mask(e.to_string()) })?;
-            config.connect_timeout(Duration::from_secs(10));
-            let client = config.connect(postgres::NoTls).map_err(|e| StoreError::Open {
-                store: name.clone(),
-                message: mask(format!(
-                    "cannot connect: {}",
-                    e.as_db_error().map_or_else(|| e.to_string(), |d| d.message().to_string())
-                )),
-            })?;
-            Store { conn: Conn::Postgres(Box::new(client)), name, location: parsed, statements: PgStatements::new() }
-        } else {
-            let path = Path::new(parsed.shown());
-            let open_err = |m: String| StoreError::Open { store: name.clone(), message: m };
-            match std::fs::File::open(path) {
-                Ok(mut f) => {
-                    use std::io::Read;
-                    let mut head = [0u8; 16];
-                    let mut got = 0;
-                    while got < 16 {
-                        match f.read(&mut head[got..]) {
-                            Ok(0) => break,
-                            Ok(n) => got += n,
-                            Err(e) => return Err(open_err(format!("cannot read: {e}"))),
+        let mut store = match &parsed {
+            Location::Postgres { connect, .. } => {
+                let mask = |m: String| parsed.mask(&m);
+                let mut config: postgres::Config = connect.parse().map_err(|e: postgres::Error| StoreError::Open {
+                    store: name.clone(),
+                    message: mask(e.to_string()),
+                })?;
+                config.connect_timeout(Duration::from_secs(10));
+                let client = config.connect(postgres::NoTls).map_err(|e| StoreError::Open {
+                    store: name.clone(),
+                    message: mask(format!(
+                        "cannot connect: {}",
+                        e.as_db_error().map_or_else(|| e.to_string(), |d| d.message().to_string())
+                    )),
+                })?;
+                Store {
+                    conn: Conn::Postgres(Box::new(client)),
+                    name,
+                    location: parsed.clone(),
+                    statements: PgStatements::new(),
+                }
+            }
+            Location::Sqlite { path } => {
+                let path = Path::new(path);
+                let open_err = |m: String| StoreError::Open { store: name.clone(), message: m };
+                match std::fs::File::open(path) {
+                    Ok(mut f) => {
+                        use std::io::Read;
+                        let mut head = [0u8; 16];
+                        let mut got = 0;
+                        while got < 16 {
+                            match f.read(&mut head[got..]) {
+                                Ok(0) => break,
+                                Ok(n) => got += n,
+                                Err(e) => return Err(open_err(format!("cannot read: {e}"))),
+                            }
+                        }
+                        if got > 0 && (got < 16 || head != *SQLITE_HEADER) {
+                            return Err(open_err("not an SQLite database (wrong header): not a gyrolab store".into()));
                         }
                     }
-                    if got > 0 && (got < 16 || head != *SQLITE_HEADER) {
-                        return Err(open_err("not an SQLite database (wrong header): not a gyrolab store".into()));
+                    Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                        if !create {
+                            return Err(StoreError::NotFound {
+                                store: name.clone(),
+                                message:
+                                    "no store here (it is created by `gyrolab store add` or `gyrolab eval --store`)"
+                                        .into(),
+                            });
+                        }
                     }
+                    Err(e) => return Err(open_err(format!("cannot open: {e}"))),
                 }
-                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                    if !create {
-                        return Err(StoreError::NotFound {
-                            store: name.clone(),
-                            message: "no store here (it is created by `gyrolab store add` or `gyrolab eval --store`)"
-                                .into(),
-                        });
-                    }
+                let conn = rusqlite::Connection::open(path).map_err(|e| open_err(e.to_string()))?;
+                conn.busy_timeout(BUSY_TIMEOUT).map_err(|e| open_err(e.to_string()))?;
+                let mut store =
+                    Store { conn: Conn::Sqlite(conn), name, location: parsed.clone(), statements: PgStatements::new() };
+                store.check_foreign_sqlite()?;
+                if let Conn::Sqlite(c) = &store.conn {
+                    set_wal(c, BUSY_TIMEOUT).map_err(|e| store.open_error(e))?;
+                    c.pragma_update(None, "foreign_keys", "ON").map_err(|e| store.open_error(e.to_string()))?;
+                    // INSERT OR REPLACE deletes the row it replaces; with recursive triggers that
+                    // delete fires the DELETE-refusing triggers (the schema's BEFORE INSERT triggers
+                    // refuse it too, for connections that do not set this).
+                    c.pragma_update(None, "recursive_triggers", "ON").map_err(|e| store.open_error(e.to_string()))?;
                 }
-                Err(e) => return Err(open_err(format!("cannot open: {e}"))),
+                store
             }
-            let conn = rusqlite::Connection::open(path).map_err(|e| open_err(e.to_string()))?;
-            conn.busy_timeout(BUSY_TIMEOUT).map_err(|e| open_err(e.to_string()))?;
-            let mut store =
-                Store { conn: Conn::Sqlite(conn), name, location: parsed.clone(), statements: PgStatements::new() };
-            store.check_foreign_sqlite()?;
-            if let Conn::Sqlite(c) = &store.conn {
-                set_wal(c, BUSY_TIMEOUT).map_err(|e| store.open_error(e))?;
-                c.pragma_update(None, "foreign_keys", "ON").map_err(|e| store.open_error(e.to_string()))?;
-                // INSERT OR REPLACE deletes the row it replaces; with recursive triggers that
-                // delete fires the DELETE-refusing triggers (the schema's BEFORE INSERT triggers
-                // refuse it too, for connections that do not set this).
-                c.pragma_update(None, "recursive_triggers", "ON").map_err(|e| store.open_error(e.to_string()))?;
-            }
-            store
         };
         store.migrate()?;
         Ok(store)
