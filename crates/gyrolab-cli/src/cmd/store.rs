@@ -320,10 +320,11 @@ fn check(a: &CheckArgs) -> CliResult {
     let mut s = open(&a.location, false)?;
     let r = s.check()?;
     print(&if a.json { to_json(&r)? } else { check_text(&r, s.name()) })?;
-    match r.problems.first() {
+    // The first broken link (a row named) first, else the first problem (a trigger).
+    match r.problems.iter().find(|p| p.row_id.is_some()).or(r.problems.first()) {
         None => Ok(()),
         Some(p) => Err(CliError::Changed(format!(
-            "store {}: BROKEN: {} problem(s), the first: {p}",
+            "store {}: BROKEN: {} problem(s); the first broken link: {p}",
             s.name(),
             r.problems.len()
         ))),
