@@ -617,10 +617,12 @@ pub fn full_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, Strin
     for t in &CHAINED {
         let total = count(x, &format!("SELECT COUNT(*) FROM {}", t.name), &[])?;
         report.rows.push((t.name.to_string(), total));
-        let sql = format!("SELECT {} FROM {} WHERE id > $1 ORDER BY id LIMIT 256", columns_sql(t), t.name);
+        // Pages of rows (report files hold up to 64 MiB each: a few at a time).
+        let page_rows = if t.name == "report_file" { 8 } else { 256 };
+        let sql = format!("SELECT {} FROM {} WHERE id > $1 ORDER BY id LIMIT {page_rows}", columns_sql(t), t.name);
         let mut last = i64::MIN;
         let mut seen = 0;
-        let ids_sql = format!("SELECT id FROM {} WHERE id > $1 ORDER BY id LIMIT 256", t.name);
+        let ids_sql = format!("SELECT id FROM {} WHERE id > $1 ORDER BY id LIMIT {page_rows}", t.name);
         loop {
             // (id, the row or why it cannot be read as its columns' types)
             let page: Vec<(i64, Result<Vec<Val>, String>)> = match x.query(&sql, &[Val::I(last)], &kinds(t)) {

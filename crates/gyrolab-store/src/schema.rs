@@ -86,9 +86,9 @@ CREATE TRIGGER report_file_kept_d BEFORE DELETE ON report_file BEGIN SELECT RAIS
 ALTER TABLE input_file ADD COLUMN id INTEGER;
 ALTER TABLE report_file ADD COLUMN id INTEGER;
 ALTER TABLE figure ADD COLUMN id INTEGER;
-DROP TRIGGER input_file_kept;
-DROP TRIGGER report_file_kept;
-DROP TRIGGER figure_kept;
+DROP TRIGGER IF EXISTS input_file_kept;
+DROP TRIGGER IF EXISTS report_file_kept;
+DROP TRIGGER IF EXISTS figure_kept;
 UPDATE input_file SET id = rowid;
 UPDATE report_file SET id = rowid;
 UPDATE figure SET id = rowid;

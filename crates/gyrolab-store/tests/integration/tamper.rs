@@ -443,3 +443,21 @@ fn a_value_of_another_type_written_on_sqlite_is_named_not_a_failure() {
     assert!(r.problems.iter().all(|p| p.row_id == Some(fid)), "{:?}", r.problems);
     assert!(matches!(Store::open_for_writing(&b.location, false), Err(StoreError::Tampered { .. })));
 }
+
+#[test]
+fn a_version_2_sqlite_store_with_a_dropped_trigger_still_migrates() {
+    let b = backends("migrate_v2_dropped").into_iter().next().unwrap();
+    let m = gyrolab_store::schema::SQLITE_MIGRATIONS;
+    let mut raw = Raw::open(&b);
+    raw.exec(&format!(
+        "{};\n{}\n{}\nINSERT INTO gyrolab_schema VALUES (1, 'earlier', '0.0.1'); INSERT INTO gyrolab_schema VALUES (2, \
+         'earlier', '0.0.2'); DROP TRIGGER figure_kept;",
+        gyrolab_store::schema::VERSION_TABLE,
+        m[0],
+        m[1]
+    ))
+    .unwrap();
+    let mut s = Store::open(&b.location, false).unwrap();
+    let r = s.check().unwrap();
+    assert!(r.is_whole() && r.triggers_ok.len() == r.triggers_expected, "{:?}", r.problems);
+}
