@@ -25,7 +25,8 @@ pub enum CliError {
     /// The evaluation succeeded and its outputs were written, but a spec limit failed (exit 3).
     #[error("{0}")]
     LimitFailed(String),
-    /// `gyrolab verify`: a file of the report changed or is missing (exit 3).
+    /// `gyrolab verify`: a file of the report changed or is missing; `gyrolab store check`: the
+    /// store's chain, files or triggers broken (exit 3).
     #[error("{0}")]
     Changed(String),
     /// The outputs were written; no limit failed but at least one required check was not

@@ -137,8 +137,8 @@ pub fn store_add(
     py.detach(|| gyrolab_store::add_report_folder(&folder, plan.as_deref(), location.as_deref())).map_err(store_err)
 }
 
-/// The location with any password replaced by `***` (URL user info and `password=` parameters),
-/// as the store's messages show it.
+/// The location as the store's messages show it: a URL's whole user information and its query
+/// masked as `***`, a keyword string's password as `***` (gyrolab_store::location).
 #[pyfunction]
 pub fn store_masked(location: &str) -> String {
     gyrolab_store::mask_location(location)

@@ -63,6 +63,8 @@ impl Val {
 pub enum Kind {
     /// 64-bit integer.
     I,
+    /// Optional 64-bit integer (null kept as null).
+    IOpt,
     /// Optional double.
     F,
     /// Optional text.
@@ -148,6 +150,7 @@ fn sqlite_row(row: &rusqlite::Row<'_>, kinds: &[Kind]) -> rusqlite::Result<Vec<V
         .map(|(i, k)| {
             Ok(match k {
                 Kind::I => Val::I(row.get::<_, Option<i64>>(i)?.unwrap_or(0)),
+                Kind::IOpt => Val::IOpt(row.get(i)?),
                 Kind::F => Val::F(row.get(i)?),
                 Kind::T => Val::T(row.get(i)?),
                 Kind::B => Val::B(row.get(i)?),
@@ -246,6 +249,7 @@ impl<C: postgres::GenericClient> Exec for PgExec<'_, C> {
                     .map(|(i, k)| {
                         Ok(match k {
                             Kind::I => Val::I(r.try_get::<_, Option<i64>>(i).map_err(pg_error)?.unwrap_or(0)),
+                            Kind::IOpt => Val::IOpt(r.try_get(i).map_err(pg_error)?),
                             Kind::F => Val::F(r.try_get(i).map_err(pg_error)?),
                             Kind::T => Val::T(r.try_get(i).map_err(pg_error)?),
                             Kind::B => Val::B(r.try_get(i).map_err(pg_error)?),

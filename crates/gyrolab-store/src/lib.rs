@@ -9,15 +9,19 @@
 //! `gyrolab::control_chart`, `gyrolab::two_sample`); [`tables`] query results as tables;
 //! [`export`] tables as CSV and Parquet.
 
+pub mod chain;
 pub mod db;
 pub mod export;
+pub mod location;
 pub mod query;
 pub mod record;
 pub mod reevaluate;
 pub mod schema;
 pub mod tables;
 
+pub use chain::{CheckReport, Problem};
 use db::{Column, Exec, Kind, PgExec, PgStatements, SqliteExec, Val};
+pub use location::{parse_location, Location, LocationError};
 use record::EvaluationRecord;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -71,6 +75,19 @@ pub enum StoreError {
         store: String,
         /// What was not found.
         message: String,
+    },
+    /// The quick check run before every write found the store tampered with: nothing written
+    /// (exit code 2; `gyrolab store check` names every broken link).
+    #[error(
+        "store {store}: refused to write: the store fails its quick check: {first}{more}; run `gyrolab store check`"
+    )]
+    Tampered {
+        /// The store, password masked.
+        store: String,
+        /// The first problem found.
+        first: String,
+        /// How many more, as text (empty when none).
+        more: String,
     },
     /// The database failed during an operation (exit code 1; the transaction was rolled back).
     #[error("store {store}: {message}")]
@@ -150,36 +167,16 @@ pub fn resolve_location(explicit: Option<&str>, plan_dir: Option<&Path>) -> Stri
     dir.join(DEFAULT_FILE).display().to_string()
 }
 
-/// True when `location` names a PostgreSQL server.
+/// True when `location` names a PostgreSQL server (a `postgres://`/`postgresql://` URL in any
+/// case, or a libpq keyword string; see [`parse_location`]).
 pub fn is_postgres(location: &str) -> bool {
-    location.starts_with("postgres://") || location.starts_with("postgresql://")
+    parse_location(location).is_ok_and(|l| l.is_postgres())
 }
 
-/// The location with any password replaced by `***` (URL user info and `password=` parameters).
+/// The location as messages show it: the URL's whole user information replaced by `***`, its
+/// query by `?***`, a keyword string's password by `***` (see [`location::shown_name`]).
 pub fn mask_location(location: &str) -> String {
-    let mut out = location.to_string();
-    if let Some(scheme_end) = out.find("://") {
-        let rest_start = scheme_end + 3;
-        let authority_end = out[rest_start..].find(['/', '?']).map_or(out.len(), |i| rest_start + i);
-        if let Some(at) = out[rest_start..authority_end].rfind('@') {
-            let userinfo = &out[rest_start..rest_start + at];
-            if let Some(colon) = userinfo.find(':') {
-                out.replace_range(rest_start + colon + 1..rest_start + at, "***");
-            }
-        }
-    }
-    let lower = out.to_ascii_lowercase();
-    if let Some(p) = lower.find("password=") {
-        let start = p + "password=".len();
-        let end = out[start..].find(['&', ' ']).map_or(out.len(), |i| start + i);
-        out.replace_range(start..end, "***");
-    }
-    out
-}
-
-fn password_of(location: &str) -> Option<String> {
-    let config: postgres::Config = location.parse().ok()?;
-    config.get_password().map(|p| String::from_utf8_lossy(p).into_owned()).filter(|p| !p.is_empty())
+    location::shown_name(location)
 }
 
 enum Conn {
@@ -191,76 +188,91 @@ enum Conn {
 pub struct Store {
     conn: Conn,
     name: String,
-    password: Option<String>,
+    location: Location,
     statements: PgStatements,
 }
 
 const SQLITE_HEADER: &[u8; 16] = b"SQLite format 3\0";
 
 impl Store {
-    /// Opens the store at `location` (a file path or a `postgres://` URL). `create`: a missing
+    /// Opens the store at `location` (a file path, `sqlite://PATH`, a `postgres://` URL or a
+    /// libpq keyword string, read by [`parse_location`]; a refused location is an
+    /// [`StoreError::Open`] naming only what may be shown). `create`: a missing
     /// SQLite file is created (else it is an error). The schema is created or migrated on first
     /// use; a store of a newer schema, a file that is not SQLite, or an SQLite file with tables
     /// but no gyrolab schema is refused with nothing written.
     pub fn open(location: &str, create: bool) -> StoreResult<Store> {
-        let name = mask_location(location);
-        let mut store = if is_postgres(location) {
-            let password = password_of(location);
-            let mask = |m: String| match &password {
-                Some(p) => m.replace(p.as_str(), "***"),
-                None => m,
-            };
-            let mut config: postgres::Config = location
-                .parse()
-                .map_err(|e: postgres::Error| StoreError::Open { store: name.clone(), message: mask(e.to_string()) })?;
-            config.connect_timeout(Duration::from_secs(10));
-            let client = config.connect(postgres::NoTls).map_err(|e| StoreError::Open {
-                store: name.clone(),
-                message: mask(format!(
-                    "cannot connect: {}",
-                    e.as_db_error().map_or_else(|| e.to_string(), |d| d.message().to_string())
-                )),
-            })?;
-            Store { conn: Conn::Postgres(Box::new(client)), name, password, statements: PgStatements::new() }
-        } else {
-            let path = Path::new(location);
-            let open_err = |m: String| StoreError::Open { store: name.clone(), message: m };
-            match std::fs::File::open(path) {
-                Ok(mut f) => {
-                    use std::io::Read;
-                    let mut head = [0u8; 16];
-                    let mut got = 0;
-                    while got < 16 {
-                        match f.read(&mut head[got..]) {
-                            Ok(0) => break,
-                            Ok(n) => got += n,
-                            Err(e) => return Err(open_err(format!("cannot read: {e}"))),
+        let parsed = parse_location(location)
+            .map_err(|e| StoreError::Open { store: e.shown.clone(), message: e.message.clone() })?;
+        let name = parsed.shown().to_string();
+        let mut store = match &parsed {
+            Location::Postgres { connect, .. } => {
+                let mask = |m: String| parsed.mask(&m);
+                let mut config: postgres::Config = connect.parse().map_err(|e: postgres::Error| StoreError::Open {
+                    store: name.clone(),
+                    message: mask(e.to_string()),
+                })?;
+                config.connect_timeout(Duration::from_secs(10));
+                let client = config.connect(postgres::NoTls).map_err(|e| StoreError::Open {
+                    store: name.clone(),
+                    message: mask(format!(
+                        "cannot connect: {}",
+                        e.as_db_error().map_or_else(|| e.to_string(), |d| d.message().to_string())
+                    )),
+                })?;
+                Store {
+                    conn: Conn::Postgres(Box::new(client)),
+                    name,
+                    location: parsed.clone(),
+                    statements: PgStatements::new(),
+                }
+            }
+            Location::Sqlite { path } => {
+                let path = Path::new(path);
+                let open_err = |m: String| StoreError::Open { store: name.clone(), message: m };
+                match std::fs::File::open(path) {
+                    Ok(mut f) => {
+                        use std::io::Read;
+                        let mut head = [0u8; 16];
+                        let mut got = 0;
+                        while got < 16 {
+                            match f.read(&mut head[got..]) {
+                                Ok(0) => break,
+                                Ok(n) => got += n,
+                                Err(e) => return Err(open_err(format!("cannot read: {e}"))),
+                            }
+                        }
+                        if got > 0 && (got < 16 || head != *SQLITE_HEADER) {
+                            return Err(open_err("not an SQLite database (wrong header): not a gyrolab store".into()));
                         }
                     }
-                    if got > 0 && (got < 16 || head != *SQLITE_HEADER) {
-                        return Err(open_err("not an SQLite database (wrong header): not a gyrolab store".into()));
+                    Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                        if !create {
+                            return Err(StoreError::NotFound {
+                                store: name.clone(),
+                                message:
+                                    "no store here (it is created by `gyrolab store add` or `gyrolab eval --store`)"
+                                        .into(),
+                            });
+                        }
                     }
+                    Err(e) => return Err(open_err(format!("cannot open: {e}"))),
                 }
-                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                    if !create {
-                        return Err(StoreError::NotFound {
-                            store: name.clone(),
-                            message: "no store here (it is created by `gyrolab store add` or `gyrolab eval --store`)"
-                                .into(),
-                        });
-                    }
+                let conn = rusqlite::Connection::open(path).map_err(|e| open_err(e.to_string()))?;
+                conn.busy_timeout(BUSY_TIMEOUT).map_err(|e| open_err(e.to_string()))?;
+                let mut store =
+                    Store { conn: Conn::Sqlite(conn), name, location: parsed.clone(), statements: PgStatements::new() };
+                store.check_foreign_sqlite()?;
+                if let Conn::Sqlite(c) = &store.conn {
+                    set_wal(c, BUSY_TIMEOUT).map_err(|e| store.open_error(e))?;
+                    c.pragma_update(None, "foreign_keys", "ON").map_err(|e| store.open_error(e.to_string()))?;
+                    // INSERT OR REPLACE deletes the row it replaces; with recursive triggers that
+                    // delete fires the DELETE-refusing triggers (the schema's BEFORE INSERT triggers
+                    // refuse it too, for connections that do not set this).
+                    c.pragma_update(None, "recursive_triggers", "ON").map_err(|e| store.open_error(e.to_string()))?;
                 }
-                Err(e) => return Err(open_err(format!("cannot open: {e}"))),
+                store
             }
-            let conn = rusqlite::Connection::open(path).map_err(|e| open_err(e.to_string()))?;
-            conn.busy_timeout(BUSY_TIMEOUT).map_err(|e| open_err(e.to_string()))?;
-            let mut store = Store { conn: Conn::Sqlite(conn), name, password: None, statements: PgStatements::new() };
-            store.check_foreign_sqlite()?;
-            if let Conn::Sqlite(c) = &store.conn {
-                set_wal(c, BUSY_TIMEOUT).map_err(|e| store.open_error(e))?;
-                c.pragma_update(None, "foreign_keys", "ON").map_err(|e| store.open_error(e.to_string()))?;
-            }
-            store
         };
         store.migrate()?;
         Ok(store)
@@ -277,10 +289,7 @@ impl Store {
     }
 
     fn mask(&self, m: String) -> String {
-        match &self.password {
-            Some(p) => m.replace(p.as_str(), "***"),
-            None => m,
-        }
+        self.location.mask(&m)
     }
 
     fn open_error(&self, m: String) -> StoreError {
@@ -311,14 +320,8 @@ impl Store {
     /// busy timeout); rolled back on any error.
     pub(crate) fn transaction<T>(&mut self, f: impl FnOnce(&mut dyn Exec) -> Result<T, StoreError>) -> StoreResult<T> {
         let name = self.name.clone();
-        let password = self.password.clone();
-        let dberr = move |m: String| StoreError::Database {
-            store: name.clone(),
-            message: match &password {
-                Some(p) => m.replace(p.as_str(), "***"),
-                None => m,
-            },
-        };
+        let location = self.location.clone();
+        let dberr = move |m: String| StoreError::Database { store: name.clone(), message: location.mask(&m) };
         match &mut self.conn {
             Conn::Sqlite(c) => {
                 let tx = c
@@ -379,6 +382,10 @@ impl Store {
             }
             for (i, sql) in migrations.iter().enumerate().skip(found as usize) {
                 x.batch(sql).map_err(&dberr)?;
+                if i + 1 == 3 {
+                    // Migration 3: the hash chain over the rows already stored.
+                    chain::build_existing(x).map_err(&dberr)?;
+                }
                 x.exec(
                     "INSERT INTO gyrolab_schema (version, applied_at, software_version) VALUES ($1, $2, $3)",
                     &[Val::I(i as i64 + 1), Val::T(Some(now.clone())), Val::T(Some(SOFTWARE_VERSION.to_string()))],
@@ -410,7 +417,20 @@ impl Store {
         let store = self.name.clone();
         let now = now_rfc3339();
         let dberr = |m: String| StoreError::Database { store: store.clone(), message: m };
+        let postgres = self.is_postgres();
         let id = self.transaction(|x| {
+            if postgres {
+                // One writer at a time appends to the chain.
+                x.exec("SELECT pg_advisory_xact_lock(7291836)", &[]).map_err(&dberr)?;
+            }
+            let quick = chain::quick_check(x, postgres).map_err(&dberr)?;
+            if let Some(first) = quick.problems.first() {
+                let more = match quick.problems.len() - 1 {
+                    0 => String::new(),
+                    n => format!(" (and {n} more)"),
+                };
+                return Err(StoreError::Tampered { store: store.clone(), first: first.to_string(), more });
+            }
             let t = |s: &str| Val::T(Some(s.to_string()));
             let o = |s: &Option<String>| Val::T(s.clone());
             let (supersedes, kind, by, why) = match revision {
@@ -472,7 +492,7 @@ impl Store {
                 Column::I(files.iter().map(|f| f.size_bytes as i64).collect()),
             ];
             x.insert_columns(
-                "INSERT INTO input_file (evaluation_id, path, sha256, size_bytes) VALUES ($1, $2, $3, $4)",
+                "INSERT INTO input_file (id, evaluation_id, path, sha256, size_bytes) VALUES ((SELECT COALESCE(MAX(id), 0) + 1 FROM input_file), $1, $2, $3, $4)",
                 "INSERT INTO input_file (evaluation_id, path, sha256, size_bytes) \
                  SELECT * FROM unnest($1::bigint[], $2::text[], $3::text[], $4::bigint[])",
                 &columns,
@@ -492,7 +512,7 @@ impl Store {
                 Column::B(packed),
             ];
             x.insert_columns(
-                "INSERT INTO report_file (evaluation_id, name, sha256, size_bytes, content_zstd) VALUES ($1, $2, $3, $4, $5)",
+                "INSERT INTO report_file (id, evaluation_id, name, sha256, size_bytes, content_zstd) VALUES ((SELECT COALESCE(MAX(id), 0) + 1 FROM report_file), $1, $2, $3, $4, $5)",
                 "INSERT INTO report_file (evaluation_id, name, sha256, size_bytes, content_zstd) \
                  SELECT * FROM unnest($1::bigint[], $2::text[], $3::text[], $4::bigint[], $5::bytea[])",
                 &columns,
@@ -516,8 +536,9 @@ impl Store {
                 Column::I(figs.iter().map(|f| f.simulated as i64).collect()),
             ];
             x.insert_columns(
-                "INSERT INTO figure (evaluation_id, axis, figure, value, unit, basis, expanded_uncertainty, coverage_factor, \
-                 limit_min, limit_max, verdict, simulated) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12)",
+                "INSERT INTO figure (id, evaluation_id, axis, figure, value, unit, basis, expanded_uncertainty, \
+                 coverage_factor, limit_min, limit_max, verdict, simulated) VALUES ((SELECT COALESCE(MAX(id), 0) + 1 FROM \
+                 figure), $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12)",
                 "INSERT INTO figure (evaluation_id, axis, figure, value, unit, basis, expanded_uncertainty, coverage_factor, \
                  limit_min, limit_max, verdict, simulated) SELECT * FROM unnest($1::bigint[], $2::text[], $3::text[], \
                  $4::float8[], $5::text[], $6::text[], $7::float8[], $8::float8[], $9::float8[], $10::float8[], $11::text[], \
@@ -525,6 +546,7 @@ impl Store {
                 &columns,
             )
             .map_err(&dberr)?;
+            chain::append_evaluation(x, id).map_err(&dberr)?;
             pause_for_test();
             Ok(id)
         });
@@ -575,6 +597,43 @@ impl Store {
         query::write_report(self, id, out)
     }
 
+    /// The full check (`gyrolab store check`): the protecting triggers, every chain link against
+    /// its row, every stored report file against its SHA-256 ([`chain::full_check`]). A store
+    /// found tampered with is a report with problems, not an error.
+    pub fn check(&mut self) -> StoreResult<CheckReport> {
+        let postgres = self.is_postgres();
+        let store = self.name.clone();
+        self.transaction(|x| {
+            chain::full_check(x, postgres).map_err(|m| StoreError::Database { store: store.clone(), message: m })
+        })
+    }
+
+    /// The quick check run before every write ([`chain::quick_check`]): the triggers, row counts
+    /// against link counts and the last links. `gyrolab eval --store` runs it before the report
+    /// folder is written.
+    pub fn quick_check(&mut self) -> StoreResult<CheckReport> {
+        let postgres = self.is_postgres();
+        let store = self.name.clone();
+        self.transaction(|x| {
+            chain::quick_check(x, postgres).map_err(|m| StoreError::Database { store: store.clone(), message: m })
+        })
+    }
+
+    /// Opens the store at `location` for writing (see [`Store::open`]) and runs the quick check,
+    /// refusing a store that fails it ([`StoreError::Tampered`], exit code 2).
+    pub fn open_for_writing(location: &str, create: bool) -> StoreResult<Store> {
+        let mut s = Store::open(location, create)?;
+        let report = s.quick_check()?;
+        if let Some(first) = report.problems.first() {
+            let more = match report.problems.len() - 1 {
+                0 => String::new(),
+                n => format!(" (and {n} more)"),
+            };
+            return Err(StoreError::Tampered { store: s.name.clone(), first: first.to_string(), more });
+        }
+        Ok(s)
+    }
+
     /// One stored evaluation with its files and figures.
     pub fn evaluation(&mut self, id: i64) -> StoreResult<query::StoredEvaluation> {
         query::evaluation(self, id)
@@ -587,7 +646,7 @@ impl Store {
 pub fn add_report_folder(dir: &Path, plan: Option<&Path>, location: Option<&str>) -> StoreResult<(i64, String)> {
     let rec = record::from_report_folder(dir, plan)?;
     let plan_dir = Path::new(&rec.plan_path).parent().filter(|p| !p.as_os_str().is_empty()).map(Path::to_path_buf);
-    let mut store = Store::open(&resolve_location(location, plan_dir.as_deref()), true)?;
+    let mut store = Store::open_for_writing(&resolve_location(location, plan_dir.as_deref()), true)?;
     let id = store.add(&rec)?;
     Ok((id, store.name().to_string()))
 }

@@ -3,7 +3,7 @@
 //! from version N - 1 to N; `gyrolab_schema` keeps one row per applied version (docs/STORE.md).
 
 /// The schema version this build writes and reads.
-pub const SCHEMA_VERSION: i64 = 2;
+pub const SCHEMA_VERSION: i64 = 3;
 
 /// SQLite migrations, by version (index 0 = version 1).
 pub const SQLITE_MIGRATIONS: &[&str] = &[
@@ -76,6 +76,44 @@ CREATE TRIGGER input_file_kept_d BEFORE DELETE ON input_file BEGIN SELECT RAISE(
 CREATE TRIGGER report_file_kept BEFORE UPDATE ON report_file BEGIN SELECT RAISE(ABORT, 'gyrolab records are never changed: store a revision'); END;
 CREATE TRIGGER report_file_kept_d BEFORE DELETE ON report_file BEGIN SELECT RAISE(ABORT, 'gyrolab records are never deleted'); END;
 "#,
+    // 3 (issue 53): tamper evidence. Every file and figure row gets a stable `id` (its rowid at
+    // migration; new rows: the next id, given by the store), the hash chain `chain` (one link
+    // per stored row, appended by the store: crate::chain), INSERT refused over an existing key
+    // (INSERT OR REPLACE deletes the old row without firing the DELETE triggers), and the chain
+    // kept like the records. The chain over the rows already stored is built by the store right
+    // after this script (crate::chain::build_existing), in the same transaction.
+    r#"
+ALTER TABLE input_file ADD COLUMN id INTEGER;
+ALTER TABLE report_file ADD COLUMN id INTEGER;
+ALTER TABLE figure ADD COLUMN id INTEGER;
+DROP TRIGGER IF EXISTS input_file_kept;
+DROP TRIGGER IF EXISTS report_file_kept;
+DROP TRIGGER IF EXISTS figure_kept;
+UPDATE input_file SET id = rowid;
+UPDATE report_file SET id = rowid;
+UPDATE figure SET id = rowid;
+CREATE TRIGGER input_file_kept BEFORE UPDATE ON input_file BEGIN SELECT RAISE(ABORT, 'gyrolab records are never changed: store a revision'); END;
+CREATE TRIGGER report_file_kept BEFORE UPDATE ON report_file BEGIN SELECT RAISE(ABORT, 'gyrolab records are never changed: store a revision'); END;
+CREATE TRIGGER figure_kept BEFORE UPDATE ON figure BEGIN SELECT RAISE(ABORT, 'gyrolab records are never changed: store a revision'); END;
+CREATE UNIQUE INDEX input_file_id ON input_file(id);
+CREATE UNIQUE INDEX report_file_id ON report_file(id);
+CREATE UNIQUE INDEX figure_id ON figure(id);
+CREATE TABLE chain (
+    seq INTEGER PRIMARY KEY,
+    tbl TEXT NOT NULL,
+    row_id INTEGER NOT NULL,
+    fields TEXT NOT NULL,
+    hash TEXT NOT NULL,
+    UNIQUE (tbl, row_id)
+);
+CREATE TRIGGER chain_kept BEFORE UPDATE ON chain BEGIN SELECT RAISE(ABORT, 'gyrolab records are never changed: store a revision'); END;
+CREATE TRIGGER chain_kept_d BEFORE DELETE ON chain BEGIN SELECT RAISE(ABORT, 'gyrolab records are never deleted'); END;
+CREATE TRIGGER evaluation_kept_r BEFORE INSERT ON evaluation WHEN EXISTS (SELECT 1 FROM evaluation WHERE id = NEW.id OR supersedes = NEW.supersedes) BEGIN SELECT RAISE(ABORT, 'gyrolab records are never replaced'); END;
+CREATE TRIGGER input_file_kept_r BEFORE INSERT ON input_file WHEN EXISTS (SELECT 1 FROM input_file WHERE rowid = NEW.rowid OR id = NEW.id) BEGIN SELECT RAISE(ABORT, 'gyrolab records are never replaced'); END;
+CREATE TRIGGER report_file_kept_r BEFORE INSERT ON report_file WHEN EXISTS (SELECT 1 FROM report_file WHERE rowid = NEW.rowid OR id = NEW.id) BEGIN SELECT RAISE(ABORT, 'gyrolab records are never replaced'); END;
+CREATE TRIGGER figure_kept_r BEFORE INSERT ON figure WHEN EXISTS (SELECT 1 FROM figure WHERE rowid = NEW.rowid OR id = NEW.id) BEGIN SELECT RAISE(ABORT, 'gyrolab records are never replaced'); END;
+CREATE TRIGGER chain_kept_r BEFORE INSERT ON chain WHEN EXISTS (SELECT 1 FROM chain WHERE seq = NEW.seq OR (tbl = NEW.tbl AND row_id = NEW.row_id)) BEGIN SELECT RAISE(ABORT, 'gyrolab records are never replaced'); END;
+"#,
 ];
 
 /// PostgreSQL migrations, by version (index 0 = version 1).
@@ -147,6 +185,28 @@ CREATE TRIGGER figure_kept BEFORE UPDATE OR DELETE ON figure FOR EACH ROW EXECUT
 ALTER TABLE report_file ADD COLUMN content_zstd BYTEA;
 CREATE TRIGGER input_file_kept BEFORE UPDATE OR DELETE ON input_file FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
 CREATE TRIGGER report_file_kept BEFORE UPDATE OR DELETE ON report_file FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
+"#,
+    // 3 (issue 53): tamper evidence (see SQLITE_MIGRATIONS): a stable `id` for file and figure
+    // rows (rows already stored are numbered in the order PostgreSQL reads them), the hash chain,
+    // and TRUNCATE refused on every table (it fires no row trigger).
+    r#"
+ALTER TABLE input_file ADD COLUMN id BIGINT GENERATED ALWAYS AS IDENTITY UNIQUE;
+ALTER TABLE report_file ADD COLUMN id BIGINT GENERATED ALWAYS AS IDENTITY UNIQUE;
+ALTER TABLE figure ADD COLUMN id BIGINT GENERATED ALWAYS AS IDENTITY UNIQUE;
+CREATE TABLE chain (
+    seq BIGINT PRIMARY KEY,
+    tbl TEXT NOT NULL,
+    row_id BIGINT NOT NULL,
+    fields TEXT NOT NULL,
+    hash TEXT NOT NULL,
+    UNIQUE (tbl, row_id)
+);
+CREATE TRIGGER chain_kept BEFORE UPDATE OR DELETE ON chain FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER evaluation_not_truncated BEFORE TRUNCATE ON evaluation FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER input_file_not_truncated BEFORE TRUNCATE ON input_file FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER report_file_not_truncated BEFORE TRUNCATE ON report_file FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER figure_not_truncated BEFORE TRUNCATE ON figure FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER chain_not_truncated BEFORE TRUNCATE ON chain FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
 "#,
 ];
 

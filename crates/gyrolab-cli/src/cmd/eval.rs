@@ -70,7 +70,7 @@ pub fn run(args: &EvalArgs) -> CliResult {
     let (folder, prepared) = std::thread::scope(|scope| {
         let preparing = location.as_deref().map(|l| {
             scope.spawn(move || {
-                let store = match Store::open(l, false) {
+                let store = match Store::open_for_writing(l, false) {
                     Ok(s) => Ok(Some(s)),
                     // Created once the folder is written: its folder must take a new file now,
                     // so that a store that cannot be made ends the run before anything is written.
@@ -100,7 +100,7 @@ pub fn run(args: &EvalArgs) -> CliResult {
         let record = from_report_folder_with(&args.out, Some(&args.plan), inputs)?;
         let mut s = match store.take() {
             Some(s) => s,
-            None => Store::open(l, true)?,
+            None => Store::open_for_writing(l, true)?,
         };
         let id = s.add(&record)?;
         if !args.quiet {

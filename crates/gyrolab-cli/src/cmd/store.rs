@@ -11,7 +11,9 @@ use gyrolab_report::format::sig_opt;
 use gyrolab_report::plot::{Axis, Figure, Orientation, Panel, RefLine, Series, SeriesStyle};
 use gyrolab_store::export::{to_csv, to_parquet, Cell, Table};
 use gyrolab_store::tables::{chart_table, compare_table, diff_table, history_table, lot_table};
-use gyrolab_store::{add_report_folder, query, reevaluate, resolve_location, Changes, Revision, RevisionKind, Store};
+use gyrolab_store::{
+    add_report_folder, query, reevaluate, resolve_location, Changes, CheckReport, Revision, RevisionKind, Store,
+};
 use std::path::PathBuf;
 
 /// Kinds of manual revision.
@@ -44,6 +46,18 @@ pub enum StoreCommand {
     Revise(ReviseArgs),
     /// Re-run a stored evaluation's plan and inputs (hash-checked) under this version: new revision and diff.
     Reevaluate(ReevaluateArgs),
+    /// Re-verify the store: its hash chain link by link against the rows, every stored file against its SHA-256, the protecting triggers (exit 3 when broken).
+    Check(CheckArgs),
+}
+
+/// Options of `gyrolab store check`.
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub location: StoreLocation,
 }
 
 /// Options of `gyrolab store add`.
@@ -203,6 +217,11 @@ fn open(location: &StoreLocation, create: bool) -> CliResult<Store> {
     Ok(Store::open(&resolve_location(location.store.as_deref(), None), create)?)
 }
 
+/// Opens a store to write to: the quick check first (exit 2 when it fails).
+fn open_for_writing(location: &StoreLocation) -> CliResult<Store> {
+    Ok(Store::open_for_writing(&resolve_location(location.store.as_deref(), None), false)?)
+}
+
 /// Runs `gyrolab store`.
 pub fn run(cmd: &StoreCommand) -> CliResult {
     match cmd {
@@ -252,7 +271,7 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
             emit(&chart_table(&c), &a.format, || to_json(&c))
         }
         StoreCommand::Revise(a) => {
-            let mut s = open(&a.location, false)?;
+            let mut s = open_for_writing(&a.location)?;
             let kind = match a.kind {
                 ReviseKind::Correction => RevisionKind::Correction,
                 ReviseKind::Approval => RevisionKind::Approval,
@@ -269,8 +288,9 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
             let id = s.revise(&r, &changes, None)?;
             print(&format!("stored {} of evaluation {} as evaluation {id} in {}\n", kind.as_str(), a.id, s.name()))
         }
+        StoreCommand::Check(a) => check(a),
         StoreCommand::Reevaluate(a) => {
-            let mut s = open(&a.location, false)?;
+            let mut s = open_for_writing(&a.location)?;
             let r = reevaluate::reevaluate(&mut s, a.id, &a.by, &a.reason, &a.out)?;
             if a.json {
                 return print(&to_json(&r)?);
@@ -293,6 +313,46 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
             print(&out)
         }
     }
+}
+
+/// `gyrolab store check`: the report printed; exit 3 naming the first problem when broken.
+fn check(a: &CheckArgs) -> CliResult {
+    let mut s = open(&a.location, false)?;
+    let r = s.check()?;
+    print(&if a.json { to_json(&r)? } else { check_text(&r, s.name()) })?;
+    // The first broken link (a row named) first, else the first problem (a trigger).
+    match r.problems.iter().find(|p| p.row_id.is_some()).or(r.problems.first()) {
+        None => Ok(()),
+        Some(p) => Err(CliError::Changed(format!(
+            "store {}: BROKEN: {} problem(s); the first broken link: {p}",
+            s.name(),
+            r.problems.len()
+        ))),
+    }
+}
+
+/// The check report as text.
+fn check_text(r: &CheckReport, name: &str) -> String {
+    let rows: Vec<String> = r.rows.iter().map(|(t, n)| format!("{t} {n}")).collect();
+    let mut out = format!(
+        "store {name}\ntriggers: {} of {} present and unaltered\nrows: {}\nchain: {} of {} link(s) re-verified against \
+         their rows\nreport files: {} re-hashed equal to their SHA-256, {} stored as hashes only\nchain head: {}\n",
+        r.triggers_ok.len(),
+        r.triggers_expected,
+        rows.join(", "),
+        r.links_checked,
+        r.links,
+        r.files_checked,
+        r.files_hash_only,
+        r.head.as_deref().unwrap_or("(empty store)")
+    );
+    if r.problems.is_empty() {
+        out.push_str("whole: nothing changed, deleted or inserted outside the store\n");
+    }
+    for p in &r.problems {
+        out.push_str(&format!("BROKEN: {p}\n"));
+    }
+    out
 }
 
 /// Prints a query's table as text, CSV or JSON (`json` makes the JSON), and writes the Parquet

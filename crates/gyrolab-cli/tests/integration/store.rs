@@ -410,7 +410,7 @@ fn bad_stores_exit_2_naming_the_store_without_the_password_and_write_nothing() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
     let all = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
-    assert!(all.contains("postgres://lab:***@127.0.0.1:1/db") && !all.contains("hunter2"), "{all}");
+    assert!(all.contains("postgres://***@127.0.0.1:1/db") && !all.contains("hunter2"), "{all}");
     assert!(!report.exists(), "nothing written");
     // The real server with a wrong password, and with the right one: never printed.
     if let Some(pg) = backends("bad_stores").into_iter().find(|b| b.name == "postgres") {
@@ -420,7 +420,7 @@ fn bad_stores_exit_2_naming_the_store_without_the_password_and_write_nothing() {
         let o = gyrolab().args(["store", "lot", "L", "--store", &wrong]).output().unwrap();
         assert_eq!(o.status.code(), Some(2));
         let all = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
-        assert!(all.contains(":***@") && !all.contains("wrong-Pa55word") && !all.contains(&right), "{all}");
+        assert!(all.contains("://***@") && !all.contains("wrong-Pa55word") && !all.contains(&right), "{all}");
         assert!(all.contains("password"), "{all}");
         let o = gyrolab()
             .args(["eval", p.to_str().unwrap(), "--out", report.to_str().unwrap(), "--store", &url])
@@ -428,7 +428,7 @@ fn bad_stores_exit_2_naming_the_store_without_the_password_and_write_nothing() {
             .unwrap();
         assert_eq!(o.status.code(), Some(3));
         let all = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
-        assert!(all.contains("Stored as evaluation") && all.contains(":***@") && !all.contains(&right), "{all}");
+        assert!(all.contains("Stored as evaluation") && all.contains("://***@") && !all.contains(&right), "{all}");
     }
 }
 
@@ -446,7 +446,7 @@ fn a_store_of_a_newer_schema_exits_2_naming_both_versions_and_writes_nothing() {
             .unwrap_or_else(|e| panic!("{}: {e}", b.name));
         assert_eq!(o.status.code(), Some(2), "{}", b.name);
         let err = String::from_utf8_lossy(&o.stderr);
-        assert!(err.contains("schema version 9") && err.contains("up to 2"), "{}: {err}", b.name);
+        assert!(err.contains("schema version 9") && err.contains("up to 3"), "{}: {err}", b.name);
         assert!(!report.exists(), "{}: nothing written", b.name);
         for args in [vec!["store", "lot", "L"], vec!["store", "history", "N1"]] {
             gyrolab()
@@ -524,5 +524,89 @@ fn an_unusable_store_is_refused_before_the_folder_is_written() {
         assert_eq!(o.status.code(), Some(2), "{err}");
         assert!(!out.exists(), "{err}");
         assert!(!err.contains("s3cr3t"), "{err}");
+
+/// Runs raw SQL on a store behind its back (the store's own user on PostgreSQL, who owns the
+/// tables and may disable their triggers).
+fn raw_sql(b: &store_backends::Backend, sql: &str) {
+    if b.name == "sqlite" {
+        rusqlite::Connection::open(&b.location).unwrap().execute_batch(sql).unwrap();
+    } else {
+        postgres::Client::connect(&b.location, postgres::NoTls).unwrap().batch_execute(sql).unwrap();
+    }
+}
+
+#[test]
+fn store_check_exits_0_when_whole_3_when_tampered_and_writing_is_refused() {
+    for b in backends("cli_store_check") {
+        let dir = tempfile::tempdir().unwrap();
+        let p = plan(dir.path(), "C1", "L");
+        eval(&p, &dir.path().join("first"), Some(&b.location));
+        let o = gyrolab().args(["store", "check", "--store", &b.location]).output().unwrap();
+        let out = String::from_utf8_lossy(&o.stdout).to_string();
+        assert_eq!(o.status.code(), Some(0), "{}: {out}{}", b.name, String::from_utf8_lossy(&o.stderr));
+        assert!(out.contains("chain head: ") && out.contains("whole") && out.contains("re-hashed equal"), "{out}");
+        // A figure turned to FAIL behind the triggers, the triggers put back: the last one stored,
+        // so that the quick check (the last links) finds it as well as the full one.
+        let forge = "UPDATE figure SET verdict = 'FAIL' WHERE id = (SELECT MAX(id) FROM figure);";
+        if b.name == "sqlite" {
+            let (_, _, create) = gyrolab_store::chain::expected_triggers(false)
+                .into_iter()
+                .find(|(_, n, _)| n == "figure_kept")
+                .unwrap();
+            raw_sql(&b, &format!("DROP TRIGGER figure_kept; {forge} {create};"));
+        } else {
+            raw_sql(
+                &b,
+                &format!("ALTER TABLE figure DISABLE TRIGGER figure_kept; {forge} ALTER TABLE figure ENABLE TRIGGER figure_kept;"),
+            );
+        }
+        let o = gyrolab().args(["store", "check", "--store", &b.location]).output().unwrap();
+        let all = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+        assert_eq!(o.status.code(), Some(3), "{}: {all}", b.name);
+        assert!(all.contains("BROKEN: figure row ") && all.contains("verdict"), "{}: {all}", b.name);
+        // Writing is refused before anything is written (the quick check): exit 2.
+        let out = dir.path().join("second");
+        let o = gyrolab()
+            .args(["eval", p.to_str().unwrap(), "--out", out.to_str().unwrap(), "--store", &b.location])
+            .output()
+            .unwrap();
+        let all = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+        assert_eq!(o.status.code(), Some(2), "{}: {all}", b.name);
+        assert!(all.contains("quick check") && all.contains("figure"), "{}: {all}", b.name);
+        assert!(!out.exists(), "{}: nothing written", b.name);
+        let o = gyrolab()
+            .args(["store", "add", dir.path().join("first").to_str().unwrap(), "--store", &b.location])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{}", b.name);
+    }
+}
+
+#[test]
+fn store_urls_never_show_a_password_nor_become_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            "postgres://odd:p@ss:w/rd?x#y%@127.0.0.1:1/db",
+            &["p@ss", "ss:w", "w/rd", "rd?x", "x#y"][..],
+            "postgres://***@127.0.0.1:1/db",
+        ),
+        ("POSTGRES://lab:Secr3tPw@127.0.0.1:1/db", &["Secr3tPw"][..], "postgres://***@127.0.0.1:1/db"),
+        ("postgress://lab:Secr3tPw@127.0.0.1:1/db", &["Secr3tPw"][..], "'postgress'"),
+        ("postgre://lab:Secr3tPw@127.0.0.1:1/db", &["Secr3tPw"][..], "'postgre'"),
+        ("host=127.0.0.1 port=1 dbname=db user=lab password=Secr3tPw", &["Secr3tPw"][..], "password=***"),
+        ("lab.db password=Secr3tPw", &["Secr3tPw"][..], "not taken as a file name"),
+    ];
+    for (location, secrets, shown) in cases {
+        for args in [&["store", "lot", "L"][..], &["store", "check"][..]] {
+            let o = gyrolab().current_dir(dir.path()).args(args).args(["--store", location]).output().unwrap();
+            let all = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+            assert_eq!(o.status.code(), Some(2), "{location}: {all}");
+            assert!(all.contains(shown), "{location}: {all}");
+            for s in secrets {
+                assert!(!all.contains(s), "{location}: {s} in {all}");
+            }
+        }
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "{location}: no file made");
     }
 }

@@ -5,3 +5,4 @@
 mod common;
 mod folder;
 mod store;
+mod tamper;
