@@ -524,6 +524,8 @@ fn an_unusable_store_is_refused_before_the_folder_is_written() {
         assert_eq!(o.status.code(), Some(2), "{err}");
         assert!(!out.exists(), "{err}");
         assert!(!err.contains("s3cr3t"), "{err}");
+    }
+}
 
 /// Runs raw SQL on a store behind its back (the store's own user on PostgreSQL, who owns the
 /// tables and may disable their triggers).
