@@ -93,12 +93,15 @@ pub struct OutputFile<'a> {
     content: Content<'a>,
 }
 
+/// A function that writes a file's bytes into the writer it is given.
+type Fill<'a> = Box<dyn FnOnce(&mut (dyn Write + Send)) -> std::io::Result<()> + 'a>;
+
 /// The content of an [`OutputFile`].
 enum Content<'a> {
     /// The bytes, whole.
     Bytes(std::borrow::Cow<'a, [u8]>),
     /// A function that writes them.
-    Stream(Box<dyn FnOnce(&mut (dyn Write + Send)) -> std::io::Result<()> + 'a>),
+    Stream(Fill<'a>),
 }
 
 impl<'a> OutputFile<'a> {
@@ -641,7 +644,7 @@ mod tests {
             (stage_in(dir.path(), Content::Bytes(b"x"[..].into())).unwrap(), dir.path().to_path_buf()),
         ];
         let (written, result) = persist_in_order(staged);
-        assert_eq!(written, [a.clone()]);
+        assert_eq!(written, std::slice::from_ref(&a));
         assert!(result.is_err());
     }
 }

@@ -48,7 +48,7 @@ pub struct RecordTemperature {
 /// assert!((s.slope_c_per_h - 0.5).abs() < 1e-9 && (s.span_c - 0.5).abs() < 1e-12 && !s.moved);
 /// ```
 pub fn record_temperature(column: &str, temp_c: &[f64], tau0_s: f64) -> Option<RecordTemperature> {
-    if !(tau0_s > 0.0) {
+    if tau0_s.is_nan() || tau0_s <= 0.0 {
         return None;
     }
     let (mut n, mut sum, mut min, mut max) = (0usize, 0.0f64, f64::INFINITY, f64::NEG_INFINITY);

@@ -190,7 +190,7 @@ pub fn real_text(v: f64) -> String {
 /// whole number; `None` for any other rate.
 pub fn whole_rate(v: f64) -> Option<i64> {
     let r = v.round();
-    (v.is_finite() && r >= 1.0 && r < 1e15 && (v - r).abs() <= 1e-9 * v.abs()).then_some(r as i64)
+    (v.is_finite() && (1.0..1e15).contains(&r) && (v - r).abs() <= 1e-9 * v.abs()).then_some(r as i64)
 }
 
 /// The rate as text: a whole rate as an integer (`200`, as Kalibr's and ORB-SLAM3's own files

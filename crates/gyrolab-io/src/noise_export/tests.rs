@@ -95,7 +95,7 @@ fn continuous_stacks_write_the_densities_under_their_keys() {
 fn vins_values_are_per_sample() {
     let text = sample().render(Stack::Vins);
     for (k, want) in
-        [("gyr_n", 2.8284271247461903e-2), ("gyr_w", 4e-4), ("acc_n", 1.1313708498984761e-1), ("acc_w", 1.2e-2)]
+        [("gyr_n", 2.828_427_124_746_19e-2), ("gyr_w", 4e-4), ("acc_n", 1.131_370_849_898_476e-1), ("acc_w", 1.2e-2)]
     {
         let got = value_of(&text, k).unwrap();
         assert!((got / want - 1.0).abs() < 1e-12, "{k}: {got}\n{text}");
