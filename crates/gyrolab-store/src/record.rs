@@ -353,6 +353,19 @@ fn hash_inputs(parsed: &gyrolab_io_plan::TestPlan) -> StoreResult<Vec<FileRecord
     Ok(inputs)
 }
 
+/// The report folder's manifest, when it has one (a folder written before 0.3 has none).
+fn read_manifest(dir: &Path) -> StoreResult<Option<gyrolab_eval::report_folder::Manifest>> {
+    let path = dir.join(gyrolab_eval::report_folder::MANIFEST);
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let text = read_text(&path)?;
+    serde_json::from_str(&text).map(Some).map_err(|e| StoreError::Input {
+        path: path.display().to_string(),
+        message: format!("not a gyrolab manifest: {e}"),
+    })
+}
+
 /// [`from_report_folder`] with the inputs' hashes already made by [`hash_plan_inputs`] of the
 /// same plan (`gyrolab eval --store` makes them on a second thread while it evaluates); `None`:
 /// hashed here.
@@ -395,6 +408,27 @@ pub fn from_report_folder_with(
         .filter(|p| p.is_file())
         .collect();
     names.sort();
+    // A folder with a manifest: only its files (and the manifest, and a report.pdf printed
+    // after it) are the report; a leftover of a killed run or a file added by hand is not
+    // stored, and an output that differs from its manifest hash refuses the folder.
+    let manifest = read_manifest(dir)?;
+    if let Some(m) = &manifest {
+        names.retain(|p| {
+            let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            name == gyrolab_eval::report_folder::MANIFEST
+                || name == "report.pdf"
+                || m.files.iter().any(|f| f.name == name)
+        });
+        for f in &m.files {
+            if !names.iter().any(|p| p.file_name().is_some_and(|n| n.to_string_lossy() == f.name)) {
+                return Err(StoreError::Input {
+                    path: dir.join(&f.name).display().to_string(),
+                    message: "missing: the folder's manifest lists it (gyrolab verify checks the folder); not stored"
+                        .into(),
+                });
+            }
+        }
+    }
     for p in names {
         let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let size = std::fs::metadata(&p).map(|m| m.len()).unwrap_or(u64::MAX);
@@ -403,6 +437,18 @@ pub fn from_report_folder_with(
                 path: p.display().to_string(),
                 message: format!("cannot read: {e}"),
             })?;
+            if let Some(f) = manifest.as_ref().and_then(|m| m.files.iter().find(|f| f.name == name)) {
+                let sha = hash_bytes(&bytes);
+                if sha != f.sha256 {
+                    return Err(StoreError::Input {
+                        path: p.display().to_string(),
+                        message: format!(
+                            "changed since the report was written (SHA-256 {sha}, manifest {}): an edited folder is not stored (gyrolab verify names every change)",
+                            f.sha256
+                        ),
+                    });
+                }
+            }
             report_files.push(FileRecord {
                 path: name,
                 sha256: hash_bytes(&bytes),

@@ -612,3 +612,28 @@ fn store_urls_never_show_a_password_nor_become_files() {
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "{location}: no file made");
     }
 }
+
+/// `store add` takes the report as its manifest lists it (issue 53): a leftover `.gyrolab-*.tmp`
+/// of a killed run is not stored, and an output edited after the folder was written refuses
+/// the folder (exit 2, the file named), nothing stored.
+#[test]
+fn store_add_takes_the_manifest_files_and_refuses_an_edited_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let plan = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper_plan.toml");
+    let out = dir.path().join("report");
+    gyrolab().arg("eval").arg(&plan).arg("--out").arg(&out).arg("-q").assert().code(3);
+    std::fs::write(out.join(".gyrolab-leftover.tmp"), b"half a file").unwrap();
+    let db = dir.path().join("g.db");
+    gyrolab().args(["store", "add"]).arg(&out).arg("--plan").arg(&plan).arg("--store").arg(&db).assert().success();
+    let back = dir.path().join("back");
+    gyrolab().args(["store", "report", "1", "--out"]).arg(&back).arg("--store").arg(&db).assert().success();
+    assert!(back.join("manifest.json").exists() && !back.join(".gyrolab-leftover.tmp").exists());
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    std::fs::write(out.join("report.html"), html.replacen("FAIL", "PASS", 1)).unwrap();
+    let db2 = dir.path().join("g2.db");
+    let o =
+        gyrolab().args(["store", "add"]).arg(&out).arg("--plan").arg(&plan).arg("--store").arg(&db2).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("report.html") && err.contains("changed since the report was written"), "{err}");
+}
