@@ -425,6 +425,8 @@ fn static_plan_evaluates_bias_and_allan_against_the_simulation_truth() {
     assert_eq!(html.matches("<svg class=\"plot\"").count(), 3, "bias time series, bias-temperature, Allan");
     assert!(html.contains("Axis x: Allan deviation (OADEV)") && html.contains("Axis x: bias time series"));
     assert!(html.contains("N = 0.") && html.contains("B = ") && html.contains("averaging time τ (s)"));
+    // The records carry no simulator header (written by the library without comments): read as
+    // measured ones, and not labelled simulated.
     assert!(!html.contains("SIMULATED DATA"), "measured records are not labelled simulated");
     for f in ["bias_tests.csv", "bias_windows_x.csv", "allan_x.csv", "summary.csv"] {
         assert!(out.join(f).is_file(), "{f} missing");
@@ -602,4 +604,40 @@ fn eval_never_overwrites_an_input_in_its_out_folder() {
     assert!(err.contains("points_x.csv") && err.contains("never overwrites an input"), "{err}");
     assert_eq!(std::fs::read(dir.path().join("points_x.csv")).unwrap(), before);
     assert!(!dir.path().join("results.json").exists() && !dir.path().join("report.html").exists());
+}
+
+/// Simulated from the records themselves (issue 53): a plan that does not say it is simulated,
+/// over records gyrolab's simulator wrote, gives a report marked SIMULATED everywhere
+/// (results.json `simulated`, the summary's rows, the HTML), naming the records.
+#[test]
+fn simulator_records_mark_the_report_whatever_the_plan_says() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, seed) in [("s1.csv", "1"), ("s2.csv", "2")] {
+        gyrolab()
+            .args(["simulate", "static", "--duration-s", "600", "--sample-rate-hz", "100", "--arw-deg-rt-h", "0.3"])
+            .args(["--seed", seed, "--out"])
+            .arg(dir.path().join(name))
+            .assert()
+            .success();
+    }
+    let plan = write(
+        dir.path(),
+        "plan.toml",
+        "[device]\nmodel = \"m\"\nserial = \"s\"\naxes = [\"x\"]\n[static.x]\nfiles = [\"s1.csv\", \"s2.csv\"]\nsample_rate_hz = 100.0\n",
+    );
+    let out = dir.path().join("r");
+    let o = gyrolab().arg("eval").arg(&plan).arg("--out").arg(&out).arg("-q").output().unwrap();
+    assert!(o.status.code().is_some_and(|c| c == 0 || c == 5), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_str(&read(&out.join("results.json"))).unwrap();
+    assert_eq!(v["simulated"], true, "{}", v["simulated"]);
+    let html = read(&out.join("report.html"));
+    assert!(
+        html.contains("SIMULATED") && html.contains("s1.csv, s2.csv were written by gyrolab"),
+        "no mark in the HTML"
+    );
+    let summary = read(&out.join("summary.csv"));
+    assert!(
+        summary.lines().skip(1).filter(|l| !l.starts_with('#')).all(|l| l.contains("true") || l.contains("SIMULATED")),
+        "{summary}"
+    );
 }

@@ -162,6 +162,30 @@ fn triad_section(t: &gyrolab_report::triad::TriadReport<'_>) -> ReportSection {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progress) -> EvalResult<ReportFolder> {
+    // Simulated from the records themselves: a plan without `[device] simulated` whose records
+    // include one gyrolab's simulator wrote (its first line says so) is marked as a simulated
+    // plan, every figure and table, whatever the plan says (a mixed plan is marked whole).
+    if plan.device.simulated.is_none() {
+        let simulated: Vec<String> = plan
+            .input_files()
+            .into_iter()
+            .filter(|f| gyrolab_io::noise_export::is_gyrolab_simulation(f))
+            .map(|f| f.file_name().map_or_else(|| f.display().to_string(), |n| n.to_string_lossy().into_owned()))
+            .collect();
+        if !simulated.is_empty() {
+            let mut marked = plan.clone();
+            marked.device.simulated = Some(format!(
+                "the records {} were written by gyrolab's simulator (their first line says so), though the plan does not say it is simulated",
+                simulated.join(", ")
+            ));
+            return evaluate_marked(&marked, plan_file, progress);
+        }
+    }
+    evaluate_marked(plan, plan_file, progress)
+}
+
+/// [`evaluate_test_plan`] of a plan whose simulated records are declared.
+fn evaluate_marked(plan: &TestPlan, plan_file: &str, progress: &dyn Progress) -> EvalResult<ReportFolder> {
     progress.begin(progress_steps(plan));
     let (axes, logs) = evaluate_plan_rates(plan, progress)?;
     let triad = match &plan.triad {

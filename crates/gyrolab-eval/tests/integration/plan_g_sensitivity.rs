@@ -42,7 +42,12 @@ fn evaluate(dir: &Path, plan: &str) -> Result<serde_json::Value, EvalError> {
         serde_json::json!(html.contains("not resolved: no record has a specific force along this axis"));
     v["verdict"] = serde_json::json!(folder.verdict.map(|v| v == Overall::Pass));
     v["csv_lines"] =
-        serde_json::json!(std::str::from_utf8(output(&folder, "g_sensitivity.csv")).unwrap().lines().count());
+        // Data rows and header; a `# SIMULATED` line first (the simulator's records mark it).
+        serde_json::json!(std::str::from_utf8(output(&folder, "g_sensitivity.csv"))
+            .unwrap()
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .count());
     Ok(v)
 }
 
