@@ -903,14 +903,9 @@ pub struct ChannelSetup<'a> {
 pub fn analyse_channel(
     setup: &ChannelSetup<'_>,
     info: &ChannelInfo,
-    mut values: Vec<f64>,
+    values: Vec<f64>,
 ) -> EvalResult<ChannelAnalysis> {
-    let (quantity, conversion) = physical_conversion(setup, info)?;
-    conversion.apply(&mut values);
-    let stillness = check_channel(&values, setup.tau0_s, quantity);
-    values.reserve_exact(1);
-    let curve = channel_curve(setup.path, info, values, setup.lines, setup.tau0_s, setup.options)?;
-    Ok(channel_analysis(setup, info, quantity, curve, stillness))
+    analyse_channel_by(setup, info, values, false)
 }
 
 /// [`analyse_channel`] of a record with more samples missing than filling is safe for: each
@@ -919,18 +914,33 @@ pub fn analyse_channel(
 pub fn analyse_channel_present(
     setup: &ChannelSetup<'_>,
     info: &ChannelInfo,
+    values: Vec<f64>,
+) -> EvalResult<ChannelAnalysis> {
+    analyse_channel_by(setup, info, values, true)
+}
+
+/// [`analyse_channel`] by the gap rule, or by the present-sample estimator (`present`).
+fn analyse_channel_by(
+    setup: &ChannelSetup<'_>,
+    info: &ChannelInfo,
     mut values: Vec<f64>,
+    present: bool,
 ) -> EvalResult<ChannelAnalysis> {
     let (quantity, conversion) = physical_conversion(setup, info)?;
     conversion.apply(&mut values);
     let stillness = check_channel(&values, setup.tau0_s, quantity);
-    let curve = gyrolab::allan::present::deviation_from_rate_present(
-        &values,
-        setup.tau0_s,
-        setup.options,
-        gyrolab::allan::present::DEFAULT_MIN_PRESENT_SHARE,
-    )
-    .map_err(|e| curve_error(setup.path, info, setup.lines, e))?;
+    let curve = if present {
+        gyrolab::allan::present::deviation_from_rate_present(
+            &values,
+            setup.tau0_s,
+            setup.options,
+            gyrolab::allan::present::DEFAULT_MIN_PRESENT_SHARE,
+        )
+        .map_err(|e| curve_error(setup.path, info, setup.lines, e))?
+    } else {
+        values.reserve_exact(1);
+        channel_curve(setup.path, info, values, setup.lines, setup.tau0_s, setup.options)?
+    };
     Ok(channel_analysis(setup, info, quantity, curve, stillness))
 }
 
