@@ -900,11 +900,7 @@ pub struct ChannelSetup<'a> {
 
 /// Analyses one channel: converts it to deg/s, computes the curve and, for data in deg/s and an
 /// Allan deviation, the noise terms.
-pub fn analyse_channel(
-    setup: &ChannelSetup<'_>,
-    info: &ChannelInfo,
-    values: Vec<f64>,
-) -> EvalResult<ChannelAnalysis> {
+pub fn analyse_channel(setup: &ChannelSetup<'_>, info: &ChannelInfo, values: Vec<f64>) -> EvalResult<ChannelAnalysis> {
     analyse_channel_by(setup, info, values, false)
 }
 

@@ -305,10 +305,33 @@ pub const TEST_PROGRAM_SEED: u64 = 2026;
 /// Writes the example test program (every test of a lab's program on one axis, SIMULATED
 /// records with known truth, [`crate::program_sim::write_test_program`]) into `dir`, created if
 /// missing: `plan.toml` and the CSV records it names.
+///
+/// All or none: the records are made in a temporary folder inside `dir`, then written in place
+/// together ([`gyrolab_io::atomic::write_outputs`]); a failure leaves `dir` as it was.
 pub fn write_test_program_folder(dir: &std::path::Path, seed: u64) -> EvalResult<()> {
     std::fs::create_dir_all(dir)
         .map_err(|e| EvalError::Output(format!("{}: cannot create the folder: {e}", dir.display())))?;
-    crate::program_sim::write_test_program(dir, seed).map(|_| ())
+    let staging = tempfile::Builder::new()
+        .prefix(".gyrolab-staging-")
+        .tempdir_in(dir)
+        .map_err(|e| EvalError::Output(format!("{}: cannot make a temporary folder in it: {e}", dir.display())))?;
+    crate::program_sim::write_test_program(staging.path(), seed)?;
+    let mut names: Vec<std::ffi::OsString> = std::fs::read_dir(staging.path())
+        .map_err(|e| EvalError::Output(format!("{}: {e}", staging.path().display())))?
+        .filter_map(|e| e.ok().map(|e| e.file_name()))
+        .collect();
+    names.sort();
+    let outputs = names
+        .iter()
+        .map(|name| {
+            let from = staging.path().join(name);
+            gyrolab_io::atomic::OutputFile::stream(dir.join(name), move |w| {
+                std::io::copy(&mut std::fs::File::open(&from)?, w).map(drop)
+            })
+        })
+        .collect();
+    gyrolab_io::atomic::write_outputs(outputs, &[])?;
+    Ok(())
 }
 
 /// CSV options of a simulated record: `decimals` fixed decimals (0 to 15) or the shortest form;
