@@ -259,7 +259,11 @@ def _allan(
         raise Error(f"topic={topic!r}: a topic picks one IMU topic of a recording file; x is not a path", keyword="topic")
     if isinstance(x, (str, os.PathLike)):
         path = os.fspath(x)
-        arrays, file_units = _gyrolab.read(path, None, None, None, topic)
+        # A list of units (read()'s and the CLI's spelling, ["gx=rad/s", "m/s^2"]) is applied by
+        # the file reader, as `gyrolab allan --unit` applies it: a bare unit per quantity (a rate
+        # unit to the gyro and unnamed columns, an acceleration unit to the accelerometers).
+        listed = units is not None and not isinstance(units, (Mapping, str))
+        arrays, file_units = _gyrolab.read(path, [str(u) for u in units] if listed else None, None, None, topic)
         frame = dict(arrays)
         if time is None:
             tcols = [k for k, u in file_units.items() if u == "s"]
@@ -270,6 +274,8 @@ def _allan(
         merged = {k: u for k, u in file_units.items() if u not in ("s", "degC") and k in frame}
         if isinstance(units, Mapping):
             merged.update({str(k): str(v) for k, v in units.items()})
+        elif listed:
+            units = None
         elif units is not None or unit is not None:
             merged = {}
         x = frame

@@ -151,3 +151,28 @@ def test_a_gmwm_poor_fit_is_refused_unless_allowed():
         text = r.export("kalibr", estimator="gmwm", allow_poor_fit=True)
     assert "GMWM POOR FIT" in text
     assert any("POOR FIT" in str(x.message) for x in w)
+
+
+def test_a_list_of_units_on_a_file_reads_as_the_cli_reads_it(tmp_path, cli):
+    # Issue 55: units=["deg/s", "g"] on a file gave every channel the last unit (gyros in g).
+    import json
+
+    rng = np.random.default_rng(5)
+    n = 20_000
+    path = tmp_path / "imu_log.csv"
+    pd.DataFrame(
+        {
+            "time_s": np.arange(n) / 100.0,
+            "gx": rng.standard_normal(n) * 0.05,
+            "ax": rng.standard_normal(n) * 0.001,
+        }
+    ).to_csv(path, index=False)
+    r = gyrolab.allan(str(path), units=["deg/s", "g"])
+    assert r["gx"].quantity == "angular_rate" and r["ax"].quantity == "acceleration"
+    out = subprocess.run(
+        [cli, "allan", str(path), "--unit", "deg/s", "--unit", "g", "--json"], capture_output=True, text=True, check=True
+    )
+    by_channel = {c["channel"]: c for c in json.loads(out.stdout)["channels"]}
+    for name in ["gx", "ax"]:
+        assert by_channel[name]["dev_unit"] == r[name].unit
+        assert by_channel[name]["dev"][0] == pytest.approx(float(r[name].dev[0]), rel=1e-12)
