@@ -230,6 +230,15 @@ impl Store {
             Location::Sqlite { path } => {
                 let path = Path::new(path);
                 let open_err = |m: String| StoreError::Open { store: name.clone(), message: m };
+                // Only a regular file is opened: opening a FIFO would wait for a writer forever,
+                // and a folder or a device is no store.
+                if let Ok(m) = std::fs::metadata(path) {
+                    if !m.is_file() {
+                        return Err(open_err(
+                            "not a regular file (a folder, a FIFO or a device): not a gyrolab store".into(),
+                        ));
+                    }
+                }
                 match std::fs::File::open(path) {
                     Ok(mut f) => {
                         use std::io::Read;

@@ -637,3 +637,32 @@ fn store_add_takes_the_manifest_files_and_refuses_an_edited_folder() {
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("report.html") && err.contains("changed since the report was written"), "{err}");
 }
+
+/// A FIFO or a folder given as the store is refused at once (issue 53: a FIFO hung `eval`,
+/// `store history` and `store add`), exit 2, nothing written.
+#[cfg(unix)]
+#[test]
+fn a_fifo_or_a_folder_as_the_store_is_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("store.db");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status().map(|s| s.success()).unwrap_or(false);
+    let mut stores = vec![dir.path().to_path_buf()];
+    if made {
+        stores.push(fifo);
+    } else {
+        eprintln!("SKIPPED: the FIFO case of a_fifo_or_a_folder_as_the_store_is_refused_at_once: mkfifo failed");
+    }
+    for store in stores {
+        let started = std::time::Instant::now();
+        let o = gyrolab()
+            .args(["store", "history", "SN1", "--store"])
+            .arg(&store)
+            .timeout(std::time::Duration::from_secs(20))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{}: {err}", store.display());
+        assert!(err.contains("not a regular file"), "{err}");
+        assert!(started.elapsed() < std::time::Duration::from_secs(5), "{:?}", started.elapsed());
+    }
+}
