@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import functools
 import json
+import math
 import os
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
@@ -196,6 +197,39 @@ def _factors(taus: Sequence[float], rate_hz: Optional[float], stamps: Optional[n
     return sorted(set(int(v) for v in m)), rounded
 
 
+def _window(
+    arrays: List[np.ndarray],
+    stamps: Optional[np.ndarray],
+    rate_hz: Optional[float],
+    start_s: Optional[float],
+    end_s: Optional[float],
+) -> Tuple[List[np.ndarray], Optional[np.ndarray]]:
+    """The samples from ``start_s`` seconds after the record's first sample up to (not
+    including) ``end_s``, by the time stamps or else the sample index over ``rate_hz``: the part
+    ``gyrolab allan --start --end`` analyses."""
+    for name, v in (("start_s", start_s), ("end_s", end_s)):
+        if v is not None and (not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0):
+            raise Error(f"{name}={v!r}: expected a number of seconds >= 0", keyword=name)
+    if start_s is not None and end_s is not None and end_s <= start_s:
+        raise Error(f"end_s {end_s} s is not after start_s {start_s} s", keyword="end_s")
+    n = len(arrays[0]) if arrays else 0
+    if stamps is not None:
+        offset = np.asarray(stamps, dtype=np.float64) - float(stamps[0])
+    elif rate_hz is not None:
+        offset = np.arange(n) / float(rate_hz)
+    else:
+        raise Error("start_s and end_s need time stamps or rate_hz", keyword="start_s")
+    keep = np.ones(n, dtype=bool)
+    if start_s is not None:
+        keep &= offset >= start_s
+    if end_s is not None:
+        keep &= offset < end_s
+    if int(keep.sum()) < 2:
+        length = float(offset[-1]) if n else 0.0
+        raise Error(f"fewer than two samples between start_s and end_s: the record is {length} s long", keyword="start_s")
+    return [a[keep] for a in arrays], (None if stamps is None else np.asarray(stamps)[keep])
+
+
 def _allan(
     x: Any,
     rate_hz: Optional[float] = None,
@@ -213,6 +247,8 @@ def _allan(
     names: Optional[Sequence[str]] = None,
     record: Optional[str] = None,
     allow_motion: bool = False,
+    start_s: Optional[float] = None,
+    end_s: Optional[float] = None,
     topic: Optional[str] = None,
 ) -> Union[AllanResult, AllanResults]:
     """Allan-family deviation, confidence bounds and noise terms of rate samples.
@@ -252,6 +288,10 @@ def _allan(
     ``allow_motion=True`` the results carry ``stillness["moved"] = True`` and every export
     a ``MOTION:`` header line.
 
+    Part of a record: ``start_s`` and ``end_s``, seconds from its first sample (samples at or
+    after the start and before the end, by the time stamps, else the sample index over
+    ``rate_hz``), as ``gyrolab allan --start --end``.
+
     Every channel is computed with the interpreter released, on gyrolab's own thread pool
     (safe in fork-based multiprocessing pools).
     """
@@ -284,6 +324,8 @@ def _allan(
     if gaps not in ("error", "analyse", "analyze"):
         raise Error(f"gaps='{gaps}': expected 'error' or 'analyse'", keyword="gaps")
     cols, arrays, chan_units, stamps, single = _channels(x, names, time, unit, units)
+    if start_s is not None or end_s is not None:
+        arrays, stamps = _window(arrays, stamps, rate_hz, start_s, end_s)
     if fit_range_s is not None:
         try:
             pair = [float(v) for v in fit_range_s]

@@ -176,3 +176,27 @@ def test_a_list_of_units_on_a_file_reads_as_the_cli_reads_it(tmp_path, cli):
     for name in ["gx", "ax"]:
         assert by_channel[name]["dev_unit"] == r[name].unit
         assert by_channel[name]["dev"][0] == pytest.approx(float(r[name].dev[0]), rel=1e-12)
+
+
+def test_start_and_end_cut_as_the_cli_does(tmp_path, cli):
+    # Issue 54: the part of a record, from Python as from `gyrolab allan --start --end`.
+    import json
+
+    rng = np.random.default_rng(8)
+    n = 30_000
+    path = tmp_path / "r.csv"
+    pd.DataFrame({"time_s": np.arange(n) / 100.0, "gyro_x [deg/s]": rng.standard_normal(n) * 0.05}).to_csv(
+        path, index=False
+    )
+    results = gyrolab.allan(str(path), start_s=50, end_s=200)
+    r = next(iter(results.values())) if hasattr(results, "values") else results
+    assert r.samples == 15_000
+    out = subprocess.run(
+        [cli, "allan", str(path), "--start", "50", "--end", "200", "--json"], capture_output=True, text=True, check=True
+    )
+    doc = json.loads(out.stdout)["channels"][0]
+    assert doc["samples"] == 15_000
+    assert list(r.dev) == pytest.approx(doc["dev"], rel=1e-12)
+    with pytest.raises(gyrolab.Error) as e:
+        gyrolab.allan(str(path), start_s=200, end_s=50)
+    assert e.value.keyword == "end_s"
