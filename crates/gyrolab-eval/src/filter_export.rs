@@ -564,11 +564,9 @@ pub fn render_export(
     Ok((export.render(stack), warnings))
 }
 
-/// Whether two output paths name one file as written (relative to the working folder, `.`
-/// components dropped; symbolic links and `..` are not resolved).
+/// Whether two output paths name one file as written ([`gyrolab_io::atomic::same_written_path`]).
 pub fn same_path(a: &Path, b: &Path) -> bool {
-    let norm = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
-    norm(a) == norm(b)
+    gyrolab_io::atomic::same_written_path(a, b)
 }
 
 /// Whether a file was written by gyrolab's simulator (the SIMULATED mark of its exports).

@@ -311,8 +311,9 @@ pub fn write_outputs(files: Vec<OutputFile<'_>>, inputs: &[&Path]) -> Result<Vec
 }
 
 /// Whether two output paths name one file as written (relative to the working folder, `.`
-/// components dropped), for targets that do not exist yet.
-fn same_written_path(a: &Path, b: &Path) -> bool {
+/// components dropped; symbolic links and `..` are not resolved), for targets that may not
+/// exist yet.
+pub fn same_written_path(a: &Path, b: &Path) -> bool {
     let norm = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
     norm(a) == norm(b)
 }
@@ -387,11 +388,6 @@ fn stage_in(dir: &Path, content: Content<'_>) -> std::io::Result<tempfile::Named
         return Err(e);
     }
     Ok(tmp)
-}
-
-/// Writes several files, each anywhere, all or none ([`write_outputs`] with no inputs named).
-pub fn write_files(files: &[(PathBuf, Vec<u8>)]) -> Result<Vec<PathBuf>, OutputError> {
-    write_outputs(files.iter().map(|(p, b)| OutputFile::bytes(p.clone(), &b[..])).collect(), &[])
 }
 
 /// A file written from its start that asks for write-back of every finished `chunk` bytes by

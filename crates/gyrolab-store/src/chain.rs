@@ -207,6 +207,7 @@ fn evaluation_rows(x: &mut dyn Exec, eval_id: i64) -> Result<Vec<(&'static Chain
     let mut out = Vec::new();
     for t in &CHAINED {
         let filter = if t.name == "evaluation" { "id" } else { "evaluation_id" };
+        // ok: table and column names from the constant CHAINED spec, the id a bound parameter
         let sql = format!("SELECT {} FROM {} WHERE {filter} = $1 ORDER BY id", columns_sql(t), t.name);
         for row in x.query(&sql, &[Val::I(eval_id)], &kinds(t))? {
             out.push((t, row));
@@ -413,6 +414,7 @@ fn check_triggers(x: &mut dyn Exec, postgres: bool, report: &mut CheckReport) ->
 }
 
 fn read_row(x: &mut dyn Exec, t: &ChainedTable, id: i64) -> Result<Option<Vec<Val>>, String> {
+    // ok: table and column names from the constant CHAINED spec, the id a bound parameter
     let sql = format!("SELECT {} FROM {} WHERE id = $1", columns_sql(t), t.name);
     Ok(x.query(&sql, &[Val::I(id)], &kinds(t))?.into_iter().next())
 }
@@ -528,6 +530,7 @@ fn check_tails(x: &mut dyn Exec, report: &mut CheckReport) -> Result<(), String>
                 _ => None,
             }))
         };
+        // ok: the table name from the constant CHAINED spec; no value in the text
         let last_row = max(x, &format!("SELECT MAX(id) FROM {}", t.name), &[])?;
         let last_link = max(x, "SELECT MAX(row_id) FROM chain WHERE tbl = $1", &[Val::T(Some(t.name.to_string()))])?;
         if let Some(id) = last_row.filter(|id| last_link.is_none_or(|l| id > &l)) {
@@ -538,6 +541,7 @@ fn check_tails(x: &mut dyn Exec, report: &mut CheckReport) -> Result<(), String>
                 what: "not in the chain (past its last row of this table): inserted outside the store".into(),
             });
         }
+        // ok: the table name from the constant CHAINED spec; no value in the text
         let no_id = x.query(&format!("SELECT 1 FROM {} WHERE id IS NULL LIMIT 1", t.name), &[], &[Kind::I])?;
         if !no_id.is_empty() {
             report.problems.push(Problem {
@@ -615,6 +619,7 @@ pub fn full_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, Strin
     let mut digests: HashMap<(&'static str, i64), [u8; 32]> = HashMap::new();
     let mut file_problems = Vec::new();
     for t in &CHAINED {
+        // ok: the table name from the constant CHAINED spec; no value in the text
         let total = count(x, &format!("SELECT COUNT(*) FROM {}", t.name), &[])?;
         report.rows.push((t.name.to_string(), total));
         // Pages of rows (report files hold up to 64 MiB each: a few at a time).

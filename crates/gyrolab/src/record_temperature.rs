@@ -44,7 +44,7 @@ pub struct RecordTemperature {
 /// use gyrolab::record_temperature::record_temperature;
 /// // 25 degC rising 0.5 degC over one hour at 1 Hz.
 /// let t: Vec<f64> = (0..3601).map(|i| 25.0 + 0.5 * i as f64 / 3600.0).collect();
-/// let s = record_temperature("temp_c", &t, 1.0).unwrap();
+/// let s = record_temperature("temp_c", &t, 1.0).unwrap(); // ok: two finite samples at least
 /// assert!((s.slope_c_per_h - 0.5).abs() < 1e-9 && (s.span_c - 0.5).abs() < 1e-12 && !s.moved);
 /// ```
 pub fn record_temperature(column: &str, temp_c: &[f64], tau0_s: f64) -> Option<RecordTemperature> {
