@@ -601,6 +601,20 @@ pub fn recording_motion(outcomes: &[AllanOutcome]) -> Vec<String> {
     outcomes.iter().flat_map(|o| o.analyses.iter().filter_map(|a| a.motion_line())).collect()
 }
 
+/// A Kalibr or imu_utils file's text with every `MOTION:` line of its recording in its header
+/// (a topic that did not move is still of a recording that did), after a `%YAML` directive.
+pub fn with_motion(text: String, motion: &[String]) -> String {
+    let missing: Vec<&String> = motion.iter().filter(|m| !text.contains(m.as_str())).collect();
+    if missing.is_empty() {
+        return text;
+    }
+    let lines: String = missing.iter().map(|m| format!("# {m}\n")).collect();
+    match text.strip_prefix("%YAML:1.0\n---\n") {
+        Some(rest) => format!("%YAML:1.0\n---\n{lines}{rest}"),
+        None => format!("{lines}{text}"),
+    }
+}
+
 /// The export files of every record of a run (one file per topic when there are several:
 /// imu.yaml -> imu_<topic>.yaml), made and checked but not written, and the warnings.
 #[allow(clippy::type_complexity)]
@@ -677,6 +691,19 @@ mod tests {
             assert_eq!(back.value.to_bits(), value.to_bits(), "{value:e}");
             assert_eq!(back.overbound_factor.map(f64::to_bits), Some(value.to_bits()));
         }
+    }
+
+    /// A recording's MOTION lines go into a Kalibr or imu_utils file's header once, after the
+    /// `%YAML` directive, and a line already there is not repeated.
+    #[test]
+    fn motion_lines_join_the_header_once() {
+        let m = vec!["MOTION: a".to_string(), "MOTION: b".to_string()];
+        assert_eq!(
+            with_motion("%YAML:1.0\n---\nx: 1\n".into(), &m),
+            "%YAML:1.0\n---\n# MOTION: a\n# MOTION: b\nx: 1\n"
+        );
+        assert_eq!(with_motion("# MOTION: a\nx: 1\n".into(), &m), "# MOTION: b\n# MOTION: a\nx: 1\n");
+        assert_eq!(with_motion("x: 1\n".into(), &[]), "x: 1\n");
     }
 
     /// Axis names as channels are named (issue 54, per-axis values for Basalt).

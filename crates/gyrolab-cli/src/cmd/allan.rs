@@ -189,7 +189,7 @@ pub fn run(args: &AllanArgs) -> CliResult {
                 let whose = outcome.topic.as_ref().map_or(String::new(), |t| format!("topic {}: ", t.topic));
                 EvalError::conflict(format!("{whose}no noise terms could be read from the curves (give the gyro channels a unit such as --unit rad/s, or calibrate outputs with --cal or --scale-factor, and use --kind oadev); no output file was written"))
             })?;
-            files.push((target, with_motion(file.text, &motion).into_bytes()));
+            files.push((target, gyrolab_eval::filter_export::with_motion(file.text, &motion).into_bytes()));
             warnings.extend(file.warnings);
         }
     }
@@ -240,20 +240,6 @@ pub fn run(args: &AllanArgs) -> CliResult {
         text.push(format!("memory: {}", streaming_note(&args.file.display().to_string(), s)));
     }
     print(&(simulated + &text.join("\n") + "\n"))
-}
-
-/// A Kalibr or imu_utils file's text with every `MOTION:` line of its recording in its header
-/// (a topic that did not move is still of a recording that did), after a `%YAML` directive.
-fn with_motion(text: String, motion: &[String]) -> String {
-    let missing: Vec<&String> = motion.iter().filter(|m| !text.contains(m.as_str())).collect();
-    if missing.is_empty() {
-        return text;
-    }
-    let lines: String = missing.iter().map(|m| format!("# {m}\n")).collect();
-    match text.strip_prefix("%YAML:1.0\n---\n") {
-        Some(rest) => format!("%YAML:1.0\n---\n{lines}{rest}"),
-        None => format!("{lines}{text}"),
-    }
 }
 
 /// The JSON document with the `memory` object (which path; docs/JSON.md) after its keys.
