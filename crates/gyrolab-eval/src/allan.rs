@@ -758,10 +758,24 @@ pub fn record_timing(data: &SeriesData, path: &Path, given_hz: Option<f64>, poli
             }
         }
     }
-    let (gaps, missing) = estimate.as_ref().map_or((Vec::new(), 0), |e| (e.gaps.clone(), e.missing));
-    check_grid_size(data, path, &gaps, missing)?;
+    let (mut gaps, mut missing) = estimate.as_ref().map_or((Vec::new(), 0), |e| (e.gaps.clone(), e.missing));
     let clock = estimate.as_ref().map(|e| e.clock);
     let reset = estimate.as_ref().and_then(|e| e.reset);
+    // A given rate within GRID_AT_GIVEN_RATE of the stamps' builds the grid at that rate: the
+    // gaps counted in its intervals. One that contradicts them (warned) keeps the stamps' grid:
+    // the user may know the sensor's clock better than a logger that drops messages.
+    if let Some((f, e)) =
+        given_hz.zip(estimate.as_ref()).filter(|(f, e)| (f / e.rate_hz() - 1.0).abs() <= GRID_AT_GIVEN_RATE)
+    {
+        let end = e.reset.map_or(usize::MAX, |r| r.index);
+        gaps = match (&data.time, &data.time_compact) {
+            (Some(t), _) => gyrolab::sampling::gaps_at(&t[..], 1.0 / f, &e.clock, end),
+            (None, Some(c)) => gyrolab::sampling::gaps_at(c, 1.0 / f, &e.clock, end),
+            (None, None) => gaps,
+        };
+        missing = gaps.iter().map(|g| g.missing).sum();
+    }
+    check_grid_size(data, path, &gaps, missing)?;
     match (given_hz, &estimate) {
         // A given rate is used; the note (a warning when they disagree) gives the stamps'.
         (Some(f), Some(e)) => Ok(Timing {
@@ -787,6 +801,11 @@ pub fn record_timing(data: &SeriesData, path: &Path, given_hz: Option<f64>, poli
         )),
     }
 }
+
+/// Largest relative difference between a given sample rate and the stamps' for the record's
+/// grid to be built at the given rate (beyond it the given rate contradicts the stamps, a
+/// warning says so, and the stamps' own grid is kept with the given interval).
+pub const GRID_AT_GIVEN_RATE: f64 = 0.05;
 
 /// Most samples the gaps of a record may add to its uniform grid, as a multiple of the samples
 /// it has: 1 (the grid at most twice the record). A stamp that leaps (far in the future, zero,

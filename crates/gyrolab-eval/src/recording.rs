@@ -142,7 +142,33 @@ pub fn per_topic_path(path: &Path, topic: &str) -> PathBuf {
 /// Writes the IMU topics of a recording (`topics` selects; empty: all) as CSV or Parquet
 /// (by `out`'s extension): `timestamp_ns` and the channels with their units in the names, in
 /// stamp order; one file per topic (`out` itself for one topic, `stem_topic.ext` for several).
-pub fn convert(path: &Path, topics: &[String], out: &Path) -> EvalResult<Converted> {
+///
+/// `window_s` keeps the messages `[start, end)` seconds after each topic's first message; a
+/// topic with fewer than two there is an error naming its length.
+pub fn convert(
+    path: &Path,
+    topics: &[String],
+    out: &Path,
+    window_s: (Option<f64>, Option<f64>),
+) -> EvalResult<Converted> {
+    for (name, v) in [("start_s", window_s.0), ("end_s", window_s.1)] {
+        if let Some(v) = v {
+            if !v.is_finite() || v < 0.0 {
+                return Err(EvalError::conflict_on(
+                    &[name],
+                    format!("{{{name}}} must be a number of seconds >= 0, got {v}"),
+                ));
+            }
+        }
+    }
+    if let (Some(a), Some(b)) = window_s {
+        if b <= a {
+            return Err(EvalError::conflict_on(
+                &["start_s", "end_s"],
+                format!("{{end_s}} {b} s is not after {{start_s}} {a} s"),
+            ));
+        }
+    }
     let format = match out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
         Some("csv") => ConvertFormat::Csv,
         Some("parquet") => ConvertFormat::Parquet,
@@ -161,7 +187,25 @@ pub fn convert(path: &Path, topics: &[String], out: &Path) -> EvalResult<Convert
             format!("a {} file, not a recording: convert reads MCAP, ROS 1 bags and PX4 ULog files", kind.name()),
         )));
     }
-    let rec = opened.read_recording(&RecordingOptions { topics: topics.to_vec(), ..Default::default() })?;
+    let mut rec = opened.read_recording(&RecordingOptions { topics: topics.to_vec(), ..Default::default() })?;
+    if window_s.0.is_some() || window_s.1.is_some() {
+        for t in &mut rec.imu {
+            let length = match (t.stamps_ns.first(), t.stamps_ns.last()) {
+                (Some(a), Some(b)) => (i128::from(*b) - i128::from(*a)) as f64 * 1e-9,
+                _ => 0.0,
+            };
+            if t.keep_window(window_s.0, window_s.1) < 2 {
+                return Err(EvalError::conflict_on(
+                    &["start_s", "end_s"],
+                    format!(
+                        "{}: topic '{}': fewer than two messages between {{start_s}} and {{end_s}}: the topic is {length} s long",
+                        path.display(),
+                        gyrolab_io::text::excerpt(&t.topic)
+                    ),
+                ));
+            }
+        }
+    }
     let several = rec.imu.len() > 1;
     // Every topic's file written together (all or none), never over the recording.
     let mut files = Vec::new();

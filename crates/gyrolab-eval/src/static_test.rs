@@ -68,6 +68,9 @@ pub struct StaticTestRequest {
     pub topics: Vec<String>,
     /// Also evaluate the warm-up of each record (records that start at power-on).
     pub warmup: Option<gyrolab::warmup::WarmupConfig>,
+    /// The part of each record evaluated: seconds from its first sample, `[start, end)`
+    /// (each topic of a recording from its own first sample); read whole then.
+    pub window_s: (Option<f64>, Option<f64>),
 }
 
 impl StaticTestRequest {
@@ -87,6 +90,7 @@ impl StaticTestRequest {
             layout: crate::layout::LogLayout::default(),
             topics: Vec::new(),
             warmup: None,
+            window_s: (None, None),
         }
     }
 }
@@ -113,6 +117,9 @@ pub struct StaticOutcome {
     pub reference: Reference,
     /// Warm-up figures per file and channel (when asked for).
     pub warmup: Vec<gyrolab_report::bias::WarmupReport>,
+    /// What the reader decided per file (the part of the record analysed), with the file
+    /// (and topic) shown.
+    pub notes: Vec<(String, crate::allan::ReadNote)>,
 }
 
 /// Evaluates every file of the request and the repeatability across them.
@@ -127,6 +134,12 @@ pub fn evaluate_static_tests(request: &StaticTestRequest) -> EvalResult<StaticOu
     if request.output_unit.is_some() && request.columns.is_empty() {
         return Err(EvalError::conflict_on(&["output_unit", "columns"], "{output_unit} needs {columns}"));
     }
+    if request.warmup.is_some() && (request.window_s.0.is_some() || request.window_s.1.is_some()) {
+        return Err(EvalError::conflict_on(
+            &["warmup_band_dph", "start_s", "end_s"],
+            "the warm-up ({warmup_band_dph}) is read from power-on, the record's first sample: not with {start_s} or {end_s}",
+        ));
+    }
     let reference = request.reference.resolve()?;
     let options = request.layout.apply(SeriesOptions {
         sample_rate_hz: request.sample_rate_hz,
@@ -140,6 +153,7 @@ pub fn evaluate_static_tests(request: &StaticTestRequest) -> EvalResult<StaticOu
     })?;
     let mut tests: Vec<TestReport> = Vec::new();
     let mut files = Vec::new();
+    let mut notes = Vec::new();
     for path in &request.files {
         let mut config = StaticTestConfig {
             latitude_deg: request.latitude_deg,
@@ -159,7 +173,8 @@ pub fn evaluate_static_tests(request: &StaticTestRequest) -> EvalResult<StaticOu
             }
         }
         let format = gyrolab_io::recording::sniff_format(path)?;
-        if format == gyrolab_io::recording::FileFormat::Text {
+        let window = request.window_s.0.is_some() || request.window_s.1.is_some();
+        if format == gyrolab_io::recording::FileFormat::Text && !window {
             if !request.topics.is_empty() {
                 return Err(EvalError::conflict_on(
                     &["topics"],
@@ -173,17 +188,32 @@ pub fn evaluate_static_tests(request: &StaticTestRequest) -> EvalResult<StaticOu
             }
             continue;
         }
-        // Parquet tables and the IMU topics of recordings, read whole.
+        // Parquet tables, the IMU topics of recordings, and a part of any record
+        // ({start_s}, {end_s}), read whole.
+        if format == gyrolab_io::recording::FileFormat::Text && !request.topics.is_empty() {
+            return Err(EvalError::conflict_on(
+                &["topics"],
+                format!(
+                    "{}: {{topics}} applies to recordings (MCAP, ROS 1 bag, PX4 ULog); this is a delimited text file",
+                    path.display()
+                ),
+            ));
+        }
         let records = gyrolab_io::recording::read_records(path, &options, &request.topics)?;
         for record in records.records {
             let rows = record.data.header.rows;
             let topic = record.topic;
-            let (results, summary) = evaluate_record(record.data, &reference, &config)
-                .map_err(|e| crate::allan::located_in(e, rows, topic.as_ref()))?;
             let shown = match &topic {
                 Some(t) => format!("{} {}", path.display(), t.topic),
                 None => path.display().to_string(),
             };
+            let mut data = record.data;
+            if let Some(note) = crate::allan::trim_to_window(&mut data, path, request.window_s, request.sample_rate_hz)?
+            {
+                notes.push((shown.clone(), note));
+            }
+            let (results, summary) = evaluate_record(data, &reference, &config)
+                .map_err(|e| crate::allan::located_in(e, rows, topic.as_ref()))?;
             files.push(FileQuality { file: shown.clone(), quality: summary.quality });
             for mut result in results {
                 if let Some(t) = &topic {
@@ -200,7 +230,7 @@ pub fn evaluate_static_tests(request: &StaticTestRequest) -> EvalResult<StaticOu
             warmup.extend(evaluate_warmups(path, &options, &request.topics, &reference, request, w)?);
         }
     }
-    Ok(StaticOutcome { tests, repeatability, files, reference, warmup })
+    Ok(StaticOutcome { tests, repeatability, files, reference, warmup, notes })
 }
 
 /// The warm-up of every channel of every record of `path` (a record must start at power-on):

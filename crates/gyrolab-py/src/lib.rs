@@ -297,8 +297,12 @@ fn allan_channels<'py>(
                     return Err(keyword_error("rate_hz", msg));
                 }
             }
-            missing = e.missing;
-            grid_gaps = e.gaps;
+            // A given rate builds the grid at that rate (as the command line's does).
+            grid_gaps = match given {
+                Some(f) => gyrolab::sampling::gaps_at(t, 1.0 / f, &e.clock, e.reset.map_or(usize::MAX, |r| r.index)),
+                None => e.gaps,
+            };
+            missing = grid_gaps.iter().map(|g| g.missing).sum();
             given.map_or(e.interval_s, |f| 1.0 / f)
         }
     };

@@ -50,6 +50,13 @@ pub struct BiasArgs {
     /// Window of the warm-up's window means, s (default 10).
     #[arg(long, value_name = "S", requires = "warmup_band_dph")]
     pub warmup_window_s: Option<f64>,
+    /// Evaluate each record from this many seconds after its first sample (each topic of a
+    /// recording from its own first sample).
+    #[arg(long, value_name = "SECONDS")]
+    pub start: Option<f64>,
+    /// Evaluate each record up to (not including) this many seconds after its first sample.
+    #[arg(long, value_name = "SECONDS")]
+    pub end: Option<f64>,
 }
 
 /// Runs `gyrolab bias`.
@@ -71,6 +78,7 @@ pub fn run(args: &BiasArgs) -> CliResult {
             window_s: args.warmup_window_s.unwrap_or(10.0),
             ..gyrolab::warmup::WarmupConfig::new(b)
         }),
+        window_s: (args.start, args.end),
     };
     if let Some((reference, stated)) = reference_from_headers(&args.files, &request.reference) {
         let shown = if args.files.len() == 1 { args.files[0].display().to_string() } else { "every file".into() };
@@ -78,6 +86,9 @@ pub fn run(args: &BiasArgs) -> CliResult {
         request.reference = reference;
     }
     let outcome = evaluate_static_tests(&request)?;
+    for (file, note) in &outcome.notes {
+        eprintln!("note: {file}: {}", note.render(&crate::error::flag));
+    }
     for f in &outcome.files {
         if let Some(c) = f.quality.first_missing.first() {
             eprintln!(

@@ -19,12 +19,19 @@ pub struct ConvertArgs {
     /// Topic to convert (default: every IMU topic), repeatable.
     #[arg(long = "topic", value_name = "NAME")]
     pub topics: Vec<String>,
+    /// Keep the messages from this many seconds after each topic's first message.
+    #[arg(long, value_name = "SECONDS")]
+    pub start: Option<f64>,
+    /// Keep the messages up to (not including) this many seconds after each topic's first
+    /// message.
+    #[arg(long, value_name = "SECONDS")]
+    pub end: Option<f64>,
 }
 
 /// Runs `gyrolab convert`.
 pub fn run(args: &ConvertArgs) -> CliResult {
     let spinner = Bar::spinner(format!("converting {}", args.file.display()));
-    let converted = gyrolab_eval::recording::convert(&args.file, &args.topics, &args.out);
+    let converted = gyrolab_eval::recording::convert(&args.file, &args.topics, &args.out, (args.start, args.end));
     spinner.finish();
     let converted = converted?;
     if let Some(w) = &converted.truncated {

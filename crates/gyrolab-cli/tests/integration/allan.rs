@@ -307,4 +307,22 @@ fn start_and_end_cut_the_record_as_a_hand_cut_file() {
         assert_eq!(out.status.code(), Some(2), "{err}");
         assert!(err.contains(word), "{err}");
     }
+    // `bias` cuts the record alike: its figures equal those of the hand-cut file.
+    let bias = |file: &std::path::Path, extra: &[&str]| -> (serde_json::Value, String) {
+        let out = gyrolab().arg("bias").arg(file).args(extra).arg("--json").output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(out.status.success(), "{err}");
+        (serde_json::from_slice(&out.stdout).unwrap(), err)
+    };
+    let (windowed, err) = bias(&p, &["--start", "50", "--end", "200"]);
+    let (by_hand, _) = bias(&q, &[]);
+    assert!(err.contains(&format!("{rows} of 30000 samples")), "{err}");
+    let (a, b) = (&windowed["tests"][0], &by_hand["tests"][0]);
+    assert_eq!(a["samples"], 15000, "{a}");
+    for key in
+        ["samples", "mean_output", "std_output", "sample_rate_hz", "bias_dph", "bias_stability_dph", "drift_line"]
+    {
+        assert!(!a[key].is_null(), "{key}: {a}");
+        assert_eq!(a[key], b[key], "{key}");
+    }
 }

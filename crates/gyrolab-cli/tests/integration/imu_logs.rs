@@ -389,3 +389,60 @@ fn a_zero_trailer_ends_the_record_in_every_command() {
     assert_eq!(test["samples"], 6280, "{test}");
     assert_eq!(test["sample_rate_hz"], 100.0, "{test}");
 }
+
+/// Host stamps with single drops (issue 54; the ArDrone bag's pattern): a 50 Hz stream stamped
+/// on arrival 0 to 6 ms late, 1.5 % of the samples dropped one at a time, each drop a single
+/// 40 ms interval followed by regular ones. `allan`, `bias` and `inspect` all read 50 Hz (to
+/// 0.05 %) and count every drop (the samples over the span would say 49.3 Hz); with
+/// `--sample-rate-hz 50` the grid is that rate's, the same drops on it.
+#[test]
+fn single_drops_in_host_stamps_are_counted_by_every_command() {
+    use rand::Rng;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(54);
+    let (rate, n) = (50.0, 4_600usize);
+    let mut text = String::from("time_s,gx_rad_s,gy_rad_s,gz_rad_s\n");
+    let (mut dropped, mut last_drop, mut rows) = (0usize, 0usize, 0usize);
+    let mut stamps = Vec::new();
+    for i in 0..n {
+        if i > 40 && i + 40 < n && i - last_drop > 10 && rng.gen::<f64>() < 0.016 {
+            dropped += 1;
+            last_drop = i;
+            continue;
+        }
+        let t = 1.7e9 + i as f64 / rate + 0.006 * rng.gen::<f64>();
+        stamps.push(t);
+        let v: [f64; 3] = [rng.gen_range(-0.02..0.02), rng.gen_range(-0.02..0.02), rng.gen_range(-0.02..0.02)];
+        text.push_str(&format!("{t:.6},{:.6},{:.6},{:.6}\n", v[0], v[1], v[2]));
+        rows += 1;
+    }
+    assert!(dropped > 40, "{dropped}");
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "host.csv", &text);
+    let said = format!("{dropped} sample(s) missing");
+    for given in [None, Some("50")] {
+        let mut cmd = gyrolab();
+        cmd.arg("allan").arg(&p).arg("--json");
+        if let Some(f) = given {
+            cmd.args(["--sample-rate-hz", f]);
+        }
+        let out = cmd.output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(out.status.success() && err.contains(&said), "{given:?}: {err}");
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let tau0 = doc["channels"][0]["tau0_s"].as_f64().unwrap();
+        assert!((tau0 * rate - 1.0).abs() < 5e-4, "{given:?}: tau0 {tau0}");
+        assert_eq!(doc["channels"][0]["samples"], rows + dropped, "{given:?}");
+    }
+    let out = gyrolab().arg("bias").arg(&p).arg("--json").output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let hz = doc["tests"][0]["sample_rate_hz"].as_f64().unwrap();
+    assert!((hz / rate - 1.0).abs() < 5e-4, "bias: {hz} Hz");
+    let out = gyrolab().arg("inspect").arg(&p).arg("--json").output().unwrap();
+    let inv: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let hz = inv["topics"][0]["rate_hz"].as_f64().unwrap();
+    assert!((hz / rate - 1.0).abs() < 5e-4, "inspect: {hz} Hz");
+    assert_eq!(inv["topics"][0]["missing"], dropped, "{inv}");
+    let plain = (rows - 1) as f64 / (stamps[rows - 1] - stamps[0]);
+    assert!(plain / rate < 0.995, "the samples over the span, {plain} Hz, should show the drops");
+}

@@ -574,3 +574,47 @@ fn snapshot_topics_are_skipped_unless_named() {
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(doc["channels"].as_array().unwrap().len(), 6);
 }
+
+/// `convert --start --end` (issue 54): cutting a flight log to a part keeps exactly the
+/// messages stamped in `[start, end)` seconds after the topic's first one, the same rows as the
+/// whole conversion holds there (pyulog's sample_flight.ulg, BSD-3-Clause); a window past the
+/// end is a usage error naming the topic's length, and nothing is written.
+#[test]
+fn convert_start_and_end_keep_the_rows_of_the_window() {
+    let ulg = root().join("examples/recordings/px4_sample_flight.ulg");
+    let dir = tempfile::tempdir().unwrap();
+    let (whole, part) = (dir.path().join("whole.csv"), dir.path().join("part.csv"));
+    gyrolab().arg("convert").arg(&ulg).args(["--topic", "sensor_combined", "--out"]).arg(&whole).assert().success();
+    gyrolab()
+        .arg("convert")
+        .arg(&ulg)
+        .args(["--topic", "sensor_combined", "--start", "5", "--end", "15", "--out"])
+        .arg(&part)
+        .assert()
+        .success();
+    let whole = std::fs::read_to_string(&whole).unwrap();
+    let mut lines = whole.lines();
+    let header = lines.next().unwrap();
+    let rows: Vec<&str> = lines.collect();
+    let stamp = |l: &str| l.split(',').next().unwrap().parse::<i64>().unwrap();
+    let first = stamp(rows[0]);
+    let expected: Vec<&str> =
+        rows.iter().copied().filter(|l| (5_000_000_000..15_000_000_000).contains(&(stamp(l) - first))).collect();
+    let part = std::fs::read_to_string(&part).unwrap();
+    let mut got = part.lines();
+    assert_eq!(got.next(), Some(header));
+    let got: Vec<&str> = got.collect();
+    assert!(expected.len() > 2000, "{}", expected.len());
+    assert_eq!(got, expected);
+    let out = gyrolab()
+        .arg("convert")
+        .arg(&ulg)
+        .args(["--topic", "sensor_combined", "--start", "500", "--out"])
+        .arg(dir.path().join("none.csv"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("fewer than two messages between --start and --end: the topic is 68.8"), "{err}");
+    assert!(!dir.path().join("none.csv").exists());
+}

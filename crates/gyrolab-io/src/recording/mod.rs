@@ -268,6 +268,21 @@ pub struct ImuTopic {
 }
 
 impl ImuTopic {
+    /// Keeps the messages stamped `[start, end)` seconds after the topic's first message
+    /// (either bound open); the number kept. Stamps are in order, so the part is one run.
+    pub fn keep_window(&mut self, start: Option<f64>, end: Option<f64>) -> usize {
+        let Some(&first) = self.stamps_ns.first() else { return 0 };
+        let offset = |t: i64| (i128::from(t) - i128::from(first)) as f64 * 1e-9;
+        let inside = |t: i64| start.is_none_or(|a| offset(t) >= a) && end.is_none_or(|b| offset(t) < b);
+        let from = self.stamps_ns.iter().position(|&t| inside(t)).unwrap_or(self.stamps_ns.len());
+        let to = self.stamps_ns.iter().rposition(|&t| inside(t)).map_or(from, |i| i + 1).max(from);
+        self.stamps_ns = self.stamps_ns[from..to].to_vec();
+        for c in &mut self.channels {
+            *c = c[from.min(c.len())..to.min(c.len())].to_vec();
+        }
+        to - from
+    }
+
     /// [`snapshot_reason`] of this decoded topic, its rate from the median interval of its
     /// stamps.
     pub fn snapshot_reason(&self) -> Option<String> {
