@@ -90,3 +90,67 @@ def test_parquet_and_mcap_recordings_are_read_by_content(tmp_path):
     with pytest.raises(gyrolab.Error) as e:
         gyrolab.allan(gx, rate_hz=200.0, topic="/imu1")
     assert e.value.keyword == "topic"
+
+
+def _mpu_with_trailer(path):
+    # An MPU6050 logger's CSV: millisecond stamps at 100 Hz, 6,280 rows, then 720 rows of
+    # zeros, the stamps included (issue 54: one clock model in every front end).
+    rng = np.random.default_rng(11)
+    rows = ["timestamp_ms,gx_dps,gy_dps,gz_dps"]
+    for i in range(6280):
+        g = 0.1 * (rng.random(3) - 0.5) + [0.1, -0.2, 0.05]
+        rows.append(f"{1010 + 10 * i},{g[0]:.4f},{g[1]:.4f},{g[2]:.4f}")
+    rows += ["0,0,0,0"] * 720
+    path.write_text("\n".join(rows) + "\n")
+
+
+def test_a_zero_trailer_ends_the_record_as_the_command_line_ends_it(tmp_path):
+    p = tmp_path / "mpu.csv"
+    _mpu_with_trailer(p)
+    with pytest.warns(UserWarning, match=r"mpu.csv: the time stamps go back at time\[6280\] \(from 63.8\d* s to 0 s.*720 sample\(s\) from there left out"):
+        r = gyrolab.allan(p)
+    gx = r["gx_dps"]
+    assert abs(gx.tau0_s - 0.01) < 1e-12
+    # The figures of the rows before the trailer, as an array of them alone gives.
+    arrays = gyrolab.read(p)
+    alone = gyrolab.allan(arrays["gx_dps"][:6280], rate_hz=100.0, unit="deg/s")
+    np.testing.assert_array_equal(gx.dev, alone.dev)
+    np.testing.assert_array_equal(gx.taus_s, alone.taus_s)
+
+
+def test_host_stamps_with_single_drops_read_as_the_command_line_reads_them():
+    # A 50 Hz stream stamped on arrival 0 to 6 ms late, 1.5 % of the samples dropped one at a
+    # time (the ArDrone bag's pattern, issue 54): the grid is 50 Hz with every drop counted,
+    # from the stamps alone and with rate_hz=50 given.
+    rng = np.random.default_rng(54)
+    keep, last = [], 0
+    for i in range(4600):
+        if 40 < i < 4560 and i - last > 10 and rng.random() < 0.016:
+            last = i
+            continue
+        keep.append(i)
+    keep = np.array(keep)
+    t = keep / 50.0 + 0.006 * rng.random(len(keep))
+    x = rng.standard_normal(len(keep)) * 0.01
+    dropped = 4600 - len(keep)
+    assert dropped > 40
+    for given in (None, 50.0):
+        d = gyrolab.allan(x, time=t, rate_hz=given, unit="rad/s", gaps="analyse").to_dict()
+        assert d["samples"] == len(keep) + dropped, given
+        assert abs(d["tau0_s"] * 50.0 - 1.0) < 5e-4, (given, d["tau0_s"])
+
+
+def test_a_real_px4_log_is_read_at_its_sample_clock():
+    # pyulog's sample_logging_tagged_and_default_params.ulg (BSD-3-Clause): sensor_combined at
+    # 250 Hz with 665 dropped samples (the grid 2,693 samples), as every command reads it
+    # (crates/gyrolab-cli/tests/integration/recordings.rs).
+    import pathlib
+    import warnings
+
+    ulg = pathlib.Path(__file__).parents[2] / "examples/recordings/px4_sample_logging_tagged_and_default_params.ulg"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = gyrolab.allan(ulg, gaps="analyse")
+    for name in ("gyro_x_rad_s", "accel_z_m_s2"):
+        d = r[name].to_dict()
+        assert (d["tau0_s"], d["samples"]) == (0.004, 2693), name

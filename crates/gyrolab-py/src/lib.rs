@@ -257,6 +257,8 @@ fn allan_channels<'py>(
     // The sampling: the given rate, else the time stamps' (gaps found there are missing samples).
     let mut grid_gaps: Vec<gyrolab::sampling::Gap> = Vec::new();
     let mut missing = 0usize;
+    // Samples analysed: all, or those before a stamp going back (as the command line ends it).
+    let mut used = n;
     let tau0_s = match (&time_s, rate_hz) {
         (None, None) => {
             return Err(keyword_error(
@@ -272,6 +274,18 @@ fn allan_channels<'py>(
             }
             let e = gyrolab::sampling::estimate_interval(t)
                 .map_err(|_| keyword_error("time", "time: fewer than two stamps, or stamps that do not increase"))?;
+            // A stamp going back to or before the first one (a clock reset, a trailer of zeros)
+            // ends the record, with the command line's words as a UserWarning.
+            if let Some(r) = e.reset {
+                used = r.index;
+                let text = format!(
+                    "{record}: the time stamps go back at time[{}] (from {} s to {} s: a clock reset or a trailer of zeros): the record ends before it, {} sample(s) from there left out",
+                    r.index, r.from_s, r.to_s, r.left_out
+                );
+                let text =
+                    std::ffi::CString::new(text).map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+                PyErr::warn(py, &py.get_type::<pyo3::exceptions::PyUserWarning>(), &text, 1)?;
+            }
             if let Some(g) = e.first_non_increasing {
                 return Err(keyword_error(
                     "time",
@@ -336,9 +350,9 @@ fn allan_channels<'py>(
                 }
             };
             match c.as_slice() {
-                Ok(s) if factor.is_none() && missing == 0 => Samples::Borrowed(s),
-                Ok(s) => Samples::Owned(owned(s.to_vec())),
-                Err(_) => Samples::Owned(owned(c.as_array().iter().copied().collect())),
+                Ok(s) if factor.is_none() && missing == 0 => Samples::Borrowed(&s[..used]),
+                Ok(s) => Samples::Owned(owned(s[..used].to_vec())),
+                Err(_) => Samples::Owned(owned(c.as_array().iter().take(used).copied().collect())),
             }
         })
         .collect();

@@ -618,3 +618,32 @@ fn convert_start_and_end_keep_the_rows_of_the_window() {
     assert!(err.contains("fewer than two messages between --start and --end: the topic is 68.8"), "{err}");
     assert!(!dir.path().join("none.csv").exists());
 }
+
+/// One clock model in every command, on a real log (issue 54): pyulog's
+/// sample_logging_tagged_and_default_params.ulg (BSD-3-Clause) steps 4 and 8 ms; `inspect`,
+/// `allan` and `bias` all read sensor_combined at 250 Hz with its 665 dropped samples (2,028
+/// messages on a grid of 2,693), and skip the 1-2 Hz snapshot topics (Python's reading is
+/// checked in python/tests/test_imu_logs.py).
+#[test]
+fn every_command_reads_the_clock_of_a_real_log_alike() {
+    let ulg = root().join("examples/recordings/px4_sample_logging_tagged_and_default_params.ulg");
+    let json = |args: &[&str]| -> Value {
+        let out = gyrolab().args(args).arg(&ulg).arg("--json").output().unwrap();
+        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let inv = json(&["inspect"]);
+    let topic = inv["topics"].as_array().unwrap().iter().find(|t| t["topic"] == "sensor_combined").unwrap();
+    assert_eq!((topic["messages"].as_u64(), topic["missing"].as_u64()), (Some(2028), Some(665)), "{topic}");
+    assert_eq!(topic["rate_hz"], 250.0, "{topic}");
+    let allan = json(&["allan"]);
+    for c in allan["channels"].as_array().unwrap() {
+        assert_eq!((c["tau0_s"].as_f64(), c["samples"].as_u64()), (Some(0.004), Some(2693)), "{}", c["channel"]);
+    }
+    let bias = json(&["bias"]);
+    let tests = bias["tests"].as_array().unwrap();
+    assert_eq!(tests.len(), 6, "sensor_combined's six channels only");
+    for t in tests {
+        assert_eq!((t["sample_rate_hz"].as_f64(), t["samples"].as_u64()), (Some(250.0), Some(2028)), "{}", t["channel"]);
+    }
+}
