@@ -39,6 +39,50 @@ pub fn remove_temporaries() -> usize {
 /// Bytes written between two requests to start write-back.
 const WRITEBACK_CHUNK: u64 = 32 << 20;
 
+/// The name prefix of this process's staged files: `.gyrolab-<pid>-` (then random, `.tmp`), so
+/// that a later run can tell a killed run's leftovers from a running one's.
+fn staging_prefix() -> String {
+    format!(".gyrolab-{}-", std::process::id())
+}
+
+/// Removes the staged files a killed run left in `dir` (`.gyrolab-<pid>-*.tmp` whose process
+/// no longer exists; never another live process's, never the `.gyrolab-old-*` copies a
+/// replacement keeps, which may be the only copy of a file a run was replacing when killed).
+/// Returns the files removed. Errors are ignored: cleaning is a courtesy, never a failure.
+pub fn clean_leftovers(dir: &Path) -> Vec<PathBuf> {
+    let mut removed = Vec::new();
+    let Ok(entries) = std::fs::read_dir(dir) else { return removed };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(name) = name.to_str() else { continue };
+        let Some(rest) = name.strip_prefix(".gyrolab-").filter(|_| name.ends_with(".tmp")) else { continue };
+        let Some(pid) = rest.split('-').next().and_then(|p| p.parse::<u32>().ok()) else { continue };
+        if pid == std::process::id() || process_alive(pid) {
+            continue;
+        }
+        if entry.file_type().is_ok_and(|t| t.is_file()) && std::fs::remove_file(entry.path()).is_ok() {
+            removed.push(entry.path());
+        }
+    }
+    removed
+}
+
+/// Whether process `pid` exists (signal 0: no signal sent, only the check).
+fn process_alive(pid: u32) -> bool {
+    #[cfg(unix)]
+    {
+        let Ok(pid) = libc::pid_t::try_from(pid) else { return true };
+        // SAFETY: kill with signal 0 sends nothing; it only checks the process exists.
+        let r = unsafe { libc::kill(pid, 0) };
+        r == 0 || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = pid;
+        true
+    }
+}
+
 /// Writes `bytes` to `path` atomically (temporary file in the same folder, then rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     write_atomic_with(path, |w| w.write_all(bytes))
@@ -54,7 +98,8 @@ pub fn write_atomic_with(
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    let tmp = tempfile::Builder::new().prefix(".gyrolab-").suffix(".tmp").tempfile_in(dir)?;
+    clean_leftovers(dir);
+    let tmp = tempfile::Builder::new().prefix(&staging_prefix()).suffix(".tmp").tempfile_in(dir)?;
     let tmp_path = tmp.path().to_path_buf();
     register(&tmp_path);
     let result = write_and_persist(tmp, path, fill);
@@ -364,7 +409,8 @@ fn persist_in_order(
 /// A temporary file in `dir` holding `content` (mode 0644, synced to disk), registered for
 /// removal on a signal until it is persisted or dropped.
 fn stage_in(dir: &Path, content: Content<'_>) -> std::io::Result<tempfile::NamedTempFile> {
-    let tmp = tempfile::Builder::new().prefix(".gyrolab-").suffix(".tmp").tempfile_in(dir)?;
+    clean_leftovers(dir);
+    let tmp = tempfile::Builder::new().prefix(&staging_prefix()).suffix(".tmp").tempfile_in(dir)?;
     register(tmp.path());
     let filled = (|| {
         #[cfg(unix)]
@@ -449,6 +495,37 @@ fn start_writeback(_file: &File, _offset: u64, _len: u64) {}
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A killed run's staged files (issue 53: after a kill -9, `.gyrolab-*.tmp` stayed in
+    /// `--out`) are removed by the next write into the folder; a live process's staged file,
+    /// the `.gyrolab-old-*` copy of a file being replaced, and other files stay.
+    #[test]
+    fn the_next_write_removes_a_killed_runs_staged_files() {
+        let dir = tempfile::tempdir().unwrap();
+        // A process that has exited: its pid is free (reused only after wrapping around).
+        let mut child = std::process::Command::new("true").spawn().unwrap();
+        let dead = child.id();
+        child.wait().unwrap();
+        let parent = std::os::unix::process::parent_id();
+        let names = [
+            format!(".gyrolab-{dead}-AbC123.tmp"),
+            format!(".gyrolab-{parent}-XyZ789.tmp"),
+            format!(".gyrolab-old-{dead}-0.tmp"),
+            "keep.csv".to_string(),
+        ];
+        for n in &names {
+            std::fs::write(dir.path().join(n), b"x").unwrap();
+        }
+        write_outputs(vec![OutputFile::bytes(dir.path().join("out.csv"), b"a,b\n".to_vec())], &[]).unwrap();
+        let mut left: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        let mut want = vec![names[1].clone(), names[2].clone(), names[3].clone(), "out.csv".to_string()];
+        want.sort();
+        assert_eq!(left, want);
+    }
 
     /// Writes `pieces` through an [`EarlyWriteback`] asking every `chunk` bytes (through a
     /// `BufWriter` of `buffer` bytes when given); returns the file's bytes and the requests.

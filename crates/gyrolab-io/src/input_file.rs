@@ -64,9 +64,59 @@ pub fn open_regular(path: &Path) -> Result<(File, u64), DataError> {
 /// SHA-256 (lower-case hex, FIPS 180-4) and size in bytes of a regular file, read in 64 KiB
 /// blocks (the integrity record of a report folder's inputs; `gyrolab verify`).
 pub fn sha256_file(path: &Path) -> Result<(String, u64), DataError> {
+    sha256_file_identified(path).map(|(sha, size, _)| (sha, size))
+}
+
+/// What identifies a file's content without reading it: device, inode, size, and the times
+/// of its last write and last status change (a rename over it, a write in place, a truncation
+/// all change one of them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FileIdentity {
+    /// Device and inode (0 where the platform has none).
+    pub device_inode: (u64, u64),
+    /// Size in bytes.
+    pub size: u64,
+    /// Last modification and last status change, ns since the epoch (status change: 0 where
+    /// the platform has none).
+    pub times_ns: (i128, i128),
+}
+
+impl FileIdentity {
+    /// The identity of a file from its metadata.
+    pub fn of(meta: &std::fs::Metadata) -> FileIdentity {
+        let modified = meta
+            .modified()
+            .ok()
+            .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
+            .map_or(0, |d| d.as_nanos() as i128);
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::MetadataExt;
+            FileIdentity {
+                device_inode: (meta.dev(), meta.ino()),
+                size: meta.len(),
+                times_ns: (modified, i128::from(meta.ctime()) * 1_000_000_000 + i128::from(meta.ctime_nsec())),
+            }
+        }
+        #[cfg(not(unix))]
+        {
+            FileIdentity { device_inode: (0, 0), size: meta.len(), times_ns: (modified, 0) }
+        }
+    }
+
+    /// The identity of the file at `path` now.
+    pub fn at(path: &Path) -> Result<FileIdentity, DataError> {
+        let meta = std::fs::metadata(path).map_err(|e| DataError::io(path, &e))?;
+        Ok(FileIdentity::of(&meta))
+    }
+}
+
+/// [`sha256_file`] with the identity of the file read (its metadata from the same open file).
+pub fn sha256_file_identified(path: &Path) -> Result<(String, u64, FileIdentity), DataError> {
     use sha2::Digest;
     use std::io::Read;
     let (mut f, _) = open_regular(path)?;
+    let identity = FileIdentity::of(&f.metadata().map_err(|e| DataError::io(path, &e))?);
     let mut h = sha2::Sha256::new();
     let mut buf = vec![0u8; 1 << 16];
     let mut size = 0u64;
@@ -78,7 +128,7 @@ pub fn sha256_file(path: &Path) -> Result<(String, u64), DataError> {
         size += n as u64;
         h.update(&buf[..n]);
     }
-    Ok((hex(&h.finalize()), size))
+    Ok((hex(&h.finalize()), size, identity))
 }
 
 /// SHA-256 (lower-case hex) of bytes.

@@ -644,6 +644,11 @@ fn every_command_reads_the_clock_of_a_real_log_alike() {
     let tests = bias["tests"].as_array().unwrap();
     assert_eq!(tests.len(), 6, "sensor_combined's six channels only");
     for t in tests {
-        assert_eq!((t["sample_rate_hz"].as_f64(), t["samples"].as_u64()), (Some(250.0), Some(2028)), "{}", t["channel"]);
+        assert_eq!(
+            (t["sample_rate_hz"].as_f64(), t["samples"].as_u64()),
+            (Some(250.0), Some(2028)),
+            "{}",
+            t["channel"]
+        );
     }
 }

@@ -187,6 +187,16 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
 /// [`evaluate_test_plan`] of a plan whose simulated records are declared.
 fn evaluate_marked(plan: &TestPlan, plan_file: &str, progress: &dyn Progress) -> EvalResult<ReportFolder> {
     progress.begin(progress_steps(plan));
+    // The integrity record is of the bytes evaluated: every input hashed before it is read,
+    // with the identity of the file hashed, and checked again once every figure is computed
+    // (a file replaced or written while the plan was evaluated is refused, never reported
+    // under a hash of other bytes).
+    progress.message("hashing the inputs");
+    let mut hashed = Vec::new();
+    for f in plan.input_files() {
+        let (sha256, size_bytes, identity) = gyrolab_io::input_file::sha256_file_identified(&f)?;
+        hashed.push((f, sha256, size_bytes, identity));
+    }
     let (axes, logs) = evaluate_plan_rates(plan, progress)?;
     let triad = match &plan.triad {
         None => None,
@@ -306,13 +316,17 @@ fn evaluate_marked(plan: &TestPlan, plan_file: &str, progress: &dyn Progress) ->
     let (test, equipment) = conditions(&plan.test, &plan.equipment, &created);
     // The integrity record: the plan (hashed, and copied into the folder) and every input with
     // its SHA-256 (docs/PLAN.md, `gyrolab verify`).
-    progress.message("hashing the inputs");
-    let plan_bytes = std::fs::read(&plan.file).map_err(|e| gyrolab_io::DataError::io(&plan.file, &e))?;
+    let plan_bytes = plan.text.as_bytes().to_vec();
     let plan_sha256 = gyrolab_io::input_file::sha256_hex(&plan_bytes);
     let plan_dir = plan.file.parent().unwrap_or(Path::new("."));
     let mut inputs_json = Vec::new();
-    for f in plan.input_files() {
-        let (sha256, size_bytes) = gyrolab_io::input_file::sha256_file(&f)?;
+    for (f, sha256, size_bytes, identity) in hashed {
+        if gyrolab_io::input_file::FileIdentity::at(&f).ok() != Some(identity) {
+            return Err(EvalError::Data(gyrolab_io::DataError::new(
+                &f,
+                "the input changed (replaced, written or removed) while the plan was evaluated: its figures and its hash could be of different bytes; evaluate again once it is settled",
+            )));
+        }
         let file = f.strip_prefix(plan_dir).unwrap_or(&f).display().to_string();
         inputs_json.push(InputJson { file, sha256, size_bytes });
     }

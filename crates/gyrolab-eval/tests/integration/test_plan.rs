@@ -320,3 +320,63 @@ fn test_conditions_equipment_and_sign_off_reach_the_report() {
     assert_eq!(v["equipment"][0]["status"], "expired");
     assert_eq!(v["equipment"][1]["status"], "valid");
 }
+
+/// Hashes of the bytes evaluated (issue 53): an input replaced by a rename while the plan is
+/// evaluated (here, when the first axis's evaluation begins, after the inputs were hashed) is refused,
+/// naming the file, instead of reporting figures of one file under the hash of another; left
+/// alone, every input's hash in results.json is that of the bytes on disk, and the plan's is
+/// that of the text parsed.
+#[test]
+fn an_input_replaced_during_the_evaluation_is_refused() {
+    use gyrolab_eval::progress::Progress;
+    struct RenameOnce {
+        from: std::path::PathBuf,
+        to: std::path::PathBuf,
+        done: std::sync::atomic::AtomicBool,
+    }
+    impl Progress for RenameOnce {
+        fn message(&self, text: &str) {
+            if text.starts_with("evaluating axis") && !self.done.swap(true, std::sync::atomic::Ordering::SeqCst) {
+                std::fs::rename(&self.from, &self.to).unwrap();
+            }
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let root = repo_root();
+    for axis in ["x", "y", "z"] {
+        let name = format!("paper_rate_table_{axis}.csv");
+        std::fs::copy(common::paper_file(&name), dir.path().join(&name)).unwrap();
+    }
+    let plan_text =
+        std::fs::read_to_string(root.join("examples/paper_plan.toml")).unwrap().replace("../data/paper/", "");
+    let plan_path = dir.path().join("plan.toml");
+    std::fs::write(&plan_path, &plan_text).unwrap();
+    let plan = read_test_plan(&plan_path).unwrap();
+    // Left alone: the hashes are of the files and of the plan's text.
+    let folder = evaluate_test_plan(&plan, "plan.toml", &Silent).unwrap();
+    let results: serde_json::Value = serde_json::from_slice(output(&folder, "results.json")).unwrap();
+    let integrity = &results["integrity"];
+    assert_eq!(integrity["plan_sha256"], gyrolab_io::input_file::sha256_hex(plan_text.as_bytes()));
+    let inputs = integrity["inputs"].as_array().unwrap();
+    assert_eq!(inputs.len(), 3, "{integrity}");
+    for i in inputs {
+        let bytes = std::fs::read(dir.path().join(i["file"].as_str().unwrap())).unwrap();
+        assert_eq!(i["sha256"], gyrolab_io::input_file::sha256_hex(&bytes), "{i}");
+    }
+    // Replaced while evaluated: refused, naming the file.
+    let y = dir.path().join("paper_rate_table_y.csv");
+    let other = dir.path().join("other.csv");
+    // Valid bytes of another record (axis x's), so that only the identity check can tell.
+    std::fs::copy(dir.path().join("paper_rate_table_x.csv"), &other).unwrap();
+    let progress = RenameOnce { from: other, to: y.clone(), done: false.into() };
+    let e = match evaluate_test_plan(&plan, "plan.toml", &progress) {
+        Ok(_) => panic!("a replaced input was reported"),
+        Err(e) => e.to_string(),
+    };
+    assert!(progress.done.load(std::sync::atomic::Ordering::SeqCst));
+    assert!(
+        e.contains("paper_rate_table_y.csv")
+            && e.contains("changed (replaced, written or removed) while the plan was evaluated"),
+        "{e}"
+    );
+}

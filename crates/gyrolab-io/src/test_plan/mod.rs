@@ -398,6 +398,9 @@ pub struct PlanLimit {
 pub struct TestPlan {
     /// The plan file.
     pub file: PathBuf,
+    /// The plan's text as parsed: the bytes a report hashes and copies (never the file read
+    /// again, which may have changed since).
+    pub text: String,
     /// The device.
     pub device: DevicePlan,
     /// Options.
@@ -994,6 +997,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
     let g_sensitivity = g_sensitivity::parse_g_sensitivity(&cx, &raw.g_sensitivity, &axes)?;
     Ok(TestPlan {
         file: path.to_path_buf(),
+        text: text.to_string(),
         device: DevicePlan {
             model: raw.device.model,
             serial: raw.device.serial,
