@@ -183,6 +183,7 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
     }
     sections.extend(inputs.extra_sections);
     gyrolab_report::html::round_rows_to_uncertainty(&mut sections, &figures, &inputs.limits);
+    gyrolab_report::html::apply_checks(&mut sections, &summary.checks);
     let verdict = if inputs.limits.is_empty() { None } else { Some(summary.overall()) };
     let lines = |keep: &dyn Fn(Verdict) -> bool| -> Vec<String> {
         summary.checks.iter().filter(|c| keep(c.verdict)).map(|c| c.line()).collect()

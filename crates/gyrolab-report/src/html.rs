@@ -135,6 +135,10 @@ pub struct FigureRow {
     /// The axis whose figure the row shows, when its value is in the figure's catalogue unit
     /// (the report then prints it rounded to its expanded uncertainty).
     pub axis: Option<String>,
+    /// The axis whose limit check gives the row's verdict: [`apply_checks`] sets it from the
+    /// report's one list of checks (the summary's and results.json's), so that a section never
+    /// shows another verdict for the same check.
+    pub check_axis: Option<String>,
 }
 
 impl FigureRow {
@@ -159,6 +163,7 @@ impl FigureRow {
             limit: limit.map_or_else(String::new, Limit::text),
             verdict: check.map(|c| c.verdict),
             axis: Some(figs.axis.clone()),
+            check_axis: Some(figs.axis.clone()),
         })
     }
 }
@@ -200,6 +205,19 @@ pub fn round_rows_to_uncertainty(sections: &mut [ReportSection], figures: &[Axis
         let check = check_limits(&applicable, std::slice::from_ref(a)).pop();
         if let Some(text) = value_cell(a, &row.key, check.as_ref(), 4) {
             row.value = text;
+        }
+    }
+}
+
+/// Sets the verdict of every section row that shows a limit check from `checks`, the report's
+/// one list (the summary's, results.json's `limit_checks`): a section is drawn before the
+/// uncertainty part has run, so its own check of a guarded rule would lack the guard band U
+/// and say NOT EVALUATED where the summary says PASS (issue 53: one verdict per check).
+pub fn apply_checks(sections: &mut [ReportSection], checks: &[LimitCheck]) {
+    for row in sections.iter_mut().flat_map(|s| s.figures.iter_mut()) {
+        let (Some(axis), false) = (row.check_axis.as_deref(), row.key.is_empty()) else { continue };
+        if let Some(c) = checks.iter().find(|c| c.axis == axis && c.figure == row.key) {
+            row.verdict = Some(c.verdict);
         }
     }
 }
@@ -787,6 +805,7 @@ pub fn rate_section(a: &AxisReport<'_>, limits: &[Limit]) -> Result<ReportSectio
             verdict: c.map(|c| c.verdict),
             // K is shown in a display unit (mV/(deg/s)) of its own.
             axis: (key != "scale_factor").then(|| figs.axis.clone()),
+            check_axis: Some(figs.axis.clone()),
         }
     };
     let hyst = if e.options.half_hysteresis { "hysteresis δ_H (half)" } else { "hysteresis δ_H" };
@@ -945,6 +964,7 @@ mod tests {
                 limit: "≤ 20".into(),
                 verdict: Some(Verdict::Pass),
                 axis: None,
+                check_axis: None,
             }],
             ..Default::default()
         };

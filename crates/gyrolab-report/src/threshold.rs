@@ -252,6 +252,7 @@ pub fn step_section(reports: &[StepReport], limits: &[Limit]) -> ReportSection {
             limit: limit.map_or_else(String::new, Limit::text),
             verdict: limit.and_then(|_| checks.iter().find(|c| c.figure == key).map(|c| c.verdict)),
             axis: Some(r.axis.clone()),
+            check_axis: Some(r.axis.clone()),
         });
         tables.push(r.table());
     }

@@ -197,6 +197,7 @@ fn section(a: &AxisResult<'_>, figures: &AxisFigures, limits: &[Limit], base: &P
             limit: String::new(),
             verdict: None,
             axis: None,
+            check_axis: None,
         });
     }
     if let Some(m) = &f.magnitude {
@@ -214,6 +215,7 @@ fn section(a: &AxisResult<'_>, figures: &AxisFigures, limits: &[Limit], base: &P
                 .map_or_else(String::new, Limit::text),
             verdict: checks.iter().find(|c| c.figure == FIGURE_KEY).map(|c| c.verdict),
             axis: None,
+            check_axis: Some(figures.axis.clone()),
         });
     }
     rows.push(FigureRow {
@@ -224,6 +226,7 @@ fn section(a: &AxisResult<'_>, figures: &AxisFigures, limits: &[Limit], base: &P
         limit: String::new(),
         verdict: None,
         axis: None,
+        check_axis: None,
     });
     let se_words = match (f.std_error_absent, f.residual_std_dph) {
         (Some(NoStdError::NoResidualDegreesOfFreedom), _) => format!(

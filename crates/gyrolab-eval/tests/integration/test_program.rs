@@ -184,3 +184,44 @@ fn figure_budgets_of_the_test_program_equal_a_recomputation() {
     // The bias stability's U reaches its check.
     close(check_u("bias_stability_dph_10s"), num(&u["bias_stability_expanded_dph"]), 1e-12, "bias stability check");
 }
+
+/// One verdict per check (issue 53): under `decision_rule = "guarded_acceptance"` every row of
+/// the report that shows a limit's verdict, in the summary and in the sections, shows the one
+/// results.json gives for that check (before, the sections printed NOT EVALUATED for twelve
+/// figures whose check was PASS or CONDITIONAL: they were checked before the uncertainty part
+/// had computed the guard band).
+#[test]
+fn every_table_shows_the_one_verdict_of_each_check() {
+    let dir = tempfile::tempdir().unwrap();
+    let plan_text = write_test_program(dir.path(), SEED).unwrap();
+    let guarded =
+        plan_text.replacen("[uncertainty]", "[options]\ndecision_rule = \"guarded_acceptance\"\n\n[uncertainty]", 1);
+    assert_ne!(guarded, plan_text);
+    std::fs::write(dir.path().join("plan.toml"), guarded).unwrap();
+    let plan = read_test_plan(&dir.path().join("plan.toml")).unwrap();
+    let folder = evaluate_test_plan(&plan, "plan.toml", &Silent).unwrap();
+    let get = |name: &str| &folder.outputs.iter().find(|o| o.name == name).unwrap().bytes;
+    let json: Value = serde_json::from_slice(get("results.json")).unwrap();
+    let checks = json["limit_checks"].as_array().unwrap();
+    let verdict_of = |key: &str| -> Option<String> {
+        checks
+            .iter()
+            .find(|c| c["figure"] == key && c["axis"] == "x")
+            .map(|c| c["verdict"].as_str().unwrap().replace('_', " "))
+    };
+    let html = String::from_utf8(get("report.html").to_vec()).unwrap();
+    let mut compared = 0;
+    let mut verdicts = std::collections::BTreeSet::new();
+    for row in html.split("<tr>").skip(1) {
+        let row = row.split("</tr>").next().unwrap();
+        let (Some(k), Some(v)) = (row.find("href=\"#def-"), row.find("class=\"verdict ")) else { continue };
+        let key = &row[k + 11..][..row[k + 11..].find('"').unwrap()];
+        let verdict = row[v + 15..].split('>').nth(1).unwrap().split('<').next().unwrap();
+        let Some(want) = verdict_of(key) else { continue };
+        assert_eq!(verdict, want, "{key}: the row says {verdict}, results.json {want}");
+        compared += 1;
+        verdicts.insert(want);
+    }
+    assert!(compared >= 20, "{compared} rows compared");
+    assert!(verdicts.contains("PASS") && verdicts.contains("CONDITIONAL"), "{verdicts:?}");
+}
