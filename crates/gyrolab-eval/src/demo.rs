@@ -263,6 +263,7 @@ pub fn paper_report_folder(request: &PaperReportRequest, progress: &dyn Progress
         triad: None,
         temperature_models: Vec::new(),
         simulated_rate: None,
+        withheld: None,
     };
     let mut folder = assemble_report(inputs, progress)?;
     folder.outputs.extend(program_outputs(progress)?);

@@ -131,6 +131,9 @@ pub struct ReportInputs<'a> {
     pub temperature_models: Vec<(String, gyrolab_io::calibration::TemperatureSection)>,
     /// The rate-table records are SIMULATED: how (their sections and summary rows say so).
     pub simulated_rate: Option<String>,
+    /// Why every limit check is withheld (NOT EVALUATED), when it is: equipment used past its
+    /// calibration due date under the plan's default rule.
+    pub withheld: Option<String>,
 }
 
 fn json<T: serde::Serialize>(value: &T) -> EvalResult<String> {
@@ -169,7 +172,10 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
             None => figures.push(extra),
         }
     }
-    let summary = SummaryTable::build(&figures, &inputs.limits);
+    let mut summary = SummaryTable::build(&figures, &inputs.limits);
+    if let Some(reason) = &inputs.withheld {
+        summary.withhold(reason);
+    }
     progress.message("drawing plots");
     let mut sections = Vec::new();
     for r in &reports {

@@ -290,6 +290,23 @@ pub struct SummaryTable {
 }
 
 impl SummaryTable {
+    /// Withholds every verdict: each check becomes NOT EVALUATED with `reason` (an expired
+    /// equipment calibration under the plan's default rule), every cell's verdict with it.
+    pub fn withhold(&mut self, reason: &str) {
+        for c in &mut self.checks {
+            c.verdict = Verdict::NotEvaluated;
+            c.reason = Some(match &c.reason {
+                Some(r) => format!("{reason} (else: {r})"),
+                None => reason.to_string(),
+            });
+        }
+        for cell in self.rows.iter_mut().flat_map(|r| r.cells.iter_mut()) {
+            if cell.1.is_some() {
+                cell.1 = Some(Verdict::NotEvaluated);
+            }
+        }
+    }
+
     /// Builds the summary from each axis's figures and the plan's limits.
     pub fn build(axes: &[AxisFigures], limits: &[Limit]) -> SummaryTable {
         let checks = check_limits(limits, axes);

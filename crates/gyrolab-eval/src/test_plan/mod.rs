@@ -342,7 +342,7 @@ fn evaluate_marked(plan: &TestPlan, plan_file: &str, progress: &dyn Progress) ->
         .clone()
         .unwrap_or_else(|| crate::report_folder::generated_report_number(&created, &plan_sha256));
     let issue_date = plan.test.issue_date.clone().unwrap_or_else(|| created.get(..10).unwrap_or_default().to_string());
-    let header = ReportHeader {
+    let mut header = ReportHeader {
         report_number,
         issue_date,
         integrity,
@@ -357,6 +357,37 @@ fn evaluate_marked(plan: &TestPlan, plan_file: &str, progress: &dyn Progress) ->
         plan_file: plan_file.to_string(),
         notes,
     };
+    // Equipment used past its calibration due date: every verdict withheld under the plan's
+    // default rule (ISO/IEC 17025:2017 6.4.7), stated either way.
+    let expired: Vec<String> = header
+        .equipment
+        .iter()
+        .filter(|e| e.status == gyrolab_report::html::CalibrationStatus::Expired)
+        .map(|e| format!("{} ({}, due {})", e.name, e.id, e.calibration_due.as_deref().unwrap_or("?")))
+        .collect();
+    let withheld = (!expired.is_empty()
+        && plan.options.expired_calibration == gyrolab_io::test_plan::ExpiredCalibration::NotEvaluated)
+        .then(|| {
+            let ids: Vec<&str> = header
+                .equipment
+                .iter()
+                .filter(|e| e.status == gyrolab_report::html::CalibrationStatus::Expired)
+                .map(|e| e.id.as_str())
+                .collect();
+            format!("equipment used past its calibration due date ({})", ids.join(", "))
+        });
+    if !expired.is_empty() {
+        header.notes.push(format!(
+            "CALIBRATION EXPIRED on the test date: {}; {}",
+            expired.join("; "),
+            match plan.options.expired_calibration {
+                gyrolab_io::test_plan::ExpiredCalibration::NotEvaluated =>
+                    "every limit check is NOT EVALUATED (expired_calibration = \"not_evaluated\", the default)",
+                gyrolab_io::test_plan::ExpiredCalibration::Stated =>
+                    "the verdicts stand as the plan's rule expired_calibration = \"stated\" says (a deviation the lab has assessed)",
+            }
+        ));
+    }
     let inputs = ReportInputs {
         header,
         device: DeviceJson {
@@ -374,6 +405,7 @@ fn evaluate_marked(plan: &TestPlan, plan_file: &str, progress: &dyn Progress) ->
         triad: triad_report,
         temperature_models: thermal.compensation,
         simulated_rate: plan.device.simulated.clone(),
+        withheld,
     };
     let mut folder = assemble_report(inputs, progress)?;
     folder.inputs = std::iter::once(plan.file.clone()).chain(plan.input_files()).collect();

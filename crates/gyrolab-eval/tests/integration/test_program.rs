@@ -225,3 +225,43 @@ fn every_table_shows_the_one_verdict_of_each_check() {
     assert!(compared >= 20, "{compared} rows compared");
     assert!(verdicts.contains("PASS") && verdicts.contains("CONDITIONAL"), "{verdicts:?}");
 }
+
+/// Expired equipment calibration (issue 53): with the test date after the DAQ's due date, the
+/// plan's default rule withholds every verdict (each check NOT EVALUATED naming the item, the
+/// overall INCOMPLETE) and the report states it; `expired_calibration = "stated"` keeps the
+/// verdicts (PASS) and still states it; an unknown rule is refused with its line and key.
+#[test]
+fn expired_equipment_calibration_withholds_the_verdicts() {
+    let dir = tempfile::tempdir().unwrap();
+    let plan_text = write_test_program(dir.path(), SEED).unwrap();
+    let late = plan_text.replacen("date = \"2026-11-20\"", "date = \"2027-05-01\"", 1);
+    assert_ne!(late, plan_text);
+    let run = |text: &str| {
+        std::fs::write(dir.path().join("plan.toml"), text).unwrap();
+        let plan = read_test_plan(&dir.path().join("plan.toml"))?;
+        evaluate_test_plan(&plan, "plan.toml", &Silent)
+    };
+    let folder = run(&late).unwrap();
+    assert_eq!(folder.verdict, Some(Overall::Incomplete));
+    let json: Value =
+        serde_json::from_slice(&folder.outputs.iter().find(|o| o.name == "results.json").unwrap().bytes).unwrap();
+    let checks = json["limit_checks"].as_array().unwrap();
+    assert!(checks.len() >= 10);
+    for c in checks {
+        assert_eq!(c["verdict"], "NOT_EVALUATED", "{c}");
+        assert!(c["reason"].as_str().unwrap().contains("past its calibration due date (DAQ-07)"), "{c}");
+    }
+    let html =
+        String::from_utf8_lossy(&folder.outputs.iter().find(|o| o.name == "report.html").unwrap().bytes).into_owned();
+    assert!(html.contains("CALIBRATION EXPIRED on the test date: data acquisition (DAQ-07, due 2027-03-31)"));
+    assert!(!html.contains("\">PASS</span>"), "no PASS verdict anywhere in the report");
+    let stated = late.replacen("[uncertainty]", "[options]\nexpired_calibration = \"stated\"\n\n[uncertainty]", 1);
+    let folder = run(&stated).unwrap();
+    assert_eq!(folder.verdict, Some(Overall::Pass));
+    let html =
+        String::from_utf8_lossy(&folder.outputs.iter().find(|o| o.name == "report.html").unwrap().bytes).into_owned();
+    assert!(html.contains("the verdicts stand as the plan&#39;s rule expired_calibration"), "stated");
+    let bad = late.replacen("[uncertainty]", "[options]\nexpired_calibration = \"ignore\"\n\n[uncertainty]", 1);
+    let e = run(&bad).unwrap_err().to_string();
+    assert!(e.contains("options.expired_calibration: unknown rule 'ignore'"), "{e}");
+}

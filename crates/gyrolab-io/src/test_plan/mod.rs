@@ -148,6 +148,7 @@ struct RawOptions {
     exports: Option<Spanned<Vec<String>>>,
     decision_rule: Option<Spanned<String>>,
     nominal_null: Option<Spanned<toml::Value>>,
+    expired_calibration: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -299,6 +300,33 @@ pub struct PlanOptions {
     /// axes is the absolute bias against it. Axes without one keep the bias shift against the
     /// rate test's rest output (docs/PLAN.md, METHODS "Bias").
     pub nominal_null: BTreeMap<String, f64>,
+    /// What an item of equipment whose calibration was due before the test date does to the
+    /// verdicts (`expired_calibration`; default [`ExpiredCalibration::NotEvaluated`]).
+    pub expired_calibration: ExpiredCalibration,
+}
+
+/// The plan's rule for equipment used past its calibration due date (`[options]
+/// expired_calibration`; ISO/IEC 17025:2017 6.4.7, 6.5: results traceable through equipment in
+/// calibration).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ExpiredCalibration {
+    /// Every limit check is NOT EVALUATED, the reason naming the item (the overall verdict is
+    /// then INCOMPLETE): `"not_evaluated"`, the default.
+    #[default]
+    NotEvaluated,
+    /// The verdicts stand; the report states the expired item (a deviation the lab has
+    /// assessed and records): `"stated"`.
+    Stated,
+}
+
+impl ExpiredCalibration {
+    /// The plan's spelling.
+    pub fn key(self) -> &'static str {
+        match self {
+            ExpiredCalibration::NotEvaluated => "not_evaluated",
+            ExpiredCalibration::Stated => "stated",
+        }
+    }
 }
 
 /// The rate-table record of one axis (`[rate.<axis>]`).
@@ -693,6 +721,19 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
     };
     let decision_rule =
         o.decision_rule.as_ref().map(|r| rule_of(r, "options.decision_rule")).transpose()?.unwrap_or_default();
+    let expired_calibration = match &o.expired_calibration {
+        None => ExpiredCalibration::default(),
+        Some(v) => [ExpiredCalibration::NotEvaluated, ExpiredCalibration::Stated]
+            .into_iter()
+            .find(|r| r.key() == v.get_ref())
+            .ok_or_else(|| {
+                cx.err(
+                    v.span(),
+                    "options.expired_calibration",
+                    format!("unknown rule '{}': expected not_evaluated or stated", crate::text::excerpt(v.get_ref())),
+                )
+            })?,
+    };
     let mut nominal_null = BTreeMap::new();
     if let Some(v) = &o.nominal_null {
         let number = |x: &toml::Value, key: &str| -> Result<f64, DataError> {
@@ -739,6 +780,7 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         calibration,
         exports,
         decision_rule,
+        expired_calibration,
     };
 
     let mut rate = Vec::new();
