@@ -163,6 +163,7 @@ pub fn calibration_file(axes: &[EvaluatedAxis]) -> CalibrationFile {
         format: CALIBRATION_FORMAT.into(),
         generator: format!("gyrolab {}", env!("CARGO_PKG_VERSION")),
         created: humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string(),
+        simulated: None,
         axes: axes.iter().map(EvaluatedAxis::calibration).collect(),
         triad: None,
     }

@@ -224,6 +224,12 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
     ];
     if !inputs.axes.is_empty() || inputs.triad.is_some() {
         let mut cal = calibration_file(inputs.axes);
+        // Any simulated part marks the calibration (its K, F0 or temperature model may rest on it).
+        if simulated {
+            cal.simulated = Some(
+                inputs.simulated_rate.clone().unwrap_or_else(|| "some of the report's records are simulated".into()),
+            );
+        }
         for (axis, model) in &inputs.temperature_models {
             if let Some(a) = cal.axes.iter_mut().find(|a| a.name == *axis) {
                 a.temperature = Some(model.clone());

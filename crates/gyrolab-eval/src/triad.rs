@@ -73,6 +73,7 @@ impl TriadResult {
             format: CALIBRATION_FORMAT.into(),
             generator: format!("gyrolab {}", env!("CARGO_PKG_VERSION")),
             created: humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string(),
+            simulated: None,
             axes: Vec::new(),
             triad: Some(TriadSection::from_calibration(
                 &self.fit.calibration,

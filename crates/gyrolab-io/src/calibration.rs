@@ -24,6 +24,9 @@ pub struct CalibrationFile {
     pub generator: String,
     /// Time of evaluation (RFC 3339, UTC).
     pub created: String,
+    /// The calibration comes from SIMULATED records: how (a comment line says so too).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub simulated: Option<String>,
     /// One entry per axis (may be empty when the file holds a `[triad]` only).
     #[serde(rename = "axis", default, skip_serializing_if = "Vec::is_empty")]
     pub axes: Vec<AxisCalibration>,
@@ -164,8 +167,12 @@ impl CalibrationFile {
     /// Serialises to TOML text with a comment header.
     pub fn to_toml(&self) -> Result<String, toml::ser::Error> {
         let body = toml::to_string_pretty(self)?;
+        let mark = match &self.simulated {
+            Some(how) => format!("# SIMULATED DATA: this calibration comes from simulated records ({how}).\n"),
+            None => String::new(),
+        };
         Ok(format!(
-            "# gyrolab calibration. Model per axis: output = sum_k coefficients[k] * rate_dps^k;\n\
+            "{mark}# gyrolab calibration. Model per axis: output = sum_k coefficients[k] * rate_dps^k;\n\
              # scale_factor is in output units per deg/s, offsets in output units.\n\
              # [triad]: outputs u = matrix * omega + bias (rows = gyros, columns = axes, omega in deg/s).\n{body}"
         ))
@@ -397,6 +404,7 @@ mod tests {
             format: CALIBRATION_FORMAT.into(),
             generator: "gyrolab test".into(),
             created: "2026-01-01T00:00:00Z".into(),
+            simulated: None,
             axes: vec![AxisCalibration {
                 name: "x".into(),
                 source_file: "x.csv".into(),

@@ -73,6 +73,10 @@ fn the_example_test_program_evaluates_every_section() {
     }
     let cal = String::from_utf8(get("calibration.toml").to_vec()).unwrap();
     assert!(cal.contains("[axis.temperature]"), "{cal}");
+    // The calibration of simulated records says so, in a comment and in a key (issue 53).
+    assert!(cal.starts_with("# SIMULATED DATA: this calibration comes from simulated records"), "{cal}");
+    let parsed = gyrolab_io::calibration::parse_calibration(Path::new("calibration.toml"), &cal).unwrap();
+    assert!(parsed.simulated.is_some());
 }
 
 fn num(v: &Value) -> f64 {

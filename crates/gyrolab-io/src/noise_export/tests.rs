@@ -193,3 +193,29 @@ fn unrepresented_terms_are_header_lines() {
     }
     assert!(!sample().header_lines(Stack::Kalibr).iter().any(|l| l.contains("NOT REPRESENTED")));
 }
+
+/// Simulated marks read from a file's first line (issue 53): the simulator's records and
+/// gyrolab's outputs made from simulated records (calibration.toml, a report's CSV tables);
+/// a measured file, a FIFO (refused without blocking) and a missing file are not.
+#[test]
+fn simulated_marks_are_read_from_the_first_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        ("sim.csv", "# gyrolab simulated static record\ntime_s,rate_dps\n", true),
+        ("cal.toml", "# SIMULATED DATA: this calibration comes from simulated records (x).\n", true),
+        ("bom.csv", "\u{feff}# SIMULATED DATA\nrate_dps\n", true),
+        ("measured.csv", "time_s,rate_dps\n0,1\n", false),
+        ("later.csv", "time_s,rate_dps\n# gyrolab simulated\n", false),
+    ];
+    for (name, text, want) in cases {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        assert_eq!(super::is_gyrolab_simulation(&p), want, "{name}");
+    }
+    assert!(!super::is_gyrolab_simulation(&dir.path().join("missing.csv")));
+    let fifo = dir.path().join("fifo.csv");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    // SAFETY: a valid NUL-terminated path; mkfifo only creates the node.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    assert!(!super::is_gyrolab_simulation(&fifo));
+}
