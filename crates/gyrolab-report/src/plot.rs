@@ -406,14 +406,56 @@ pub fn tick_label(v: f64) -> String {
     crate::format::short(v, 4)
 }
 
+/// Tick label of `v` on a linear axis spanning `span`: as many decimals as the tick spacing
+/// (about a tenth of the span) needs, so that neighbouring ticks never read the same (a scale
+/// factor from 7.4995 to 7.5005 labelled "7.5" three times, issue 53); e-notation outside
+/// 1e-3 to 1e5 as [`tick_label`].
+pub fn tick_label_in(v: f64, span: f64) -> String {
+    if !(span.is_finite() && span > 0.0 && v.is_finite()) {
+        return tick_label(v);
+    }
+    let a = v.abs();
+    // Decimals of a step a tenth of the span (plotters places up to about ten ticks), plus one.
+    let decimals = |step: f64| ((-step.log10()).ceil() + 1.0).clamp(0.0, 15.0) as usize;
+    let trim = |s: String| -> String {
+        if !s.contains('.') {
+            return s;
+        }
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
+    // Zero, or a tick within a step of it, is 0.
+    if a < span * 1e-9 {
+        return "0".into();
+    }
+    if (1e-3..1e5).contains(&a) {
+        let s = trim(format!("{:.*}", decimals(span / 10.0), v));
+        return if s == "-0" { "0".into() } else { s };
+    }
+    let e = a.log10().floor() as i32;
+    let scale = 10f64.powi(e);
+    format!("{}e{e}", trim(format!("{:.*}", decimals(span / 10.0 / scale), v / scale)))
+}
+
 fn draw_panel(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, panel: &Panel) -> Result<(), String> {
     let xr = axis_range(panel, true);
     let yr = axis_range(panel, false);
+    let span = |r: &Range<f64>, scale: Scale| (scale == Scale::Linear).then_some(r.end - r.start);
+    // A counted axis (runs, power-ups) gets as many labels as whole numbers in its range, so
+    // that its ticks fall on them (no tick at 1.5 runs).
+    let labels = |r: &Range<f64>, axis: &Axis, default: usize| {
+        if axis.integer && r.end > r.start {
+            ((r.end.floor() - r.start.ceil()).max(0.0) as usize + 1).clamp(2, default)
+        } else {
+            default
+        }
+    };
+    let spans =
+        (span(&xr, panel.x.scale), span(&yr, panel.y.scale), labels(&xr, &panel.x, 8), labels(&yr, &panel.y, 6));
     match (panel.x.scale, panel.y.scale) {
-        (Scale::Linear, Scale::Linear) => draw_in(area, panel, xr, yr),
-        (Scale::Log, Scale::Log) => draw_in(area, panel, xr.log_scale(), yr.log_scale()),
-        (Scale::Linear, Scale::Log) => draw_in(area, panel, xr, yr.log_scale()),
-        (Scale::Log, Scale::Linear) => draw_in(area, panel, xr.log_scale(), yr),
+        (Scale::Linear, Scale::Linear) => draw_in(area, panel, xr, yr, spans),
+        (Scale::Log, Scale::Log) => draw_in(area, panel, xr.log_scale(), yr.log_scale(), spans),
+        (Scale::Linear, Scale::Log) => draw_in(area, panel, xr, yr.log_scale(), spans),
+        (Scale::Log, Scale::Linear) => draw_in(area, panel, xr.log_scale(), yr, spans),
     }
 }
 
@@ -422,6 +464,7 @@ fn draw_in<XS, YS>(
     panel: &Panel,
     xs: XS,
     ys: YS,
+    (x_span, y_span, x_labels, y_labels): (Option<f64>, Option<f64>, usize, usize),
 ) -> Result<(), String>
 where
     XS: AsRangedCoord<Value = f64>,
@@ -436,16 +479,25 @@ where
         builder.caption(&panel.caption, ("sans-serif", px(14.0)));
     }
     let mut chart = builder.build_cartesian_2d(xs, ys).map_err(|x| e(&x))?;
-    let fmt_x = |v: &f64| if panel.x.integer && v.fract().abs() > 1e-9 { String::new() } else { tick_label(*v) };
-    let fmt_y = |v: &f64| if panel.y.integer && v.fract().abs() > 1e-9 { String::new() } else { tick_label(*v) };
+    let label = |v: f64, integer: bool, span: Option<f64>| -> String {
+        if integer && v.fract().abs() > 1e-9 {
+            return String::new();
+        }
+        match span {
+            Some(s) => tick_label_in(v, s),
+            None => tick_label(v),
+        }
+    };
+    let fmt_x = |v: &f64| label(*v, panel.x.integer, x_span);
+    let fmt_y = |v: &f64| label(*v, panel.y.integer, y_span);
     chart
         .configure_mesh()
         .x_desc(&panel.x.label)
         .y_desc(&panel.y.label)
         .x_label_formatter(&fmt_x)
         .y_label_formatter(&fmt_y)
-        .x_labels(8)
-        .y_labels(6)
+        .x_labels(x_labels)
+        .y_labels(y_labels)
         .label_style(("sans-serif", px(12.0)))
         .axis_desc_style(("sans-serif", px(13.0)))
         .light_line_style(RGBColor(238, 238, 238))
@@ -627,6 +679,40 @@ mod tests {
         // Data in all four corners: headroom above (range widened by 45 % of the span) and upper left.
         let p = panel(vec![(0.0, 0.0), (0.0, 10.0), (10.0, 10.0), (10.0, 0.0)]);
         assert_eq!((p.legend, p.y.range), (LegendCorner::UpperLeft, Some((-0.5, 14.5))));
+    }
+
+    /// Tick labels that always differ, and counted axes on whole numbers (issue 53: the per-run
+    /// scale-factor plot labelled two ticks "7.5" and put ticks at fractional runs).
+    #[test]
+    fn tick_labels_differ_and_counted_axes_carry_whole_numbers() {
+        let mut runs = Axis::linear("run");
+        runs.integer = true;
+        let mut p = Panel::new(runs, Axis::linear("scale factor (mV/(deg/s))"));
+        let k = [7.49962, 7.50031, 7.49987, 7.50018];
+        p.series.push(Series::new(
+            "K of the run",
+            k.iter().enumerate().map(|(i, &k)| ((i + 1) as f64, k)).collect(),
+            SeriesStyle::LineMarkers,
+            0,
+        ));
+        let svg = Figure::single("scale factor per run", p).to_svg().unwrap();
+        // Every text element's content: the tick labels are among them.
+        let texts: Vec<&str> =
+            svg.split("<text").skip(1).filter_map(|t| t.split('>').nth(1)?.split('<').next()).collect();
+        let numbers: Vec<f64> = texts.iter().filter_map(|t| t.trim().parse::<f64>().ok()).collect();
+        let y: Vec<&str> = texts.iter().copied().filter(|t| t.starts_with("7.")).collect();
+        assert!(y.len() >= 3, "{texts:?}");
+        let mut distinct = y.clone();
+        distinct.sort();
+        distinct.dedup();
+        assert_eq!(distinct.len(), y.len(), "every y tick reads differently: {y:?}");
+        let x: Vec<f64> = numbers.iter().copied().filter(|v| *v < 7.0).collect();
+        assert!(x.len() >= 3 && x.iter().all(|v| v.fract() == 0.0), "{x:?}");
+        assert_eq!(tick_label_in(7.5005, 0.001), "7.5005");
+        assert_eq!(tick_label_in(7.5, 0.001), "7.5");
+        assert_eq!(tick_label_in(-1e-17, 1.0), "0");
+        assert_eq!(tick_label_in(2.5e-6, 1e-6), "2.5e-6");
+        assert_eq!(tick_label_in(3.0, 4.0), "3");
     }
 
     #[test]
