@@ -602,7 +602,7 @@ fn write_summary(h: &mut String, s: &SummaryTable, simulated: bool) {
     h.push_str("</tbody></table>\n</section>\n");
 }
 
-fn write_methods(h: &mut String) {
+fn write_methods(h: &mut String, summary: &SummaryTable) {
     h.push_str("<section class=\"page-break\">\n<h2>Appendix: methods</h2>\n<p class=\"note\">Each figure with its formula, unit and source. \
         Notation: Ω_j table rates (deg/s), ȳ_j point means, ȳ_j,fwd and ȳ_j,rev stroke means, K scale factor, \
         F0 zero offset, F_r rest reference, Y_FS full-scale output. Sources: [P] Cheng et al. 2014 (the paper), \
@@ -619,11 +619,15 @@ fn write_methods(h: &mut String) {
         let _ = writeln!(h, "<h3>{}</h3>", group.title());
         h.push_str("<table class=\"methods\"><thead><tr><th class=\"name\">figure</th><th class=\"name\">key</th><th class=\"name\">formula</th><th class=\"name\">unit</th><th class=\"name\">source</th></tr></thead><tbody>\n");
         for d in FIGURES.iter().filter(|d| d.group == group) {
+            // The report's own name of the figure where its axes gave it one (the bias is
+            // absolute against a plan's nominal null, not a shift): the appendix agrees with the
+            // tables it explains.
+            let label = summary.rows.iter().find(|r| r.key == d.key).map_or(d.label, |r| r.label.as_str());
             let _ = writeln!(
                 h,
                 "<tr id=\"{}\"><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td><td class=\"name\">{}</td></tr>",
                 anchor(d.key),
-                escape(d.label),
+                escape(label),
                 escape(d.key),
                 escape(d.formula),
                 escape(d.unit),
@@ -797,7 +801,7 @@ pub fn render_html(r: &Report) -> String {
     }
     write_sign_off(&mut h, &hd.test);
     write_inputs(&mut h, &hd.integrity);
-    write_methods(&mut h);
+    write_methods(&mut h, &r.summary);
     let _ = writeln!(h, "<p class=\"end\">End of report {}</p>", escape(&hd.report_number));
     h.push_str("</body>\n</html>\n");
     h

@@ -343,6 +343,10 @@ fn absolute_bias_against_the_nominal_null_is_within_its_u_of_the_truth_over_8_se
             String::from_utf8(output(&folder, "report.html").to_vec()).unwrap()
         };
         assert!(html.contains("bias B_0 (absolute, against the nominal null)"));
+        // The methods appendix names it so too, never "shift" (issue 53).
+        let appendix = &html[html.find("Appendix: methods").unwrap()..];
+        let row = appendix.split("<tr id=").find(|r| r.contains(">bias_dph<")).unwrap();
+        assert!(row.contains("bias B_0 (absolute, against the nominal null)") && !row.contains("(shift"), "{row}");
         let shifted = evaluate(dir.path(), &plan(""));
         shifts.push(f(&shifted["sections"]["uncertainty"]["x"]["budgets"]["bias"]["value"]));
     }

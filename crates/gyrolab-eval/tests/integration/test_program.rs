@@ -71,6 +71,11 @@ fn the_example_test_program_evaluates_every_section() {
     ] {
         assert!(html.contains(title), "no section {title}");
     }
+    // The methods appendix gives U(K) with every line the budget holds: the power-ups' scatter
+    // and the test temperature (issue 53).
+    let appendix = &html[html.find("Appendix: methods").unwrap()..];
+    let row = appendix.split("<tr id=").find(|r| r.contains(">scale_factor_expanded_uncertainty_ppm<")).unwrap();
+    assert!(row.contains("u_PU") && row.contains("power-ups") && row.contains("u_T"), "{row}");
     let cal = String::from_utf8(get("calibration.toml").to_vec()).unwrap();
     assert!(cal.contains("[axis.temperature]"), "{cal}");
     // The calibration of simulated records says so, in a comment and in a key (issue 53).
