@@ -88,6 +88,16 @@ pub struct TestConditions {
     pub receipt_date: Option<String>,
     /// Deviations from, additions to or exclusions from the method.
     pub deviations: Option<String>,
+    /// The last date of a test over several days, `YYYY-MM-DD`.
+    pub test_date_end: Option<String>,
+    /// The laboratory's name.
+    pub laboratory: Option<String>,
+    /// The laboratory's address.
+    pub laboratory_address: Option<String>,
+    /// The customer's contact information.
+    pub customer_contact: Option<String>,
+    /// Reference to the sampling plan and method.
+    pub sampling: Option<String>,
 }
 
 /// Whether a piece of equipment was within its calibration on the test date.
@@ -646,11 +656,19 @@ fn write_conditions(h: &mut String, t: &TestConditions, equipment: &[EquipmentRo
     let num =
         |v: Option<f64>, unit: &str| v.map_or(String::new(), |x| format!("{} {unit}", crate::format::short(x, 4)));
     h.push_str("<table class=\"conditions\"><caption>Test conditions</caption><tbody>\n");
+    let test_dates = match (&t.test_date, &t.test_date_end) {
+        (Some(a), Some(b)) if a != b => format!("{} to {}", escape(a), escape(b)),
+        _ => text(&t.test_date),
+    };
     let rows = [
+        ("laboratory", text(&t.laboratory)),
+        ("laboratory address", text(&t.laboratory_address)),
         ("customer", text(&t.customer)),
+        ("customer contact", text(&t.customer_contact)),
         ("item condition on receipt", text(&t.item_condition)),
         ("receipt date", text(&t.receipt_date)),
-        ("test date", text(&t.test_date)),
+        ("sampling", text(&t.sampling)),
+        ("test date", test_dates),
         ("site", text(&t.site)),
         ("procedure", text(&t.procedure)),
         ("ambient temperature", num(t.ambient_temperature_c, "degC")),

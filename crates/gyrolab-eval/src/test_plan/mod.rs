@@ -421,7 +421,13 @@ fn conditions(
 ) -> (gyrolab_report::html::TestConditions, Vec<gyrolab_report::html::EquipmentRow>) {
     use gyrolab_io::test_plan::parse_date;
     use gyrolab_report::html::{CalibrationStatus, EquipmentRow, TestConditions};
-    let on = test.date.as_deref().and_then(parse_date).or_else(|| created.get(..10).and_then(parse_date));
+    // In calibration through the test's last day (its range's end where it took several days).
+    let on = test
+        .date_end
+        .as_deref()
+        .or(test.date.as_deref())
+        .and_then(parse_date)
+        .or_else(|| created.get(..10).and_then(parse_date));
     let rows = equipment
         .iter()
         .map(|e| {
@@ -452,6 +458,11 @@ fn conditions(
         item_condition: test.item_condition.clone(),
         receipt_date: test.receipt_date.clone(),
         deviations: test.deviations.clone(),
+        test_date_end: test.date_end.clone(),
+        laboratory: test.laboratory.clone(),
+        laboratory_address: test.laboratory_address.clone(),
+        customer_contact: test.customer_contact.clone(),
+        sampling: test.sampling.clone(),
     };
     (conditions, rows)
 }

@@ -380,3 +380,51 @@ fn an_input_replaced_during_the_evaluation_is_refused() {
         "{e}"
     );
 }
+
+/// ISO/IEC 17025:2017 7.8.2.1 fields a plan can fill (issue 53): the laboratory's name and
+/// address, the customer's contact, the sampling reference and the test's date range reach the
+/// report and results.json; the equipment must be in calibration through the range's last day;
+/// an end before the start, or an end without a start, is refused with its line and key.
+#[test]
+fn laboratory_customer_sampling_and_date_range_reach_the_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let paper = repo_root().join("data/paper");
+    let base = std::fs::read_to_string(repo_root().join("examples/paper_plan.toml"))
+        .unwrap()
+        .replace("../data/paper", &paper.display().to_string());
+    let with = |test: &str| {
+        let text = format!(
+            "{}\n[[equipment]]\nname = \"data acquisition\"\nid = \"DAQ-2\"\ncalibration_due = \"2014-03-13\"\n",
+            base.replace("[test]\n", &format!("[test]\n{test}"))
+        );
+        let p = dir.path().join("plan.toml");
+        std::fs::write(&p, text).unwrap();
+        read_test_plan(&p)
+    };
+    let plan = with(
+        "laboratory = \"Inertial Test Lab\"\nlaboratory_address = \"1 Gyro Road, Xi'an\"\n\
+         customer_contact = \"q.engineer@example.com\"\nsampling = \"lot L7, AQL sampling plan SP-2\"\n\
+         date = \"2014-03-12\"\ndate_end = \"2014-03-14\"\n",
+    )
+    .unwrap();
+    let folder = evaluate_test_plan(&plan, "plan.toml", &Silent).unwrap();
+    let html = String::from_utf8(output(&folder, "report.html").to_vec()).unwrap();
+    for s in [
+        "Inertial Test Lab",
+        "1 Gyro Road, Xi&#39;an",
+        "q.engineer@example.com",
+        "lot L7, AQL sampling plan SP-2",
+        "2014-03-12 to 2014-03-14",
+    ] {
+        assert!(html.contains(s), "no '{s}' in the report");
+    }
+    let v: serde_json::Value = serde_json::from_slice(output(&folder, "results.json")).unwrap();
+    assert_eq!(v["test"]["laboratory"], "Inertial Test Lab");
+    assert_eq!(v["test"]["test_date_end"], "2014-03-14");
+    // Due on the 13th, the test ran to the 14th: expired.
+    assert_eq!(v["equipment"][0]["status"], "expired");
+    let e = with("date = \"2014-03-12\"\ndate_end = \"2014-03-11\"\n").unwrap_err().to_string();
+    assert!(e.contains("test.date_end: 2014-03-11 is before test.date 2014-03-12"), "{e}");
+    let e = with("date_end = \"2014-03-11\"\n").unwrap_err().to_string();
+    assert!(e.contains("test.date_end: needs test.date"), "{e}");
+}

@@ -75,6 +75,11 @@ struct RawTest {
     item_condition: Option<String>,
     receipt_date: Option<Spanned<String>>,
     deviations: Option<String>,
+    date_end: Option<Spanned<String>>,
+    laboratory: Option<String>,
+    laboratory_address: Option<String>,
+    customer_contact: Option<String>,
+    sampling: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -240,6 +245,18 @@ pub struct TestInfo {
     pub receipt_date: Option<String>,
     /// Deviations from, additions to or exclusions from the method (7.8.2.1 l; 7.8.3.1 a).
     pub deviations: Option<String>,
+    /// The last date of the test when it took several days, `YYYY-MM-DD`, not before `date`
+    /// (7.8.2.1 h: the dates of performance).
+    pub date_end: Option<String>,
+    /// The laboratory's name (7.8.2.1 a).
+    pub laboratory: Option<String>,
+    /// The laboratory's address (7.8.2.1 a).
+    pub laboratory_address: Option<String>,
+    /// The customer's contact information (7.8.2.1 e).
+    pub customer_contact: Option<String>,
+    /// Reference to the sampling plan and method, where the item was sampled (7.8.2.1 i,
+    /// 7.8.5).
+    pub sampling: Option<String>,
 }
 
 /// One piece of test equipment (`[[equipment]]`): rate table, chamber, data acquisition.
@@ -958,6 +975,23 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
         item_condition: t.item_condition.clone(),
         receipt_date: t.receipt_date.as_ref().map(|d| date(d, "test.receipt_date")).transpose()?,
         deviations: t.deviations.clone(),
+        date_end: match (&t.date_end, &t.date) {
+            (None, _) => None,
+            (Some(e), None) => {
+                return Err(cx.err(e.span(), "test.date_end", "needs test.date, the first day of the test"))
+            }
+            (Some(e), Some(d)) => {
+                let (end, first) = (date(e, "test.date_end")?, date(d, "test.date")?);
+                if parse_date(&end) < parse_date(&first) {
+                    return Err(cx.err(e.span(), "test.date_end", format!("{end} is before test.date {first}")));
+                }
+                Some(end)
+            }
+        },
+        laboratory: t.laboratory.clone(),
+        laboratory_address: t.laboratory_address.clone(),
+        customer_contact: t.customer_contact.clone(),
+        sampling: t.sampling.clone(),
     };
     let mut equipment = Vec::with_capacity(raw.equipment.len());
     for (i, e) in raw.equipment.iter().enumerate() {
