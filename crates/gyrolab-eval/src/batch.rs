@@ -233,7 +233,7 @@ pub fn journal_line(input: &DoneInput) -> String {
     let rows: Vec<Vec<String>> = input.rows.iter().map(|r| r.0.iter().map(Cell::text).collect()).collect();
     let value = serde_json::json!({
         "sha256": input.sha256,
-        "file": input.file.to_string_lossy(),
+        "file": gyrolab_io::text::path_text(&input.file),
         "rows": rows,
     });
     value.to_string() + "\n"
@@ -275,7 +275,7 @@ impl Journal {
 fn parse_entry(line: &str) -> Option<DoneInput> {
     let v: serde_json::Value = serde_json::from_str(line).ok()?;
     let sha256 = v.get("sha256")?.as_str()?.to_string();
-    let file = PathBuf::from(v.get("file")?.as_str()?);
+    let file = gyrolab_io::text::path_from_text(v.get("file")?.as_str()?)?;
     let mut rows = Vec::new();
     for r in v.get("rows")?.as_array()? {
         let cells = r.as_array()?;
@@ -307,7 +307,8 @@ fn hex(bytes: &[u8]) -> String {
 /// line starts with [`SIMULATED_MARK`]: then that line, without `# `).
 pub fn hash_file(path: &Path) -> Result<(String, Option<String>), DataError> {
     let err = |e: std::io::Error| DataError::new(path, format!("cannot read the file: {e}"));
-    let mut f = std::fs::File::open(path).map_err(err)?;
+    // A regular file only (a FIFO named among the inputs would block).
+    let (mut f, _) = gyrolab_io::input_file::open_regular(path)?;
     let mut hasher = Sha256::new();
     let mut buf = vec![0u8; 1 << 20];
     let mut first: Vec<u8> = Vec::new();
@@ -328,64 +329,152 @@ pub fn hash_file(path: &Path) -> Result<(String, Option<String>), DataError> {
     Ok((hex(&hasher.finalize()), simulated))
 }
 
+/// The inputs a batch found, and the entries it passed over with the reason.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CollectedInputs {
+    /// The record files, in order.
+    pub files: Vec<PathBuf>,
+    /// Entries not taken, each with why: a FIFO, socket or device; a link out of the folder
+    /// (without `follow_links`); a link back into a folder already walked (a cycle).
+    pub passed_over: Vec<(PathBuf, String)>,
+}
+
 /// The inputs of a batch: each spec a file, a folder (its record files, see
 /// [`RECORD_EXTENSIONS`], at any depth, in name order; hidden entries and `exclude` passed
 /// over) or a glob pattern (`*`, `?`, `[...]`, `**`); each list file one spec a line (blank
 /// lines and `#` comments passed over). A path given twice is taken once.
-pub fn collect_inputs(specs: &[String], lists: &[PathBuf], exclude: Option<&Path>) -> EvalResult<Vec<PathBuf>> {
+///
+/// Only regular files are read: a FIFO, socket or device (named, or met in a folder) is passed
+/// over with its kind, never opened (a FIFO would block). In a folder, a symbolic link is
+/// followed when its target lies inside the folder given (or anywhere with `follow_links`),
+/// and every folder is walked once (a link back to a folder already walked, a cycle such as
+/// `a -> .`, is passed over), so a walk always ends.
+pub fn collect_inputs(
+    specs: &[String],
+    lists: &[PathBuf],
+    exclude: Option<&Path>,
+    follow_links: bool,
+) -> EvalResult<CollectedInputs> {
     let mut all: Vec<String> = specs.to_vec();
     for list in lists {
+        gyrolab_io::input_file::check_regular(list)?;
         let text = std::fs::read_to_string(list)
             .map_err(|e| DataError::new(list, format!("cannot read the list of inputs: {e}")))?;
         all.extend(text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')).map(String::from));
     }
     let exclude = exclude.and_then(|p| p.canonicalize().ok());
-    let mut out = Vec::new();
+    let mut found = CollectedInputs::default();
     for spec in &all {
         let path = Path::new(spec);
         if path.is_dir() {
-            walk(path, exclude.as_deref(), &mut out)?;
-        } else if path.exists() {
-            out.push(path.to_path_buf());
+            let mut walk = Walk {
+                root: path.canonicalize().map_err(|e| DataError::io(path, &e))?,
+                exclude: exclude.as_deref(),
+                follow_links,
+                visited: std::collections::HashSet::new(),
+                found: &mut found,
+            };
+            walk.folder(path)?;
+        } else if std::fs::symlink_metadata(path).is_ok() {
+            match not_regular(path) {
+                Some(kind) => found.passed_over.push((path.to_path_buf(), kind)),
+                None => found.files.push(path.to_path_buf()),
+            }
         } else if spec.contains(['*', '?', '[']) {
             let paths = glob::glob(spec).map_err(|e| {
                 EvalError::conflict_on(&["inputs"], format!("'{spec}': not a usable pattern for {{inputs}}: {e}"))
             })?;
-            let mut found: Vec<PathBuf> =
-                paths.filter_map(Result::ok).filter(|p| p.is_file() && is_record(p)).collect();
-            found.sort();
-            out.append(&mut found);
+            let mut matched: Vec<PathBuf> = paths.filter_map(Result::ok).filter(|p| is_record(p)).collect();
+            matched.sort();
+            for p in matched {
+                if p.is_dir() {
+                    continue;
+                }
+                match not_regular(&p) {
+                    Some(kind) => found.passed_over.push((p, kind)),
+                    None => found.files.push(p),
+                }
+            }
         } else {
             return Err(DataError::new(path, "no such file or folder").into());
         }
     }
     let mut seen = std::collections::HashSet::new();
-    out.retain(|p| seen.insert(p.clone()));
-    Ok(out)
+    found.files.retain(|p| seen.insert(p.clone()));
+    Ok(found)
+}
+
+/// What a path is when it is not a regular file (following links): "a FIFO (named pipe)",
+/// "a socket", ...; `None` for a regular file.
+fn not_regular(path: &Path) -> Option<String> {
+    match gyrolab_io::input_file::check_regular(path) {
+        Ok(_) => None,
+        Err(e) => Some(e.message.split(", not a regular file").next().unwrap_or("not a regular file").to_string()),
+    }
 }
 
 fn is_record(p: &Path) -> bool {
     p.extension().and_then(|e| e.to_str()).is_some_and(|e| RECORD_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
 }
 
-fn walk(dir: &Path, exclude: Option<&Path>, out: &mut Vec<PathBuf>) -> EvalResult<()> {
-    if exclude.is_some() && dir.canonicalize().ok().as_deref() == exclude {
-        return Ok(());
-    }
-    let read = std::fs::read_dir(dir).map_err(|e| DataError::new(dir, format!("cannot read the folder: {e}")))?;
-    let mut entries: Vec<PathBuf> = read.filter_map(Result::ok).map(|e| e.path()).collect();
-    entries.sort();
-    for p in entries {
-        if p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with('.')) {
-            continue;
+/// One folder walk of [`collect_inputs`].
+struct Walk<'a> {
+    /// The folder given, canonical: links are followed only to targets inside it (unless
+    /// `follow_links`).
+    root: PathBuf,
+    exclude: Option<&'a Path>,
+    follow_links: bool,
+    /// Canonical folders walked (a folder reached twice, through a link, is walked once).
+    visited: std::collections::HashSet<PathBuf>,
+    found: &'a mut CollectedInputs,
+}
+
+impl Walk<'_> {
+    fn folder(&mut self, dir: &Path) -> EvalResult<()> {
+        let canonical = dir.canonicalize().map_err(|e| DataError::io(dir, &e))?;
+        if self.exclude == Some(canonical.as_path()) {
+            return Ok(());
         }
-        if p.is_dir() {
-            walk(&p, exclude, out)?;
-        } else if is_record(&p) {
-            out.push(p);
+        if !self.visited.insert(canonical) {
+            self.found.passed_over.push((dir.to_path_buf(), "a folder already walked (a link cycle)".into()));
+            return Ok(());
         }
+        let read = std::fs::read_dir(dir).map_err(|e| DataError::new(dir, format!("cannot read the folder: {e}")))?;
+        let mut entries: Vec<PathBuf> = read.filter_map(Result::ok).map(|e| e.path()).collect();
+        entries.sort();
+        for p in entries {
+            if p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with('.')) {
+                continue;
+            }
+            let Ok(meta) = std::fs::symlink_metadata(&p) else { continue };
+            if meta.file_type().is_symlink() {
+                let Ok(target) = p.canonicalize() else {
+                    if is_record(&p) {
+                        self.found.passed_over.push((p, "a link to nothing".into()));
+                    }
+                    continue;
+                };
+                if !self.follow_links && !target.starts_with(&self.root) {
+                    if target.is_dir() || is_record(&p) {
+                        self.found.passed_over.push((
+                            p,
+                            format!("a link out of the folder (to {}; --follow-links follows it)", target.display()),
+                        ));
+                    }
+                    continue;
+                }
+            }
+            if p.is_dir() {
+                self.folder(&p)?;
+            } else if is_record(&p) {
+                match not_regular(&p) {
+                    Some(kind) => self.found.passed_over.push((p, kind)),
+                    None => self.found.files.push(p),
+                }
+            }
+        }
+        Ok(())
     }
-    Ok(())
 }
 
 /// The rows of one input: every channel of every record (topic) it holds.
@@ -429,7 +518,7 @@ pub fn result_row(j: &AllanJson, file: &Path, sha256: &str, simulated: Option<&s
     let accel_readings = accel.map_or(&[][..], |n| &n.readings[..]);
     let fit_quality = fit.and_then(|f| serde_json::to_value(f.quality).ok()).and_then(|v| v.as_str().map(String::from));
     ResultRow(vec![
-        text(&file.to_string_lossy()),
+        text(&gyrolab_io::text::path_text(file)),
         text(sha256),
         opt_text(simulated.map(|s| format!("SIMULATED: {s}")).as_deref()),
         opt_text(j.topic.as_deref()),

@@ -385,9 +385,96 @@ pub fn check_magnitude(v: f64) -> Result<f64, String> {
     }
 }
 
+/// A path as text, exactly and reversibly ([`path_from_text`] gives it back): a name in UTF-8
+/// as it is, except that a backslash is doubled; a byte that is not UTF-8 (a non-UTF-8 name
+/// on Unix) as `\xNN`. Tables and journals hold this text, never a lossy one that would turn
+/// two names into the same replacement character.
+///
+/// ```
+/// use std::path::Path;
+/// assert_eq!(gyrolab_io::text::path_text(Path::new("fleet/imu 1.csv")), "fleet/imu 1.csv");
+/// assert_eq!(gyrolab_io::text::path_text(Path::new(r"a\b.csv")), r"a\\b.csv");
+/// ```
+pub fn path_text(path: &Path) -> String {
+    #[cfg(unix)]
+    let bytes: &[u8] = std::os::unix::ffi::OsStrExt::as_bytes(path.as_os_str());
+    #[cfg(not(unix))]
+    let owned = path.to_string_lossy().into_owned().into_bytes();
+    #[cfg(not(unix))]
+    let bytes: &[u8] = &owned;
+    let mut out = String::with_capacity(bytes.len());
+    for chunk in bytes.utf8_chunks() {
+        for c in chunk.valid().chars() {
+            if c == '\\' {
+                out.push_str("\\\\");
+            } else {
+                out.push(c);
+            }
+        }
+        for b in chunk.invalid() {
+            out.push_str(&format!("\\x{b:02X}"));
+        }
+    }
+    out
+}
+
+/// The path [`path_text`] wrote (`None` for text it cannot have written).
+pub fn path_from_text(text: &str) -> Option<std::path::PathBuf> {
+    let mut bytes = Vec::with_capacity(text.len());
+    let mut rest = text.as_bytes();
+    while let Some((&b, tail)) = rest.split_first() {
+        if b != b'\\' {
+            bytes.push(b);
+            rest = tail;
+            continue;
+        }
+        match tail {
+            [b'\\', more @ ..] => {
+                bytes.push(b'\\');
+                rest = more;
+            }
+            [b'x', h, l, more @ ..] => {
+                let hex = std::str::from_utf8(&[*h, *l]).ok().and_then(|s| u8::from_str_radix(s, 16).ok())?;
+                bytes.push(hex);
+                rest = more;
+            }
+            _ => return None,
+        }
+    }
+    #[cfg(unix)]
+    {
+        Some(std::path::PathBuf::from(<std::ffi::OsString as std::os::unix::ffi::OsStringExt>::from_vec(bytes)))
+    }
+    #[cfg(not(unix))]
+    {
+        String::from_utf8(bytes).ok().map(std::path::PathBuf::from)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Non-UTF-8 names kept exactly (issue 55): every name reads back as written, two names
+    /// that a lossy conversion would merge stay apart.
+    #[cfg(unix)]
+    #[test]
+    fn path_text_is_exact_and_reversible() {
+        use std::os::unix::ffi::OsStrExt;
+        let names: [&[u8]; 6] =
+            [b"plain.csv", b"caf\xc3\xa9.csv", b"bad\xff.csv", b"bad\xfe.csv", b"back\\slash\\x41.csv", b"\xff\\xff"];
+        let mut texts = Vec::new();
+        for n in names {
+            let p = Path::new(std::ffi::OsStr::from_bytes(n));
+            let t = path_text(p);
+            assert_eq!(path_from_text(&t).as_deref(), Some(p), "{t}");
+            texts.push(t);
+        }
+        assert_eq!(texts[1], "caf\u{e9}.csv");
+        assert_eq!(texts[2], "bad\\xFF.csv");
+        assert_ne!(texts[2], texts[3]);
+        assert_eq!(path_from_text("a\\q"), None);
+    }
 
     #[test]
     fn parses_comments_header_rows_and_sniffs() {

@@ -48,6 +48,10 @@ pub struct BatchArgs {
     /// No progress bar and no summary on standard output (failures still go to stderr).
     #[arg(long, short)]
     pub quiet: bool,
+    /// In a folder, follow symbolic links that lead out of it too (by default only links to
+    /// places inside the folder given are followed; a link cycle is walked once either way).
+    #[arg(long)]
+    pub follow_links: bool,
     #[command(flatten)]
     pub analysis: AnalysisArgs,
 }
@@ -164,7 +168,11 @@ pub fn run(args: &BatchArgs) -> CliResult {
     if let Some(n) = args.jobs {
         validate::positive("jobs", n as f64)?;
     }
-    let inputs = collect_inputs(&args.inputs, &args.lists, Some(&args.out))?;
+    let collected = collect_inputs(&args.inputs, &args.lists, Some(&args.out), args.follow_links)?;
+    for (path, why) in &collected.passed_over {
+        eprintln!("note: {}: passed over: {why}", gyrolab_io::text::path_text(path));
+    }
+    let inputs = collected.files;
     if inputs.is_empty() {
         return Err(
             EvalError::conflict("no record to evaluate: give files, folders, glob patterns or --list FILE").into()
@@ -209,7 +217,7 @@ pub fn run(args: &BatchArgs) -> CliResult {
         let mut s = String::from("file,reason\n");
         for f in &outcome.failures {
             let reason = f.error.render(&flag).replace('"', "\"\"");
-            s.push_str(&format!("\"{}\",\"{reason}\"\n", f.file.display().to_string().replace('"', "\"\"")));
+            s.push_str(&format!("\"{}\",\"{reason}\"\n", gyrolab_io::text::path_text(&f.file).replace('"', "\"\"")));
         }
         s
     });
@@ -222,6 +230,17 @@ pub fn run(args: &BatchArgs) -> CliResult {
     if failures_csv.is_none() {
         // A list of failures from an earlier run would no longer be true.
         let _ = std::fs::remove_file(args.out.join("failures.csv"));
+    }
+    // Byte-identical inputs: one row, both names said.
+    for s in &outcome.skipped {
+        if let Skipped::SameAs { file, original } = s {
+            eprintln!(
+                "note: {}: the same bytes as {}: evaluated once, its rows are {}'s",
+                gyrolab_io::text::path_text(file),
+                gyrolab_io::text::path_text(original),
+                gyrolab_io::text::path_text(original)
+            );
+        }
     }
     let done_before = outcome.skipped.iter().filter(|s| matches!(s, Skipped::AlreadyDone { .. })).count();
     let duplicates = outcome.skipped.len() - done_before;

@@ -194,3 +194,60 @@ fn a_journal_of_other_options_is_not_resumed() {
     let run = gyrolab().arg("batch").arg(dir.path().join("nothing")).arg("--out").arg(&out).assert().code(2);
     assert!(String::from_utf8_lossy(&run.get_output().stderr).contains("no such file or folder"));
 }
+
+/// `batch` on a real folder (issue 55): a FIFO and a socket named with the record extension, a
+/// link cycle (`loop -> .`), a link out of the folder (`up -> ..`), a link to nothing, two
+/// byte-identical records and a non-UTF-8 name. The walk ends (within the test's own time: a
+/// FIFO used to block, the cycle to walk without end), every entry is accounted for (evaluated,
+/// a duplicate naming both files, or passed over with its reason), and the non-UTF-8 name is
+/// written exactly (`\xFF`, reversible). A FIFO named on the command line is passed over too.
+/// (An unreadable file is not tried: the tests run as root, whom permissions do not stop.)
+#[cfg(unix)]
+#[test]
+fn a_folder_as_it_comes_is_walked_to_its_end_with_every_entry_accounted_for() {
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let fleet = dir.path().join("fleet");
+    std::fs::create_dir(&fleet).unwrap();
+    let a = simulate(&fleet, "a.csv", 1);
+    std::fs::copy(&a, fleet.join("b.csv")).unwrap();
+    let odd = fleet.join(std::ffi::OsStr::from_bytes(b"imu\xff.csv"));
+    std::fs::copy(simulate(dir.path(), "c.csv", 2), &odd).unwrap();
+    let fifo = fleet.join("pipe.csv");
+    assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let _socket = std::os::unix::net::UnixListener::bind(fleet.join("sock.csv")).unwrap();
+    std::os::unix::fs::symlink(".", fleet.join("loop")).unwrap();
+    std::os::unix::fs::symlink("..", fleet.join("up")).unwrap();
+    std::os::unix::fs::symlink("nowhere.csv", fleet.join("dangling.csv")).unwrap();
+    let out = dir.path().join("out");
+    let run = gyrolab()
+        .arg("batch")
+        .arg(&fleet)
+        .arg(&fifo)
+        .arg("--out")
+        .arg(&out)
+        .timeout(std::time::Duration::from_secs(120))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&run.stderr).into_owned();
+    assert!(run.status.success(), "{err}");
+    for said in [
+        "pipe.csv: passed over: a FIFO (named pipe)",
+        "sock.csv: passed over: a socket",
+        "up: passed over: a link out of the folder",
+        "--follow-links follows it",
+        "dangling.csv: passed over: a link to nothing",
+        "loop: passed over: a folder already walked (a link cycle)",
+        "b.csv: the same bytes as",
+    ] {
+        assert!(err.contains(said), "{said}: {err}");
+    }
+    let rows = results(&out);
+    let files: BTreeSet<&str> = rows.iter().map(|r| r["file"].as_str()).collect();
+    let want: BTreeSet<String> = [a.display().to_string(), format!("{}/imu\\xFF.csv", fleet.display())].into();
+    assert_eq!(files, want.iter().map(String::as_str).collect::<BTreeSet<_>>());
+    assert_eq!(
+        gyrolab_io::text::path_from_text(&format!("{}/imu\\xFF.csv", fleet.display())).as_deref(),
+        Some(odd.as_path())
+    );
+}
