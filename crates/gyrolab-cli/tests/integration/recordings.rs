@@ -652,3 +652,25 @@ fn every_command_reads_the_clock_of_a_real_log_alike() {
         );
     }
 }
+
+/// A ROS 1 bag cut after its version line (issue 55) is refused by every command that reads
+/// it, naming where it ends, instead of listed as a bag with no topics (exit 0); cut inside its
+/// first record, likewise. The whole bag reads.
+#[test]
+fn a_bag_cut_after_its_version_line_is_refused() {
+    let bag = std::fs::read(root().join("examples/recordings/simulated_imu_ros1.bag")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    for (cut, said) in
+        [(13usize, "at byte 13: the file ends after its version line: no bag header"), (200, "more than the 110 left")]
+    {
+        let p = dir.path().join(format!("cut{cut}.bag"));
+        std::fs::write(&p, &bag[..cut]).unwrap();
+        for cmd in ["inspect", "allan", "bias"] {
+            let out = gyrolab().arg(cmd).arg(&p).output().unwrap();
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(2), "{cmd} {cut}: {err}");
+            assert!(err.contains(said), "{cmd} {cut}: {err}");
+        }
+    }
+    gyrolab().arg("inspect").arg(root().join("examples/recordings/simulated_imu_ros1.bag")).assert().success();
+}

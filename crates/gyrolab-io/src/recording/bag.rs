@@ -228,6 +228,15 @@ pub(super) fn read(path: &Path, file: std::fs::File, size: u64, c: &mut Collecto
     let mut at = MAGIC.len() as u64;
     let mut index_pos = size;
     let damaged = |at: u64, what: String| Stop::Damaged { at: format!("byte {at}"), what };
+    // Every bag 2.0 begins with its bag header record (its first record after the version
+    // line): a file cut before it holds no connection, no chunk and no index.
+    if at >= size {
+        return Err(Stop::Damaged {
+            at: format!("byte {size}"),
+            what: "the file ends after its version line: no bag header, no records and no index (cut off, or an empty bag never written)".into(),
+        });
+    }
+    let mut header_seen = false;
     while at < index_pos.min(size) {
         let left = size - at;
         let hl = u64::from(u32::from_le_bytes(
@@ -252,8 +261,15 @@ pub(super) fn read(path: &Path, file: std::fs::File, size: u64, c: &mut Collecto
         }
         let head_fields = fields(&head).map_err(|why| damaged(at, why))?;
         let op = field(&head_fields, "op").and_then(|o| o.first().copied());
+        if !header_seen && op != Some(OP_BAG_HEADER) {
+            return Err(damaged(
+                at,
+                "the first record is not the bag header (op 0x03) a ROS 1 bag 2.0 begins with".into(),
+            ));
+        }
         match op {
             Some(OP_BAG_HEADER) => {
+                header_seen = true;
                 let p = field(&head_fields, "index_pos")
                     .and_then(|v| <[u8; 8]>::try_from(v).ok())
                     .map(u64::from_le_bytes)
