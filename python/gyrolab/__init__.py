@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import functools
 import json
+import warnings
 import math
 import os
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
@@ -297,7 +298,8 @@ def _allan(
     """
     if topic is not None and not isinstance(x, (str, os.PathLike)):
         raise Error(f"topic={topic!r}: a topic picks one IMU topic of a recording file; x is not a path", keyword="topic")
-    if isinstance(x, (str, os.PathLike)):
+    from_file = isinstance(x, (str, os.PathLike))
+    if from_file:
         path = os.fspath(x)
         # A list of units (read()'s and the CLI's spelling, ["gx=rad/s", "m/s^2"]) is applied by
         # the file reader, as `gyrolab allan --unit` applies it: a bare unit per quantity (a rate
@@ -321,6 +323,15 @@ def _allan(
         x = frame
         units = merged if merged else units
         record = record or path
+    # A file read above (its columns already in seconds and in its units) takes the array path.
+    table = None if from_file else _named_table(x, names, taus, unit, units)
+    if table is not None:
+        # A DataFrame or a dict of named columns is read as the command line reads a file with
+        # that header (one reading for every front end, issue 55).
+        return _allan_table(
+            table, x, time, unit, units, rate_hz, kind, taus, confidence, scale_factor, null, fit_range_s,
+            gaps, record, allow_motion, start_s, end_s,
+        )
     if gaps not in ("error", "analyse", "analyze"):
         raise Error(f"gaps='{gaps}': expected 'error' or 'analyse'", keyword="gaps")
     cols, arrays, chan_units, stamps, single = _channels(x, names, time, unit, units)
@@ -375,6 +386,103 @@ def _allan(
         return next(iter(results.values()))
     return AllanResults(results, record or "<array>")
 
+
+
+# Unit spellings of the array path that the command line's reader writes otherwise.
+_CLI_UNIT = {"m/s2": "m/s^2", "m/s**2": "m/s^2", "m/s²": "m/s^2", "m·s^-2": "m/s^2"}
+# Units the array path converts first (micro-g to milli-g), which the command line has not.
+_ARRAY_ONLY_UNITS = {"ug", "µg", "μg", "micro-g", "1", "none", "unitless"}
+
+
+def _unit_spellings(unit: Any, units: Any) -> List[str]:
+    """Every unit named in ``unit`` and ``units`` (a dict's values, a list's entries after '=')."""
+    named: List[str] = []
+    if isinstance(units, Mapping):
+        named += [str(v) for v in units.values()]
+    elif isinstance(units, str):
+        named.append(units)
+    elif units is not None:
+        named += [str(u).partition("=")[2] or str(u) for u in units]
+    if unit is not None:
+        named.append(str(unit))
+    return [u.strip().lower() for u in named]
+
+
+def _named_table(x: Any, names: Any, taus: Any, unit: Any, units: Any) -> Optional[Dict[str, Any]]:
+    """The columns of a DataFrame or dict of columns to read by their header, or None: an
+    array, explicit ``names``, a list of taus (rounded against a known interval), a unit only
+    the array path converts, or a frame from :func:`read` (its units are already read) take
+    the array path."""
+    if names is not None or not isinstance(taus, str):
+        return None
+    if any(u in _ARRAY_ONLY_UNITS for u in _unit_spellings(unit, units)):
+        return None
+    if hasattr(x, "columns") and hasattr(x, "to_numpy"):
+        if getattr(x, "attrs", {}).get("units"):
+            return None
+        return {str(c): x[c].to_numpy() for c in x.columns}
+    if isinstance(x, Mapping) and x and all(not isinstance(v, (str, bytes)) for v in x.values()):
+        return {str(k): v for k, v in x.items()}
+    return None
+
+
+def _allan_table(
+    table: Dict[str, Any], x: Any, time: Any, unit: Any, units: Any, rate_hz: Any, kind: str, taus: str,
+    confidence: Any, scale_factor: Any, null: Any, fit_range_s: Any, gaps: str, record: Optional[str],
+    allow_motion: bool, start_s: Any, end_s: Any,
+) -> "AllanResults":
+    """:func:`allan` of a named table through the command line's reader (see ``_named_table``)."""
+    spell = lambda u: _CLI_UNIT.get(str(u).strip().lower(), str(u).strip())  # noqa: E731
+    layout: List[str] = []
+    if isinstance(units, Mapping):
+        layout += [f"{k}={spell(v)}" for k, v in units.items()]
+    elif isinstance(units, str):
+        layout.append(spell(units))
+    elif units is not None:
+        for u in units:
+            k, eq, v = str(u).partition("=")
+            layout.append(f"{k}={spell(v)}" if eq else spell(k))
+    if unit is not None:
+        layout.append(spell(unit))
+    time_column = None
+    if isinstance(time, str):
+        if time not in table:
+            raise Error(f"time='{time}': no such column (columns: {', '.join(table)})", keyword="time")
+        time_column = time
+    elif time is not None:
+        time_column = "time_s" if "time_s" not in table else "__time_s"
+        table = {time_column: time, **table}
+        layout.append(f"{time_column}=s")
+    names = list(table)
+    columns = []
+    for c in names:
+        a = np.asarray(table[c])
+        if a.ndim != 1 or a.dtype.kind not in "iuf":
+            raise Error(f"column '{c}': expected one number a row (a 1-D numeric column), got {a.dtype} of shape {a.shape}")
+        columns.append(np.ascontiguousarray(a, dtype=np.float64))
+    if fit_range_s is not None:
+        fit_range_s = [float(v) for v in fit_range_s]
+    if rate_hz is not None:
+        try:
+            rate_hz = float(rate_hz)
+        except (TypeError, ValueError):
+            raise Error(f"rate_hz={rate_hz!r}: expected a number of hertz", keyword="rate_hz") from None
+    doc_json, per_channel, lazy, notes = _gyrolab.allan_table(
+        columns, names, layout, time_column, rate_hz, kind, taus, None, confidence, scale_factor, null,
+        fit_range_s, "analyse" if gaps == "analyze" else gaps, record or "<array>", bool(allow_motion),
+        None if start_s is None else float(start_s), None if end_s is None else float(end_s),
+    )
+    for is_warning, text in notes:
+        if is_warning:
+            warnings.warn(text, UserWarning, stacklevel=3)
+    channels = json.loads(doc_json)
+    results = {
+        ch["channel"]: AllanResult._from_json(ch, arrays_of, {}, (lazy, i))
+        for i, (ch, arrays_of) in enumerate(zip(channels, per_channel))
+    }
+    out = AllanResults(results, record or "<array>")
+    out.notes = [text for _, text in notes]
+    return out
 
 
 @functools.wraps(_allan)

@@ -106,8 +106,8 @@ def test_mdev_flicker_floor_is_the_oadev_floor_scaled_as_sp1065():
 
 def test_channels_draw_the_mdev_asymptotes_of_their_own_oadev_terms(record):
     both = {"g1": record, "g2": record * 2.0}
-    oadev = gyrolab.allan(both, rate_hz=100.0)
-    mdev = gyrolab.allan(both, rate_hz=100.0, kind="mdev")
+    oadev = gyrolab.allan(both, rate_hz=100.0, unit="dps")
+    mdev = gyrolab.allan(both, rate_hz=100.0, kind="mdev", unit="dps")
     ax = mdev.plot(asymptotes=True, terms=oadev)
     n_lines = [line for line in ax.get_lines() if line.get_label().startswith("MDEV N = ")]
     assert len(n_lines) == 2

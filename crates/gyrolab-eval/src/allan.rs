@@ -1163,7 +1163,7 @@ pub fn analyse_records(request: &AllanRequest) -> EvalResult<Vec<AllanOutcome>> 
 
 /// The gravity check of a record with exactly three accelerometer channels (in m/s^2, each with
 /// an evaluated stillness check), attached to each of them; `None` for other records.
-pub(crate) fn gravity_of(analyses: &mut [ChannelAnalysis]) -> Option<gyrolab::stillness::GravityCheck> {
+pub fn gravity_of(analyses: &mut [ChannelAnalysis]) -> Option<gyrolab::stillness::GravityCheck> {
     use gyrolab::units::Quantity;
     let accel: Vec<usize> = (0..analyses.len()).filter(|&i| analyses[i].quantity == Quantity::Acceleration).collect();
     let [a, b, c] = accel[..] else { return None };
@@ -1391,10 +1391,8 @@ pub fn analyse_data(
             }
         }
     }
-    let results: Vec<EvalResult<(ChannelAnalysis, FillCount, usize)>> = channels
-        .into_par_iter()
-        .zip(infos.into_par_iter())
-        .map(|(values, info)| {
+    let one = |(values, info): (Vec<f64>, ChannelInfo)| -> EvalResult<(ChannelAnalysis, FillCount, usize)> {
+        {
             let mut values = match policy {
                 GapPolicy::Contiguous => values,
                 _ => on_grid(values, &timing.gaps, timing.missing),
@@ -1407,8 +1405,16 @@ pub fn analyse_data(
                 analyse_channel(&setup, &info, values)?
             };
             Ok((analysis, fill, n))
-        })
-        .collect();
+        }
+    };
+    // A short record on the calling thread, without any rayon call (no pool started: the
+    // Python package's small calls, issue 56); else the channels in parallel.
+    let total: usize = channels.iter().map(|c| c.len().saturating_add(timing.missing)).sum();
+    let results: Vec<EvalResult<(ChannelAnalysis, FillCount, usize)>> = if gyrolab::allan::runs_serially(total) {
+        channels.into_iter().zip(infos).map(one).collect()
+    } else {
+        channels.into_par_iter().zip(infos.into_par_iter()).map(one).collect()
+    };
     let results = results.into_iter().collect::<Result<Vec<_>, _>>()?;
     if let Some(most) = results.iter().map(|r| r.1).max_by_key(|f| f.filled).filter(|f| f.filled > 0) {
         let samples = results.iter().map(|r| r.2).max().unwrap_or(0);

@@ -401,6 +401,15 @@ fn allan_channels<'py>(
     }
     .map_err(err)?;
     gyrolab_eval::allan::refuse_motion(&analyses, path, allow_motion).map_err(err)?;
+    channels_out(py, analyses)
+}
+/// The channel JSON, per-channel arrays and lazy GMWM holder of analysed channels (the return
+/// of [`allan_channels`] and [`allan_table`]).
+#[allow(clippy::type_complexity)]
+fn channels_out<'py>(
+    py: Python<'py>,
+    analyses: Vec<gyrolab_report::allan::ChannelAnalysis>,
+) -> PyResult<(String, Vec<Vec<Bound<'py, PyArray1<f64>>>>, AllanChannels)> {
     // The GMWM and the filter terms (which hold it) are left to the first call that needs them
     // (`AllanChannels`): most calls read the curve and the slope terms only (issue 56).
     let doc = gyrolab_report::allan::allan_document_with(&analyses, false).ok_or_else(|| error("no channel"))?;
@@ -423,6 +432,101 @@ fn allan_channels<'py>(
         })
         .collect();
     Ok((json, arrays, AllanChannels { analyses }))
+}
+
+/// Allan analysis of a named table (a DataFrame, a dict of columns) read exactly as the
+/// command line reads a delimited file with that header (issue 55: one reading for every front
+/// end): the time column and its unit, units from the names or `units` (`COLUMN=UNIT` or a
+/// bare unit per quantity, the CLI's `--unit`), temperature and other columns skipped with a
+/// note, resets, gaps and dropouts as `gyrolab allan` handles them (`gaps`: fill, analyse,
+/// contiguous or error). Returns what [`allan_channels`] returns, and the reader's notes as
+/// (is_warning, text) with keywords spelled as Python's.
+#[pyfunction]
+#[pyo3(signature = (columns, names, units, time_column, rate_hz, kind, taus, factors, confidence, scale_factor=None, null=None, fit_range_s=None, gaps="fill", record="<table>", allow_motion=false, start_s=None, end_s=None))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn allan_table<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    names: Vec<String>,
+    units: Vec<String>,
+    time_column: Option<String>,
+    rate_hz: Option<f64>,
+    kind: &str,
+    taus: &str,
+    factors: Option<Vec<usize>>,
+    confidence: Option<f64>,
+    scale_factor: Option<f64>,
+    null: Option<f64>,
+    fit_range_s: Option<Vec<f64>>,
+    gaps: &str,
+    record: &str,
+    allow_motion: bool,
+    start_s: Option<f64>,
+    end_s: Option<f64>,
+) -> PyResult<(String, Vec<Vec<Bound<'py, PyArray1<f64>>>>, AllanChannels, Vec<(bool, String)>)> {
+    use gyrolab_eval::allan::{analyse_data, AllanRequest};
+    if columns.len() != names.len() || columns.is_empty() {
+        return Err(error(format!("give one name per column: {} columns, {} names", columns.len(), names.len())));
+    }
+    let kind = DeviationKind::parse(kind).map_err(|e| keyword_error("kind", e.to_string()))?;
+    let taus = match factors {
+        Some(m) => TauList::Factors(m),
+        None => parse_taus(taus).map_err(err)?,
+    };
+    let fit_range_s = match fit_range_s {
+        None => None,
+        Some(v) => gyrolab::validate::increasing_pair("fit_range_s", &v).map_err(|e| err(e.into()))?,
+    };
+    let layout = gyrolab_eval::layout::LogLayout { units, time_column, names: Vec::new() };
+    let request = AllanRequest {
+        file: PathBuf::from(record),
+        columns: Vec::new(),
+        sample_rate_hz: rate_hz,
+        reference: ReferenceRequest { scale_factor, null, ..Default::default() },
+        kind,
+        taus,
+        confidence,
+        fit_range_s,
+        layout: layout.clone(),
+        gaps: GapPolicy::parse(gaps).map_err(|e| err(e.into()))?,
+        topics: Vec::new(),
+        allow_motion,
+        window_s: (start_s, end_s),
+    };
+    let options = layout
+        .apply(SeriesOptions { sample_rate_hz: rate_hz, tolerant: true, ..SeriesOptions::default() })
+        .map_err(err)?;
+    let reference = request.reference.resolve().map_err(err)?;
+    let data: Vec<Vec<f64>> = columns.iter().map(|c| c.as_array().iter().copied().collect()).collect();
+    let work = || {
+        let data = gyrolab_io::series::series_from_columns(
+            Path::new(record),
+            &names,
+            data,
+            gyrolab_io::series::RowKind::Row,
+            &options,
+        )?;
+        let mut outcome = analyse_data(&request, &reference, data, None)?;
+        if let Some(g) = gyrolab_eval::allan::gravity_of(&mut outcome.analyses) {
+            outcome.notes.push(gyrolab_eval::allan::ReadNote::Gravity(g));
+        }
+        gyrolab_eval::allan::refuse_motion(&outcome.analyses, Path::new(record), allow_motion)?;
+        Ok::<_, EvalError>(outcome)
+    };
+    // A short record on the calling thread with the interpreter released (no pool, no thread
+    // started), as `allan_channels` does; else on the package's pool.
+    let samples: usize = columns.iter().map(|c| c.len()).sum();
+    let outcome = if gyrolab::allan::runs_serially(samples) { py.detach(work) } else { run(py, work)? };
+    let outcome = outcome.map_err(err)?;
+    // Warnings, and the note that channels without a unit get no noise terms, reach Python as
+    // UserWarnings (the command line prints them on stderr).
+    let notes = outcome
+        .notes
+        .iter()
+        .map(|n| (n.is_warning() || matches!(n, gyrolab_eval::allan::ReadNote::Unitless { .. }), n.render(&keyword)))
+        .collect();
+    let (json, arrays, lazy) = channels_out(py, outcome.analyses)?;
+    Ok((json, arrays, lazy, notes))
 }
 
 /// The analyses of one `allan_channels` call, kept for what is computed only when asked for:
@@ -797,6 +901,7 @@ fn apply<'py>(
 fn _gyrolab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(allan_channels, m)?)?;
+    m.add_function(wrap_pyfunction!(allan_table, m)?)?;
     m.add_class::<AllanChannels>()?;
     m.add_function(wrap_pyfunction!(render_export, m)?)?;
     m.add_function(wrap_pyfunction!(bias, m)?)?;

@@ -347,19 +347,24 @@ fn tally_in_parts(channels: &[&[f64]]) -> DropoutTally {
     use rayon::prelude::*;
     const PARTS: usize = 4;
     let parts = if n < (1 << 16) { 1 } else { PARTS };
+    let part = |k: usize| {
+        let (a, b) = (n * k / parts, n * (k + 1) / parts);
+        let mut t = DropoutTally::new(channels.len());
+        if a > 0 {
+            t.prev = channels.iter().map(|c| c[a - 1]).collect();
+            t.prev_zero = t.prev.iter().all(|&v| v == 0.0);
+        }
+        let part: Vec<&[f64]> = channels.iter().map(|c| &c[a..b]).collect();
+        t.push_block(&part);
+        t
+    };
+    // A short record in one part on the calling thread: no rayon call, so no pool is started.
+    if parts == 1 {
+        return part(0);
+    }
     (0..parts)
         .into_par_iter()
-        .map(|k| {
-            let (a, b) = (n * k / parts, n * (k + 1) / parts);
-            let mut t = DropoutTally::new(channels.len());
-            if a > 0 {
-                t.prev = channels.iter().map(|c| c[a - 1]).collect();
-                t.prev_zero = t.prev.iter().all(|&v| v == 0.0);
-            }
-            let part: Vec<&[f64]> = channels.iter().map(|c| &c[a..b]).collect();
-            t.push_block(&part);
-            t
-        })
+        .map(part)
         .reduce_with(DropoutTally::join)
         .unwrap_or_else(|| DropoutTally::new(channels.len()))
 }
