@@ -1,7 +1,8 @@
 //! The hash chain over every stored record (issue 53; docs/STORE.md "Threat model and checks").
 //!
 //! Every row the store inserts into a record table ([`CHAINED`]: `evaluation`, `input_file`,
-//! `report_file`, `figure`; approvals and corrections are `evaluation` rows) gets one link in the
+//! `report_file`, `figure`; approvals and corrections are `evaluation` rows; from schema version
+//! 4 also `account`, `account_change`, `audit_event`, `signing_key` and `issue`) gets one link in the
 //! append-only table `chain` (`seq`, `tbl`, `row_id`, `fields`, `hash`), computed here in Rust,
 //! inside the transaction that inserts the row, from the row **as read back** from the database:
 //!
@@ -21,8 +22,10 @@
 //! the check names the columns that differ.
 //!
 //! Links are appended per evaluation in one order: the `evaluation` row, then its `input_file`,
-//! `report_file` and `figure` rows, each by `id`. Migration 3 builds the chain over the rows of
-//! an existing store in that order, evaluations by `id` ([`build_existing`]).
+//! `report_file` and `figure` rows, each by `id`, then its audit event; an account, an account
+//! change, a signing key or an issue is chained when it is inserted, then its audit event
+//! ([`append_row`]). Migration 3 builds the chain over the rows of an existing store in that
+//! order, evaluations by `id` ([`build_existing`]).
 
 use crate::db::{Column, Exec, Kind, Val};
 use crate::schema;

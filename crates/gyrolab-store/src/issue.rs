@@ -279,7 +279,7 @@ fn issued_html(draft: &str, t: &IssueText, draft_number: &str, draft_issue_date:
         "<table class=\"sign-off\"><thead><tr><th class=\"name\">role</th><th class=\"name\">name</th><th class=\"name\">\
          signature</th><th class=\"name\">date</th></tr></thead><tbody>\n",
     );
-    let tested = t.record.operator.clone().unwrap_or_default();
+    let tested = t.record.operator.clone().unwrap_or_else(|| "(not named in the plan)".into());
     block.push_str(&format!(
         "<tr><td class=\"name\">tested by</td><td class=\"name\">{}</td><td class=\"name\">stored by {}</td><td \
          class=\"name\">{}</td></tr>\n",

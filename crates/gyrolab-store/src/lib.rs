@@ -7,7 +7,9 @@
 //! [`record`] what is kept of one evaluation, read from a finished report folder; [`query`] the
 //! queries and their statistics (computed by the core crate: `gyrolab::process_capability`,
 //! `gyrolab::control_chart`, `gyrolab::two_sample`); [`tables`] query results as tables;
-//! [`export`] tables as CSV and Parquet.
+//! [`export`] tables as CSV and Parquet; [`chain`] the hash chain and the checks; [`account`]
+//! accounts, roles, authentication and the audit trail; [`sign`] the lab's Ed25519 key files and
+//! signatures; [`issue`] issued reports and amendments (issue 53).
 
 pub mod account;
 pub mod chain;

@@ -630,8 +630,19 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
         StoreCommand::Report(a) => {
             let mut s = open(&a.location, false)?;
             let written = s.write_report(a.id, &a.out)?;
+            let what = match s.issue_of(a.id)? {
+                Some(r) => format!(
+                    "issued report {} ({}): each file equal to its signed manifest, the signature verified with the \
+                     store's lab key {}; check it with the lab's own public key: gyrolab verify {} --public-key LAB.pub",
+                    r.report_number,
+                    r.status(),
+                    r.key_fingerprint,
+                    a.out.display()
+                ),
+                None => "a DRAFT: each equal to its stored SHA-256".into(),
+            };
             print(&format!(
-                "wrote the {} report file(s) of evaluation {} to {} (each equal to its stored SHA-256)\n",
+                "wrote the {} report file(s) of evaluation {} to {} ({what})\n",
                 written.len(),
                 a.id,
                 a.out.display()
