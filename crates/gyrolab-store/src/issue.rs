@@ -157,12 +157,13 @@ pub(crate) fn lineage(x: &mut dyn Exec, id: i64) -> Result<Vec<i64>, String> {
     Ok(out)
 }
 
-/// The accounts that stored evaluation `id` or any revision it supersedes (the audit trail).
+/// The accounts that stored evaluation `id` or any revision it supersedes (the audit trail:
+/// stores, corrections and re-evaluations; not approvals, issues and amendments).
 pub(crate) fn stored_by(x: &mut dyn Exec, id: i64) -> Result<Vec<i64>, String> {
     let mut out = Vec::new();
     for e in lineage(x, id)? {
         for r in x.query(
-            "SELECT account_id FROM audit_event WHERE evaluation_id = $1 AND account_id IS NOT NULL AND action NOT IN ('issue', 'amend')",
+            "SELECT account_id FROM audit_event WHERE evaluation_id = $1 AND account_id IS NOT NULL AND action NOT IN ('issue', 'amend', 'approval')",
             &[Val::I(e)],
             &[Kind::I],
         )? {

@@ -308,6 +308,23 @@ fn accounts_issue_verify_and_amend_from_the_command_line() {
         let check = r.ok(&["store", "check"], None, None);
         assert!(check.contains("whole"), "{}: {check}", b.name);
 
+        // A re-evaluation of the amended report, amended in turn: "Amendment 2 to report <the first
+        // amendment>"; an approver's approval revision does not make the approver its author.
+        let re = dir.path().join("re");
+        let said =
+            r.ok(&["store", "reevaluate", &id4, "--out", re.to_str().unwrap(), "--reason", "new version"], op, None);
+        let id5 =
+            said.split("evaluation ").nth(2).unwrap().split(|c: char| !c.is_ascii_digit()).next().unwrap().to_string();
+        r.ok(&["store", "amend", &id5, "--reason", "re-evaluated", "--signing-key", k], appr2, None);
+        let second = dir.path().join("second");
+        r.ok(&["store", "report", &id5, "--out", second.to_str().unwrap()], None, None);
+        let a2 = json(&second.join("issue.json"));
+        assert_eq!(a2["amendment"]["number"], 2, "{}: {a2}", b.name);
+        assert_eq!(a2["amendment"]["replaces_report"], new_number.as_str());
+        assert_eq!(verify(&mut r, &second, true).0, 0, "{}", b.name);
+        let (code, _, err) = r.run(&["store", "amend", &id1, "--reason", "again", "--signing-key", k], appr, None);
+        assert_eq!(code, 2, "{}: nothing left to amend without a new revision: {err}", b.name);
+
         // A disabled account cannot authenticate (the same message).
         r.ok(&["store", "user", "disable", "appr2"], Some(("admin", ADMIN_PW)), None);
         let (code, _, err) = r.run(&args(&issue(&id3)), appr2, None);
