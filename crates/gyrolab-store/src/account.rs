@@ -83,19 +83,29 @@ pub struct Account {
 
 /// Who makes a write: an account authenticated by [`crate::Store::authenticate`], or nobody (a
 /// store with no account). Made only by the store, so a holder of an `Actor` has authenticated.
-#[derive(Debug, Clone, PartialEq)]
+/// It is bound to the password hash it was authenticated against: used with another store (whose
+/// account of the same name has another salt) or after the password was reset, it is refused.
+#[derive(Clone, PartialEq)]
 pub struct Actor {
     account: Option<Account>,
+    verified_hash: String,
+}
+
+impl std::fmt::Debug for Actor {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        // Never the hash.
+        f.debug_struct("Actor").field("account", &self.account).finish_non_exhaustive()
+    }
 }
 
 impl Actor {
     /// No account: accepted only by a store that has none ([`UNAUTHENTICATED`] is recorded).
     pub fn unauthenticated() -> Actor {
-        Actor { account: None }
+        Actor { account: None, verified_hash: String::new() }
     }
 
-    pub(crate) fn of(account: Account) -> Actor {
-        Actor { account: Some(account) }
+    pub(crate) fn of(account: Account, verified_hash: String) -> Actor {
+        Actor { account: Some(account), verified_hash }
     }
 
     /// The authenticated account, if any.
@@ -208,8 +218,13 @@ pub(crate) fn any(x: &mut dyn Exec) -> Result<bool, String> {
     Ok(!x.query("SELECT id FROM account LIMIT 1", &[], &[Kind::I])?.is_empty())
 }
 
-/// Authenticates `name` with `password`: the account, or [`AUTH_FAILED`] whatever was wrong.
-pub(crate) fn authenticate(x: &mut dyn Exec, name: &str, password: &str) -> Result<Result<Account, ()>, String> {
+/// Authenticates `name` with `password`: the account and the hash it was verified against, or
+/// [`AUTH_FAILED`] whatever was wrong.
+pub(crate) fn authenticate(
+    x: &mut dyn Exec,
+    name: &str,
+    password: &str,
+) -> Result<Result<(Account, String), ()>, String> {
     let found = by_name(x, name)?;
     let ok = match &found {
         Some((_, hash)) => verify_password(password, hash),
@@ -219,7 +234,7 @@ pub(crate) fn authenticate(x: &mut dyn Exec, name: &str, password: &str) -> Resu
         }
     };
     Ok(match found {
-        Some((a, _)) if ok && !a.disabled => Ok(a),
+        Some((a, hash)) if ok && !a.disabled => Ok((a, hash)),
         _ => Err(()),
     })
 }
@@ -252,10 +267,10 @@ pub(crate) fn check_actor(
             Ok((None, UNAUTHENTICATED.to_string()))
         }
         Some(a) => {
-            let Some((now, _)) = by_name(x, &a.name).map_err(dberr)? else {
+            let Some((now, hash)) = by_name(x, &a.name).map_err(dberr)? else {
                 return Err(StoreError::Auth { store: store.to_string() });
             };
-            if now.id != a.id || now.disabled {
+            if now.id != a.id || now.disabled || hash != actor.verified_hash {
                 return Err(StoreError::Auth { store: store.to_string() });
             }
             let allowed = match need {

@@ -443,7 +443,7 @@ impl Store {
             account::authenticate(x, name, password)
                 .map_err(|m| StoreError::Database { store: store.clone(), message: m })
         })?;
-        found.map(Actor::of).map_err(|()| StoreError::Auth { store: self.name.clone() })
+        found.map(|(a, hash)| Actor::of(a, hash)).map_err(|()| StoreError::Auth { store: self.name.clone() })
     }
 
     /// Whether the store has any account (then every write needs one).

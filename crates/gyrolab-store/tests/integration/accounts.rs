@@ -69,9 +69,20 @@ fn accounts_roles_and_the_audit_trail() {
         let e = s.revise_as(&again, &Changes::default(), None, &appr).unwrap_err();
         assert!(e.to_string().contains("self-approval refused"), "{}: {e}", b.name);
 
+        // An actor of another store (the same name and id, another salt) is refused here.
+        let other_dir = tempfile::tempdir().unwrap();
+        let mut other = Store::open(other_dir.path().join("other.db").to_str().unwrap(), true).unwrap();
+        other.add_account(&none, "admin", "Other", Role::Admin, "password-other").unwrap();
+        let foreign = other.authenticate("admin", "password-other").unwrap();
+        assert!(matches!(s.add_account(&foreign, "x", "X", Role::Admin, "password-x"), Err(StoreError::Auth { .. })));
+
         // Disabled, and a new password: each a new record.
         s.reset_password(&admin, "op", "password-op-2").unwrap();
         assert!(s.authenticate("op", "password-op").is_err());
+        assert!(
+            matches!(s.add_as(&record("SN4", None, &[("x", "bias_dph", 10.0)]), &op), Err(StoreError::Auth { .. })),
+            "an actor authenticated with the old password is refused after a reset"
+        );
         let op2 = s.authenticate("op", "password-op-2").unwrap();
         s.disable_account(&admin, "op").unwrap();
         let disabled = s.authenticate("op", "password-op-2").unwrap_err();
