@@ -569,8 +569,15 @@ impl Store {
                 let mut out: Vec<String> = Vec::new();
                 for e in lineage(x, id).map_err(dberr)?.into_iter().rev() {
                     for ev in account::events(x, Some(e)).map_err(dberr)? {
-                        if ev.action != "issue" && ev.action != "amend" && !out.contains(&ev.actor) {
-                            out.push(ev.actor);
+                        if matches!(ev.action.as_str(), "issue" | "amend" | "approval") {
+                            continue;
+                        }
+                        let shown = match account::by_name(x, &ev.actor).map_err(dberr)? {
+                            Some((a, _)) => format!("{} ({})", a.display_name, a.name),
+                            None => ev.actor,
+                        };
+                        if !out.contains(&shown) {
+                            out.push(shown);
                         }
                     }
                 }

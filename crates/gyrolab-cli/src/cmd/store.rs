@@ -425,6 +425,19 @@ fn read_key(path: &std::path::Path) -> CliResult<gyrolab_store::sign::SigningKey
     sign::read_signing_key(path).map_err(CliError::Usage)
 }
 
+/// The note printed when a revision supersedes an issued evaluation: the new revision is a
+/// draft, issued only as an amendment (empty otherwise).
+fn draft_note(s: &mut Store, superseded: i64, revision: i64) -> CliResult<String> {
+    Ok(match s.issue_of(superseded)? {
+        Some(r) => format!(
+            "evaluation {superseded} is issued as report {}, which stays as issued: evaluation {revision} is a DRAFT \
+             until an approver issues it as an amendment (gyrolab store amend {revision} --reason ...)\n",
+            r.report_number
+        ),
+        None => String::new(),
+    })
+}
+
 /// `gyrolab store issue` and `amend`.
 fn issue(location: &StoreLocation, auth: &AuthArgs, req: &IssueRequest) -> CliResult {
     let mut s = open_for_writing(location)?;
@@ -684,7 +697,13 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
             let actor = actor(&mut s, &a.auth)?;
             let r = Revision { supersedes: a.id, kind, by: by(&actor, a.by.as_deref())?, reason: a.reason.clone() };
             let id = s.revise_as(&r, &changes, None, &actor)?;
-            print(&format!("stored {} of evaluation {} as evaluation {id} in {}\n", kind.as_str(), a.id, s.name()))
+            let note = draft_note(&mut s, a.id, id)?;
+            print(&format!(
+                "stored {} of evaluation {} as evaluation {id} in {}\n{note}",
+                kind.as_str(),
+                a.id,
+                s.name()
+            ))
         }
         StoreCommand::Check(a) => check(a),
         StoreCommand::User(u) => user(u),
@@ -714,6 +733,10 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
             let actor = actor(&mut s, &a.auth)?;
             let who = by(&actor, a.by.as_deref())?;
             let r = reevaluate::reevaluate_as(&mut s, a.id, &who, &a.reason, &a.out, &actor)?;
+            let note = draft_note(&mut s, a.id, r.revision)?;
+            if !note.is_empty() {
+                eprint!("{note}");
+            }
             if a.json {
                 return print(&to_json(&r)?);
             }
