@@ -27,6 +27,23 @@ pub struct VerifyArgs {
     pub public_key: Option<PathBuf>,
 }
 
+/// A file's bytes, refused past `limit` bytes (a hostile folder cannot exhaust memory).
+fn read_bounded(p: &std::path::Path, limit: u64) -> Result<Vec<u8>, String> {
+    use std::io::Read;
+    // Only a regular file is opened (a FIFO would wait for a writer forever).
+    let meta = std::fs::metadata(p).map_err(|e| format!("{}: cannot read: {e}", p.display()))?;
+    if !meta.is_file() {
+        return Err(format!("{}: not a regular file", p.display()));
+    }
+    let f = std::fs::File::open(p).map_err(|e| format!("{}: cannot read: {e}", p.display()))?;
+    let mut bytes = Vec::new();
+    f.take(limit + 1).read_to_end(&mut bytes).map_err(|e| format!("{}: cannot read: {e}", p.display()))?;
+    if bytes.len() as u64 > limit {
+        return Err(format!("{}: larger than {limit} bytes", p.display()));
+    }
+    Ok(bytes)
+}
+
 /// The signature of an issued folder: (a line to print, the problem when it does not verify,
 /// whether it was checked). A folder with neither issue.json nor manifest.sig is a draft.
 fn check_signature(args: &VerifyArgs) -> CliResult<(Option<String>, Option<String>, bool)> {
@@ -55,7 +72,7 @@ fn check_signature(args: &VerifyArgs) -> CliResult<(Option<String>, Option<Strin
             false,
         ));
     };
-    let read = |p: &std::path::Path| std::fs::read(p).map_err(|e| format!("{}: cannot read: {e}", p.display()));
+    let read = |p: &std::path::Path| read_bounded(p, gyrolab_io::text::MAX_TABLE_BYTES);
     let detached: Result<sign::DetachedSignature, String> = read(&sig_path)
         .and_then(|b| serde_json::from_slice(&b).map_err(|e| format!("manifest.sig: not a gyrolab signature: {e}")));
     let manifest = read(&dir.join("manifest.json"));
@@ -85,7 +102,7 @@ pub fn run(args: &VerifyArgs) -> CliResult {
     let mut v = verify_folder(&args.dir, args.plan_dir.as_deref())?;
     // The detached signature is not in the manifest it signs.
     v.extra.retain(|e| e != gyrolab_store::sign::SIGNATURE_FILE);
-    let issued_number = std::fs::read(args.dir.join(gyrolab_store::sign::ISSUE_FILE))
+    let issued_number = read_bounded(&args.dir.join(gyrolab_store::sign::ISSUE_FILE), 16 << 20)
         .ok()
         .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
         .and_then(|j| {
