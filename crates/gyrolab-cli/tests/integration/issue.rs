@@ -408,7 +408,8 @@ fn a_database_administrator_rewriting_an_issued_report_is_caught_by_the_signatur
                 on.push_str(&format!("{create};"));
             }
         }
-        let forge = |x: &mut dyn Exec| {
+        // Stage 1: summary.csv's row alone; stage 2: the issue and the key too.
+        let forge = |x: &mut dyn Exec, stage: u8| {
             x.batch(&off).unwrap();
             let eid: i64 = id.parse().unwrap();
             let f = x
@@ -422,16 +423,31 @@ fn a_database_administrator_rewriting_an_issued_report_is_caught_by_the_signatur
             let bytes = zstd::stream::decode_all(f[1].bytes().unwrap()).unwrap();
             let forged = String::from_utf8(bytes).unwrap().replace("FAIL", "PASS");
             let sha = gyrolab_io::input_file::sha256_hex(forged.as_bytes());
-            x.exec(
-                "UPDATE report_file SET content_zstd = $1, sha256 = $2, size_bytes = $3 WHERE id = $4",
-                &[
-                    Val::B(Some(zstd::bulk::compress(forged.as_bytes(), 3).unwrap())),
-                    Val::T(Some(sha.clone())),
-                    Val::I(forged.len() as i64),
-                    Val::I(f[0].int()),
-                ],
-            )
-            .unwrap();
+            if stage == 1 {
+                x.exec(
+                    "UPDATE report_file SET content_zstd = $1, sha256 = $2, size_bytes = $3 WHERE id = $4",
+                    &[
+                        Val::B(Some(zstd::bulk::compress(forged.as_bytes(), 3).unwrap())),
+                        Val::T(Some(sha.clone())),
+                        Val::I(forged.len() as i64),
+                        Val::I(f[0].int()),
+                    ],
+                )
+                .unwrap();
+            }
+            if stage == 1 {
+                let first = x
+                    .query(
+                        "SELECT seq FROM chain WHERE tbl = 'report_file' AND row_id = $1",
+                        &[Val::I(f[0].int())],
+                        &[Kind::I],
+                    )
+                    .unwrap()[0][0]
+                    .int();
+                rechain(x, first);
+                x.batch(&on).unwrap();
+                return;
+            }
             let manifest = x
                 .query("SELECT manifest FROM issue WHERE evaluation_id = $1", &[Val::I(eid)], &[Kind::T])
                 .unwrap()[0][0]
@@ -467,14 +483,27 @@ fn a_database_administrator_rewriting_an_issued_report_is_caught_by_the_signatur
             rechain(x, first);
             x.batch(&on).unwrap();
         };
-        if postgres {
-            let mut c = postgres::Client::connect(&b.location, postgres::NoTls).unwrap();
-            let mut st = Default::default();
-            forge(&mut gyrolab_store::db::PgExec(&mut c, &mut st));
-        } else {
-            let c = rusqlite::Connection::open(&b.location).unwrap();
-            forge(&mut gyrolab_store::db::SqliteExec(&c));
-        }
+        let run = |stage: u8| {
+            if postgres {
+                let mut c = postgres::Client::connect(&b.location, postgres::NoTls).unwrap();
+                let mut st = Default::default();
+                forge(&mut gyrolab_store::db::PgExec(&mut c, &mut st), stage);
+            } else {
+                let c = rusqlite::Connection::open(&b.location).unwrap();
+                forge(&mut gyrolab_store::db::SqliteExec(&c), stage);
+            }
+        };
+        // The file's row alone, its chain recomputed: the store check is whole, but `store report`
+        // refuses the folder, naming the file against the signed manifest.
+        run(1);
+        let check = r.ok(&["store", "check"], None, None);
+        assert!(check.contains("whole"), "{}: {check}", b.name);
+        let half = dir.path().join("half");
+        let (code, _, err) = r.run(&["store", "report", &id, "--out", half.to_str().unwrap()], None, None);
+        assert_eq!(code, 2, "{}: {err}", b.name);
+        assert!(err.contains("summary.csv differs from its signed manifest"), "{}: {err}", b.name);
+        assert!(!half.exists(), "{}: nothing written", b.name);
+        run(2);
         // The store is whole again, with another head; its report folder is consistent.
         let check = r.ok(&["store", "check"], None, None);
         assert!(check.contains("whole"), "{}: {check}", b.name);
