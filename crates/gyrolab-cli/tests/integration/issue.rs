@@ -434,8 +434,6 @@ fn a_database_administrator_rewriting_an_issued_report_is_caught_by_the_signatur
                     ],
                 )
                 .unwrap();
-            }
-            if stage == 1 {
                 let first = x
                     .query(
                         "SELECT seq FROM chain WHERE tbl = 'report_file' AND row_id = $1",
