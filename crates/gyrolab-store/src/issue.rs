@@ -518,7 +518,9 @@ impl Store {
                     )))
                 }
                 (Some(reason), Some(p)) => {
-                    if let Some(s) = &p.superseded_by {
+                    // Read again inside the transaction: another amendment may have landed since.
+                    let now = issue_of(x, p.evaluation_id).map_err(dberr)?;
+                    if let Some(s) = now.as_ref().and_then(|n| n.superseded_by.as_ref()) {
                         return Err(refused(format!(
                             "report {} is superseded already by report {s}: amend that one",
                             p.report_number
@@ -675,8 +677,8 @@ impl Store {
                 .map_err(|m| {
                     if m.contains("UNIQUE") || m.contains("unique") || m.contains("duplicate") || m.contains("replaced") {
                         refused(format!(
-                            "report number {number:?} or evaluation {target} is issued already (the store refuses a \
-                             second issue of either)"
+                            "report number {number:?} or evaluation {target} is issued already, or the report it amends \
+                             is amended already (the store refuses a second issue of any of them)"
                         ))
                     } else {
                         dberr(m)
