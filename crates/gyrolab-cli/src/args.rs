@@ -193,3 +193,75 @@ pub struct QueryOutput {
     #[arg(long, value_name = "FILE.parquet")]
     pub parquet: Option<PathBuf>,
 }
+
+/// The environment variable naming the account a write to the store is made as.
+pub const USER_ENV: &str = "GYROLAB_USER";
+/// The environment variable holding that account's password.
+pub const PASSWORD_ENV: &str = "GYROLAB_PASSWORD";
+
+/// Who writes to the store (docs/STORE.md "Accounts and attribution"): `--user NAME` (or
+/// GYROLAB_USER) with the password from GYROLAB_PASSWORD, `--password-stdin` or a prompt at the
+/// terminal (no echo). A store without accounts takes writes without them.
+#[derive(Debug, Clone, Default, Args)]
+pub struct AuthArgs {
+    /// The account to write as (default: GYROLAB_USER). Its password: `--password-stdin`, else
+    /// GYROLAB_PASSWORD, else a prompt at the terminal.
+    #[arg(long = "user", value_name = "NAME")]
+    pub user: Option<String>,
+    /// Read the password from the first line of standard input.
+    #[arg(long)]
+    pub password_stdin: bool,
+}
+
+/// The first line of standard input, without its line end (a password).
+pub fn stdin_line() -> CliResult<String> {
+    let mut line = String::new();
+    std::io::stdin()
+        .read_line(&mut line)
+        .map_err(|e| crate::error::CliError::Usage(format!("cannot read the password from standard input: {e}")))?;
+    while line.ends_with('\n') || line.ends_with('\r') {
+        line.pop();
+    }
+    Ok(line)
+}
+
+/// A password typed at the terminal without echo (`prompt` printed on the terminal), or a usage
+/// error saying where else a password may come from.
+pub fn prompt_password(prompt: &str, alternatives: &str) -> CliResult<String> {
+    use std::io::IsTerminal;
+    if !std::io::stdin().is_terminal() {
+        return Err(crate::error::CliError::Usage(format!(
+            "no password: not at a terminal; give it with {alternatives}"
+        )));
+    }
+    rpassword::prompt_password(prompt)
+        .map_err(|e| crate::error::CliError::Usage(format!("cannot read the password at the terminal: {e}")))
+}
+
+impl AuthArgs {
+    /// The account name given (`--user`, else GYROLAB_USER), if any.
+    pub fn user(&self) -> Option<String> {
+        self.user.clone().filter(|u| !u.is_empty()).or_else(|| std::env::var(USER_ENV).ok().filter(|u| !u.is_empty()))
+    }
+
+    /// The credentials (name, password) when an account is named; `stdin_free`: whether
+    /// `--password-stdin` may read this password (false when standard input carries another).
+    pub fn credentials(&self, stdin_free: bool) -> CliResult<Option<(String, String)>> {
+        let Some(user) = self.user() else {
+            if self.password_stdin && stdin_free {
+                return Err(crate::error::CliError::Usage(
+                    "--password-stdin without an account: name it with --user NAME or GYROLAB_USER".into(),
+                ));
+            }
+            return Ok(None);
+        };
+        let password = if self.password_stdin && stdin_free {
+            stdin_line()?
+        } else if let Ok(p) = std::env::var(PASSWORD_ENV) {
+            p
+        } else {
+            prompt_password(&format!("Password of {user}: "), &format!("{PASSWORD_ENV} or --password-stdin"))?
+        };
+        Ok(Some((user, password)))
+    }
+}

@@ -706,11 +706,21 @@ fn write_conditions(h: &mut String, t: &TestConditions, equipment: &[EquipmentRo
     h.push_str("</tbody></table>\n");
 }
 
+/// The comment lines around the sign-off block: `gyrolab store issue` replaces everything
+/// between them (both included) with the issued report's signature block (crate gyrolab-store,
+/// `issue`).
+pub const SIGNATURE_BLOCK_BEGIN: &str = "<!-- gyrolab:signature-block:begin -->";
+/// See [`SIGNATURE_BLOCK_BEGIN`].
+pub const SIGNATURE_BLOCK_END: &str = "<!-- gyrolab:signature-block:end -->";
+
 /// The sign-off block: who tested and who approves, each with a signature and a date to fill
-/// in by hand.
+/// in by hand, marked DRAFT (a report is issued, numbered and signed by `gyrolab store issue`,
+/// which replaces this block between its markers).
 fn write_sign_off(h: &mut String, t: &TestConditions) {
     let name = |v: &Option<String>| v.as_deref().map_or(String::new(), escape);
-    h.push_str("<section class=\"sign-off\">\n<h2>Sign-off</h2>\n<table class=\"sign-off\"><thead><tr><th class=\"name\">role</th><th class=\"name\">name</th><th class=\"name\">signature</th><th class=\"name\">date</th></tr></thead><tbody>\n");
+    h.push_str(SIGNATURE_BLOCK_BEGIN);
+    h.push('\n');
+    h.push_str("<section class=\"sign-off\">\n<h2>Sign-off</h2>\n<p class=\"note\"><b>DRAFT: not issued.</b> An issued report carries its report number, issue date and electronic signature here (gyrolab store issue).</p>\n<table class=\"sign-off\"><thead><tr><th class=\"name\">role</th><th class=\"name\">name</th><th class=\"name\">signature</th><th class=\"name\">date</th></tr></thead><tbody>\n");
     for (role, who) in [("tested by", &t.operator), ("approved by", &t.approver)] {
         let _ = writeln!(
             h,
@@ -719,6 +729,8 @@ fn write_sign_off(h: &mut String, t: &TestConditions) {
         );
     }
     h.push_str("</tbody></table>\n</section>\n");
+    h.push_str(SIGNATURE_BLOCK_END);
+    h.push('\n');
 }
 
 /// The printed page's margin boxes: the report number at the foot of every page and "page x of

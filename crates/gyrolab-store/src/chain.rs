@@ -1,7 +1,8 @@
 //! The hash chain over every stored record (issue 53; docs/STORE.md "Threat model and checks").
 //!
 //! Every row the store inserts into a record table ([`CHAINED`]: `evaluation`, `input_file`,
-//! `report_file`, `figure`; approvals and corrections are `evaluation` rows) gets one link in the
+//! `report_file`, `figure`; approvals and corrections are `evaluation` rows; from schema version
+//! 4 also `account`, `account_change`, `audit_event`, `signing_key` and `issue`) gets one link in the
 //! append-only table `chain` (`seq`, `tbl`, `row_id`, `fields`, `hash`), computed here in Rust,
 //! inside the transaction that inserts the row, from the row **as read back** from the database:
 //!
@@ -21,8 +22,10 @@
 //! the check names the columns that differ.
 //!
 //! Links are appended per evaluation in one order: the `evaluation` row, then its `input_file`,
-//! `report_file` and `figure` rows, each by `id`. Migration 3 builds the chain over the rows of
-//! an existing store in that order, evaluations by `id` ([`build_existing`]).
+//! `report_file` and `figure` rows, each by `id`, then its audit event; an account, an account
+//! change, a signing key or an issue is chained when it is inserted, then its audit event
+//! ([`append_row`]). Migration 3 builds the chain over the rows of an existing store in that
+//! order, evaluations by `id` ([`build_existing`]).
 
 use crate::db::{Column, Exec, Kind, Val};
 use crate::schema;
@@ -41,7 +44,7 @@ pub struct ChainedTable {
 use Kind::{IOpt, B, F, T};
 
 /// Every table whose rows are records, in the order an evaluation's rows are chained.
-pub const CHAINED: [ChainedTable; 4] = [
+pub const CHAINED: [ChainedTable; 9] = [
     ChainedTable {
         name: "evaluation",
         columns: &[
@@ -100,7 +103,77 @@ pub const CHAINED: [ChainedTable; 4] = [
             ("simulated", IOpt),
         ],
     },
+    // Schema version 4 (issue 53): accounts, their changes, the audit trail, the lab's public
+    // keys and issued reports, each row chained when the store inserts it ([`append_row`]).
+    ChainedTable {
+        name: "account",
+        columns: &[
+            ("id", IOpt),
+            ("name", T),
+            ("display_name", T),
+            ("role", T),
+            ("password_hash", T),
+            ("created_at", T),
+            ("created_by", T),
+        ],
+    },
+    ChainedTable {
+        name: "account_change",
+        columns: &[
+            ("id", IOpt),
+            ("account_id", IOpt),
+            ("change", T),
+            ("password_hash", T),
+            ("changed_at", T),
+            ("changed_by", IOpt),
+        ],
+    },
+    ChainedTable {
+        name: "audit_event",
+        columns: &[
+            ("id", IOpt),
+            ("at", T),
+            ("account_id", IOpt),
+            ("actor", T),
+            ("action", T),
+            ("evaluation_id", IOpt),
+            ("detail", T),
+        ],
+    },
+    ChainedTable {
+        name: "signing_key",
+        columns: &[("id", IOpt), ("public_key", T), ("fingerprint", T), ("added_at", T), ("added_by", T)],
+    },
+    ChainedTable {
+        name: "issue",
+        columns: &[
+            ("id", IOpt),
+            ("evaluation_id", IOpt),
+            ("report_number", T),
+            ("issued_at", T),
+            ("signer_account_id", IOpt),
+            ("signer_name", T),
+            ("signer_display_name", T),
+            ("signer_role", T),
+            ("meaning", T),
+            ("key_fingerprint", T),
+            ("chain_head", T),
+            ("issue_json", T),
+            ("report_html_zstd", B),
+            ("manifest", T),
+            ("signature", T),
+            ("amends", IOpt),
+            ("amendment_no", IOpt),
+            ("amend_reason", T),
+            ("superseded_issue_json", T),
+            ("superseded_manifest", T),
+            ("superseded_signature", T),
+        ],
+    },
 ];
+
+/// How many of [`CHAINED`]'s tables (the first ones) hold an evaluation's rows.
+pub const EVALUATION_TABLES: usize = 4;
 
 /// How many of the last links the quick check (every write) verifies.
 pub const QUICK_LINKS: i64 = 32;
@@ -205,7 +278,7 @@ fn columns_sql(t: &ChainedTable) -> String {
 /// The rows of one evaluation in chain order: (table, row).
 fn evaluation_rows(x: &mut dyn Exec, eval_id: i64) -> Result<Vec<(&'static ChainedTable, Vec<Val>)>, String> {
     let mut out = Vec::new();
-    for t in &CHAINED {
+    for t in &CHAINED[..EVALUATION_TABLES] {
         let filter = if t.name == "evaluation" { "id" } else { "evaluation_id" };
         // ok: table and column names from the constant CHAINED spec, the id a bound parameter
         let sql = format!("SELECT {} FROM {} WHERE {filter} = $1 ORDER BY id", columns_sql(t), t.name);
@@ -265,6 +338,33 @@ pub fn append_evaluation(x: &mut dyn Exec, eval_id: i64) -> Result<String, Strin
         &[Column::I(seqs), Column::T(tbls), Column::I(ids), Column::T(fields), Column::T(hashes)],
     )?;
     Ok(hex(&prev))
+}
+
+/// Appends the link of one row of `table` (inside the transaction that inserted it: an account,
+/// an account change, an audit event, a signing key, an issue); the new head.
+pub fn append_row(x: &mut dyn Exec, table_name: &str, id: i64) -> Result<String, String> {
+    let t = table(table_name).ok_or_else(|| format!("'{table_name}' is not a chained table"))?;
+    let row = read_row(x, t, id)?.ok_or_else(|| format!("{table_name} row {id} is not there to be chained"))?;
+    let (seq, prev) = head(x)?;
+    let seq = seq + 1;
+    let hash = link_hash(&prev, seq, &row_digest(t, &row));
+    x.exec(
+        "INSERT INTO chain (seq, tbl, row_id, fields, hash) VALUES ($1, $2, $3, $4, $5)",
+        &[
+            Val::I(seq),
+            Val::T(Some(t.name.to_string())),
+            Val::I(id),
+            Val::T(Some(field_digests(t, &row))),
+            Val::T(Some(hex(&hash))),
+        ],
+    )?;
+    Ok(hex(&hash))
+}
+
+/// The chain head (hex) as it is now, none for an empty chain.
+pub fn current_head(x: &mut dyn Exec) -> Result<Option<String>, String> {
+    let (n, h) = head(x)?;
+    Ok((n > 0).then(|| hex(&h)))
 }
 
 /// Builds the chain over every row of a store that had none (migration 3): evaluations by id,
@@ -812,6 +912,6 @@ mod tests {
         assert_eq!(s.iter().filter(|(_, n, _)| n == "figure_kept").count(), 1);
         let p = expected_triggers(true);
         assert!(p.iter().any(|(t, n, _)| t == "figure" && n == "figure_not_truncated"));
-        assert_eq!(p.len(), 10);
+        assert_eq!(p.len(), 20);
     }
 }

@@ -7,18 +7,24 @@
 //! [`record`] what is kept of one evaluation, read from a finished report folder; [`query`] the
 //! queries and their statistics (computed by the core crate: `gyrolab::process_capability`,
 //! `gyrolab::control_chart`, `gyrolab::two_sample`); [`tables`] query results as tables;
-//! [`export`] tables as CSV and Parquet.
+//! [`export`] tables as CSV and Parquet; [`chain`] the hash chain and the checks; [`account`]
+//! accounts, roles, authentication and the audit trail; [`sign`] the lab's Ed25519 key files and
+//! signatures; [`issue`] issued reports and amendments (issue 53).
 
+pub mod account;
 pub mod chain;
 pub mod db;
 pub mod export;
+pub mod issue;
 pub mod location;
 pub mod query;
 pub mod record;
 pub mod reevaluate;
 pub mod schema;
+pub mod sign;
 pub mod tables;
 
+pub use account::{Account, Actor, AuditEvent, Role};
 pub use chain::{CheckReport, Problem};
 use db::{Column, Exec, Kind, PgExec, PgStatements, SqliteExec, Val};
 pub use location::{parse_location, Location, LocationError};
@@ -88,6 +94,13 @@ pub enum StoreError {
         first: String,
         /// How many more, as text (empty when none).
         more: String,
+    },
+    /// Authentication refused: an unknown name, a wrong password or a disabled account, never
+    /// saying which (exit code 2).
+    #[error("store {store}: {}", account::AUTH_FAILED)]
+    Auth {
+        /// The store, password masked.
+        store: String,
     },
     /// The database failed during an operation (exit code 1; the transaction was rolled back).
     #[error("store {store}: {message}")]
@@ -409,12 +422,201 @@ impl Store {
         })
     }
 
-    /// Stores one evaluation (a new original record) in one transaction; its id.
+    /// Stores one evaluation (a new original record) in one transaction, without an account (a
+    /// store that has accounts refuses it: see [`Store::add_as`]); its id.
     pub fn add(&mut self, record: &EvaluationRecord) -> StoreResult<i64> {
-        self.insert(record, None)
+        self.insert(record, None, &Actor::unauthenticated())
     }
 
-    pub(crate) fn insert(&mut self, record: &EvaluationRecord, revision: Option<&Revision>) -> StoreResult<i64> {
+    /// Stores one evaluation as `actor` (an account that may store, or no account in a store
+    /// that has none), recording who and the database's time in the audit trail; its id.
+    pub fn add_as(&mut self, record: &EvaluationRecord, actor: &Actor) -> StoreResult<i64> {
+        self.insert(record, None, actor)
+    }
+
+    /// Authenticates `name` with `password` (Argon2id against the stored hash): the actor for
+    /// later writes, or [`StoreError::Auth`] whatever was wrong (unknown name, wrong password,
+    /// disabled account).
+    pub fn authenticate(&mut self, name: &str, password: &str) -> StoreResult<Actor> {
+        let store = self.name.clone();
+        let found = self.transaction(|x| {
+            account::authenticate(x, name, password)
+                .map_err(|m| StoreError::Database { store: store.clone(), message: m })
+        })?;
+        found.map(|(a, hash)| Actor::of(a, hash)).map_err(|()| StoreError::Auth { store: self.name.clone() })
+    }
+
+    /// Whether the store has any account (then every write needs one).
+    pub fn has_accounts(&mut self) -> StoreResult<bool> {
+        let store = self.name.clone();
+        self.transaction(|x| account::any(x).map_err(|m| StoreError::Database { store: store.clone(), message: m }))
+    }
+
+    /// Every account as it stands now (no password hashes).
+    pub fn accounts(&mut self) -> StoreResult<Vec<Account>> {
+        let store = self.name.clone();
+        self.transaction(|x| {
+            account::accounts(x)
+                .map(|v| v.into_iter().map(|(a, _)| a).collect())
+                .map_err(|m| StoreError::Database { store: store.clone(), message: m })
+        })
+    }
+
+    /// The audit trail of evaluation `id` (every event with `None`), oldest first.
+    pub fn audit_events(&mut self, id: Option<i64>) -> StoreResult<Vec<AuditEvent>> {
+        let store = self.name.clone();
+        self.transaction(|x| {
+            account::events(x, id).map_err(|m| StoreError::Database { store: store.clone(), message: m })
+        })
+    }
+
+    /// Runs `f` in a write transaction: the chain's lock (PostgreSQL), the quick check, then `f`.
+    pub(crate) fn write<T>(&mut self, f: impl FnOnce(&mut dyn Exec, &str) -> StoreResult<T>) -> StoreResult<T> {
+        let store = self.name.clone();
+        let postgres = self.is_postgres();
+        let dberr = |m: String| StoreError::Database { store: store.clone(), message: m };
+        let out = self.transaction(|x| {
+            if postgres {
+                x.exec("SELECT pg_advisory_xact_lock(7291836)", &[]).map_err(&dberr)?;
+            }
+            let quick = chain::quick_check(x, postgres).map_err(&dberr)?;
+            if let Some(first) = quick.problems.first() {
+                let more = match quick.problems.len() - 1 {
+                    0 => String::new(),
+                    n => format!(" (and {n} more)"),
+                };
+                return Err(StoreError::Tampered { store: store.clone(), first: first.to_string(), more });
+            }
+            f(x, &store)
+        });
+        out.map_err(|e| match e {
+            StoreError::Database { store, message } => StoreError::Database { store, message: self.mask(message) },
+            other => other,
+        })
+    }
+
+    /// Adds an account. The first account of a store must be an admin and needs no actor
+    /// (`actor` unauthenticated); every later one is added by an authenticated admin. Its id.
+    pub fn add_account(
+        &mut self,
+        actor: &Actor,
+        name: &str,
+        display_name: &str,
+        role: Role,
+        password: &str,
+    ) -> StoreResult<i64> {
+        account::check_new(name, display_name, password)
+            .map_err(|m| StoreError::Refused { store: self.name.clone(), message: m })?;
+        let hash = account::hash_password(password).map_err(|m| self.db_error(m))?;
+        self.write(|x, store| {
+            let dberr = |m: String| StoreError::Database { store: store.to_string(), message: m };
+            let refused = |m: String| StoreError::Refused { store: store.to_string(), message: m };
+            let first = !account::any(x).map_err(dberr)?;
+            let (by_id, by) = if first {
+                if role != Role::Admin {
+                    return Err(refused(format!(
+                        "the first account of a store must be an admin (--role admin), not {}",
+                        role.as_str()
+                    )));
+                }
+                (None, UNAUTHENTICATED_FIRST.to_string())
+            } else {
+                account::check_actor(x, store, actor, account::Need::Admin)?
+            };
+            if account::by_name(x, name).map_err(dberr)?.is_some() {
+                return Err(refused(format!("an account named {name:?} exists already")));
+            }
+            let rows = x
+                .query(
+                    "INSERT INTO account (name, display_name, role, password_hash, created_by) VALUES ($1, $2, $3, $4, $5) RETURNING id",
+                    &[
+                        Val::T(Some(name.to_string())),
+                        Val::T(Some(display_name.to_string())),
+                        Val::T(Some(role.as_str().to_string())),
+                        Val::T(Some(hash.clone())),
+                        Val::T(Some(by.clone())),
+                    ],
+                    &[Kind::I],
+                )
+                .map_err(dberr)?;
+            let id = rows.first().map(|r| r[0].int()).ok_or_else(|| dberr("no id returned".into()))?;
+            chain::append_row(x, "account", id).map_err(dberr)?;
+            account::audit(x, by_id, &by, "user add", None, Some(&format!("{name} ({})", role.as_str())))
+                .map_err(dberr)?;
+            Ok(id)
+        })
+    }
+
+    /// Disables an account (an admin; a new `account_change` row: it can no longer authenticate).
+    pub fn disable_account(&mut self, actor: &Actor, name: &str) -> StoreResult<()> {
+        self.change_account(actor, name, None)
+    }
+
+    /// Sets a new password of an account (an admin; a new `account_change` row).
+    pub fn reset_password(&mut self, actor: &Actor, name: &str, password: &str) -> StoreResult<()> {
+        account::check_password(password).map_err(|m| StoreError::Refused { store: self.name.clone(), message: m })?;
+        let hash = account::hash_password(password).map_err(|m| self.db_error(m))?;
+        self.change_account(actor, name, Some(hash))
+    }
+
+    fn change_account(&mut self, actor: &Actor, name: &str, password_hash: Option<String>) -> StoreResult<()> {
+        self.write(|x, store| {
+            let dberr = |m: String| StoreError::Database { store: store.to_string(), message: m };
+            let (by_id, by) = account::check_actor(x, store, actor, account::Need::Admin)?;
+            let by_id = by_id.ok_or_else(|| StoreError::Auth { store: store.to_string() })?;
+            let Some((target, _)) = account::by_name(x, name).map_err(dberr)? else {
+                return Err(StoreError::NotFound { store: store.to_string(), message: format!("no account {name:?}") });
+            };
+            let change = if password_hash.is_some() { "password" } else { "disable" };
+            if change == "disable" && target.disabled {
+                return Err(StoreError::Refused {
+                    store: store.to_string(),
+                    message: format!("account {name:?} is disabled already"),
+                });
+            }
+            let rows = x
+                .query(
+                    "INSERT INTO account_change (account_id, change, password_hash, changed_by) VALUES ($1, $2, $3, $4) RETURNING id",
+                    &[Val::I(target.id), Val::T(Some(change.into())), Val::T(password_hash.clone()), Val::I(by_id)],
+                    &[Kind::I],
+                )
+                .map_err(dberr)?;
+            let id = rows.first().map(|r| r[0].int()).ok_or_else(|| dberr("no id returned".into()))?;
+            chain::append_row(x, "account_change", id).map_err(dberr)?;
+            let action = if change == "disable" { "user disable" } else { "user reset" };
+            account::audit(x, Some(by_id), &by, action, None, Some(name)).map_err(dberr)?;
+            Ok(())
+        })
+    }
+
+    /// Records the lab's public key (an admin, or no account in the store), so that issues can be
+    /// signed with its private key; its fingerprint.
+    pub fn add_signing_key(&mut self, actor: &Actor, key: &ed25519_dalek::VerifyingKey) -> StoreResult<String> {
+        let fingerprint = sign::fingerprint(key);
+        let public = sign::public_hex(key);
+        self.write(|x, store| {
+            let dberr = |m: String| StoreError::Database { store: store.to_string(), message: m };
+            let (by_id, by) = account::check_actor(x, store, actor, account::Need::Admin)?;
+            let rows = x
+                .query(
+                    "INSERT INTO signing_key (public_key, fingerprint, added_by) VALUES ($1, $2, $3) RETURNING id",
+                    &[Val::T(Some(public.clone())), Val::T(Some(fingerprint.clone())), Val::T(Some(by.clone()))],
+                    &[Kind::I],
+                )
+                .map_err(dberr)?;
+            let id = rows.first().map(|r| r[0].int()).ok_or_else(|| dberr("no id returned".into()))?;
+            chain::append_row(x, "signing_key", id).map_err(dberr)?;
+            account::audit(x, by_id, &by, "key add", None, Some(&fingerprint)).map_err(dberr)?;
+            Ok(fingerprint.clone())
+        })
+    }
+
+    pub(crate) fn insert(
+        &mut self,
+        record: &EvaluationRecord,
+        revision: Option<&Revision>,
+        actor: &Actor,
+    ) -> StoreResult<i64> {
         if let Err(m) = record.check() {
             return Err(StoreError::Refused { store: self.name.clone(), message: m });
         }
@@ -439,6 +641,29 @@ impl Store {
                     n => format!(" (and {n} more)"),
                 };
                 return Err(StoreError::Tampered { store: store.clone(), first: first.to_string(), more });
+            }
+            let need = match revision.map(|r| r.kind) {
+                Some(RevisionKind::Approval) => account::Need::Approver,
+                _ => account::Need::Store,
+            };
+            // A store without accounts keeps its free-text approvals (no account to check).
+            let need = if need == account::Need::Approver && actor.account().is_none() {
+                account::Need::Store
+            } else {
+                need
+            };
+            let (account_id, actor_name) = account::check_actor(x, &store, actor, need)?;
+            if let (Some(r), Some(me)) = (revision, account_id) {
+                if r.kind == RevisionKind::Approval && issue::stored_by(x, r.supersedes).map_err(&dberr)?.contains(&me) {
+                    return Err(StoreError::Refused {
+                        store: store.clone(),
+                        message: format!(
+                            "self-approval refused: account {actor_name:?} stored evaluation {} or a revision of it; \
+                             another approver must approve it",
+                            r.supersedes
+                        ),
+                    });
+                }
             }
             let t = |s: &str| Val::T(Some(s.to_string()));
             let o = |s: &Option<String>| Val::T(s.clone());
@@ -556,6 +781,11 @@ impl Store {
             )
             .map_err(&dberr)?;
             chain::append_evaluation(x, id).map_err(&dberr)?;
+            let (action, detail) = match revision {
+                Some(r) => (r.kind.as_str(), Some(format!("supersedes {}: {}", r.supersedes, r.reason))),
+                None => ("store", None),
+            };
+            account::audit(x, account_id, &actor_name, action, Some(id), detail.as_deref()).map_err(&dberr)?;
             pause_for_test();
             Ok(id)
         });
@@ -573,6 +803,18 @@ impl Store {
         revision: &Revision,
         changes: &Changes,
         record: Option<&EvaluationRecord>,
+    ) -> StoreResult<i64> {
+        self.revise_as(revision, changes, record, &Actor::unauthenticated())
+    }
+
+    /// [`Store::revise`] as `actor` (an approval needs an approver who did not store the
+    /// evaluation or a revision of it, once the store has accounts).
+    pub fn revise_as(
+        &mut self,
+        revision: &Revision,
+        changes: &Changes,
+        record: Option<&EvaluationRecord>,
+        actor: &Actor,
     ) -> StoreResult<i64> {
         let mut rec = match record {
             Some(r) => r.clone(),
@@ -598,7 +840,7 @@ impl Store {
         } else if let Some(v) = &changes.approver {
             rec.approver = Some(v.clone());
         }
-        self.insert(&rec, Some(revision))
+        self.insert(&rec, Some(revision), actor)
     }
 
     /// Writes the stored report folder of evaluation `id` to `out` (see [`query::write_report`]).
@@ -653,12 +895,30 @@ impl Store {
 /// default is `gyrolab.db` beside the plan), created when missing: the evaluation's id and the
 /// store's name (password masked). Shared by `gyrolab store add` and `gyrolab eval --store`.
 pub fn add_report_folder(dir: &Path, plan: Option<&Path>, location: Option<&str>) -> StoreResult<(i64, String)> {
+    add_report_folder_as(dir, plan, location, None)
+}
+
+/// [`add_report_folder`] as the account `credentials` (name, password) authenticates, or
+/// without an account (`None`: a store that has accounts refuses it).
+pub fn add_report_folder_as(
+    dir: &Path,
+    plan: Option<&Path>,
+    location: Option<&str>,
+    credentials: Option<(&str, &str)>,
+) -> StoreResult<(i64, String)> {
     let rec = record::from_report_folder(dir, plan)?;
     let plan_dir = Path::new(&rec.plan_path).parent().filter(|p| !p.as_os_str().is_empty()).map(Path::to_path_buf);
     let mut store = Store::open_for_writing(&resolve_location(location, plan_dir.as_deref()), true)?;
-    let id = store.add(&rec)?;
+    let actor = match credentials {
+        Some((user, password)) => store.authenticate(user, password)?,
+        None => Actor::unauthenticated(),
+    };
+    let id = store.add_as(&rec, &actor)?;
     Ok((id, store.name().to_string()))
 }
+
+/// Recorded as the creator of a store's first account (made without authentication).
+const UNAUTHENTICATED_FIRST: &str = "local (the store's first account)";
 
 /// Kinds of revision.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]

@@ -171,6 +171,8 @@ pub struct HistoryRow {
     /// The figure.
     #[serde(flatten)]
     pub figure: FigureRecord,
+    /// The evaluation's report: `DRAFT`, `ISSUED <number>`, or `SUPERSEDED <number> by <number>`.
+    pub report: String,
 }
 
 /// Every figure of every evaluation (all revisions) of a serial, oldest first.
@@ -217,9 +219,26 @@ pub fn history(store: &mut Store, serial: &str) -> StoreResult<Vec<HistoryRow>> 
             });
         }
     }
+    let issued: HashMap<i64, String> = store
+        .query(
+            "SELECT i.evaluation_id, i.report_number, (SELECT s.report_number FROM issue s WHERE s.amends = i.id) FROM issue i \
+             JOIN evaluation e ON e.id = i.evaluation_id WHERE e.serial = $1",
+            &[Val::T(Some(serial.to_string()))],
+            &[Kind::I, Kind::T, Kind::T],
+        )?
+        .into_iter()
+        .map(|r| {
+            let status = match r[2].text() {
+                Some(by) => format!("SUPERSEDED {} by {by}", r[1].string()),
+                None => format!("ISSUED {}", r[1].string()),
+            };
+            (r[0].int(), status)
+        })
+        .collect();
     Ok(rows
         .into_iter()
         .map(|r| HistoryRow {
+            report: issued.get(&r[0].int()).cloned().unwrap_or_else(|| "DRAFT".into()),
             evaluation: r[0].int(),
             supersedes: r[1].text().and_then(|s| s.parse().ok()),
             current: r[2].int() == 1,
@@ -630,8 +649,14 @@ fn read_report_files(store: &mut Store, id: i64) -> StoreResult<Vec<(String, Opt
 
 /// Writes the stored report folder of evaluation `id` to `out` (every file or none; each checked
 /// against its SHA-256 first); the files written.
+/// An issued evaluation's folder is the issued one (crate::issue: the signed manifest, manifest.sig
+/// and issue.json, superseded when amended), every file checked against the signed manifest and
+/// the signature against the lab key recorded in the store.
 pub fn write_report(store: &mut Store, id: i64, out: &std::path::Path) -> StoreResult<Vec<std::path::PathBuf>> {
-    let files = report_files(store, id)?;
+    let files = match store.issued_files(id)? {
+        Some(f) => f,
+        None => report_files(store, id)?,
+    };
     let refs: Vec<(&str, &[u8])> = files.iter().map(|(n, b)| (n.as_str(), b.as_slice())).collect();
     gyrolab_io::atomic::write_folder(out, &refs, &[])
         .map_err(|e| StoreError::Input { path: e.path.display().to_string(), message: e.to_string() })

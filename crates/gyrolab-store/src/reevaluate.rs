@@ -32,6 +32,18 @@ pub struct Reevaluation {
 /// Re-evaluates evaluation `id` (which must be current) into the report folder `out` and stores
 /// the result as its revision by `by` for `reason`.
 pub fn reevaluate(store: &mut Store, id: i64, by: &str, reason: &str, out: &Path) -> StoreResult<Reevaluation> {
+    reevaluate_as(store, id, by, reason, out, &crate::Actor::unauthenticated())
+}
+
+/// [`reevaluate`] as `actor` (recorded in the audit trail; a store with accounts needs one).
+pub fn reevaluate_as(
+    store: &mut Store,
+    id: i64,
+    by: &str,
+    reason: &str,
+    out: &Path,
+    actor: &crate::Actor,
+) -> StoreResult<Reevaluation> {
     let old = store.evaluation(id)?;
     if let Some(later) = old.superseded_by {
         return Err(StoreError::Refused {
@@ -86,7 +98,7 @@ pub fn reevaluate(store: &mut Store, id: i64, by: &str, reason: &str, out: &Path
     new.test_date = rec.test_date.clone();
     let revision =
         Revision { supersedes: id, kind: RevisionKind::Reevaluation, by: by.to_string(), reason: reason.to_string() };
-    let new_id = store.revise(&revision, &Changes::default(), Some(&new))?;
+    let new_id = store.revise_as(&revision, &Changes::default(), Some(&new), actor)?;
     Ok(Reevaluation {
         superseded: id,
         revision: new_id,

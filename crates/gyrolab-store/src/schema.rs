@@ -3,7 +3,7 @@
 //! from version N - 1 to N; `gyrolab_schema` keeps one row per applied version (docs/STORE.md).
 
 /// The schema version this build writes and reads.
-pub const SCHEMA_VERSION: i64 = 3;
+pub const SCHEMA_VERSION: i64 = 4;
 
 /// SQLite migrations, by version (index 0 = version 1).
 pub const SQLITE_MIGRATIONS: &[&str] = &[
@@ -114,6 +114,84 @@ CREATE TRIGGER report_file_kept_r BEFORE INSERT ON report_file WHEN EXISTS (SELE
 CREATE TRIGGER figure_kept_r BEFORE INSERT ON figure WHEN EXISTS (SELECT 1 FROM figure WHERE rowid = NEW.rowid OR id = NEW.id) BEGIN SELECT RAISE(ABORT, 'gyrolab records are never replaced'); END;
 CREATE TRIGGER chain_kept_r BEFORE INSERT ON chain WHEN EXISTS (SELECT 1 FROM chain WHERE seq = NEW.seq OR (tbl = NEW.tbl AND row_id = NEW.row_id)) BEGIN SELECT RAISE(ABORT, 'gyrolab records are never replaced'); END;
 "#,
+    // 4 (issue 53): accounts, the audit trail, the lab's public keys and issued reports. Every
+    // row is a record (chained, never changed: a disabled account or a new password is a new
+    // `account_change` row). Times come from the database's clock (the column defaults).
+    r#"
+CREATE TABLE account (
+    id INTEGER PRIMARY KEY AUTOINCREMENT,
+    name TEXT NOT NULL UNIQUE,
+    display_name TEXT NOT NULL,
+    role TEXT NOT NULL CHECK (role IN ('viewer', 'operator', 'approver', 'admin')),
+    password_hash TEXT NOT NULL,
+    created_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
+    created_by TEXT NOT NULL
+);
+CREATE TABLE account_change (
+    id INTEGER PRIMARY KEY AUTOINCREMENT,
+    account_id INTEGER NOT NULL REFERENCES account(id),
+    change TEXT NOT NULL CHECK (change IN ('disable', 'password')),
+    password_hash TEXT,
+    changed_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
+    changed_by INTEGER NOT NULL REFERENCES account(id)
+);
+CREATE INDEX account_change_account ON account_change(account_id);
+CREATE TABLE audit_event (
+    id INTEGER PRIMARY KEY AUTOINCREMENT,
+    at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
+    account_id INTEGER REFERENCES account(id),
+    actor TEXT NOT NULL,
+    action TEXT NOT NULL,
+    evaluation_id INTEGER REFERENCES evaluation(id),
+    detail TEXT
+);
+CREATE INDEX audit_event_evaluation ON audit_event(evaluation_id);
+CREATE TABLE signing_key (
+    id INTEGER PRIMARY KEY AUTOINCREMENT,
+    public_key TEXT NOT NULL UNIQUE,
+    fingerprint TEXT NOT NULL,
+    added_at TEXT NOT NULL DEFAULT (strftime('%Y-%m-%dT%H:%M:%fZ', 'now')),
+    added_by TEXT NOT NULL
+);
+CREATE TABLE issue (
+    id INTEGER PRIMARY KEY AUTOINCREMENT,
+    evaluation_id INTEGER NOT NULL UNIQUE REFERENCES evaluation(id),
+    report_number TEXT NOT NULL UNIQUE,
+    issued_at TEXT NOT NULL,
+    signer_account_id INTEGER NOT NULL REFERENCES account(id),
+    signer_name TEXT NOT NULL,
+    signer_display_name TEXT NOT NULL,
+    signer_role TEXT NOT NULL,
+    meaning TEXT NOT NULL CHECK (meaning IN ('approved', 'reviewed')),
+    key_fingerprint TEXT NOT NULL,
+    chain_head TEXT NOT NULL,
+    issue_json TEXT NOT NULL,
+    report_html_zstd BLOB NOT NULL,
+    manifest TEXT NOT NULL,
+    signature TEXT NOT NULL,
+    amends INTEGER UNIQUE REFERENCES issue(id),
+    amendment_no INTEGER,
+    amend_reason TEXT,
+    superseded_issue_json TEXT,
+    superseded_manifest TEXT,
+    superseded_signature TEXT
+);
+CREATE TRIGGER account_kept BEFORE UPDATE ON account BEGIN SELECT RAISE(ABORT, 'gyrolab records are never changed: store a revision'); END;
+CREATE TRIGGER account_kept_d BEFORE DELETE ON account BEGIN SELECT RAISE(ABORT, 'gyrolab records are never deleted'); END;
+CREATE TRIGGER account_kept_r BEFORE INSERT ON account WHEN EXISTS (SELECT 1 FROM account WHERE id = NEW.id OR name = NEW.name) BEGIN SELECT RAISE(ABORT, 'gyrolab records are never replaced'); END;
+CREATE TRIGGER account_change_kept BEFORE UPDATE ON account_change BEGIN SELECT RAISE(ABORT, 'gyrolab records are never changed: store a revision'); END;
+CREATE TRIGGER account_change_kept_d BEFORE DELETE ON account_change BEGIN SELECT RAISE(ABORT, 'gyrolab records are never deleted'); END;
+CREATE TRIGGER account_change_kept_r BEFORE INSERT ON account_change WHEN EXISTS (SELECT 1 FROM account_change WHERE id = NEW.id) BEGIN SELECT RAISE(ABORT, 'gyrolab records are never replaced'); END;
+CREATE TRIGGER audit_event_kept BEFORE UPDATE ON audit_event BEGIN SELECT RAISE(ABORT, 'gyrolab records are never changed: store a revision'); END;
+CREATE TRIGGER audit_event_kept_d BEFORE DELETE ON audit_event BEGIN SELECT RAISE(ABORT, 'gyrolab records are never deleted'); END;
+CREATE TRIGGER audit_event_kept_r BEFORE INSERT ON audit_event WHEN EXISTS (SELECT 1 FROM audit_event WHERE id = NEW.id) BEGIN SELECT RAISE(ABORT, 'gyrolab records are never replaced'); END;
+CREATE TRIGGER signing_key_kept BEFORE UPDATE ON signing_key BEGIN SELECT RAISE(ABORT, 'gyrolab records are never changed: store a revision'); END;
+CREATE TRIGGER signing_key_kept_d BEFORE DELETE ON signing_key BEGIN SELECT RAISE(ABORT, 'gyrolab records are never deleted'); END;
+CREATE TRIGGER signing_key_kept_r BEFORE INSERT ON signing_key WHEN EXISTS (SELECT 1 FROM signing_key WHERE id = NEW.id OR public_key = NEW.public_key) BEGIN SELECT RAISE(ABORT, 'gyrolab records are never replaced'); END;
+CREATE TRIGGER issue_kept BEFORE UPDATE ON issue BEGIN SELECT RAISE(ABORT, 'gyrolab records are never changed: store a revision'); END;
+CREATE TRIGGER issue_kept_d BEFORE DELETE ON issue BEGIN SELECT RAISE(ABORT, 'gyrolab records are never deleted'); END;
+CREATE TRIGGER issue_kept_r BEFORE INSERT ON issue WHEN EXISTS (SELECT 1 FROM issue WHERE id = NEW.id OR evaluation_id = NEW.evaluation_id OR report_number = NEW.report_number OR amends = NEW.amends) BEGIN SELECT RAISE(ABORT, 'gyrolab records are never replaced (a report number, an evaluation and a report amended are issued once)'); END;
+"#,
 ];
 
 /// PostgreSQL migrations, by version (index 0 = version 1).
@@ -208,8 +286,90 @@ CREATE TRIGGER report_file_not_truncated BEFORE TRUNCATE ON report_file FOR EACH
 CREATE TRIGGER figure_not_truncated BEFORE TRUNCATE ON figure FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
 CREATE TRIGGER chain_not_truncated BEFORE TRUNCATE ON chain FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
 "#,
+    // 4 (issue 53): accounts, the audit trail, the lab's public keys and issued reports (see
+    // SQLITE_MIGRATIONS); times from the server's clock.
+    r#"
+CREATE TABLE account (
+    id BIGINT GENERATED ALWAYS AS IDENTITY PRIMARY KEY,
+    name TEXT NOT NULL UNIQUE,
+    display_name TEXT NOT NULL,
+    role TEXT NOT NULL CHECK (role IN ('viewer', 'operator', 'approver', 'admin')),
+    password_hash TEXT NOT NULL,
+    created_at TEXT NOT NULL DEFAULT (to_char(clock_timestamp() AT TIME ZONE 'UTC', 'YYYY-MM-DD"T"HH24:MI:SS.MS"Z"')),
+    created_by TEXT NOT NULL
+);
+CREATE TABLE account_change (
+    id BIGINT GENERATED ALWAYS AS IDENTITY PRIMARY KEY,
+    account_id BIGINT NOT NULL REFERENCES account(id),
+    change TEXT NOT NULL CHECK (change IN ('disable', 'password')),
+    password_hash TEXT,
+    changed_at TEXT NOT NULL DEFAULT (to_char(clock_timestamp() AT TIME ZONE 'UTC', 'YYYY-MM-DD"T"HH24:MI:SS.MS"Z"')),
+    changed_by BIGINT NOT NULL REFERENCES account(id)
+);
+CREATE INDEX account_change_account ON account_change(account_id);
+CREATE TABLE audit_event (
+    id BIGINT GENERATED ALWAYS AS IDENTITY PRIMARY KEY,
+    at TEXT NOT NULL DEFAULT (to_char(clock_timestamp() AT TIME ZONE 'UTC', 'YYYY-MM-DD"T"HH24:MI:SS.MS"Z"')),
+    account_id BIGINT REFERENCES account(id),
+    actor TEXT NOT NULL,
+    action TEXT NOT NULL,
+    evaluation_id BIGINT REFERENCES evaluation(id),
+    detail TEXT
+);
+CREATE INDEX audit_event_evaluation ON audit_event(evaluation_id);
+CREATE TABLE signing_key (
+    id BIGINT GENERATED ALWAYS AS IDENTITY PRIMARY KEY,
+    public_key TEXT NOT NULL UNIQUE,
+    fingerprint TEXT NOT NULL,
+    added_at TEXT NOT NULL DEFAULT (to_char(clock_timestamp() AT TIME ZONE 'UTC', 'YYYY-MM-DD"T"HH24:MI:SS.MS"Z"')),
+    added_by TEXT NOT NULL
+);
+CREATE TABLE issue (
+    id BIGINT GENERATED ALWAYS AS IDENTITY PRIMARY KEY,
+    evaluation_id BIGINT NOT NULL UNIQUE REFERENCES evaluation(id),
+    report_number TEXT NOT NULL UNIQUE,
+    issued_at TEXT NOT NULL,
+    signer_account_id BIGINT NOT NULL REFERENCES account(id),
+    signer_name TEXT NOT NULL,
+    signer_display_name TEXT NOT NULL,
+    signer_role TEXT NOT NULL,
+    meaning TEXT NOT NULL CHECK (meaning IN ('approved', 'reviewed')),
+    key_fingerprint TEXT NOT NULL,
+    chain_head TEXT NOT NULL,
+    issue_json TEXT NOT NULL,
+    report_html_zstd BYTEA NOT NULL,
+    manifest TEXT NOT NULL,
+    signature TEXT NOT NULL,
+    amends BIGINT UNIQUE REFERENCES issue(id),
+    amendment_no BIGINT,
+    amend_reason TEXT,
+    superseded_issue_json TEXT,
+    superseded_manifest TEXT,
+    superseded_signature TEXT
+);
+CREATE TRIGGER account_kept BEFORE UPDATE OR DELETE ON account FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER account_not_truncated BEFORE TRUNCATE ON account FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER account_change_kept BEFORE UPDATE OR DELETE ON account_change FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER account_change_not_truncated BEFORE TRUNCATE ON account_change FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER audit_event_kept BEFORE UPDATE OR DELETE ON audit_event FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER audit_event_not_truncated BEFORE TRUNCATE ON audit_event FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER signing_key_kept BEFORE UPDATE OR DELETE ON signing_key FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER signing_key_not_truncated BEFORE TRUNCATE ON signing_key FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER issue_kept BEFORE UPDATE OR DELETE ON issue FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER issue_not_truncated BEFORE TRUNCATE ON issue FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
+"#,
 ];
 
 /// The version table (both back ends).
 pub const VERSION_TABLE: &str =
     "CREATE TABLE IF NOT EXISTS gyrolab_schema (version BIGINT NOT NULL PRIMARY KEY, applied_at TEXT NOT NULL, software_version TEXT NOT NULL)";
+
+/// The database's clock as RFC 3339 UTC text to the millisecond (the column defaults of
+/// migration 4 use the same expression): the time every account, audit event and issue records.
+pub fn clock_sql(postgres: bool) -> &'static str {
+    if postgres {
+        "SELECT to_char(clock_timestamp() AT TIME ZONE 'UTC', 'YYYY-MM-DD\"T\"HH24:MI:SS.MS\"Z\"')"
+    } else {
+        "SELECT strftime('%Y-%m-%dT%H:%M:%fZ', 'now')"
+    }
+}

@@ -43,6 +43,7 @@ pub fn history_table(rows: &[query::HistoryRow]) -> Table {
         ("limit_max", N),
         ("verdict", T),
         ("simulated", T),
+        ("report", T),
     ]);
     let body = rows
         .iter()
@@ -65,6 +66,7 @@ pub fn history_table(rows: &[query::HistoryRow]) -> Table {
                 num(r.figure.limit_max),
                 opt(&r.figure.verdict),
                 text(if r.figure.simulated { "SIMULATED" } else { "" }),
+                text(&r.report),
             ]
         })
         .collect();

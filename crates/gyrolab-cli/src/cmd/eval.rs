@@ -3,13 +3,14 @@
 //! when a limit fails, 1 when `--pdf` could not make the PDF. `--store` also keeps the evaluation
 //! in the records store (docs/STORE.md).
 
+use crate::args::AuthArgs;
 use crate::error::{CliError, CliResult};
 use crate::folder::write_and_finish;
 use crate::progress::Bar;
 use clap::Args;
 use gyrolab_eval::test_plan::{evaluate_test_plan, read_test_plan};
 use gyrolab_store::record::{from_report_folder_with, hash_plan_inputs};
-use gyrolab_store::{resolve_location, Store, StoreError};
+use gyrolab_store::{resolve_location, Actor, Store, StoreError};
 use std::path::PathBuf;
 
 /// Options of `gyrolab eval`.
@@ -36,6 +37,9 @@ pub struct EvalArgs {
     /// after the folder is written, also when a limit fails.
     #[arg(long, value_name = "PATH|URL", num_args = 0..=1, default_missing_value = "")]
     pub store: Option<String>,
+    /// With --store: the account that stores the evaluation (a store with accounts needs one).
+    #[command(flatten)]
+    pub auth: AuthArgs,
 }
 
 /// Whether an SQLite store can be created at `location` (a path): its folder exists and takes a
@@ -66,12 +70,38 @@ pub fn run(args: &EvalArgs) -> CliResult {
         let plan_dir = args.plan.parent().filter(|p| !p.as_os_str().is_empty());
         resolve_location(Some(s), plan_dir)
     });
+    // The password is read here, before the evaluation (a prompt, standard input, or
+    // GYROLAB_PASSWORD); the account is authenticated with the store's check, before any output.
+    let credentials = match &location {
+        Some(_) => args.auth.credentials(true)?,
+        None => None,
+    };
     let bar = Bar::new(args.quiet);
     let (folder, prepared) = std::thread::scope(|scope| {
         let preparing = location.as_deref().map(|l| {
             scope.spawn(move || {
                 let store = match Store::open_for_writing(l, false) {
-                    Ok(s) => Ok(Some(s)),
+                    Ok(mut s) => match &credentials {
+                        Some((user, password)) => {
+                            s.authenticate(user, password).map(|a| Some((s, a))).map_err(CliError::from)
+                        }
+                        None => match s.has_accounts() {
+                            Ok(false) => Ok(Some((s, Actor::unauthenticated()))),
+                            Ok(true) => Err(CliError::from(StoreError::Refused {
+                                store: s.name().to_string(),
+                                message:
+                                    "this store has accounts: every write needs one (--user NAME or GYROLAB_USER, \
+                                          the password from GYROLAB_PASSWORD, --password-stdin or a prompt); nothing \
+                                          was written"
+                                        .into(),
+                            })),
+                            Err(e) => Err(CliError::from(e)),
+                        },
+                    },
+                    // A new store has no account to authenticate.
+                    Err(StoreError::NotFound { store, .. }) if credentials.is_some() => {
+                        Err(CliError::from(StoreError::Auth { store }))
+                    }
                     // Created once the folder is written: its folder must take a new file now,
                     // so that a store that cannot be made ends the run before anything is written.
                     Err(StoreError::NotFound { .. }) => creatable(l).map(|()| None),
@@ -98,11 +128,11 @@ pub fn run(args: &EvalArgs) -> CliResult {
             None => None,
         };
         let record = from_report_folder_with(&args.out, Some(&args.plan), inputs)?;
-        let mut s = match store.take() {
+        let (mut s, actor) = match store.take() {
             Some(s) => s,
-            None => Store::open_for_writing(l, true)?,
+            None => (Store::open_for_writing(l, true)?, Actor::unauthenticated()),
         };
-        let id = s.add(&record)?;
+        let id = s.add_as(&record, &actor)?;
         if !args.quiet {
             eprintln!("Stored as evaluation {id} in {}", s.name());
         }

@@ -3,16 +3,18 @@
 //! statistics, lot comparison, control charts, revisions (correction, approval) and
 //! re-evaluation. Arguments to requests and printing only.
 
-use crate::args::{QueryOutput, StoreLocation};
+use crate::args::{prompt_password, stdin_line, AuthArgs, QueryOutput, StoreLocation};
 use crate::error::{CliError, CliResult};
 use crate::output::{print, to_json, write_file};
 use clap::{Args, Subcommand, ValueEnum};
 use gyrolab_report::format::sig_opt;
 use gyrolab_report::plot::{Axis, Figure, Orientation, Panel, RefLine, Series, SeriesStyle};
 use gyrolab_store::export::{to_csv, to_parquet, Cell, Table};
+use gyrolab_store::issue::{IssueRequest, IssuedReport, Meaning};
 use gyrolab_store::tables::{chart_table, compare_table, diff_table, history_table, lot_table};
 use gyrolab_store::{
-    add_report_folder, query, reevaluate, resolve_location, Changes, CheckReport, Revision, RevisionKind, Store,
+    add_report_folder_as, query, reevaluate, resolve_location, sign, Actor, Changes, CheckReport, Revision,
+    RevisionKind, Role, Store,
 };
 use std::path::PathBuf;
 
@@ -48,6 +50,168 @@ pub enum StoreCommand {
     Reevaluate(ReevaluateArgs),
     /// Re-verify the store: its hash chain link by link against the rows, every stored file against its SHA-256, the protecting triggers (exit 3 when broken).
     Check(CheckArgs),
+    /// Accounts: add, list, disable, reset a password (the first account is an admin; then an admin manages them).
+    #[command(subcommand)]
+    User(UserCommand),
+    /// The lab's Ed25519 signing key: `key init --out lab.key` makes one and records its public key.
+    #[command(subcommand)]
+    Key(KeyCommand),
+    /// Issue a draft evaluation: report number, issue date, signature (an approver who did not store it), signed manifest.
+    Issue(IssueArgs),
+    /// Issue a later revision of an issued evaluation as "Amendment N to report R"; the replaced report is marked superseded.
+    Amend(AmendArgs),
+}
+
+/// Meanings of an issuing signature.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum MeaningArg {
+    /// The signer approves the results for issue.
+    Approved,
+    /// The signer reviewed the report.
+    Reviewed,
+}
+
+/// Roles of an account.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum RoleArg {
+    /// Reads only.
+    Viewer,
+    /// Stores evaluations, corrections and re-evaluations.
+    Operator,
+    /// Also issues and amends reports (never their own work).
+    Approver,
+    /// Manages accounts and the lab key.
+    Admin,
+}
+
+/// `gyrolab store user` subcommands.
+#[derive(Debug, Subcommand)]
+pub enum UserCommand {
+    /// Add an account (the store's first must be an admin and needs no authentication).
+    Add(UserAddArgs),
+    /// List the accounts: name, display name, role, disabled, created.
+    List(UserListArgs),
+    /// Disable an account (an admin): it can no longer authenticate.
+    Disable(UserNameArgs),
+    /// Set a new password of an account (an admin).
+    Reset(UserNameArgs),
+}
+
+/// The authenticating admin of a user command: `--user` (or GYROLAB_USER), the password from
+/// GYROLAB_PASSWORD or a prompt (standard input carries the new password).
+#[derive(Debug, Args)]
+pub struct AdminArgs {
+    /// The admin making the change (default: GYROLAB_USER); password from GYROLAB_PASSWORD or a prompt.
+    #[arg(long = "user", value_name = "NAME")]
+    pub user: Option<String>,
+}
+
+/// Options of `gyrolab store user add`.
+#[derive(Debug, Args)]
+pub struct UserAddArgs {
+    /// Login name (letters, digits, . _ - @).
+    pub name: String,
+    /// Role.
+    #[arg(long, value_enum)]
+    pub role: RoleArg,
+    /// Name printed on reports and signatures (default: the login name).
+    #[arg(long, value_name = "TEXT")]
+    pub display_name: Option<String>,
+    /// Read the new account's password from the first line of standard input (else
+    /// GYROLAB_NEW_PASSWORD, else a prompt, twice).
+    #[arg(long)]
+    pub password_stdin: bool,
+    #[command(flatten)]
+    pub admin: AdminArgs,
+    #[command(flatten)]
+    pub location: StoreLocation,
+}
+
+/// Options of `gyrolab store user disable` and `reset`.
+#[derive(Debug, Args)]
+pub struct UserNameArgs {
+    /// The account.
+    pub name: String,
+    /// `reset`: read the new password from the first line of standard input (else
+    /// GYROLAB_NEW_PASSWORD, else a prompt, twice).
+    #[arg(long)]
+    pub password_stdin: bool,
+    #[command(flatten)]
+    pub admin: AdminArgs,
+    #[command(flatten)]
+    pub location: StoreLocation,
+}
+
+/// Options of `gyrolab store user list`.
+#[derive(Debug, Args)]
+pub struct UserListArgs {
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub location: StoreLocation,
+}
+
+/// `gyrolab store key` subcommands.
+#[derive(Debug, Subcommand)]
+pub enum KeyCommand {
+    /// Make the lab's Ed25519 key pair: the private key in --out (mode 0600, never overwritten), the public key beside it (.pub), recorded in the store.
+    Init(KeyInitArgs),
+}
+
+/// Options of `gyrolab store key init`.
+#[derive(Debug, Args)]
+pub struct KeyInitArgs {
+    /// The private key file to write (the public key goes beside it, `.pub`).
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub auth: AuthArgs,
+    #[command(flatten)]
+    pub location: StoreLocation,
+}
+
+/// Options of `gyrolab store issue`.
+#[derive(Debug, Args)]
+pub struct IssueArgs {
+    /// The evaluation to issue (a current, never issued revision).
+    pub id: i64,
+    /// The meaning of the signature.
+    #[arg(long, value_enum)]
+    pub meaning: MeaningArg,
+    /// The lab's private key file (`gyrolab store key init`).
+    #[arg(long, value_name = "FILE")]
+    pub signing_key: PathBuf,
+    /// The report number (default: the store's next GL-YYYY-NNNN); unique in the store.
+    #[arg(long, value_name = "TEXT")]
+    pub report_number: Option<String>,
+    #[command(flatten)]
+    pub auth: AuthArgs,
+    #[command(flatten)]
+    pub location: StoreLocation,
+}
+
+/// Options of `gyrolab store amend`.
+#[derive(Debug, Args)]
+pub struct AmendArgs {
+    /// The issued evaluation (its current revision is issued) or that later revision.
+    pub id: i64,
+    /// Why the report is amended (printed in the amendment).
+    #[arg(long, value_name = "TEXT")]
+    pub reason: String,
+    /// The meaning of the signature.
+    #[arg(long, value_enum, default_value = "approved")]
+    pub meaning: MeaningArg,
+    /// The lab's private key file.
+    #[arg(long, value_name = "FILE")]
+    pub signing_key: PathBuf,
+    /// The amendment's report number (default: the store's next GL-YYYY-NNNN).
+    #[arg(long, value_name = "TEXT")]
+    pub report_number: Option<String>,
+    #[command(flatten)]
+    pub auth: AuthArgs,
+    #[command(flatten)]
+    pub location: StoreLocation,
 }
 
 /// Options of `gyrolab store check`.
@@ -69,6 +233,8 @@ pub struct AddArgs {
     /// The plan of the folders (default: the plan_file each results.json names).
     #[arg(long, value_name = "PLAN.toml")]
     pub plan: Option<PathBuf>,
+    #[command(flatten)]
+    pub auth: AuthArgs,
     #[command(flatten)]
     pub location: StoreLocation,
 }
@@ -155,12 +321,14 @@ pub struct ReviseArgs {
     /// correction or approval.
     #[arg(long, value_enum)]
     pub kind: ReviseKind,
-    /// Who makes the revision (the approver of an approval).
+    /// Who makes the revision (the approver of an approval); with --user, the account (default).
     #[arg(long, value_name = "NAME")]
-    pub by: String,
+    pub by: Option<String>,
     /// Why.
     #[arg(long, value_name = "TEXT")]
     pub reason: String,
+    #[command(flatten)]
+    pub auth: AuthArgs,
     /// Corrected serial.
     #[arg(long)]
     pub serial: Option<String>,
@@ -200,9 +368,11 @@ pub struct ReevaluateArgs {
     /// Folder for the new report.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Who re-evaluates.
+    /// Who re-evaluates; with --user, the account (default).
     #[arg(long, value_name = "NAME")]
-    pub by: String,
+    pub by: Option<String>,
+    #[command(flatten)]
+    pub auth: AuthArgs,
     /// Why.
     #[arg(long, value_name = "TEXT")]
     pub reason: String,
@@ -222,13 +392,219 @@ fn open_for_writing(location: &StoreLocation) -> CliResult<Store> {
     Ok(Store::open_for_writing(&resolve_location(location.store.as_deref(), None), false)?)
 }
 
+/// The actor of a write: the account `auth` names, authenticated, else no account (which a
+/// store with accounts refuses).
+fn actor(s: &mut Store, auth: &AuthArgs) -> CliResult<Actor> {
+    Ok(match auth.credentials(true)? {
+        Some((user, password)) => s.authenticate(&user, &password)?,
+        None => Actor::unauthenticated(),
+    })
+}
+
+/// Who a revision is recorded as made by: the account (a different `--by` refused), else `--by`.
+fn by(actor: &Actor, given: Option<&str>) -> CliResult<String> {
+    match (actor.account(), given) {
+        (Some(a), Some(b)) if b != a.name => Err(CliError::Usage(format!(
+            "--by {b:?}: the revision is made by the authenticated account {:?} (leave --by out)",
+            a.name
+        ))),
+        (Some(a), _) => Ok(a.name.clone()),
+        (None, Some(b)) => Ok(b.to_string()),
+        (None, None) => Err(CliError::Usage("a revision needs who made it (--by NAME, or --user NAME)".into())),
+    }
+}
+
+fn meaning(m: MeaningArg) -> Meaning {
+    match m {
+        MeaningArg::Approved => Meaning::Approved,
+        MeaningArg::Reviewed => Meaning::Reviewed,
+    }
+}
+
+fn read_key(path: &std::path::Path) -> CliResult<gyrolab_store::sign::SigningKey> {
+    sign::read_signing_key(path).map_err(CliError::Usage)
+}
+
+/// The note printed when a revision supersedes an issued evaluation: the new revision is a
+/// draft, issued only as an amendment (empty otherwise).
+fn draft_note(s: &mut Store, superseded: i64, revision: i64) -> CliResult<String> {
+    Ok(match s.issue_of(superseded)? {
+        Some(r) => format!(
+            "evaluation {superseded} is issued as report {}, which stays as issued: evaluation {revision} is a DRAFT \
+             until an approver issues it as an amendment (gyrolab store amend {revision} --reason ...)\n",
+            r.report_number
+        ),
+        None => String::new(),
+    })
+}
+
+/// `gyrolab store issue` and `amend`.
+fn issue(location: &StoreLocation, auth: &AuthArgs, req: &IssueRequest) -> CliResult {
+    let mut s = open_for_writing(location)?;
+    let Some((user, password)) = auth.credentials(true)? else {
+        return Err(CliError::Usage(
+            "issuing needs an approver's account: --user NAME (or GYROLAB_USER) with its password (GYROLAB_PASSWORD, \
+             --password-stdin or a prompt)"
+                .into(),
+        ));
+    };
+    let actor = s.authenticate(&user, &password)?;
+    let r = s.issue(&actor, req)?;
+    let what = match (&r.amends_report, r.amendment_no) {
+        (Some(old), Some(n)) => format!("amendment {n} to report {old} (now SUPERSEDED), "),
+        _ => String::new(),
+    };
+    print(&format!(
+        "issued evaluation {} as report {} ({what}{} by {} ({}), {} UTC), signed with key {}\nstore chain head at \
+         issue: {}\nwrite the issued folder: gyrolab store report {} --out DIR; check it: gyrolab verify DIR \
+         --public-key LAB.pub\n",
+        r.evaluation_id,
+        r.report_number,
+        r.meaning,
+        r.signer_display_name,
+        r.signer,
+        r.issued_at,
+        r.key_fingerprint,
+        r.chain_head,
+        r.evaluation_id
+    ))
+}
+
+/// The new password of `store user add` and `reset`: standard input, GYROLAB_NEW_PASSWORD, or
+/// typed twice at the terminal.
+fn new_password(from_stdin: bool, name: &str) -> CliResult<String> {
+    if from_stdin {
+        return stdin_line();
+    }
+    if let Ok(p) = std::env::var("GYROLAB_NEW_PASSWORD") {
+        return Ok(p);
+    }
+    let alternatives = "--password-stdin or GYROLAB_NEW_PASSWORD";
+    let first = prompt_password(&format!("New password of {name}: "), alternatives)?;
+    let second = prompt_password("The same again: ", alternatives)?;
+    if first != second {
+        return Err(CliError::Usage("the two passwords typed differ; nothing was changed".into()));
+    }
+    Ok(first)
+}
+
+/// The admin of a user or key command, authenticated (the password from GYROLAB_PASSWORD or a
+/// prompt); no account when none is named.
+fn admin(s: &mut Store, a: &AdminArgs) -> CliResult<Actor> {
+    let auth = AuthArgs { user: a.user.clone(), password_stdin: false };
+    Ok(match auth.credentials(false)? {
+        Some((user, password)) => s.authenticate(&user, &password)?,
+        None => Actor::unauthenticated(),
+    })
+}
+
+fn user(cmd: &UserCommand) -> CliResult {
+    match cmd {
+        UserCommand::Add(a) => {
+            let mut s = Store::open_for_writing(&resolve_location(a.location.store.as_deref(), None), true)?;
+            let actor = admin(&mut s, &a.admin)?;
+            let password = new_password(a.password_stdin, &a.name)?;
+            let role = match a.role {
+                RoleArg::Viewer => Role::Viewer,
+                RoleArg::Operator => Role::Operator,
+                RoleArg::Approver => Role::Approver,
+                RoleArg::Admin => Role::Admin,
+            };
+            let display = a.display_name.clone().unwrap_or_else(|| a.name.clone());
+            s.add_account(&actor, &a.name, &display, role, &password)?;
+            print(&format!("added account {} ({}, {}) to {}\n", a.name, display, role.as_str(), s.name()))
+        }
+        UserCommand::List(a) => {
+            let mut s = open(&a.location, false)?;
+            let accounts = s.accounts()?;
+            if a.json {
+                return print(&to_json(&accounts)?);
+            }
+            let mut out = String::from("name\tdisplay name\trole\tstate\tcreated\tcreated by\n");
+            for x in &accounts {
+                out.push_str(&format!(
+                    "{}\t{}\t{}\t{}\t{}\t{}\n",
+                    x.name,
+                    x.display_name,
+                    x.role.as_str(),
+                    if x.disabled { "DISABLED" } else { "active" },
+                    x.created_at,
+                    x.created_by
+                ));
+            }
+            if accounts.is_empty() {
+                out.push_str("(no accounts: writes to this store need no authentication)\n");
+            }
+            print(&out)
+        }
+        UserCommand::Disable(a) => {
+            let mut s = open_for_writing(&a.location)?;
+            let actor = admin(&mut s, &a.admin)?;
+            s.disable_account(&actor, &a.name)?;
+            print(&format!("disabled account {} in {}\n", a.name, s.name()))
+        }
+        UserCommand::Reset(a) => {
+            let mut s = open_for_writing(&a.location)?;
+            let actor = admin(&mut s, &a.admin)?;
+            let password = new_password(a.password_stdin, &a.name)?;
+            s.reset_password(&actor, &a.name, &password)?;
+            print(&format!("set a new password of account {} in {}\n", a.name, s.name()))
+        }
+    }
+}
+
+/// `gyrolab store key init`: the actor checked before any file is written.
+fn key_init(a: &KeyInitArgs) -> CliResult {
+    let mut s = Store::open_for_writing(&resolve_location(a.location.store.as_deref(), None), true)?;
+    let actor = actor(&mut s, &a.auth)?;
+    let allowed = match actor.account() {
+        Some(acc) => acc.role == Role::Admin,
+        None => !s.has_accounts()?,
+    };
+    if !allowed {
+        return Err(CliError::Usage(
+            "the lab key is recorded by an admin: --user NAME of an admin account, with its password".into(),
+        ));
+    }
+    let key = sign::create_key_files(&a.out).map_err(CliError::Usage)?;
+    let fingerprint = s.add_signing_key(&actor, &key)?;
+    print(&format!(
+        "wrote the private key {} (mode 0600: keep it secret, outside the store) and the public key {}\nrecorded \
+         public key {fingerprint} in {}\n",
+        a.out.display(),
+        sign::public_path_for(&a.out).display(),
+        s.name()
+    ))
+}
+
+/// The issue line of `store show`.
+fn issue_line(r: &IssuedReport) -> String {
+    let mut s = format!(
+        "report {} {} {}: {} by {} ({}, {}), key {}\n",
+        r.report_number,
+        r.status(),
+        r.issued_at,
+        r.meaning,
+        r.signer_display_name,
+        r.signer,
+        r.signer_role,
+        r.key_fingerprint
+    );
+    if let (Some(old), Some(n)) = (&r.amends_report, r.amendment_no) {
+        s.push_str(&format!("amendment {n} to report {old}: {}\n", r.amend_reason.as_deref().unwrap_or_default()));
+    }
+    s
+}
+
 /// Runs `gyrolab store`.
 pub fn run(cmd: &StoreCommand) -> CliResult {
     match cmd {
         StoreCommand::Add(a) => {
             let mut out = String::new();
+            let credentials = a.auth.credentials(true)?;
+            let credentials = credentials.as_ref().map(|(u, p)| (u.as_str(), p.as_str()));
             for d in &a.dirs {
-                let (id, name) = add_report_folder(d, a.plan.as_deref(), a.location.store.as_deref())?;
+                let (id, name) = add_report_folder_as(d, a.plan.as_deref(), a.location.store.as_deref(), credentials)?;
                 out.push_str(&format!("stored {} as evaluation {id} in {name}\n", d.display()));
             }
             print(&out)
@@ -236,16 +612,50 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
         StoreCommand::Show(a) => {
             let mut s = open(&a.location, false)?;
             let e = s.evaluation(a.id)?;
+            let issued = s.issue_of(a.id)?;
+            let events = s.audit_events(Some(a.id))?;
             if a.json {
-                return print(&to_json(&e)?);
+                let mut v = serde_json::to_value(&e).map_err(|e| CliError::Output(e.to_string()))?;
+                v["issue"] = serde_json::to_value(&issued).map_err(|e| CliError::Output(e.to_string()))?;
+                v["audit"] = serde_json::to_value(&events).map_err(|e| CliError::Output(e.to_string()))?;
+                return print(&to_json(&v)?);
             }
-            print(&show_text(&e))
+            let mut text = show_text(&e);
+            match &issued {
+                Some(r) => text.push_str(&issue_line(r)),
+                None => text.push_str("report: DRAFT (not issued: gyrolab store issue)\n"),
+            }
+            text.push_str("audit trail (the store's clock):\n");
+            if events.is_empty() {
+                text.push_str("  (none: stored before schema version 4)\n");
+            }
+            for ev in &events {
+                text.push_str(&format!(
+                    "  {} {} by {}{}\n",
+                    ev.at,
+                    ev.action,
+                    ev.actor,
+                    ev.detail.as_deref().map_or_else(String::new, |d| format!(": {d:?}"))
+                ));
+            }
+            print(&text)
         }
         StoreCommand::Report(a) => {
             let mut s = open(&a.location, false)?;
             let written = s.write_report(a.id, &a.out)?;
+            let what = match s.issue_of(a.id)? {
+                Some(r) => format!(
+                    "issued report {} ({}): each file equal to its signed manifest, the signature verified with the \
+                     store's lab key {}; check it with the lab's own public key: gyrolab verify {} --public-key LAB.pub",
+                    r.report_number,
+                    r.status(),
+                    r.key_fingerprint,
+                    a.out.display()
+                ),
+                None => "a DRAFT: each equal to its stored SHA-256".into(),
+            };
             print(&format!(
-                "wrote the {} report file(s) of evaluation {} to {} (each equal to its stored SHA-256)\n",
+                "wrote the {} report file(s) of evaluation {} to {} ({what})\n",
                 written.len(),
                 a.id,
                 a.out.display()
@@ -284,14 +694,49 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
                 approver: None,
                 test_date: a.test_date.clone(),
             };
-            let r = Revision { supersedes: a.id, kind, by: a.by.clone(), reason: a.reason.clone() };
-            let id = s.revise(&r, &changes, None)?;
-            print(&format!("stored {} of evaluation {} as evaluation {id} in {}\n", kind.as_str(), a.id, s.name()))
+            let actor = actor(&mut s, &a.auth)?;
+            let r = Revision { supersedes: a.id, kind, by: by(&actor, a.by.as_deref())?, reason: a.reason.clone() };
+            let id = s.revise_as(&r, &changes, None, &actor)?;
+            let note = draft_note(&mut s, a.id, id)?;
+            print(&format!(
+                "stored {} of evaluation {} as evaluation {id} in {}\n{note}",
+                kind.as_str(),
+                a.id,
+                s.name()
+            ))
         }
         StoreCommand::Check(a) => check(a),
+        StoreCommand::User(u) => user(u),
+        StoreCommand::Key(KeyCommand::Init(a)) => key_init(a),
+        StoreCommand::Issue(a) => {
+            let req = IssueRequest {
+                evaluation: a.id,
+                meaning: meaning(a.meaning),
+                key: &read_key(&a.signing_key)?,
+                report_number: a.report_number.as_deref(),
+                amend_reason: None,
+            };
+            issue(&a.location, &a.auth, &req)
+        }
+        StoreCommand::Amend(a) => {
+            let req = IssueRequest {
+                evaluation: a.id,
+                meaning: meaning(a.meaning),
+                key: &read_key(&a.signing_key)?,
+                report_number: a.report_number.as_deref(),
+                amend_reason: Some(&a.reason),
+            };
+            issue(&a.location, &a.auth, &req)
+        }
         StoreCommand::Reevaluate(a) => {
             let mut s = open_for_writing(&a.location)?;
-            let r = reevaluate::reevaluate(&mut s, a.id, &a.by, &a.reason, &a.out)?;
+            let actor = actor(&mut s, &a.auth)?;
+            let who = by(&actor, a.by.as_deref())?;
+            let r = reevaluate::reevaluate_as(&mut s, a.id, &who, &a.reason, &a.out, &actor)?;
+            let note = draft_note(&mut s, a.id, r.revision)?;
+            if !note.is_empty() {
+                eprint!("{note}");
+            }
             if a.json {
                 return print(&to_json(&r)?);
             }

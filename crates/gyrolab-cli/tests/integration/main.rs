@@ -14,6 +14,7 @@ mod eval;
 mod export;
 mod hostile;
 mod imu_logs;
+mod issue;
 mod pdf;
 mod rate;
 mod raw_log;

@@ -2,6 +2,7 @@
 //! docs/PERFORMANCE.md). Each file is a module; run one with
 //! `cargo test -p gyrolab-store --test integration -- MODULE::`.
 
+mod accounts;
 mod common;
 mod folder;
 mod store;

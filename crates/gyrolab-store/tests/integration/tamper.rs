@@ -415,7 +415,7 @@ fn a_version_2_store_gets_its_chain_on_migration() {
         )
         .unwrap();
         let mut s = Store::open(&b.location, false).unwrap();
-        assert_eq!(s.schema_version().unwrap(), 3);
+        assert_eq!(s.schema_version().unwrap(), gyrolab_store::schema::SCHEMA_VERSION);
         let r = s.check().unwrap();
         assert!(r.is_whole(), "{}: {:?}", b.name, r.problems);
         assert_eq!((r.links, r.files_hash_only), (5, 1), "{}", b.name);
@@ -424,7 +424,8 @@ fn a_version_2_store_gets_its_chain_on_migration() {
         assert_eq!(order, ["evaluation", "input_file", "report_file", "figure", "figure"]);
         s.add(&record("NEW", None, &[("x", "bias_dph", 10.0)])).unwrap();
         let r = s.check().unwrap();
-        assert!(r.is_whole() && r.links == 9, "{}: {} {:?}", b.name, r.links, r.problems);
+        // Four rows of the evaluation and its audit event (schema version 4).
+        assert!(r.is_whole() && r.links == 10, "{}: {} {:?}", b.name, r.links, r.problems);
         assert_eq!(r.triggers_ok.len(), r.triggers_expected);
     }
 }
@@ -460,4 +461,37 @@ fn a_version_2_sqlite_store_with_a_dropped_trigger_still_migrates() {
     let mut s = Store::open(&b.location, false).unwrap();
     let r = s.check().unwrap();
     assert!(r.is_whole() && r.triggers_ok.len() == r.triggers_expected, "{:?}", r.problems);
+}
+
+#[test]
+fn an_account_changed_behind_the_triggers_is_found_and_replace_refused() {
+    for b in backends("tamper_accounts") {
+        let mut s = Store::open(&b.location, true).unwrap();
+        let none = gyrolab_store::Actor::unauthenticated();
+        s.add_account(&none, "admin", "A. Admin", gyrolab_store::Role::Admin, "password-admin").unwrap();
+        let admin = s.authenticate("admin", "password-admin").unwrap();
+        s.add_account(&admin, "op", "O. P.", gyrolab_store::Role::Operator, "password-op").unwrap();
+        let mut raw = Raw::open(&b);
+        // Plain statements are refused: UPDATE, DELETE, and REPLACE (SQLite) or TRUNCATE (PostgreSQL).
+        assert!(raw.exec("UPDATE account SET role = 'admin' WHERE name = 'op'").is_err());
+        assert!(raw.exec("DELETE FROM audit_event").is_err());
+        if b.name == "sqlite" {
+            assert!(raw
+                .exec(
+                    "INSERT OR REPLACE INTO account (id, name, display_name, role, password_hash, created_by) VALUES \
+                     (2, 'op', 'O. P.', 'admin', 'x', 'admin')"
+                )
+                .is_err());
+        } else {
+            assert!(raw.exec("TRUNCATE account_change, account CASCADE").is_err());
+        }
+        assert!(s.check().unwrap().is_whole(), "{}", b.name);
+        // Behind the triggers: the operator made an admin; found, naming the row and column.
+        raw.behind_the_triggers(&["account"], "UPDATE account SET role = 'admin' WHERE name = 'op';");
+        let r = s.check().unwrap();
+        let p =
+            r.problems.iter().find(|p| p.table == "account").unwrap_or_else(|| panic!("{}: {:?}", b.name, r.problems));
+        assert!(p.what.contains("role"), "{}: {p}", b.name);
+        writing_is_refused(&b, "account");
+    }
 }
