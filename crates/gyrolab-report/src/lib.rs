@@ -7,6 +7,7 @@
 //! - [`limits`]: spec limits checked against the figures (PASS, FAIL, NOT EVALUATED);
 //! - [`plot`]: SVG plot building blocks; [`rate_plots`]: the rate-table plots;
 //! - [`html`]: the self-contained HTML report (header, summary, sections, methods appendix);
+//! - [`signature`]: the signature block of an issued report (who issued it, when, with what key);
 //! - [`inventory`]: the topics of a recording (`gyrolab inspect`);
 //! - [`results`]: the results.json document of `gyrolab eval`;
 //! - [`segments`]: segmentation summaries of raw rate-table logs;
@@ -31,6 +32,7 @@ pub mod rate;
 pub mod rate_plots;
 pub mod results;
 pub mod segments;
+pub mod signature;
 pub mod static_report;
 pub mod tables_csv;
 pub mod thermal;

@@ -185,21 +185,6 @@ fn current_of(x: &mut dyn Exec, id: i64) -> Result<i64, String> {
     Ok(at)
 }
 
-fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            c => out.push(c),
-        }
-    }
-    out
-}
-
 /// What the issued report's HTML and issue.json say about the issue.
 struct IssueText<'a> {
     number: &'a str,
@@ -254,79 +239,21 @@ fn issue_json(t: &IssueText, superseded_by: Option<(&str, &str, &str)>) -> Strin
     serde_json::to_string_pretty(&v).map(|s| s + "\n").unwrap_or_default()
 }
 
-/// The report.html of the issued report: the draft's sign-off block (between its markers, else
-/// the `sign-off` section) replaced by the signature block, and the draft's report number and
-/// issue date replaced by the issued ones.
+/// The report.html of the issued report, drawn by the report crate from the issue's facts.
 fn issued_html(draft: &str, t: &IssueText, draft_number: &str, draft_issue_date: &str) -> String {
-    use gyrolab_report::html::{SIGNATURE_BLOCK_BEGIN, SIGNATURE_BLOCK_END};
-    let mut block = format!("{SIGNATURE_BLOCK_BEGIN}\n<section class=\"sign-off\">\n<h2>Sign-off</h2>\n");
-    block.push_str(&format!(
-        "<p class=\"note\"><b>ISSUED</b>: report {} issued {} (UTC, the records store's clock).</p>\n",
-        escape(t.number),
-        escape(t.issued_at)
-    ));
-    if let Some((n, replaces, reason, changes)) = t.amendment {
-        block.push_str(&format!(
-            "<p class=\"note\"><b>Amendment {n} to report {}</b>, which it replaces. Reason: {}</p>\n<ul>\n",
-            escape(replaces),
-            escape(reason)
-        ));
-        for c in changes {
-            block.push_str(&format!("<li>{}</li>\n", escape(c)));
-        }
-        block.push_str("</ul>\n");
-    }
-    block.push_str(
-        "<table class=\"sign-off\"><thead><tr><th class=\"name\">role</th><th class=\"name\">name</th><th class=\"name\">\
-         signature</th><th class=\"name\">date</th></tr></thead><tbody>\n",
-    );
-    let tested = t.record.operator.clone().unwrap_or_else(|| "(not named in the plan)".into());
-    block.push_str(&format!(
-        "<tr><td class=\"name\">tested by</td><td class=\"name\">{}</td><td class=\"name\">stored by {}</td><td \
-         class=\"name\">{}</td></tr>\n",
-        escape(&tested),
-        escape(&t.stored_by.join(", ")),
-        escape(t.record.test_date.as_deref().unwrap_or(&t.record.evaluated_at))
-    ));
-    block.push_str(&format!(
-        "<tr><td class=\"name\">{} by</td><td class=\"name\">{} ({}, {})</td><td class=\"name\">signed electronically \
-         (Ed25519, key {})</td><td class=\"name\">{}</td></tr>\n",
-        t.meaning.as_str(),
-        escape(&t.signer.display_name),
-        escape(&t.signer.name),
-        t.signer.role.as_str(),
-        escape(t.fingerprint),
-        escape(t.issued_at)
-    ));
-    block.push_str(&format!(
-        "</tbody></table>\n<p class=\"note\">manifest.json (every file of this folder with its SHA-256) is signed in \
-         manifest.sig; <code>gyrolab verify DIR --public-key LAB.pub</code> checks the signature and every file. The \
-         records store's chain head at issue: <code>{}</code>.</p>\n</section>\n{SIGNATURE_BLOCK_END}",
-        escape(t.head)
-    ));
-    let mut html = match (draft.find(SIGNATURE_BLOCK_BEGIN), draft.find(SIGNATURE_BLOCK_END)) {
-        (Some(a), Some(b)) if b > a => format!("{}{block}{}", &draft[..a], &draft[b + SIGNATURE_BLOCK_END.len()..]),
-        _ => match draft.find("<section class=\"sign-off\">") {
-            Some(a) => {
-                let end = draft[a..].find("</section>").map_or(a, |e| a + e + "</section>".len());
-                format!("{}{block}{}", &draft[..a], &draft[end..])
-            }
-            None => match draft.find("<p class=\"end\">") {
-                Some(a) => format!("{}{block}\n{}", &draft[..a], &draft[a..]),
-                None => format!("{draft}{block}\n"),
-            },
-        },
+    let block = gyrolab_report::signature::SignatureBlock {
+        number: t.number,
+        issued_at: t.issued_at,
+        amendment: t.amendment,
+        tested_by: t.record.operator.clone().unwrap_or_else(|| "(not named in the plan)".into()),
+        stored_by: &t.stored_by,
+        tested_on: t.record.test_date.as_deref().unwrap_or(&t.record.evaluated_at),
+        meaning: t.meaning.as_str(),
+        signer: (&t.signer.display_name, &t.signer.name, t.signer.role.as_str()),
+        fingerprint: t.fingerprint,
+        head: t.head,
     };
-    if !draft_issue_date.is_empty() {
-        html = html.replace(
-            &format!("<tr><td><b>issued</b></td><td>{}</td></tr>", escape(draft_issue_date)),
-            &format!("<tr><td><b>issued</b></td><td>{}</td></tr>", escape(t.issued_at)),
-        );
-    }
-    if draft_number.len() >= 4 {
-        html = html.replace(&escape(draft_number), &escape(t.number));
-    }
-    html
+    gyrolab_report::signature::issued_html(draft, &block, draft_number, draft_issue_date)
 }
 
 /// The files of an issued folder (the stored ones but their manifest and any earlier issue
