@@ -170,6 +170,27 @@ fn reference(scale_factor: Option<f64>, null: Option<f64>) -> PyResult<gyrolab_e
     ReferenceRequest { scale_factor, null, ..Default::default() }.resolve().map_err(err)
 }
 
+/// The deviation, the taus (averaging factors replace the tau list when given) and the fit
+/// range of an Allan call, checked.
+#[allow(clippy::type_complexity)]
+fn analysis_choices(
+    kind: &str,
+    taus: &str,
+    factors: Option<Vec<usize>>,
+    fit_range_s: Option<Vec<f64>>,
+) -> PyResult<(DeviationKind, TauList, Option<(f64, f64)>)> {
+    let kind = DeviationKind::parse(kind).map_err(|e| keyword_error("kind", e.to_string()))?;
+    let taus = match factors {
+        Some(m) => TauList::Factors(m),
+        None => parse_taus(taus).map_err(err)?,
+    };
+    let fit_range_s = match fit_range_s {
+        None => None,
+        Some(v) => gyrolab::validate::increasing_pair("fit_range_s", &v).map_err(|e| err(e.into()))?,
+    };
+    Ok((kind, taus, fit_range_s))
+}
+
 /// One channel's samples as the engine reads them: borrowed where they can be, else a copy.
 enum Samples<'a> {
     Borrowed(&'a [f64]),
@@ -211,15 +232,7 @@ fn allan_channels<'py>(
     if let Some(c) = confidence {
         gyrolab::validate::confidence("confidence", c).map_err(|e| err(e.into()))?;
     }
-    let fit_range_s = match fit_range_s {
-        None => None,
-        Some(v) => gyrolab::validate::increasing_pair("fit_range_s", &v).map_err(|e| err(e.into()))?,
-    };
-    let kind = DeviationKind::parse(kind).map_err(|e| keyword_error("kind", e.to_string()))?;
-    let taus = match factors {
-        Some(m) => TauList::Factors(m),
-        None => parse_taus(taus).map_err(err)?,
-    };
+    let (kind, taus, fit_range_s) = analysis_choices(kind, taus, factors, fit_range_s)?;
     if columns.len() != names.len() || columns.len() != units.len() || columns.is_empty() {
         return Err(error(format!(
             "give one name and one unit per channel: {} channels, {} names, {} units",
@@ -468,15 +481,7 @@ fn allan_table<'py>(
     if columns.len() != names.len() || columns.is_empty() {
         return Err(error(format!("give one name per column: {} columns, {} names", columns.len(), names.len())));
     }
-    let kind = DeviationKind::parse(kind).map_err(|e| keyword_error("kind", e.to_string()))?;
-    let taus = match factors {
-        Some(m) => TauList::Factors(m),
-        None => parse_taus(taus).map_err(err)?,
-    };
-    let fit_range_s = match fit_range_s {
-        None => None,
-        Some(v) => gyrolab::validate::increasing_pair("fit_range_s", &v).map_err(|e| err(e.into()))?,
-    };
+    let (kind, taus, fit_range_s) = analysis_choices(kind, taus, factors, fit_range_s)?;
     let layout = gyrolab_eval::layout::LogLayout { units, time_column, names: Vec::new() };
     let request = AllanRequest {
         file: PathBuf::from(record),

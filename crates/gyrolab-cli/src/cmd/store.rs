@@ -179,16 +179,8 @@ pub struct IssueArgs {
     /// The meaning of the signature.
     #[arg(long, value_enum)]
     pub meaning: MeaningArg,
-    /// The lab's private key file (`gyrolab store key init`).
-    #[arg(long, value_name = "FILE")]
-    pub signing_key: PathBuf,
-    /// The report number (default: the store's next GL-YYYY-NNNN); unique in the store.
-    #[arg(long, value_name = "TEXT")]
-    pub report_number: Option<String>,
     #[command(flatten)]
-    pub auth: AuthArgs,
-    #[command(flatten)]
-    pub location: StoreLocation,
+    pub signing: SigningArgs,
 }
 
 /// Options of `gyrolab store amend`.
@@ -202,10 +194,17 @@ pub struct AmendArgs {
     /// The meaning of the signature.
     #[arg(long, value_enum, default_value = "approved")]
     pub meaning: MeaningArg,
-    /// The lab's private key file.
+    #[command(flatten)]
+    pub signing: SigningArgs,
+}
+
+/// What `store issue` and `store amend` share: the key, the number, who signs, the store.
+#[derive(Debug, Args)]
+pub struct SigningArgs {
+    /// The lab's private key file (`gyrolab store key init`).
     #[arg(long, value_name = "FILE")]
     pub signing_key: PathBuf,
-    /// The amendment's report number (default: the store's next GL-YYYY-NNNN).
+    /// The report number (default: the store's next GL-YYYY-NNNN); unique in the store.
     #[arg(long, value_name = "TEXT")]
     pub report_number: Option<String>,
     #[command(flatten)]
@@ -439,6 +438,18 @@ fn draft_note(s: &mut Store, superseded: i64, revision: i64) -> CliResult<String
 }
 
 /// `gyrolab store issue` and `amend`.
+/// `store issue` (no reason) or `store amend` (its reason) of evaluation `id`.
+fn signed(id: i64, m: MeaningArg, amend_reason: Option<&str>, a: &SigningArgs) -> CliResult {
+    let req = IssueRequest {
+        evaluation: id,
+        meaning: meaning(m),
+        key: &read_key(&a.signing_key)?,
+        report_number: a.report_number.as_deref(),
+        amend_reason,
+    };
+    issue(&a.location, &a.auth, &req)
+}
+
 fn issue(location: &StoreLocation, auth: &AuthArgs, req: &IssueRequest) -> CliResult {
     let mut s = open_for_writing(location)?;
     let Some((user, password)) = auth.credentials(true)? else {
@@ -708,26 +719,8 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
         StoreCommand::Check(a) => check(a),
         StoreCommand::User(u) => user(u),
         StoreCommand::Key(KeyCommand::Init(a)) => key_init(a),
-        StoreCommand::Issue(a) => {
-            let req = IssueRequest {
-                evaluation: a.id,
-                meaning: meaning(a.meaning),
-                key: &read_key(&a.signing_key)?,
-                report_number: a.report_number.as_deref(),
-                amend_reason: None,
-            };
-            issue(&a.location, &a.auth, &req)
-        }
-        StoreCommand::Amend(a) => {
-            let req = IssueRequest {
-                evaluation: a.id,
-                meaning: meaning(a.meaning),
-                key: &read_key(&a.signing_key)?,
-                report_number: a.report_number.as_deref(),
-                amend_reason: Some(&a.reason),
-            };
-            issue(&a.location, &a.auth, &req)
-        }
+        StoreCommand::Issue(a) => signed(a.id, a.meaning, None, &a.signing),
+        StoreCommand::Amend(a) => signed(a.id, a.meaning, Some(&a.reason), &a.signing),
         StoreCommand::Reevaluate(a) => {
             let mut s = open_for_writing(&a.location)?;
             let actor = actor(&mut s, &a.auth)?;
