@@ -8,6 +8,24 @@ use std::path::{Path, PathBuf};
 
 /// Prints text to standard output; a closed pipe (`| head`) ends quietly.
 pub fn print(text: &str) -> CliResult {
+    // Control characters from stored or read text (an escape sequence in a lot or operator
+    // name) never reach the terminal raw: shown as \u{1b}; line breaks and tabs stay.
+    let shown;
+    let text = if text.chars().any(|c| c.is_control() && c != '\n' && c != '\t') {
+        shown =
+            text.chars()
+                .map(|c| {
+                    if c.is_control() && c != '\n' && c != '\t' {
+                        c.escape_unicode().to_string()
+                    } else {
+                        c.to_string()
+                    }
+                })
+                .collect::<String>();
+        shown.as_str()
+    } else {
+        text
+    };
     let mut out = std::io::stdout().lock();
     match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
         Ok(()) => Ok(()),

@@ -666,3 +666,32 @@ fn a_fifo_or_a_folder_as_the_store_is_refused_at_once() {
         assert!(started.elapsed() < std::time::Duration::from_secs(5), "{:?}", started.elapsed());
     }
 }
+
+/// Control characters in stored text (issue 53: an escape sequence in a lot or operator name
+/// reached the terminal raw through `store show`): the text tables print them as `\u{1b}`,
+/// the JSON keeps them exactly (escaped by JSON itself).
+#[test]
+fn control_characters_in_stored_text_never_reach_the_terminal_raw() {
+    let dir = tempfile::tempdir().unwrap();
+    let store = dir.path().join("s.db").display().to_string();
+    let evil = "L7\u{1b}[2J\u{1b}[31mRED\u{7}";
+    let p = plan_with(dir.path(), "c.toml", "SN-C", evil, evil, "");
+    let out = dir.path().join("r");
+    let o = gyrolab()
+        .args(["eval", p.to_str().unwrap(), "--out", out.to_str().unwrap(), "-q", "--store", &store])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(3), "{}", String::from_utf8_lossy(&o.stderr));
+    let id = history_ids(&store, "SN-C").keys().next().unwrap().to_string();
+    for args in [vec!["store", "show", id.as_str()], vec!["store", "history", "SN-C"], vec!["store", "lot", evil]] {
+        let o = gyrolab().args(&args).args(["--store", &store]).output().unwrap();
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+        assert!(!text.contains('\u{1b}') && !text.contains('\u{7}'), "{args:?}: a raw control character");
+        if args[1] == "show" {
+            assert!(text.contains("L7\\u{1b}[2J\\u{1b}[31mRED\\u{7}"), "{text}");
+        }
+    }
+    let shown = json_of(&["store", "show", &id], &store);
+    assert_eq!(shown["record"]["lot"].as_str(), Some(evil), "JSON keeps the text exactly");
+}
