@@ -134,7 +134,11 @@ pub fn store_add(
     folder: PathBuf,
     plan: Option<PathBuf>,
 ) -> PyResult<(i64, String)> {
-    py.detach(|| gyrolab_store::add_report_folder(&folder, plan.as_deref(), location.as_deref())).map_err(store_err)
+    // A folder stored already gives the evaluation that holds it (adding is idempotent).
+    match py.detach(|| gyrolab_store::add_report_folder(&folder, plan.as_deref(), location.as_deref())) {
+        Err(gyrolab_store::StoreError::AlreadyStored { store, id }) => Ok((id, store)),
+        other => other.map_err(store_err),
+    }
 }
 
 /// The location as the store's messages show it: a URL's whole user information and its query

@@ -36,6 +36,15 @@ use thiserror::Error;
 /// Errors of the store; each names the store (password masked).
 #[derive(Debug, Error)]
 pub enum StoreError {
+    /// The report folder is stored already, as evaluation `id` (the same results.json of the
+    /// same serial, current): nothing was added. Not a failure: `store add` says so, exit 0.
+    #[error("store {store}: already stored as evaluation {id} (the same results.json): nothing added")]
+    AlreadyStored {
+        /// The store, password masked.
+        store: String,
+        /// The evaluation that holds it.
+        id: i64,
+    },
     /// The store cannot be opened or is not a gyrolab store (exit code 2).
     #[error("store {store}: {message}")]
     Open {
@@ -444,6 +453,23 @@ impl Store {
                 .map_err(|m| StoreError::Database { store: store.clone(), message: m })
         })?;
         found.map(|(a, hash)| Actor::of(a, hash)).map_err(|()| StoreError::Auth { store: self.name.clone() })
+    }
+
+    /// The current evaluation of `serial` whose results.json is exactly `results_json`, if
+    /// one is stored (a report folder added before).
+    pub fn current_with_results(&mut self, serial: &str, results_json: &str) -> StoreResult<Option<i64>> {
+        let store = self.name.clone();
+        self.transaction(|x| {
+            let rows = x
+                .query(
+                    "SELECT id FROM evaluation WHERE serial = $1 AND results_json = $2 \
+                     AND NOT EXISTS (SELECT 1 FROM evaluation later WHERE later.supersedes = evaluation.id) ORDER BY id",
+                    &[Val::T(Some(serial.to_string())), Val::T(Some(results_json.to_string()))],
+                    &[Kind::I],
+                )
+                .map_err(|m| StoreError::Database { store: store.clone(), message: m })?;
+            Ok(rows.first().map(|r| r[0].int()))
+        })
     }
 
     /// Whether the store has any account (then every write needs one).
@@ -913,6 +939,12 @@ pub fn add_report_folder_as(
         Some((user, password)) => store.authenticate(user, password)?,
         None => Actor::unauthenticated(),
     };
+    // The same folder added again (the same results.json of the same serial, still current) is
+    // the evaluation already stored: nothing is added (issue 53: re-adding a folder made a
+    // second current original).
+    if let Some(id) = store.current_with_results(&rec.serial, &rec.results_json)? {
+        return Err(StoreError::AlreadyStored { store: store.name().to_string(), id });
+    }
     let id = store.add_as(&rec, &actor)?;
     Ok((id, store.name().to_string()))
 }

@@ -615,8 +615,14 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
             let credentials = a.auth.credentials(true)?;
             let credentials = credentials.as_ref().map(|(u, p)| (u.as_str(), p.as_str()));
             for d in &a.dirs {
-                let (id, name) = add_report_folder_as(d, a.plan.as_deref(), a.location.store.as_deref(), credentials)?;
-                out.push_str(&format!("stored {} as evaluation {id} in {name}\n", d.display()));
+                match add_report_folder_as(d, a.plan.as_deref(), a.location.store.as_deref(), credentials) {
+                    Ok((id, name)) => out.push_str(&format!("stored {} as evaluation {id} in {name}\n", d.display())),
+                    Err(gyrolab_store::StoreError::AlreadyStored { store, id }) => out.push_str(&format!(
+                        "{} is stored already as evaluation {id} in {store} (the same results.json): nothing added\n",
+                        d.display()
+                    )),
+                    Err(e) => return Err(e.into()),
+                }
             }
             print(&out)
         }

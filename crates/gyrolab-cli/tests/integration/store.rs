@@ -695,3 +695,27 @@ fn control_characters_in_stored_text_never_reach_the_terminal_raw() {
     let shown = json_of(&["store", "show", &id], &store);
     assert_eq!(shown["record"]["lot"].as_str(), Some(evil), "JSON keeps the text exactly");
 }
+
+/// Re-adding a report folder is idempotent (issue 53: it made a second current original): the
+/// second `store add` says where it is stored already, exit 0, and the serial still has one
+/// evaluation; on SQLite and PostgreSQL.
+#[test]
+fn adding_the_same_folder_again_adds_nothing() {
+    for b in backends("readd") {
+        let dir = tempfile::tempdir().unwrap();
+        let p = plan(dir.path(), "RE-ADD", "L1");
+        let out = dir.path().join("r");
+        eval(&p, &out, None);
+        let first = gyrolab().args(["store", "add", out.to_str().unwrap(), "--store", &b.location]).output().unwrap();
+        assert!(first.status.success(), "{}: {}", b.name, String::from_utf8_lossy(&first.stderr));
+        let again = gyrolab().args(["store", "add", out.to_str().unwrap(), "--store", &b.location]).output().unwrap();
+        let said = String::from_utf8_lossy(&again.stdout);
+        assert!(again.status.success(), "{}: {}", b.name, String::from_utf8_lossy(&again.stderr));
+        assert!(
+            said.contains("is stored already as evaluation") && said.contains("nothing added"),
+            "{}: {said}",
+            b.name
+        );
+        assert_eq!(history_ids(&b.location, "RE-ADD").len(), 1, "{}", b.name);
+    }
+}
