@@ -287,6 +287,50 @@ pub fn figures_from_summary(text: &str, path: &Path, coverage: f64, simulated: b
     Ok(out)
 }
 
+/// The expanded uncertainty U and coverage factor k of every figure as the report computed
+/// them (results.json `sections.uncertainty.<axis>`): `<figure>_expanded_uncertainty`, and for K,
+/// F0, B0, B_s(T) (the quoted smoothing time) and N their budgets' `expanded` with the budget's
+/// own k; the axis's `coverage_factor` for the others. Replaces what summary.csv's rows gave
+/// (issue 53: k was stored as the plan's repeatability factor 3 for a U computed with k = 2, and
+/// U was empty for K, B_s and K_a).
+fn attach_uncertainties(results: &serde_json::Value, figures: &mut [FigureRecord]) {
+    let Some(axes) = results.pointer("/sections/uncertainty").and_then(|u| u.as_object()) else { return };
+    for f in figures.iter_mut() {
+        let Some(u) = axes.get(&f.axis) else { continue };
+        let num = |key: &str| u.get(key).and_then(serde_json::Value::as_f64);
+        let axis_k = num("coverage_factor");
+        let budget_k = |name: &str| u.pointer(&format!("/budgets/{name}/coverage_factor")).and_then(|k| k.as_f64());
+        let quoted = num("bias_stability_smoothing_s").map(|t| format!("bias_stability_dph_{}s", short_seconds(t)));
+        let (expanded, k) = if f.figure.contains("_expanded_uncertainty") {
+            // The U rows themselves: their k.
+            (f.value, axis_k)
+        } else {
+            match f.figure.as_str() {
+                "scale_factor" => (num("scale_factor_expanded"), budget_k("scale_factor").or(axis_k)),
+                "zero_offset" => (num("zero_offset_expanded"), budget_k("zero_offset").or(axis_k)),
+                "bias_dph" => (num("bias_expanded_dph"), budget_k("bias").or(axis_k)),
+                "arw_deg_rt_h" => (num("arw_expanded_deg_rt_h"), budget_k("arw").or(axis_k)),
+                name if quoted.as_deref() == Some(name) => {
+                    (num("bias_stability_expanded_dph"), budget_k("bias_stability").or(axis_k))
+                }
+                name => (num(&format!("{name}_expanded_uncertainty")), axis_k),
+            }
+        };
+        if let Some(x) = expanded {
+            if !f.figure.contains("_expanded_uncertainty") {
+                f.expanded_uncertainty = Some(x);
+            }
+            f.coverage_factor = k;
+        }
+    }
+}
+
+/// Seconds as a figure key writes them (`10`, `0.01`).
+fn short_seconds(t: f64) -> String {
+    let s = format!("{t}");
+    s.strip_suffix(".0").map_or(s.clone(), str::to_string)
+}
+
 /// Marks the figures that are upper bounds: results.json objects naming a figure key with a
 /// `basis` of `upper_bound` (the Allan noise terms), matched by key and axis where given.
 fn mark_bounds(results: &serde_json::Value, figures: &mut [FigureRecord]) {
@@ -465,6 +509,7 @@ pub fn from_report_folder_with(
     let mut figures =
         figures_from_summary(&read_text(&summary_path)?, &summary_path, parsed.options.coverage, simulated)?;
     mark_bounds(&results, &mut figures);
+    attach_uncertainties(&results, &mut figures);
     let verdict = json_text(&results, &["verdict"]);
     Ok(EvaluationRecord {
         serial,

@@ -258,29 +258,41 @@ fn the_default_store_is_beside_the_plan_or_gyrolab_store() {
 fn two_processes_storing_at_once_both_land() {
     for b in backends("concurrent") {
         let dir = tempfile::tempdir().unwrap();
+        // Ten report folders of each serial, each of its own plan (a comment apart), so each its
+        // own results.json: the same folder added twice is stored once.
         let mut outs = Vec::new();
         for serial in ["A", "B"] {
-            let p = plan(dir.path(), serial, "L");
-            let out = dir.path().join(format!("r-{serial}"));
-            eval(&p, &out, None);
-            outs.push((p, out));
+            let folders: Vec<PathBuf> = (0..10)
+                .map(|i| {
+                    let p = plan_with(
+                        dir.path(),
+                        &format!("{serial}-{i}.toml"),
+                        serial,
+                        "L",
+                        "A. Operator",
+                        &format!("# copy {i}\n"),
+                    );
+                    let out = dir.path().join(format!("r-{serial}-{i}"));
+                    eval(&p, &out, None);
+                    out
+                })
+                .collect();
+            outs.push(folders);
         }
         // Create the store first for SQLite, so both writers meet an existing file.
         let children: Vec<_> = outs
             .iter()
-            .map(|(p, out)| {
+            .map(|folders| {
                 let mut c = gyrolab_process();
-                c.args(["store", "add", "--plan", p.to_str().unwrap(), "--store", &b.location]);
-                for _ in 0..10 {
-                    c.arg(out);
-                }
+                c.args(["store", "add", "--store", &b.location]);
+                c.args(folders);
                 c.stdout(std::process::Stdio::null()).spawn().unwrap()
             })
             .collect();
         for mut c in children {
             assert!(c.wait().unwrap().success(), "{}", b.name);
         }
-        let n = summary_rows(&outs[0].1);
+        let n = summary_rows(&outs[0][0]);
         for serial in ["A", "B"] {
             let ids = history_ids(&b.location, serial);
             assert_eq!(ids.len(), 10, "{} {serial}", b.name);
@@ -294,8 +306,12 @@ fn a_process_killed_inside_the_transaction_leaves_nothing_of_its_evaluation() {
     for b in backends("kill") {
         let dir = tempfile::tempdir().unwrap();
         let p = plan(dir.path(), "K", "L");
+        // One evaluation stored (of the plan with a comment more: its own results.json); the
+        // killed adds try to store the other.
+        let other = plan_with(dir.path(), "K-stored.toml", "K", "L", "A. Operator", "# stored first\n");
+        eval(&other, &dir.path().join("stored"), Some(&b.location));
         let out = dir.path().join("r");
-        eval(&p, &out, Some(&b.location));
+        eval(&p, &out, None);
         let n = summary_rows(&out);
         for round in 0..2 {
             // The store pauses after writing every row of the evaluation, before the commit.
@@ -717,5 +733,43 @@ fn adding_the_same_folder_again_adds_nothing() {
             b.name
         );
         assert_eq!(history_ids(&b.location, "RE-ADD").len(), 1, "{}", b.name);
+    }
+}
+
+/// The stored U and k are the report's (issue 53: k was stored as 3, the repeatability factor,
+/// for a U computed with k = 2, and U was empty for K, B_s and K_a): on the example test
+/// program, every figure the uncertainty section gives a U carries it with its budget's k.
+#[test]
+fn the_stored_uncertainties_are_the_reports() {
+    let dir = tempfile::tempdir().unwrap();
+    let prog = dir.path().join("prog");
+    gyrolab().args(["simulate", "test-program"]).arg(&prog).assert().success();
+    let out = dir.path().join("r");
+    let store = dir.path().join("s.db").display().to_string();
+    let o = gyrolab()
+        .args(["eval", prog.join("plan.toml").to_str().unwrap(), "--out", out.to_str().unwrap(), "-q"])
+        .args(["--store", &store])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let results: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("results.json")).unwrap()).unwrap();
+    let u = &results["sections"]["uncertainty"]["x"];
+    let id = history_ids(&store, "SIM-0001").keys().next().copied().unwrap_or(1).to_string();
+    let shown = json_of(&["store", "show", &id], &store);
+    let figures = shown["record"]["figures"].as_array().unwrap();
+    let find = |name: &str| {
+        figures.iter().find(|f| f["axis"] == "x" && f["figure"] == name).unwrap_or_else(|| panic!("{name}"))
+    };
+    for (figure, key, budget) in [
+        ("scale_factor", "scale_factor_expanded", Some("scale_factor")),
+        ("bias_stability_dph_10s", "bias_stability_expanded_dph", Some("bias_stability")),
+        ("nonlinearity_pct", "nonlinearity_pct_expanded_uncertainty", None),
+        ("bias_thermal_hysteresis_dph", "bias_thermal_hysteresis_dph_expanded_uncertainty", None),
+    ] {
+        let f = find(figure);
+        assert_eq!(f["expanded_uncertainty"].as_f64(), u[key].as_f64(), "{figure}: {f}");
+        let k = budget.map_or(&u["coverage_factor"], |b| &u["budgets"][b]["coverage_factor"]);
+        assert_eq!(f["coverage_factor"].as_f64(), k.as_f64(), "{figure}: {f}");
+        assert_eq!(f["coverage_factor"].as_f64(), Some(2.0), "{figure}");
     }
 }
