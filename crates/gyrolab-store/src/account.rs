@@ -203,12 +203,14 @@ const ACCOUNT_KINDS: [Kind; 8] = [Kind::I, Kind::T, Kind::T, Kind::T, Kind::T, K
 
 /// Every account, by id, with its current password hash.
 pub(crate) fn accounts(x: &mut dyn Exec) -> Result<Vec<(Account, String)>, String> {
+    // ok: SQL from the module's constant column list; every value is a parameter.
     let sql = format!("{ACCOUNT_SQL} ORDER BY a.id");
     Ok(x.query(&sql, &[], &ACCOUNT_KINDS)?.iter().map(|r| account_of(r)).collect())
 }
 
 /// The account named `name`, with its current password hash.
 pub(crate) fn by_name(x: &mut dyn Exec, name: &str) -> Result<Option<(Account, String)>, String> {
+    // ok: SQL from the module's constant column list; every value is a parameter.
     let sql = format!("{ACCOUNT_SQL} WHERE a.name = $1");
     Ok(x.query(&sql, &[Val::T(Some(name.to_string()))], &ACCOUNT_KINDS)?.first().map(|r| account_of(r)))
 }

@@ -126,12 +126,14 @@ fn issued_of(r: &[Val]) -> IssuedReport {
 
 /// The issue of evaluation `id`, if it was issued.
 pub(crate) fn issue_of(x: &mut dyn Exec, id: i64) -> Result<Option<IssuedReport>, String> {
+    // ok: SQL from the module's constant column list; every value is a parameter.
     let sql = format!("SELECT {ISSUE_COLUMNS} FROM issue i WHERE i.evaluation_id = $1");
     Ok(x.query(&sql, &[Val::I(id)], &ISSUE_KINDS)?.first().map(|r| issued_of(r)))
 }
 
 /// Every issued report, oldest first.
 pub(crate) fn all(x: &mut dyn Exec) -> Result<Vec<IssuedReport>, String> {
+    // ok: SQL from the module's constant column list; every value is a parameter.
     let sql = format!("SELECT {ISSUE_COLUMNS} FROM issue i ORDER BY i.id");
     Ok(x.query(&sql, &[], &ISSUE_KINDS)?.iter().map(|r| issued_of(r)).collect())
 }
