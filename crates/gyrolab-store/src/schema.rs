@@ -3,7 +3,7 @@
 //! from version N - 1 to N; `gyrolab_schema` keeps one row per applied version (docs/STORE.md).
 
 /// The schema version this build writes and reads.
-pub const SCHEMA_VERSION: i64 = 4;
+pub const SCHEMA_VERSION: i64 = 5;
 
 /// SQLite migrations, by version (index 0 = version 1).
 pub const SQLITE_MIGRATIONS: &[&str] = &[
@@ -192,6 +192,9 @@ CREATE TRIGGER issue_kept BEFORE UPDATE ON issue BEGIN SELECT RAISE(ABORT, 'gyro
 CREATE TRIGGER issue_kept_d BEFORE DELETE ON issue BEGIN SELECT RAISE(ABORT, 'gyrolab records are never deleted'); END;
 CREATE TRIGGER issue_kept_r BEFORE INSERT ON issue WHEN EXISTS (SELECT 1 FROM issue WHERE id = NEW.id OR evaluation_id = NEW.evaluation_id OR report_number = NEW.report_number OR amends = NEW.amends) BEGIN SELECT RAISE(ABORT, 'gyrolab records are never replaced (a report number, an evaluation and a report amended are issued once)'); END;
 "#,
+    // 5 (issue 53): no change on SQLite, whose indexes take a text of any length (the serial
+    // and lot indexes are made hash indexes on PostgreSQL, whose B-tree rows stop at 2.7 KB).
+    "CREATE INDEX IF NOT EXISTS evaluation_serial ON evaluation(serial);",
 ];
 
 /// PostgreSQL migrations, by version (index 0 = version 1).
@@ -357,6 +360,15 @@ CREATE TRIGGER signing_key_kept BEFORE UPDATE OR DELETE ON signing_key FOR EACH 
 CREATE TRIGGER signing_key_not_truncated BEFORE TRUNCATE ON signing_key FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
 CREATE TRIGGER issue_kept BEFORE UPDATE OR DELETE ON issue FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
 CREATE TRIGGER issue_not_truncated BEFORE TRUNCATE ON issue FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
+"#,
+    // 5 (issue 53): the serial and lot indexes as hash indexes: a B-tree index row stops at
+    // about 2.7 KB, so a longer serial (SQLite takes 16 MiB) was refused; every query of them is
+    // an equality.
+    r#"
+DROP INDEX evaluation_serial;
+CREATE INDEX evaluation_serial ON evaluation USING hash (serial);
+DROP INDEX evaluation_lot;
+CREATE INDEX evaluation_lot ON evaluation USING hash (lot);
 "#,
 ];
 
