@@ -70,12 +70,13 @@ fn read(text: &str, key: &str) -> f64 {
         for prefix in [format!("\"{key}\": ["), format!("{key}: [")] {
             if let Some(rest) = l.strip_prefix(&prefix) {
                 // ok: test code; a file that does not read back fails the test
-                return rest.split([',', ']']).next().unwrap().trim().parse().unwrap();
+                let first = rest.split([',', ']']).next().unwrap(); // ok: test module
+                return first.trim().parse().unwrap(); // ok: test module
             }
         }
         if let Some(rest) = l.strip_prefix(&format!("\"{key}\": ")) {
             // ok: test code; a file that does not read back fails the test
-            return rest.trim_end_matches(',').trim().parse().unwrap();
+            return rest.trim_end_matches(',').trim().parse().unwrap(); // ok: test module (cfg(test)): a panic fails the test
         }
     }
     panic!("{key} not in\n{text}")
@@ -115,9 +116,9 @@ fn stack_step(stack: Stack, text: &str, accel: bool) -> (f64, usize, f64, f64) {
         // B = dt on the angle (velocity), C(9:15) += NgaWalk once per measurement).
         Stack::Orbslam3 => {
             // ok: test code; a missing or non-integer IMU.Frequency fails the test
-            let freq = text.lines().find_map(|l| l.strip_prefix("IMU.Frequency:")).unwrap();
-            // ok: test code; a non-integer IMU.Frequency fails the test
-            let freq: i64 = freq.split('#').next().unwrap().trim().parse().expect("an integer IMU.Frequency");
+            let freq = text.lines().find_map(|l| l.strip_prefix("IMU.Frequency:")).unwrap(); // ok: test module (cfg(test)): a panic fails the test
+                                                                                             // ok: test code; a non-integer IMU.Frequency fails the test
+            let freq: i64 = freq.split('#').next().unwrap().trim().parse().expect("an integer IMU.Frequency"); // ok: test module (cfg(test)): a panic fails the test
             let sf = (freq as f64).sqrt();
             let ng = pick("IMU.NoiseGyro", "IMU.NoiseAcc") * sf;
             let ngw = pick("IMU.GyroWalk", "IMU.AccWalk") / sf;
@@ -189,9 +190,9 @@ fn every_stack_reproduces_the_variance_growth_of_simulated_truth() {
     let export = sample();
     assert_eq!(export.rate_hz, RATE);
     // ok: test code; the sample export holds every term
-    let gyro = (export.gyro_noise.as_ref().unwrap().value, export.gyro_walk.as_ref().unwrap().value);
-    // ok: test code; the sample export holds every term
-    let accel = (export.accel_noise.as_ref().unwrap().value, export.accel_walk.as_ref().unwrap().value);
+    let gyro = (export.gyro_noise.as_ref().unwrap().value, export.gyro_walk.as_ref().unwrap().value); // ok: test module (cfg(test)): a panic fails the test
+                                                                                                      // ok: test code; the sample export holds every term
+    let accel = (export.accel_noise.as_ref().unwrap().value, export.accel_walk.as_ref().unwrap().value); // ok: test module (cfg(test)): a panic fails the test
     let truths = [truth(gyro.0, gyro.1), truth(accel.0, accel.1)];
     // The truth itself against its closed form (N^2 T + K^2 T^3 / 3 for the angle, K^2 T for
     // the bias): the simulation is what the propagations are compared with.
