@@ -5,8 +5,8 @@
 
 use crate::error::{CliError, CliResult};
 use crate::output::{print, write_folder};
-use gyrolab_eval::report_folder::ReportFolder;
-use gyrolab_report::limits::Overall;
+use gyrolab_lab::report_folder::ReportFolder;
+use gyrolab::limits::Overall;
 use std::path::Path;
 
 /// Writes the folder whole, prints what was written (unless quiet), prints report.html to

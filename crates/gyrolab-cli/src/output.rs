@@ -2,7 +2,7 @@
 //! or a report folder.
 
 use crate::error::{CliError, CliResult};
-use gyrolab_eval::report_folder::NamedOutput;
+use gyrolab_io::manifest::NamedOutput;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 

@@ -19,7 +19,7 @@ use gyrolab_io::recording::{read_records, TopicMeta};
 use gyrolab_io::series::{ChannelInfo, SeriesData, SeriesOptions};
 use gyrolab_io::series::{LineMap, RowKind, SkipReason, SkippedColumn, UnitSource};
 use gyrolab_io::DataError;
-use gyrolab_report::allan::{ChannelAnalysis, LazyGmwm};
+use crate::outcome::allan::{ChannelAnalysis, LazyGmwm};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 

@@ -10,7 +10,7 @@ use gyrolab::gmwm::{gauss_markov_filter_bound, overbound_factors, MarkovBound, P
 use gyrolab::noise::Reading;
 use gyrolab::units::{self, Quantity};
 use gyrolab_io::noise_export::{real_text, ExportTerm, NoiseExport, Stack, TermSource};
-use gyrolab_report::allan::ChannelAnalysis;
+use crate::outcome::allan::ChannelAnalysis;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 

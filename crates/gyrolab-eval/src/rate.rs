@@ -9,7 +9,7 @@ use gyrolab::validate;
 use gyrolab_io::calibration::{AxisCalibration, CalibrationFile, PolynomialModel, CALIBRATION_FORMAT};
 use gyrolab_io::rate_table::{parse_rate_table, read_rate_table, RateColumns, RateLayout, RateTableFile};
 use gyrolab_io::raw_log::{detect_raw_log, header_names};
-use gyrolab_report::rate::AxisReport;
+use crate::outcome::rate::AxisReport;
 use std::path::{Path, PathBuf};
 
 /// Evaluation options of a rate-table test, as a front end gives them (checked by

@@ -13,7 +13,7 @@ use gyrolab::validate;
 use gyrolab_io::rate_table::{RateLayout, RateTableFile};
 use gyrolab_io::raw_log::{header_names, read_manual_segments, read_raw_log, segments_csv, table_rate_column, RawLog};
 use gyrolab_io::DataError;
-use gyrolab_report::segments::SegmentationReport;
+use crate::outcome::segments::SegmentationReport;
 use std::path::{Path, PathBuf};
 
 /// How raw logs are segmented; `None` keeps the default of [`SegmentOptions`].

@@ -4,7 +4,7 @@
 use crate::error::{EvalError, EvalResult};
 use gyrolab::sampling::estimate_interval;
 use gyrolab_io::recording::{open, RecordingOptions};
-use gyrolab_report::inventory::{Inventory, TopicInventory};
+use crate::outcome::inventory::{Inventory, TopicInventory};
 use std::path::{Path, PathBuf};
 
 /// Rate, duration, gaps of a topic's stamps (ns, any order).

@@ -9,7 +9,7 @@ use gyrolab::static_test::{bias_repeatability, StaticTestConfig, StaticTestResul
 use gyrolab::units::OutputUnit;
 use gyrolab::validate;
 use gyrolab_io::series::{evaluate_static_file, ReaderQuality, SeriesOptions, SeriesSummary};
-use gyrolab_report::bias::{ChannelRepeatability, TestReport};
+use crate::outcome::static_test::{ChannelRepeatability, TestReport};
 use std::path::{Path, PathBuf};
 
 /// Static tests, one file per test.
@@ -116,7 +116,7 @@ pub struct StaticOutcome {
     /// The reference used.
     pub reference: Reference,
     /// Warm-up figures per file and channel (when asked for).
-    pub warmup: Vec<gyrolab_report::bias::WarmupReport>,
+    pub warmup: Vec<crate::outcome::static_test::WarmupReport>,
     /// What the reader decided per file (the part of the record analysed), with the file
     /// (and topic) shown.
     pub notes: Vec<(String, crate::allan::ReadNote)>,
@@ -243,7 +243,7 @@ fn evaluate_warmups(
     reference: &Reference,
     request: &StaticTestRequest,
     config: &gyrolab::warmup::WarmupConfig,
-) -> EvalResult<Vec<gyrolab_report::bias::WarmupReport>> {
+) -> EvalResult<Vec<crate::outcome::static_test::WarmupReport>> {
     let records = gyrolab_io::recording::read_records(path, options, topics)?;
     let mut out = Vec::new();
     for record in records.records {
@@ -290,7 +290,7 @@ fn evaluate_warmups(
                     format!("channel '{}': warm-up: {e}", gyrolab_io::text::excerpt(&info.name)),
                 ))
             })?;
-            out.push(gyrolab_report::bias::WarmupReport { file: shown.clone(), channel: info.name.clone(), result });
+            out.push(crate::outcome::static_test::WarmupReport { file: shown.clone(), channel: info.name.clone(), result });
         }
     }
     Ok(out)

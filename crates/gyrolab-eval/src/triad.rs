@@ -9,7 +9,7 @@ use gyrolab::units::OutputUnit;
 use gyrolab_io::calibration::{CalibrationFile, TriadSection, CALIBRATION_FORMAT};
 use gyrolab_io::raw_log::read_raw_log;
 use gyrolab_io::DataError;
-use gyrolab_report::triad::TriadReport;
+use crate::outcome::triad::TriadReport;
 use std::path::PathBuf;
 
 /// A three-axis calibration set.

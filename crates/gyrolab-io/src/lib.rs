@@ -2,6 +2,7 @@
 //!
 //! - [`error`]: the [`DataError`] every reader returns;
 //! - [`atomic`]: outputs written to a temporary file and renamed into place;
+//! - [`manifest`]: a report folder's outputs and their manifest (names, SHA-256, sizes);
 //! - [`text`]: a small delimited-text parser with line numbers;
 //! - [`rate_table`]: rate-table records in the long and wide layouts;
 //! - [`calibration`]: calibration files (TOML) written by `gyrolab rate --cal-out`;
@@ -23,6 +24,7 @@ pub mod contained;
 pub mod decimal;
 pub mod error;
 pub mod input_file;
+pub mod manifest;
 pub mod noise_export;
 pub mod pages;
 pub mod parquet_table;

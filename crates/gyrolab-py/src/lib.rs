@@ -421,7 +421,7 @@ fn allan_channels<'py>(
 #[allow(clippy::type_complexity)]
 fn channels_out<'py>(
     py: Python<'py>,
-    analyses: Vec<gyrolab_report::allan::ChannelAnalysis>,
+    analyses: Vec<gyrolab_eval::outcome::allan::ChannelAnalysis>,
 ) -> PyResult<(String, Vec<Vec<Bound<'py, PyArray1<f64>>>>, AllanChannels)> {
     // The GMWM and the filter terms (which hold it) are left to the first call that needs them
     // (`AllanChannels`): most calls read the curve and the slope terms only (issue 56).
@@ -538,11 +538,11 @@ fn allan_table<'py>(
 /// each channel's GMWM fit and its filter terms (JSON texts, the keys of docs/JSON.md).
 #[pyclass(frozen, module = "gyrolab._gyrolab")]
 struct AllanChannels {
-    analyses: Vec<gyrolab_report::allan::ChannelAnalysis>,
+    analyses: Vec<gyrolab_eval::outcome::allan::ChannelAnalysis>,
 }
 
 impl AllanChannels {
-    fn channel(&self, index: usize) -> PyResult<&gyrolab_report::allan::ChannelAnalysis> {
+    fn channel(&self, index: usize) -> PyResult<&gyrolab_eval::outcome::allan::ChannelAnalysis> {
         self.analyses.get(index).ok_or_else(|| error(format!("no channel {index}")))
     }
 }
@@ -664,7 +664,7 @@ fn bias(
         gyrolab_eval::static_test::evaluate_samples(&block, &config, &reference)
     })?
     .map_err(err)?;
-    serde_json::to_string(&gyrolab_report::bias::TestReport { file: "<array>".into(), result }).map_err(json_err)
+    serde_json::to_string(&gyrolab_eval::outcome::static_test::TestReport { file: "<array>".into(), result }).map_err(json_err)
 }
 
 /// Rate-table evaluation of observations (rates deg/s, outputs, runs, strokes `fwd`/`rev`):
@@ -859,8 +859,8 @@ fn evaluate_plan(
     out: PathBuf,
 ) -> PyResult<(Option<String>, Vec<PathBuf>, Vec<String>, Vec<String>)> {
     let folder = run(py, || {
-        let p = gyrolab_eval::test_plan::read_test_plan(&plan)?;
-        gyrolab_eval::test_plan::evaluate_test_plan(&p, &plan.display().to_string(), &gyrolab_eval::Silent)
+        let p = gyrolab_lab::test_plan::read_test_plan(&plan)?;
+        gyrolab_lab::test_plan::evaluate_test_plan(&p, &plan.display().to_string(), &gyrolab_eval::Silent)
     })?
     .map_err(err)?;
     let files: Vec<(&str, &[u8])> = folder.outputs.iter().map(|o| (o.name.as_str(), &o.bytes[..])).collect();

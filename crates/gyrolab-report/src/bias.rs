@@ -1,32 +1,13 @@
 //! Reports of static (bias) tests: the summary table, data-quality findings and JSON
 //! (keys in docs/JSON.md).
 
-use crate::format::{short, sig, sig_opt};
+use gyrolab_eval::outcome::static_test::{ChannelRepeatability, TestReport, WarmupReport};
+use gyrolab::format::{short, sig, sig_opt};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Cell, CellAlignment, Table};
 use gyrolab::static_test::{
-    reported_smoothing_times, smoothing_key, BiasRepeatability, QualityIssue, StaticTestResult,
+    reported_smoothing_times, smoothing_key, QualityIssue, StaticTestResult,
 };
 use serde::Serialize;
-
-/// One evaluated test (one channel of one file).
-#[derive(Debug, Clone, Serialize)]
-pub struct TestReport {
-    /// Source file.
-    pub file: String,
-    /// The figures (flattened into the JSON object).
-    #[serde(flatten)]
-    pub result: StaticTestResult,
-}
-
-/// Repeatability of one channel across the files.
-#[derive(Debug, Clone, Serialize)]
-pub struct ChannelRepeatability {
-    /// Channel name.
-    pub channel: String,
-    /// The figures.
-    #[serde(flatten)]
-    pub repeatability: BiasRepeatability,
-}
 
 /// JSON document of `gyrolab bias --json`.
 #[derive(Debug, Clone, Serialize)]
@@ -43,17 +24,6 @@ pub struct BiasJson {
     /// Warm-up figures per file and channel (`--warmup-band-dph`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warmup: Vec<WarmupJson>,
-}
-
-/// The warm-up of one channel of one record (from power-on).
-#[derive(Debug, Clone)]
-pub struct WarmupReport {
-    /// Source file.
-    pub file: String,
-    /// Channel.
-    pub channel: String,
-    /// The figures, in deg/h.
-    pub result: gyrolab::warmup::WarmupResult,
 }
 
 /// The exponential settling model in JSON.

@@ -3,15 +3,15 @@
 //!
 //! A report is a [`Report`]: a device header, the summary table of every figure with its limit
 //! and verdict ([`SummaryTable`]), a list of [`ReportSection`]s and the methods appendix built
-//! from the figure catalogue ([`crate::figures::FIGURES`]). A section is generic (title, a
+//! from the figure catalogue ([`gyrolab::figures::FIGURES`]). A section is generic (title, a
 //! simulated-data flag, a figure table, data tables, plots), so the static-bias and Allan
 //! sections are added by building more `ReportSection`s: the page template does not change.
 
-use crate::figures::{known_figure, AxisFigures, FigureGroup, FIGURES};
-use crate::format::{sig, sig_opt};
-use crate::limits::{check_limits, overall, DecisionRule, Limit, LimitCheck, Overall, Support, Verdict};
+use gyrolab::figures::{known_figure, AxisFigures, FigureGroup, FIGURES};
+use gyrolab::format::{sig, sig_opt};
+use gyrolab::limits::{check_limits, overall, DecisionRule, Limit, LimitCheck, Overall, Support, Verdict};
 use crate::plot::PlotError;
-use crate::rate::AxisReport;
+use gyrolab_eval::outcome::rate::AxisReport;
 use crate::rate_plots::{calibration_plot, hysteresis_plot, scale_factor_plot};
 use gyrolab::units::{ratio_to_pct, ratio_to_ppm};
 use std::fmt::Write;
@@ -188,12 +188,12 @@ pub fn value_cell(a: &AxisFigures, key: &str, check: Option<&LimitCheck>, digits
     let text = match (check, k.support) {
         (Some(c), _) => c.value_text(digits),
         (None, Support::Value) => u
-            .and_then(|u| crate::format::rounded_to_uncertainty(k.value, u))
+            .and_then(|u| gyrolab::format::rounded_to_uncertainty(k.value, u))
             .map_or_else(|| sig(k.value, digits), |(v, _)| v),
         (None, Support::UpperBound) => format!("at most {}", sig(k.value, digits)),
         (None, Support::LowerBound) => format!("above {}", sig(k.value, digits)),
     };
-    Some(match u.and_then(|u| crate::format::rounded_to_uncertainty(1.0, u)) {
+    Some(match u.and_then(|u| gyrolab::format::rounded_to_uncertainty(1.0, u)) {
         Some((_, u_text)) => format!("{text} ± {u_text}"),
         None => text,
     })
@@ -324,13 +324,13 @@ impl SummaryTable {
         for def in FIGURES {
             for a in axes {
                 for (k, _) in &a.values {
-                    if crate::figures::name_matches(def.key, k) && !keys.contains(k) {
+                    if gyrolab::figures::name_matches(def.key, k) && !keys.contains(k) {
                         keys.push(k.clone());
                     }
                 }
             }
             for l in limits {
-                if crate::figures::name_matches(def.key, &l.figure) && !keys.contains(&l.figure) {
+                if gyrolab::figures::name_matches(def.key, &l.figure) && !keys.contains(&l.figure) {
                     keys.push(l.figure.clone());
                 }
             }
@@ -654,7 +654,7 @@ fn write_methods(h: &mut String, summary: &SummaryTable) {
 fn write_conditions(h: &mut String, t: &TestConditions, equipment: &[EquipmentRow]) {
     let text = |v: &Option<String>| v.as_deref().map_or(String::new(), escape);
     let num =
-        |v: Option<f64>, unit: &str| v.map_or(String::new(), |x| format!("{} {unit}", crate::format::short(x, 4)));
+        |v: Option<f64>, unit: &str| v.map_or(String::new(), |x| format!("{} {unit}", gyrolab::format::short(x, 4)));
     h.push_str("<table class=\"conditions\"><caption>Test conditions</caption><tbody>\n");
     let test_dates = match (&t.test_date, &t.test_date_end) {
         (Some(a), Some(b)) if a != b => format!("{} to {}", escape(a), escape(b)),
@@ -843,7 +843,7 @@ pub fn rate_section(a: &AxisReport<'_>, limits: &[Limit]) -> Result<ReportSectio
     let e = a.evaluation;
     let u = a.output_unit.symbol();
     let (du, df) = a.output_unit.scale_factor_display();
-    let figs = crate::figures::rate_figures(&crate::rate::AxisJson::new(a));
+    let figs = crate::rate::rate_figures(&crate::rate::AxisJson::new(a));
     let checks = check_limits(limits, std::slice::from_ref(&figs));
     let row = |key: &str, label: &str, value: String, unit: String| {
         let c = checks.iter().find(|c| c.figure == key);
@@ -948,7 +948,7 @@ pub fn rate_section(a: &AxisReport<'_>, limits: &[Limit]) -> Result<ReportSectio
             .iter()
             .map(|p| {
                 vec![
-                    crate::format::short(p.rate_dps, 6),
+                    gyrolab::format::short(p.rate_dps, 6),
                     format!("{:.8}", p.forward_mean),
                     format!("{:.8}", p.reverse_mean),
                     format!("{:.8}", p.mean),

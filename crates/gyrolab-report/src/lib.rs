@@ -3,8 +3,6 @@
 //! - [`allan`]: Allan-deviation tables, CSV, JSON, noise terms and Kalibr YAML;
 //! - [`bias`]: static (bias) test tables and JSON;
 //! - [`rate`]: rate-table evaluation tables and JSON (keys in docs/JSON.md);
-//! - [`figures`]: the catalogue of figure names (limit names), units, formulas and sources;
-//! - [`limits`]: spec limits checked against the figures (PASS, FAIL, NOT EVALUATED);
 //! - [`plot`]: SVG plot building blocks; [`rate_plots`]: the rate-table plots;
 //! - [`html`]: the self-contained HTML report (header, summary, sections, methods appendix);
 //! - [`signature`]: the signature block of an issued report (who issued it, when, with what key);
@@ -16,15 +14,11 @@
 //! - [`paper`]: the paper's printed tables beside the recomputation, for `gyrolab demo`;
 //! - [`tables_csv`]: the CSV tables of a report folder (points, runs, summary);
 //! - [`threshold`]: threshold and resolution tests (section, figures, JSON);
-//! - [`format`]: number formatting.
 
 pub mod allan;
 pub mod bias;
-pub mod figures;
-pub mod format;
 pub mod html;
 pub mod inventory;
-pub mod limits;
 pub mod paper;
 pub mod plot;
 pub mod power_ups;

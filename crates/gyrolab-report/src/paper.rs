@@ -4,7 +4,7 @@
 //! data do not support a printed figure, the report says so and shows why, computed from the
 //! data (it never adjusts a formula to match a printed value).
 
-use crate::format::sig;
+use gyrolab::format::sig;
 use crate::html::{DataTable, ReportSection};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Cell, CellAlignment, Table};
 use gyrolab::fit;

@@ -401,9 +401,9 @@ pub fn tick_label(v: f64) -> String {
         if (m.abs() - 1.0).abs() < 1e-9 {
             return format!("{}1e{e}", if v < 0.0 { "-" } else { "" });
         }
-        return format!("{}e{e}", crate::format::short(m, 3));
+        return format!("{}e{e}", gyrolab::format::short(m, 3));
     }
-    crate::format::short(v, 4)
+    gyrolab::format::short(v, 4)
 }
 
 /// Tick label of `v` on a linear axis spanning `span`: as many decimals as the tick spacing

@@ -2,11 +2,12 @@
 //! results.json objects (`sections.power_ups.<axis>`, `sections.warmup.<axis>`) and the warm-up
 //! plot. Formulas: [`gyrolab::power_ups`], [`gyrolab::warmup`]; docs/METHODS.md.
 
-use crate::bias::{warmup_text, WarmupJson, WarmupReport};
-use crate::figures::{known_figure, AxisFigures};
-use crate::format::{short, sig};
+use crate::bias::{warmup_text, WarmupJson};
+use gyrolab_eval::outcome::static_test::WarmupReport;
+use gyrolab::figures::{known_figure, AxisFigures};
+use gyrolab::format::{short, sig};
 use crate::html::{DataTable, FigureRow, PlotBlock, ReportSection};
-use crate::limits::Limit;
+use gyrolab::limits::Limit;
 use crate::plot::{Axis, Figure, LegendCorner, Panel, PlotError, Series, SeriesStyle};
 use crate::static_report::ReferenceJson;
 use gyrolab::power_ups::PowerUpSpread;

@@ -2,28 +2,13 @@
 //! JSON keys are documented in docs/JSON.md; each key names its unit or says it is in output
 //! units (the axis's `output_unit`).
 
-use crate::format::{short, sig, sig_opt};
+use gyrolab_eval::outcome::rate::AxisReport;
+use gyrolab::format::{short, sig, sig_opt};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Cell, CellAlignment, Table};
 use gyrolab::rate_test::{RateEvaluation, RestReferenceSource};
 use gyrolab::units::{ratio_to_pct, ratio_to_ppm, OutputUnit};
+use gyrolab::figures::AxisFigures;
 use serde::Serialize;
-
-/// One evaluated axis with what is needed to report it.
-#[derive(Debug, Clone)]
-pub struct AxisReport<'a> {
-    /// Axis name.
-    pub name: String,
-    /// Source file as given.
-    pub file: String,
-    /// Layout the record was read in (`long` or `wide`).
-    pub layout: String,
-    /// Output unit.
-    pub output_unit: OutputUnit,
-    /// Number of output samples read.
-    pub samples: usize,
-    /// The evaluation.
-    pub evaluation: &'a RateEvaluation,
-}
 
 /// JSON document of `gyrolab rate --json`.
 #[derive(Debug, Clone, Serialize)]
@@ -366,3 +351,29 @@ pub fn rate_points_table(a: &AxisReport<'_>) -> String {
     right(&mut t, 0);
     t.to_string()
 }
+
+/// The rate-table figures of an axis, from its JSON.
+pub fn rate_figures(a: &AxisJson) -> AxisFigures {
+    let mut f = AxisFigures { axis: a.name.clone(), output_unit: a.output_unit.clone(), ..Default::default() };
+    let opt = [
+        ("scale_factor", Some(a.scale_factor)),
+        ("zero_offset", Some(a.zero_offset)),
+        ("nonlinearity_pct", Some(a.nonlinearity_pct)),
+        ("nonlinearity_ppm", Some(a.nonlinearity_ppm)),
+        ("linearity_pct", Some(a.linearity_pct)),
+        ("hysteresis_pct", Some(a.hysteresis_pct)),
+        ("repeatability_pct", a.repeatability_pct),
+        ("accuracy_pct", a.accuracy_pct),
+        ("accuracy_rss_pct", a.accuracy_rss_pct),
+        ("asymmetry_pct", a.asymmetry_pct),
+        ("scale_factor_repeatability_ppm", a.scale_factor_repeatability_ppm),
+        ("scale_factor_repeatability_pct", a.scale_factor_repeatability_pct),
+    ];
+    for (k, v) in opt {
+        if let Some(v) = v {
+            f.set(k, v);
+        }
+    }
+    f
+}
+

@@ -1,9 +1,9 @@
 //! The rate-table plots of one axis: calibration curve with residuals (the paper's Figures 1 to
 //! 3), hysteresis (forward and reverse stroke means minus the line) and scale factor per run.
 
-use crate::format::sig;
+use gyrolab::format::sig;
 use crate::plot::{Axis, Figure, Orientation, Panel, PlotError, RefLine, Series, SeriesStyle};
-use crate::rate::AxisReport;
+use gyrolab_eval::outcome::rate::AxisReport;
 
 /// Unit and factor for small output differences (volts shown in mV).
 fn display_unit(a: &AxisReport<'_>) -> (String, f64) {

@@ -2,7 +2,7 @@
 //! rate-table figure per axis (the `gyrolab rate --json` axis objects), the limits and their
 //! verdicts. The static (bias) and Allan sections (and the demo's `paper`) go under their own key in `sections`.
 
-use crate::limits::{DecisionRule, Limit, LimitCheck, Overall};
+use gyrolab::limits::{DecisionRule, Limit, LimitCheck, Overall};
 use crate::rate::AxisJson;
 use serde::Serialize;
 use std::collections::BTreeMap;

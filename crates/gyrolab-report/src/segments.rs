@@ -1,24 +1,10 @@
 //! Segmentation summaries of raw rate-table logs (`gyrolab rate` on raw logs): text and JSON.
 
+use gyrolab_eval::outcome::segments::SegmentationReport;
 use gyrolab::rate_test::Stroke;
-use gyrolab::segment::{Segment, SegmentKind};
+use gyrolab::segment::SegmentKind;
 use serde::Serialize;
 use std::fmt::Write as _;
-
-/// The segmentation of one raw log, with what is needed to report it.
-#[derive(Debug, Clone)]
-pub struct SegmentationReport<'a> {
-    /// Source file as given.
-    pub file: String,
-    /// `automatic` or `manual` (from a segment file).
-    pub mode: &'static str,
-    /// Samples in the log.
-    pub samples: usize,
-    /// The labelled segments.
-    pub segments: &'a [Segment],
-    /// Source line of each sample.
-    pub lines: &'a [u64],
-}
 
 /// Plateaus of one run and stroke.
 #[derive(Debug, Clone, Serialize)]
@@ -189,8 +175,8 @@ pub fn segmentation_text(r: &SegmentationReport<'_>) -> String {
             g.run,
             g.stroke,
             g.plateaus,
-            crate::format::short(g.rate_min_dps, 6),
-            crate::format::short(g.rate_max_dps, 6),
+            gyrolab::format::short(g.rate_min_dps, 6),
+            gyrolab::format::short(g.rate_max_dps, 6),
             g.first_line,
             g.last_line
         );

@@ -2,12 +2,13 @@
 //! window means, bias against temperature, Allan deviation on log-log axes with confidence bars,
 //! noise asymptotes and N, B, K read-offs), their summary figures, JSON and CSV tables.
 
-use crate::allan::{allan_csv, allan_json, ChannelAnalysis};
-use crate::bias::TestReport;
-use crate::figures::AxisFigures;
-use crate::format::{short, sig, sig_opt};
+use crate::allan::{allan_csv, allan_json};
+use gyrolab_eval::outcome::allan::ChannelAnalysis;
+use gyrolab_eval::outcome::static_test::TestReport;
+use gyrolab::figures::AxisFigures;
+use gyrolab::format::{short, sig, sig_opt};
 use crate::html::{DataTable, FigureRow, PlotBlock, ReportSection};
-use crate::limits::Limit;
+use gyrolab::limits::Limit;
 use crate::plot::{
     scatter_fit_plot, Annotation, Axis, Figure, LegendCorner, Orientation, Panel, PlotError, RefLine, Series,
     SeriesStyle,
@@ -193,7 +194,7 @@ impl StaticAxisReport {
             .values
             .iter()
             .filter(|(k, _)| {
-                crate::figures::known_figure(k).is_some_and(|d| d.group != crate::figures::FigureGroup::Allan)
+                gyrolab::figures::known_figure(k).is_some_and(|d| d.group != gyrolab::figures::FigureGroup::Allan)
             })
             .map(|(k, v)| (k.clone(), serde_json::json!(v)))
             .collect();

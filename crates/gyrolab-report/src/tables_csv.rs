@@ -1,9 +1,9 @@
 //! The CSV tables of a report folder: per-point means of each rate-table axis, per-run scale
 //! factors, and the summary of every figure with its unit, limit and verdict.
 
-use crate::figures::AxisFigures;
+use gyrolab::figures::AxisFigures;
 use crate::html::SummaryTable;
-use crate::limits::Limit;
+use gyrolab::limits::Limit;
 use crate::rate::AxisJson;
 
 fn csv_field(s: &str) -> String {

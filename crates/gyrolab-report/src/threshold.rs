@@ -4,10 +4,10 @@
 //! `sections.resolution.<axis>` (docs/JSON.md). Definitions: docs/METHODS.md, "Threshold and
 //! resolution" (GJB 2426A-2004, IEEE Std 528).
 
-use crate::figures::AxisFigures;
-use crate::format::{short, sig};
+use gyrolab::figures::AxisFigures;
+use gyrolab::format::{short, sig};
 use crate::html::{DataTable, FigureRow, ReportSection};
-use crate::limits::{check_limits, Limit};
+use gyrolab::limits::{check_limits, Limit};
 use gyrolab::threshold::{StepEstimate, Support, MARGINAL_STANDARD_ERRORS, PASS_FRACTION};
 use serde_json::json;
 
@@ -301,10 +301,10 @@ mod tests {
         // Above 0.1 against <= 0.05: FAIL (the issue's "no response even at 0.5 against <= 0.2");
         // against <= 0.5 the bound cannot decide.
         let s = step_section(std::slice::from_ref(&r), &[Limit::new("threshold_dps", None, Some(0.05))]);
-        assert_eq!(s.figures[0].verdict, Some(crate::limits::Verdict::Fail));
+        assert_eq!(s.figures[0].verdict, Some(gyrolab::limits::Verdict::Fail));
         assert_eq!(s.tables[0].rows.len(), 3);
         let s = step_section(std::slice::from_ref(&r), &[Limit::new("threshold_dps", None, Some(0.5))]);
-        assert_eq!(s.figures[0].verdict, Some(crate::limits::Verdict::NotEvaluated));
+        assert_eq!(s.figures[0].verdict, Some(gyrolab::limits::Verdict::NotEvaluated));
     }
 
     #[test]
@@ -317,9 +317,9 @@ mod tests {
         assert_eq!(j["rates_tried"][0]["pass"], true);
         // At most 0.1 against <= 0.05 cannot be decided; against <= 0.2 it passes.
         let s = step_section(std::slice::from_ref(&r), &[Limit::new("threshold_dps", None, Some(0.05))]);
-        assert_eq!(s.figures[0].verdict, Some(crate::limits::Verdict::NotEvaluated));
+        assert_eq!(s.figures[0].verdict, Some(gyrolab::limits::Verdict::NotEvaluated));
         assert!(s.figures[0].value.starts_with("at most 0.1"));
         let s = step_section(std::slice::from_ref(&r), &[Limit::new("threshold_dps", None, Some(0.2))]);
-        assert_eq!(s.figures[0].verdict, Some(crate::limits::Verdict::Pass));
+        assert_eq!(s.figures[0].verdict, Some(gyrolab::limits::Verdict::Pass));
     }
 }

@@ -1,24 +1,11 @@
 //! Reports of three-axis (triad) calibrations (`gyrolab rate --triad`): text and JSON. Keys name
 //! their unit; output-valued keys are in `output_unit`.
 
-use crate::format::sig;
+use gyrolab_eval::outcome::triad::TriadReport;
+use gyrolab::format::sig;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, CellAlignment, Table};
-use gyrolab::triad::{TableAxis, TriadFit};
-use gyrolab::units::OutputUnit;
+use gyrolab::triad::TableAxis;
 use serde::Serialize;
-
-/// A three-axis fit with what is needed to report it.
-#[derive(Debug, Clone)]
-pub struct TriadReport<'a> {
-    /// The records: (table axis, file as given).
-    pub files: Vec<(TableAxis, String)>,
-    /// Names of the gyro output columns, in the order x, y, z.
-    pub gyro_columns: [String; 3],
-    /// Unit of the outputs.
-    pub output_unit: OutputUnit,
-    /// The fit.
-    pub fit: &'a TriadFit,
-}
 
 /// A record of the set in JSON.
 #[derive(Debug, Clone, Serialize)]

@@ -16,7 +16,7 @@ use crate::account::{self, Need};
 use crate::db::{Exec, Kind, Val};
 use crate::{chain, schema, sign, Actor, Store, StoreError, StoreResult};
 use ed25519_dalek::SigningKey;
-use gyrolab_eval::report_folder::{manifest_json, Manifest, NamedOutput, MANIFEST};
+use gyrolab_io::manifest::{manifest_json, Manifest, NamedOutput, MANIFEST};
 use serde::Serialize;
 
 /// The meaning of an issuing signature.
@@ -241,9 +241,16 @@ fn issue_json(t: &IssueText, superseded_by: Option<(&str, &str, &str)>) -> Strin
     serde_json::to_string_pretty(&v).map(|s| s + "\n").unwrap_or_default()
 }
 
-/// The report.html of the issued report, drawn by the report crate from the issue's facts.
-fn issued_html(draft: &str, t: &IssueText, draft_number: &str, draft_issue_date: &str) -> String {
-    let block = gyrolab_report::signature::SignatureBlock {
+/// The report.html of the issued report, drawn by the caller's renderer (the report crate's
+/// `signature::issued_html`) from the issue's facts.
+fn issued_html(
+    render: IssuedHtml<'_>,
+    draft: &str,
+    t: &IssueText,
+    draft_number: &str,
+    draft_issue_date: &str,
+) -> String {
+    let block = gyrolab::sign_off::SignOff {
         number: t.number,
         issued_at: t.issued_at,
         amendment: t.amendment,
@@ -255,7 +262,7 @@ fn issued_html(draft: &str, t: &IssueText, draft_number: &str, draft_issue_date:
         fingerprint: t.fingerprint,
         head: t.head,
     };
-    gyrolab_report::signature::issued_html(draft, &block, draft_number, draft_issue_date)
+    render(draft, &block, draft_number, draft_issue_date)
 }
 
 /// The files of an issued folder (the stored ones but their manifest and any earlier issue
@@ -282,8 +289,15 @@ fn issued_outputs(
 /// A file of a report folder: its name and bytes.
 pub type NamedFile = (String, Vec<u8>);
 
+/// Draws the issued report.html from the draft's, the sign-off's facts, the draft's report
+/// number and its issue date (the report crate's `signature::issued_html`; the store persists
+/// and draws nothing).
+pub type IssuedHtml<'a> = &'a dyn Fn(&str, &gyrolab::sign_off::SignOff<'_>, &str, &str) -> String;
+
 /// What an issue or an amendment asks for.
 pub struct IssueRequest<'a> {
+    /// Draws the issued report.html ([`IssuedHtml`]).
+    pub render: IssuedHtml<'a>,
     /// The evaluation to issue (for an amendment: the issued evaluation or its later revision).
     pub evaluation: i64,
     /// The meaning of the signature.
@@ -538,7 +552,8 @@ impl Store {
             let json = issue_json(&text, None);
             let draft_html = new.files.iter().find(|(n, _)| n == "report.html").map(|(_, b)| b.clone());
             let html = match draft_html {
-                Some(b) => issued_html(&String::from_utf8_lossy(&b), &text, &new.number, &new.issue_date).into_bytes(),
+                Some(b) => issued_html(req.render, &String::from_utf8_lossy(&b), &text, &new.number, &new.issue_date)
+                    .into_bytes(),
                 None => return Err(refused(format!("evaluation {target} has no stored report.html to issue"))),
             };
             let (_, manifest) = issued_outputs(&new.files, &html, &json)?;

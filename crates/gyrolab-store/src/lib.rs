@@ -19,7 +19,6 @@ pub mod issue;
 pub mod location;
 pub mod query;
 pub mod record;
-pub mod reevaluate;
 pub mod schema;
 pub mod sign;
 pub mod tables;

@@ -3,7 +3,7 @@
 //! it names, hashed), so that `gyrolab store add DIR` and `gyrolab eval --store` take one path.
 
 use crate::{StoreError, StoreResult};
-use gyrolab_eval::test_plan::read_test_plan;
+use gyrolab_io::test_plan::read_plan as read_test_plan;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -158,7 +158,7 @@ pub fn plan_inputs(plan: &gyrolab_io_plan::TestPlan) -> Vec<PathBuf> {
     plan.input_files()
 }
 
-/// The plan types (re-exported by gyrolab-eval's plan reader).
+/// The plan types (gyrolab-io's plan reader).
 pub mod gyrolab_io_plan {
     pub use gyrolab_io::test_plan::TestPlan;
 }
@@ -398,8 +398,8 @@ fn hash_inputs(parsed: &gyrolab_io_plan::TestPlan) -> StoreResult<Vec<FileRecord
 }
 
 /// The report folder's manifest, when it has one (a folder written before 0.3 has none).
-fn read_manifest(dir: &Path) -> StoreResult<Option<gyrolab_eval::report_folder::Manifest>> {
-    let path = dir.join(gyrolab_eval::report_folder::MANIFEST);
+fn read_manifest(dir: &Path) -> StoreResult<Option<gyrolab_io::manifest::Manifest>> {
+    let path = dir.join(gyrolab_io::manifest::MANIFEST);
     if !path.is_file() {
         return Ok(None);
     }
@@ -459,7 +459,7 @@ pub fn from_report_folder_with(
     if let Some(m) = &manifest {
         names.retain(|p| {
             let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-            name == gyrolab_eval::report_folder::MANIFEST
+            name == gyrolab_io::manifest::MANIFEST
                 || name == "report.pdf"
                 || m.files.iter().any(|f| f.name == name)
         });

@@ -272,6 +272,6 @@ fn streaming_note(file: &str, s: &gyrolab_eval::allan_memory::StreamingSummary) 
 /// Whether a channel's curve is flat at zero: every deviation at or below 1e-9 (in the
 /// channel's unit: far below any sensor's noise, above the rounding of a constant record's
 /// angle sums), i.e. every sample has the same value.
-fn is_flat(a: &gyrolab_report::allan::ChannelAnalysis) -> bool {
+fn is_flat(a: &gyrolab_eval::outcome::allan::ChannelAnalysis) -> bool {
     !a.curve.points.is_empty() && a.curve.points.iter().all(|p| p.deviation.abs() <= 1e-9)
 }

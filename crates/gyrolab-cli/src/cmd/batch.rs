@@ -14,7 +14,7 @@ use crate::output::print;
 use clap::Args;
 use gyrolab::validate;
 use gyrolab_eval::allan::AllanRequest;
-use gyrolab_eval::batch::{
+use gyrolab_lab::batch::{
     collect_inputs, journal_header, journal_line, journal_rows, options_fingerprint, results_csv, results_parquet,
     run_batch, BatchRequest, BatchSink, Cell, DoneInput, FailedInput, Journal, ResultRow, Skipped,
 };

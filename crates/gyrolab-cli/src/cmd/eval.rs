@@ -8,7 +8,7 @@ use crate::error::{CliError, CliResult};
 use crate::folder::write_and_finish;
 use crate::progress::Bar;
 use clap::Args;
-use gyrolab_eval::test_plan::{evaluate_test_plan, read_test_plan};
+use gyrolab_lab::test_plan::{evaluate_test_plan, read_test_plan};
 use gyrolab_store::record::{from_report_folder_with, hash_plan_inputs};
 use gyrolab_store::{resolve_location, Actor, Store, StoreError};
 use std::path::PathBuf;

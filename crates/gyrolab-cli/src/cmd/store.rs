@@ -7,13 +7,15 @@ use crate::args::{prompt_password, stdin_line, AuthArgs, QueryOutput, StoreLocat
 use crate::error::{CliError, CliResult};
 use crate::output::{print, to_json, write_file};
 use clap::{Args, Subcommand, ValueEnum};
-use gyrolab_report::format::sig_opt;
+use gyrolab::format::sig_opt;
 use gyrolab_report::plot::{Axis, Figure, Orientation, Panel, RefLine, Series, SeriesStyle};
 use gyrolab_store::export::{to_csv, to_parquet, Cell, Table};
-use gyrolab_store::issue::{IssueRequest, IssuedReport, Meaning};
+use gyrolab_lab::issue::Issue;
+use gyrolab_lab::reevaluate;
+use gyrolab_store::issue::{IssuedReport, Meaning};
 use gyrolab_store::tables::{chart_table, compare_table, diff_table, history_table, lot_table};
 use gyrolab_store::{
-    add_report_folder_as, query, reevaluate, resolve_location, sign, Actor, Changes, CheckReport, Revision,
+    add_report_folder_as, query, resolve_location, sign, Actor, Changes, CheckReport, Revision,
     RevisionKind, Role, Store,
 };
 use std::path::PathBuf;
@@ -440,7 +442,7 @@ fn draft_note(s: &mut Store, superseded: i64, revision: i64) -> CliResult<String
 /// `gyrolab store issue` and `amend`.
 /// `store issue` (no reason) or `store amend` (its reason) of evaluation `id`.
 fn signed(id: i64, m: MeaningArg, amend_reason: Option<&str>, a: &SigningArgs) -> CliResult {
-    let req = IssueRequest {
+    let req = Issue {
         evaluation: id,
         meaning: meaning(m),
         key: &read_key(&a.signing_key)?,
@@ -450,7 +452,7 @@ fn signed(id: i64, m: MeaningArg, amend_reason: Option<&str>, a: &SigningArgs) -
     issue(&a.location, &a.auth, &req)
 }
 
-fn issue(location: &StoreLocation, auth: &AuthArgs, req: &IssueRequest) -> CliResult {
+fn issue(location: &StoreLocation, auth: &AuthArgs, req: &Issue) -> CliResult {
     let mut s = open_for_writing(location)?;
     let Some((user, password)) = auth.credentials(true)? else {
         return Err(CliError::Usage(
@@ -460,7 +462,7 @@ fn issue(location: &StoreLocation, auth: &AuthArgs, req: &IssueRequest) -> CliRe
         ));
     };
     let actor = s.authenticate(&user, &password)?;
-    let r = s.issue(&actor, req)?;
+    let r = gyrolab_lab::issue::issue(&mut s, &actor, req)?;
     let what = match (&r.amends_report, r.amendment_no) {
         (Some(old), Some(n)) => format!("amendment {n} to report {old} (now SUPERSEDED), "),
         _ => String::new(),

@@ -8,7 +8,7 @@
 use crate::error::{CliError, CliResult};
 use crate::output::print;
 use clap::Args;
-use gyrolab_eval::verify::{verify_folder, FileState};
+use gyrolab_lab::verify::{verify_folder, FileState};
 use std::path::PathBuf;
 
 /// Options of `gyrolab verify`.

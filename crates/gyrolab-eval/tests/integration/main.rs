@@ -5,15 +5,7 @@
 mod allan;
 mod clock;
 mod common;
-mod demo;
-mod plan_g_sensitivity;
-mod plan_power_ups;
-mod plan_temperature;
-mod plan_threshold;
-mod plan_uncertainty;
 mod rate;
 mod raw_log;
 mod static_test;
-mod test_plan;
-mod test_program;
 mod triad;

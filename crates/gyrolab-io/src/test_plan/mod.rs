@@ -526,10 +526,23 @@ impl TestPlan {
     }
 }
 
-/// Reads and checks a plan file; `known_figure` tells which `[limits]` names exist.
-pub fn read_plan(path: &Path, known_figure: &dyn Fn(&str) -> bool) -> Result<TestPlan, DataError> {
+/// Reads and checks a plan file: every `[limits]` name must be in the figure catalogue
+/// ([`gyrolab::figures`]) and able to carry a limit (a refusal names the reason and the line).
+pub fn read_plan(path: &Path) -> Result<TestPlan, DataError> {
     let text = crate::text::read_text_file(path, crate::text::MAX_CONFIG_BYTES, "a test plan (TOML)")?;
-    parse_plan(path, &text, known_figure)
+    parse_plan(path, &text)
+}
+
+/// Parses and checks a plan's text (as [`read_plan`]; `path` names the file in errors and
+/// resolves its relative paths).
+pub fn parse_plan(path: &Path, text: &str) -> Result<TestPlan, DataError> {
+    let plan = parse_plan_with(path, text, &|n| gyrolab::figures::known_figure(n).is_some())?;
+    for l in &plan.limits {
+        if let Some(why) = gyrolab::figures::limit_refusal(&l.figure) {
+            return Err(DataError::new(path, format!("limits.{}: {why}", l.figure)).at_line(l.line));
+        }
+    }
+    Ok(plan)
 }
 
 pub(crate) struct Ctx<'a> {
@@ -622,7 +635,7 @@ impl Ctx<'_> {
 }
 
 /// Parses and checks plan text; `path` names it in errors and its folder anchors relative paths.
-pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) -> Result<TestPlan, DataError> {
+fn parse_plan_with(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) -> Result<TestPlan, DataError> {
     let raw: RawPlan = toml::from_str(text).map_err(|e| {
         let mut d = DataError::new(path, format!("not a valid test plan: {}", crate::text::short_message(e.message())));
         if let Some(span) = e.span() {
@@ -1103,10 +1116,6 @@ pub fn parse_plan(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) 
 mod tests {
     use super::*;
 
-    fn known(n: &str) -> bool {
-        matches!(n, "nonlinearity_pct" | "bias_stability_dph_10s")
-    }
-
     /// A folder with two record files and a plan around them.
     fn setup(plan: &str) -> (tempfile::TempDir, Result<TestPlan, DataError>) {
         let dir = tempfile::tempdir().unwrap();
@@ -1114,7 +1123,7 @@ mod tests {
         std::fs::write(dir.path().join("s1.csv"), "t,v\n").unwrap();
         let p = dir.path().join("plan.toml");
         std::fs::write(&p, plan).unwrap();
-        let r = read_plan(&p, &known);
+        let r = read_plan(&p);
         (dir, r)
     }
 

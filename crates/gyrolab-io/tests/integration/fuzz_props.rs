@@ -65,7 +65,7 @@ fn all_readers(bytes: &[u8]) -> Result<(), TestCaseError> {
     bounded(parse_manual_segments(p, &text))?;
     bounded(parse_calibration(p, &text))?;
     bounded(parse_sim_config(p, &text))?;
-    bounded(parse_plan(&plan_path(), &text, &|n| n.ends_with("_pct") || n.ends_with("_dph")))?;
+    bounded(parse_plan(&plan_path(), &text))?;
     series(bytes, 16)?;
     series(bytes, 1 << 20)
 }
@@ -194,7 +194,7 @@ fn the_seeds_are_valid() {
     parse_manual_segments(p, SEGMENTS).unwrap();
     parse_sim_config(p, SIM).unwrap();
     parse_calibration(p, &calibration_text()).unwrap();
-    parse_plan(&plan_path(), PLAN, &|_| true).unwrap();
+    parse_plan(&plan_path(), PLAN).unwrap();
     let o = SeriesOptions { table_rate_column: Some("table_rate_dps".into()), ..SeriesOptions::default() };
     let mut r = SeriesReader::from_reader("s.csv", SERIES.as_bytes(), &o).unwrap();
     assert_eq!(r.next_block().unwrap().unwrap().len(), 4);
@@ -218,7 +218,7 @@ mod regressions {
             let text = String::from_utf8_lossy(&bytes);
             let errors = [
                 parse_calibration(Path::new("c.toml"), &text).map(|_| ()),
-                parse_plan(&plan_path(), &text, &|_| true).map(|_| ()),
+                parse_plan(&plan_path(), &text).map(|_| ()),
             ];
             for e in errors.into_iter().filter_map(Result::err) {
                 let shown = e.to_string();

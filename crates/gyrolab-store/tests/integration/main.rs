@@ -4,6 +4,5 @@
 
 mod accounts;
 mod common;
-mod folder;
 mod store;
 mod tamper;
