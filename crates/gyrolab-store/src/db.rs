@@ -300,6 +300,9 @@ impl Row {
     }
 }
 
+/// A result as fetched: the names of its columns and every row's values in that order.
+pub type Fetched = (Arc<[String]>, Vec<Vec<Val>>);
+
 /// How the columns of a result are read: by name (every column of the result declared, every
 /// declared column present) or by position.
 #[derive(Debug, Clone, Copy)]
@@ -349,12 +352,7 @@ pub trait Exec {
     fn exec(&mut self, sql: &str, params: &[Val]) -> Result<u64, DbError>;
     /// Runs a query; the names of the result's columns and every row's values, read as `decode`
     /// says.
-    fn fetch(
-        &mut self,
-        sql: &str,
-        params: &[Val],
-        decode: Decode<'_>,
-    ) -> Result<(Arc<[String]>, Vec<Vec<Val>>), DbError>;
+    fn fetch(&mut self, sql: &str, params: &[Val], decode: Decode<'_>) -> Result<Fetched, DbError>;
     /// Runs several statements without parameters (schema changes).
     fn batch(&mut self, sql: &str) -> Result<(), DbError>;
     /// Inserts rows given as columns: SQLite runs `row_sql` (one row's `$1..$n`) once per row
@@ -413,12 +411,7 @@ impl Exec for SqliteExec<'_> {
         let mut st = self.0.prepare_cached(sql)?;
         Ok(st.execute(rusqlite::params_from_iter(params.iter()))? as u64)
     }
-    fn fetch(
-        &mut self,
-        sql: &str,
-        params: &[Val],
-        decode: Decode<'_>,
-    ) -> Result<(Arc<[String]>, Vec<Vec<Val>>), DbError> {
+    fn fetch(&mut self, sql: &str, params: &[Val], decode: Decode<'_>) -> Result<Fetched, DbError> {
         let mut st = self.0.prepare_cached(sql)?;
         let names: Arc<[String]> = st.column_names().into_iter().map(str::to_string).collect();
         let kinds = decode.kinds(&names)?;
@@ -490,12 +483,7 @@ impl<C: postgres::GenericClient> Exec for PgExec<'_, C> {
         let refs: Vec<&(dyn postgres::types::ToSql + Sync)> = p.iter().map(|b| b.as_ref()).collect();
         Ok(self.0.execute(&st, &refs)?)
     }
-    fn fetch(
-        &mut self,
-        sql: &str,
-        params: &[Val],
-        decode: Decode<'_>,
-    ) -> Result<(Arc<[String]>, Vec<Vec<Val>>), DbError> {
+    fn fetch(&mut self, sql: &str, params: &[Val], decode: Decode<'_>) -> Result<Fetched, DbError> {
         let st = self.statement(sql)?;
         let names: Arc<[String]> = st.columns().iter().map(|c| c.name().to_string()).collect();
         let kinds = decode.kinds(&names)?;
@@ -553,4 +541,54 @@ pub fn returned_id(rows: &[Row]) -> Result<i64, DbError> {
 /// `SELECT COALESCE(MAX(...), 0)`).
 pub fn first_int(rows: &[Row], name: &str, default: i64) -> Result<i64, DbError> {
     rows.first().map_or(Ok(default), |r| r.int(name))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn conn() -> rusqlite::Connection {
+        let c = rusqlite::Connection::open_in_memory().expect("in-memory SQLite"); // ok: test
+        c.execute_batch("CREATE TABLE t (id INTEGER, serial TEXT, value REAL); INSERT INTO t VALUES (7, 'SN-1', 1.5);")
+            .expect("table"); // ok: test
+        c
+    }
+
+    #[test]
+    fn rows_are_read_by_name_whatever_the_order() {
+        let c = conn();
+        let cols: Columns<'_> = &[("value", Kind::F), ("id", Kind::I), ("serial", Kind::T)];
+        let rows = SqliteExec(&c).rows("SELECT serial, id, value FROM t", &[], cols).expect("rows"); // ok: test
+        let r = &rows[0];
+        assert_eq!(r.names(), ["serial", "id", "value"]);
+        assert_eq!(r.int("id"), Ok(7));
+        assert_eq!(r.string("serial").as_deref(), Ok("SN-1"));
+        assert_eq!(r.float("value"), Ok(Some(1.5)));
+    }
+
+    #[test]
+    fn a_missing_or_undeclared_column_or_another_kind_is_an_error_naming_the_column() {
+        let c = conn();
+        let rows = SqliteExec(&c).rows("SELECT id, serial FROM t", &[], &[("id", Kind::I), ("serial", Kind::T)]);
+        let r = &rows.expect("rows")[0]; // ok: test
+        let e = r.int("lot").unwrap_err();
+        assert!(matches!(&e, DbError::MissingColumn { column, .. } if column == "lot"), "{e:?}");
+        assert!(e.to_string().contains("\"lot\"") && e.to_string().contains("id, serial"), "{e}");
+        let e = r.int("serial").unwrap_err();
+        assert!(matches!(&e, DbError::WrongKind { column, .. } if column == "serial"), "{e:?}");
+        assert!(e.to_string().contains("\"serial\" holds a text, read as an integer"), "{e}");
+        let e = SqliteExec(&c).rows("SELECT id FROM t", &[], &[("id", Kind::I), ("lot", Kind::T)]).unwrap_err();
+        assert!(matches!(&e, DbError::MissingColumn { column, .. } if column == "lot"), "{e:?}");
+        let e = SqliteExec(&c).rows("SELECT id, serial FROM t", &[], &[("id", Kind::I)]).unwrap_err();
+        assert_eq!(e, DbError::UndeclaredColumn { column: "serial".into() });
+    }
+
+    #[test]
+    fn failures_are_typed() {
+        let c = conn();
+        let e = SqliteExec(&c).exec("INSERT INTO nowhere VALUES (1)", &[]).unwrap_err();
+        assert!(matches!(&e, DbError::Sqlite(m) if m.contains("nowhere")), "{e:?}");
+        let e = SqliteExec(&c).insert_columns("", "", &[Column::I(vec![1]), Column::T(vec![])]).unwrap_err();
+        assert_eq!(e, DbError::UnequalColumns);
+    }
 }

@@ -413,17 +413,22 @@ impl Store {
         db::first_int(&rows, "version", 0).map_err(|e| self.row_error(e))
     }
 
-    /// The checksums recorded in the store: (version, name, SHA-256) of every applied migration,
-    /// oldest first (name and checksum null only in a store that no build with checksums has
-    /// opened yet).
-    pub fn recorded_migrations(&mut self) -> StoreResult<Vec<(i64, Option<String>, Option<String>)>> {
+    /// The migrations recorded in the store's `gyrolab_schema`, oldest first (their name and
+    /// checksum are null only in a store no build with checksums has opened yet).
+    pub fn recorded_migrations(&mut self) -> StoreResult<Vec<schema::RecordedMigration>> {
         let rows = self.rows(
             "SELECT version, name, sha256 FROM gyrolab_schema ORDER BY version",
             &[],
             &[("version", Kind::I), ("name", Kind::T), ("sha256", Kind::T)],
         )?;
         rows.iter()
-            .map(|r| Ok((r.int("version")?, r.string_opt("name")?, r.string_opt("sha256")?)))
+            .map(|r| {
+                Ok(schema::RecordedMigration {
+                    version: r.int("version")?,
+                    name: r.string_opt("name")?,
+                    sha256: r.string_opt("sha256")?,
+                })
+            })
             .collect::<Result<Vec<_>, DbError>>()
             .map_err(|e| self.row_error(e))
     }

@@ -29,6 +29,17 @@ impl Migration {
     }
 }
 
+/// One row of `gyrolab_schema` as a store records it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RecordedMigration {
+    /// The version applied.
+    pub version: i64,
+    /// The migration's name (null until a build with checksums opened the store).
+    pub name: Option<String>,
+    /// SHA-256 (hex) of the SQL applied (null until a build with checksums opened the store).
+    pub sha256: Option<String>,
+}
+
 /// A migration of back end `$dir` from `migrations/$dir/$file`.
 macro_rules! migration {
     ($dir:literal, $version:literal, $name:literal, $file:literal) => {

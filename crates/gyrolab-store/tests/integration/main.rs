@@ -5,5 +5,6 @@
 mod accounts;
 mod common;
 mod folder;
+mod migrations;
 mod store;
 mod tamper;
