@@ -7,7 +7,7 @@
 //! `audit_event`. A store with no account works without authentication (the actor recorded as
 //! [`UNAUTHENTICATED`]); once it has one, every write needs an authenticated account.
 
-use crate::db::{Exec, Kind, Val};
+use crate::db::{returned_id, Columns, DbError, Exec, Kind, Row, Val};
 use crate::{chain, StoreError};
 use argon2::password_hash::{PasswordHash, PasswordHasher, PasswordVerifier, SaltString};
 use argon2::Argon2;
@@ -179,45 +179,56 @@ pub fn check_password(password: &str) -> Result<(), String> {
     Ok(())
 }
 
-const ACCOUNT_SQL: &str = "SELECT a.id, a.name, a.display_name, a.role, a.created_at, a.created_by, \
-     (SELECT COUNT(*) FROM account_change c WHERE c.account_id = a.id AND c.change = 'disable'), \
+const ACCOUNT_SQL: &str = "SELECT a.id AS id, a.name AS name, a.display_name AS display_name, a.role AS role, \
+     a.created_at AS created_at, a.created_by AS created_by, \
+     (SELECT COUNT(*) FROM account_change c WHERE c.account_id = a.id AND c.change = 'disable') AS disables, \
      COALESCE((SELECT c.password_hash FROM account_change c WHERE c.account_id = a.id AND c.change = 'password' \
-     ORDER BY c.id DESC LIMIT 1), a.password_hash) FROM account a";
+     ORDER BY c.id DESC LIMIT 1), a.password_hash) AS password_hash FROM account a";
 
-fn account_of(r: &[Val]) -> (Account, String) {
-    (
+/// The columns of [`ACCOUNT_SQL`].
+const ACCOUNT_COLUMNS: Columns<'static> = &[
+    ("id", Kind::I),
+    ("name", Kind::T),
+    ("display_name", Kind::T),
+    ("role", Kind::T),
+    ("created_at", Kind::T),
+    ("created_by", Kind::T),
+    ("disables", Kind::I),
+    ("password_hash", Kind::T),
+];
+
+fn account_of(r: &Row) -> Result<(Account, String), DbError> {
+    Ok((
         Account {
-            id: r[0].int(),
-            name: r[1].string(),
-            display_name: r[2].string(),
-            role: Role::parse(r[3].text().unwrap_or_default()).unwrap_or(Role::Viewer),
-            created_at: r[4].string(),
-            created_by: r[5].string(),
-            disabled: r[6].int() > 0,
+            id: r.int("id")?,
+            name: r.string("name")?,
+            display_name: r.string("display_name")?,
+            role: Role::parse(r.text("role")?.unwrap_or_default()).unwrap_or(Role::Viewer),
+            created_at: r.string("created_at")?,
+            created_by: r.string("created_by")?,
+            disabled: r.int("disables")? > 0,
         },
-        r[7].string(),
-    )
+        r.string("password_hash")?,
+    ))
 }
 
-const ACCOUNT_KINDS: [Kind; 8] = [Kind::I, Kind::T, Kind::T, Kind::T, Kind::T, Kind::T, Kind::I, Kind::T];
-
 /// Every account, by id, with its current password hash.
-pub(crate) fn accounts(x: &mut dyn Exec) -> Result<Vec<(Account, String)>, String> {
+pub(crate) fn accounts(x: &mut dyn Exec) -> Result<Vec<(Account, String)>, DbError> {
     // ok: SQL from the module's constant column list; every value is a parameter.
     let sql = format!("{ACCOUNT_SQL} ORDER BY a.id");
-    Ok(x.query(&sql, &[], &ACCOUNT_KINDS)?.iter().map(|r| account_of(r)).collect())
+    x.rows(&sql, &[], ACCOUNT_COLUMNS)?.iter().map(account_of).collect()
 }
 
 /// The account named `name`, with its current password hash.
-pub(crate) fn by_name(x: &mut dyn Exec, name: &str) -> Result<Option<(Account, String)>, String> {
+pub(crate) fn by_name(x: &mut dyn Exec, name: &str) -> Result<Option<(Account, String)>, DbError> {
     // ok: SQL from the module's constant column list; every value is a parameter.
     let sql = format!("{ACCOUNT_SQL} WHERE a.name = $1");
-    Ok(x.query(&sql, &[Val::T(Some(name.to_string()))], &ACCOUNT_KINDS)?.first().map(|r| account_of(r)))
+    x.rows(&sql, &[Val::T(Some(name.to_string()))], ACCOUNT_COLUMNS)?.first().map(account_of).transpose()
 }
 
 /// Whether the store has any account.
-pub(crate) fn any(x: &mut dyn Exec) -> Result<bool, String> {
-    Ok(!x.query("SELECT id FROM account LIMIT 1", &[], &[Kind::I])?.is_empty())
+pub(crate) fn any(x: &mut dyn Exec) -> Result<bool, DbError> {
+    Ok(!x.rows("SELECT id FROM account LIMIT 1", &[], &[("id", Kind::I)])?.is_empty())
 }
 
 /// Authenticates `name` with `password`: the account and the hash it was verified against, or
@@ -226,7 +237,7 @@ pub(crate) fn authenticate(
     x: &mut dyn Exec,
     name: &str,
     password: &str,
-) -> Result<Result<(Account, String), ()>, String> {
+) -> Result<Result<(Account, String), ()>, DbError> {
     let found = by_name(x, name)?;
     let ok = match &found {
         Some((_, hash)) => verify_password(password, hash),
@@ -250,7 +261,7 @@ pub(crate) fn check_actor(
     actor: &Actor,
     need: Need,
 ) -> Result<(Option<i64>, String), StoreError> {
-    let dberr = |m: String| StoreError::Database { store: store.to_string(), message: m };
+    let dberr = |m: DbError| StoreError::Database { store: store.to_string(), message: m.to_string() };
     let refused = |m: String| StoreError::Refused { store: store.to_string(), message: m };
     match actor.account() {
         None => {
@@ -301,8 +312,8 @@ pub(crate) fn audit(
     action: &str,
     evaluation_id: Option<i64>,
     detail: Option<&str>,
-) -> Result<i64, String> {
-    let rows = x.query(
+) -> Result<i64, DbError> {
+    let rows = x.rows(
         "INSERT INTO audit_event (account_id, actor, action, evaluation_id, detail) VALUES ($1, $2, $3, $4, $5) RETURNING id",
         &[
             Val::IOpt(account_id),
@@ -311,9 +322,9 @@ pub(crate) fn audit(
             Val::IOpt(evaluation_id),
             Val::T(detail.map(str::to_string)),
         ],
-        &[Kind::I],
+        &[("id", Kind::I)],
     )?;
-    let id = rows.first().map(|r| r[0].int()).ok_or("no id returned for the audit event")?;
+    let id = returned_id(&rows)?;
     chain::append_row(x, "audit_event", id)?;
     Ok(id)
 }
@@ -336,32 +347,37 @@ pub struct AuditEvent {
 }
 
 /// The audit events of evaluation `id` (or every one with `None`), oldest first.
-pub(crate) fn events(x: &mut dyn Exec, evaluation: Option<i64>) -> Result<Vec<AuditEvent>, String> {
-    let kinds = [Kind::I, Kind::T, Kind::T, Kind::T, Kind::IOpt, Kind::T];
+pub(crate) fn events(x: &mut dyn Exec, evaluation: Option<i64>) -> Result<Vec<AuditEvent>, DbError> {
+    let kinds: Columns<'_> = &[
+        ("id", Kind::I),
+        ("at", Kind::T),
+        ("actor", Kind::T),
+        ("action", Kind::T),
+        ("evaluation_id", Kind::IOpt),
+        ("detail", Kind::T),
+    ];
     let rows = match evaluation {
-        Some(id) => x.query(
+        Some(id) => x.rows(
             "SELECT id, at, actor, action, evaluation_id, detail FROM audit_event WHERE evaluation_id = $1 ORDER BY id",
             &[Val::I(id)],
-            &kinds,
+            kinds,
         )?,
         None => {
-            x.query("SELECT id, at, actor, action, evaluation_id, detail FROM audit_event ORDER BY id", &[], &kinds)?
+            x.rows("SELECT id, at, actor, action, evaluation_id, detail FROM audit_event ORDER BY id", &[], kinds)?
         }
     };
-    Ok(rows
-        .iter()
-        .map(|r| AuditEvent {
-            id: r[0].int(),
-            at: r[1].string(),
-            actor: r[2].string(),
-            action: r[3].string(),
-            evaluation_id: match r[4] {
-                Val::IOpt(v) => v,
-                _ => None,
-            },
-            detail: r[5].text().map(str::to_string),
+    rows.iter()
+        .map(|r| {
+            Ok(AuditEvent {
+                id: r.int("id")?,
+                at: r.string("at")?,
+                actor: r.string("actor")?,
+                action: r.string("action")?,
+                evaluation_id: r.int_opt("evaluation_id")?,
+                detail: r.string_opt("detail")?,
+            })
         })
-        .collect())
+        .collect()
 }
 
 #[cfg(test)]

@@ -27,7 +27,7 @@
 //! ([`append_row`]). Migration 3 builds the chain over the rows of an existing store in that
 //! order, evaluations by `id` ([`build_existing`]).
 
-use crate::db::{Column, Exec, Kind, Val};
+use crate::db::{first_int, Column, DbError, Exec, Kind, Row, Val};
 use crate::schema;
 use sha2::{Digest, Sha256};
 use std::collections::HashMap;
@@ -267,8 +267,9 @@ fn unhex(s: &str) -> Option<[u8; 32]> {
     Some(out)
 }
 
-fn kinds(t: &ChainedTable) -> Vec<Kind> {
-    t.columns.iter().map(|c| c.1).collect()
+/// The values of a row of `t` read by name, in the order of `t.columns` (the canonical order).
+pub fn chained_values(t: &ChainedTable, row: &Row) -> Result<Vec<Val>, DbError> {
+    t.columns.iter().map(|(name, _)| row.get(name).cloned()).collect()
 }
 
 fn columns_sql(t: &ChainedTable) -> String {
@@ -276,14 +277,15 @@ fn columns_sql(t: &ChainedTable) -> String {
 }
 
 /// The rows of one evaluation in chain order: (table, row).
-fn evaluation_rows(x: &mut dyn Exec, eval_id: i64) -> Result<Vec<(&'static ChainedTable, Vec<Val>)>, String> {
+#[allow(clippy::type_complexity)]
+fn evaluation_rows(x: &mut dyn Exec, eval_id: i64) -> Result<Vec<(&'static ChainedTable, i64, Vec<Val>)>, DbError> {
     let mut out = Vec::new();
     for t in &CHAINED[..EVALUATION_TABLES] {
         let filter = if t.name == "evaluation" { "id" } else { "evaluation_id" };
         // ok: table and column names from the constant CHAINED spec, the id a bound parameter
         let sql = format!("SELECT {} FROM {} WHERE {filter} = $1 ORDER BY id", columns_sql(t), t.name); // ok: constant spec, no value
-        for row in x.query(&sql, &[Val::I(eval_id)], &kinds(t))? {
-            out.push((t, row));
+        for row in x.rows(&sql, &[Val::I(eval_id)], t.columns)? {
+            out.push((t, row.int("id")?, chained_values(t, &row)?));
         }
     }
     Ok(out)
@@ -299,35 +301,44 @@ struct Link {
     hash: String,
 }
 
-const LINK_KINDS: [Kind; 5] = [Kind::I, Kind::T, Kind::I, Kind::T, Kind::T];
+const LINK_COLUMNS: &[(&str, Kind)] =
+    &[("seq", Kind::I), ("tbl", Kind::T), ("row_id", Kind::I), ("fields", Kind::T), ("hash", Kind::T)];
 
-fn link_of(r: &[Val]) -> Link {
-    Link { seq: r[0].int(), tbl: r[1].string(), row_id: r[2].int(), fields: r[3].string(), hash: r[4].string() }
+fn link_of(r: &Row) -> Result<Link, DbError> {
+    Ok(Link {
+        seq: r.int("seq")?,
+        tbl: r.string("tbl")?,
+        row_id: r.int("row_id")?,
+        fields: r.string("fields")?,
+        hash: r.string("hash")?,
+    })
 }
 
-fn head(x: &mut dyn Exec) -> Result<(i64, [u8; 32]), String> {
-    let rows = x.query("SELECT seq, hash FROM chain ORDER BY seq DESC LIMIT 1", &[], &[Kind::I, Kind::T])?;
+fn head(x: &mut dyn Exec) -> Result<(i64, [u8; 32]), DbError> {
+    let rows =
+        x.rows("SELECT seq, hash FROM chain ORDER BY seq DESC LIMIT 1", &[], &[("seq", Kind::I), ("hash", Kind::T)])?;
     match rows.first() {
         None => Ok((0, [0u8; 32])),
         Some(r) => {
-            let h = unhex(&r[1].string()).ok_or_else(|| format!("chain link {} holds no valid hash", r[0].int()))?;
-            Ok((r[0].int(), h))
+            let seq = r.int("seq")?;
+            let h = unhex(&r.string("hash")?).ok_or_else(|| format!("chain link {seq} holds no valid hash"))?;
+            Ok((seq, h))
         }
     }
 }
 
 /// Appends the links of evaluation `eval_id` and its rows (inside the transaction that inserted
 /// them); the new head.
-pub fn append_evaluation(x: &mut dyn Exec, eval_id: i64) -> Result<String, String> {
+pub fn append_evaluation(x: &mut dyn Exec, eval_id: i64) -> Result<String, DbError> {
     let (mut seq, mut prev) = head(x)?;
     let rows = evaluation_rows(x, eval_id)?;
     let (mut seqs, mut tbls, mut ids, mut fields, mut hashes) = (vec![], vec![], vec![], vec![], vec![]);
-    for (t, row) in &rows {
+    for (t, id, row) in &rows {
         seq += 1;
         prev = link_hash(&prev, seq, &row_digest(t, row));
         seqs.push(seq);
         tbls.push(Some(t.name.to_string()));
-        ids.push(row[0].int());
+        ids.push(*id);
         fields.push(Some(field_digests(t, row)));
         hashes.push(Some(hex(&prev)));
     }
@@ -342,9 +353,10 @@ pub fn append_evaluation(x: &mut dyn Exec, eval_id: i64) -> Result<String, Strin
 
 /// Appends the link of one row of `table` (inside the transaction that inserted it: an account,
 /// an account change, an audit event, a signing key, an issue); the new head.
-pub fn append_row(x: &mut dyn Exec, table_name: &str, id: i64) -> Result<String, String> {
+pub fn append_row(x: &mut dyn Exec, table_name: &str, id: i64) -> Result<String, DbError> {
     let t = table(table_name).ok_or_else(|| format!("'{table_name}' is not a chained table"))?;
     let row = read_row(x, t, id)?.ok_or_else(|| format!("{table_name} row {id} is not there to be chained"))?;
+    let row = chained_values(t, &row)?;
     let (seq, prev) = head(x)?;
     let seq = seq + 1;
     let hash = link_hash(&prev, seq, &row_digest(t, &row));
@@ -362,17 +374,17 @@ pub fn append_row(x: &mut dyn Exec, table_name: &str, id: i64) -> Result<String,
 }
 
 /// The chain head (hex) as it is now, none for an empty chain.
-pub fn current_head(x: &mut dyn Exec) -> Result<Option<String>, String> {
+pub fn current_head(x: &mut dyn Exec) -> Result<Option<String>, DbError> {
     let (n, h) = head(x)?;
     Ok((n > 0).then(|| hex(&h)))
 }
 
 /// Builds the chain over every row of a store that had none (migration 3): evaluations by id,
 /// each followed by its files and figures (see the module's documentation).
-pub fn build_existing(x: &mut dyn Exec) -> Result<(), String> {
-    let ids = x.query("SELECT id FROM evaluation ORDER BY id", &[], &[Kind::I])?;
+pub fn build_existing(x: &mut dyn Exec) -> Result<(), DbError> {
+    let ids = x.rows("SELECT id FROM evaluation ORDER BY id", &[], &[("id", Kind::I)])?;
     for r in ids {
-        append_evaluation(x, r[0].int())?;
+        append_evaluation(x, r.int("id")?)?;
     }
     Ok(())
 }
@@ -439,10 +451,9 @@ impl CheckReport {
 /// The protecting triggers of a back end: (table, trigger name, its SQL as written in the
 /// migrations), from the migration scripts themselves.
 pub fn expected_triggers(postgres: bool) -> Vec<(String, String, String)> {
-    let migrations = if postgres { schema::POSTGRES_MIGRATIONS } else { schema::SQLITE_MIGRATIONS };
     let mut out: Vec<(String, String, String)> = Vec::new();
-    for m in migrations {
-        for line in m.lines().filter(|l| l.starts_with("CREATE TRIGGER ")) {
+    for m in schema::migrations(postgres) {
+        for line in m.sql.lines().filter(|l| l.starts_with("CREATE TRIGGER ")) {
             let words: Vec<&str> = line.split_whitespace().collect();
             let name = words[2].to_string();
             let on = words.iter().position(|w| *w == "ON").map(|i| words[i + 1].to_string()).unwrap_or_default();
@@ -453,20 +464,20 @@ pub fn expected_triggers(postgres: bool) -> Vec<(String, String, String)> {
     out
 }
 
-fn check_triggers(x: &mut dyn Exec, postgres: bool, report: &mut CheckReport) -> Result<(), String> {
+fn check_triggers(x: &mut dyn Exec, postgres: bool, report: &mut CheckReport) -> Result<(), DbError> {
     let expected = expected_triggers(postgres);
     report.triggers_expected = expected.len();
     if postgres {
         let mut found: HashMap<(String, String), (String, String)> = HashMap::new();
         for t in CHAINED.iter().map(|t| t.name).chain(["chain"]) {
-            let rows = x.query(
-                "SELECT t.tgname::text, t.tgenabled::text, p.prosrc FROM pg_trigger t JOIN pg_proc p ON p.oid = t.tgfoid \
-                 WHERE t.tgrelid = to_regclass($1::text) AND NOT t.tgisinternal",
+            let rows = x.rows(
+                "SELECT t.tgname::text AS name, t.tgenabled::text AS enabled, p.prosrc AS source FROM pg_trigger t \
+                 JOIN pg_proc p ON p.oid = t.tgfoid WHERE t.tgrelid = to_regclass($1::text) AND NOT t.tgisinternal",
                 &[Val::T(Some(t.to_string()))],
-                &[Kind::T, Kind::T, Kind::T],
+                &[("name", Kind::T), ("enabled", Kind::T), ("source", Kind::T)],
             )?;
             for r in rows {
-                found.insert((t.to_string(), r[0].string()), (r[1].string(), r[2].string()));
+                found.insert((t.to_string(), r.string("name")?), (r.string("enabled")?, r.string("source")?));
             }
         }
         for (table, name, _) in expected {
@@ -490,8 +501,13 @@ fn check_triggers(x: &mut dyn Exec, postgres: bool, report: &mut CheckReport) ->
             }
         }
     } else {
-        let rows = x.query("SELECT name, sql FROM sqlite_master WHERE type = 'trigger'", &[], &[Kind::T, Kind::T])?;
-        let found: HashMap<String, String> = rows.into_iter().map(|r| (r[0].string(), r[1].string())).collect();
+        let rows = x.rows(
+            "SELECT name, sql FROM sqlite_master WHERE type = 'trigger'",
+            &[],
+            &[("name", Kind::T), ("sql", Kind::T)],
+        )?;
+        let found: HashMap<String, String> =
+            rows.iter().map(|r| Ok((r.string("name")?, r.string("sql")?))).collect::<Result<_, DbError>>()?;
         for (table, name, sql) in expected {
             match found.get(&name) {
                 Some(s) if s.trim().trim_end_matches(';') == sql => report.triggers_ok.push(name),
@@ -513,10 +529,10 @@ fn check_triggers(x: &mut dyn Exec, postgres: bool, report: &mut CheckReport) ->
     Ok(())
 }
 
-fn read_row(x: &mut dyn Exec, t: &ChainedTable, id: i64) -> Result<Option<Vec<Val>>, String> {
+fn read_row(x: &mut dyn Exec, t: &ChainedTable, id: i64) -> Result<Option<Row>, DbError> {
     // ok: table and column names from the constant CHAINED spec, the id a bound parameter
     let sql = format!("SELECT {} FROM {} WHERE id = $1", columns_sql(t), t.name); // ok: constant spec, no value
-    Ok(x.query(&sql, &[Val::I(id)], &kinds(t))?.into_iter().next())
+    Ok(x.rows(&sql, &[Val::I(id)], t.columns)?.into_iter().next())
 }
 
 /// Verifies link `l` against the stored hash before it (`prev`) and the row's digest (`None`:
@@ -528,7 +544,7 @@ fn verify_link(
     prev: &[u8; 32],
     digest: Option<[u8; 32]>,
     prev_link: Option<&Link>,
-) -> Result<Option<Problem>, String> {
+) -> Result<Option<Problem>, DbError> {
     let Some(t) = table(&l.tbl) else {
         return Ok(Some(Problem {
             table: "chain".into(),
@@ -549,7 +565,8 @@ fn verify_link(
         return Ok(None);
     }
     let row = match read_row(x, t, l.row_id) {
-        Ok(r) => r.unwrap_or_default(),
+        Ok(Some(r)) => chained_values(t, &r)?,
+        Ok(None) => Vec::new(),
         Err(e) => return Ok(Some(unreadable(t, l.row_id, Some(l.seq), &e))),
     };
     let now = field_digests(t, &row);
@@ -590,7 +607,7 @@ fn verify_link(
 
 /// A row that cannot be read as its columns' types (SQLite keeps any value in any column: a text
 /// written into a REAL column behind the store's back).
-fn unreadable(t: &ChainedTable, row_id: i64, link: Option<i64>, e: &str) -> Problem {
+fn unreadable(t: &ChainedTable, row_id: i64, link: Option<i64>, e: &DbError) -> Problem {
     Problem {
         table: t.name.into(),
         row_id: Some(row_id),
@@ -606,9 +623,9 @@ fn digest_of(
     t: &ChainedTable,
     id: i64,
     problems: &mut Vec<Problem>,
-) -> Result<Option<[u8; 32]>, String> {
+) -> Result<Option<[u8; 32]>, DbError> {
     match read_row(x, t, id) {
-        Ok(r) => Ok(r.map(|r| row_digest(t, &r))),
+        Ok(r) => Ok(r.map(|r| chained_values(t, &r)).transpose()?.map(|r| row_digest(t, &r))),
         Err(e) => {
             problems.push(unreadable(t, id, None, &e));
             Ok(Some([0u8; 32]))
@@ -616,23 +633,22 @@ fn digest_of(
     }
 }
 
-fn count(x: &mut dyn Exec, sql: &str, params: &[Val]) -> Result<i64, String> {
-    Ok(x.query(sql, params, &[Kind::I])?.first().map_or(0, |r| r[0].int()))
+/// The count of a `SELECT COUNT(*) AS n ...`.
+fn count(x: &mut dyn Exec, sql: &str, params: &[Val]) -> Result<i64, DbError> {
+    first_int(&x.rows(sql, params, &[("n", Kind::I)])?, "n", 0)
 }
 
 /// Rows past the end of the chain: per table, a row whose id is above the last chained one, or a
 /// row without an id (index look-ups only, whatever the size of the store).
-fn check_tails(x: &mut dyn Exec, report: &mut CheckReport) -> Result<(), String> {
+fn check_tails(x: &mut dyn Exec, report: &mut CheckReport) -> Result<(), DbError> {
     for t in &CHAINED {
-        let max = |x: &mut dyn Exec, sql: &str, p: &[Val]| -> Result<Option<i64>, String> {
-            Ok(x.query(sql, p, &[Kind::IOpt])?.first().and_then(|r| match r[0] {
-                Val::IOpt(v) => v,
-                _ => None,
-            }))
+        let max = |x: &mut dyn Exec, sql: &str, p: &[Val]| -> Result<Option<i64>, DbError> {
+            Ok(x.rows(sql, p, &[("last", Kind::IOpt)])?.first().map(|r| r.int_opt("last")).transpose()?.flatten())
         };
         // ok: the table name from the constant CHAINED spec; no value in the text
-        let last_row = max(x, &format!("SELECT MAX(id) FROM {}", t.name), &[])?; // ok: constant spec, no value
-        let last_link = max(x, "SELECT MAX(row_id) FROM chain WHERE tbl = $1", &[Val::T(Some(t.name.to_string()))])?;
+        let last_row = max(x, &format!("SELECT MAX(id) AS last FROM {}", t.name), &[])?; // ok: constant spec, no value
+        let last_link =
+            max(x, "SELECT MAX(row_id) AS last FROM chain WHERE tbl = $1", &[Val::T(Some(t.name.to_string()))])?;
         if let Some(id) = last_row.filter(|id| last_link.is_none_or(|l| id > &l)) {
             report.problems.push(Problem {
                 table: t.name.into(),
@@ -642,7 +658,8 @@ fn check_tails(x: &mut dyn Exec, report: &mut CheckReport) -> Result<(), String>
             });
         }
         // ok: the table name from the constant CHAINED spec; no value in the text
-        let no_id = x.query(&format!("SELECT 1 FROM {} WHERE id IS NULL LIMIT 1", t.name), &[], &[Kind::I])?; // ok: constant spec, no value
+        let no_id =
+            x.rows(&format!("SELECT 1 AS one FROM {} WHERE id IS NULL LIMIT 1", t.name), &[], &[("one", Kind::I)])?; // ok: constant spec, no value
         if !no_id.is_empty() {
             report.problems.push(Problem {
                 table: t.name.into(),
@@ -659,7 +676,7 @@ fn check_tails(x: &mut dyn Exec, report: &mut CheckReport) -> Result<(), String>
 /// whatever the size of the store: triggers present, no row past the chain's end or without an
 /// id, and the last [`QUICK_LINKS`] links, without gaps, against their rows. A row changed,
 /// deleted or inserted deeper in the store is found by [`full_check`] only.
-pub fn quick_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, String> {
+pub fn quick_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, DbError> {
     let mut report = CheckReport { quick: true, ..CheckReport::default() };
     check_triggers(x, postgres, &mut report)?;
     check_tails(x, &mut report)?;
@@ -668,14 +685,14 @@ pub fn quick_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, Stri
     report.head = (n > 0).then(|| hex(&h));
     let from = (n - QUICK_LINKS).max(0);
     let links: Vec<Link> = x
-        .query(
+        .rows(
             "SELECT seq, tbl, row_id, fields, hash FROM chain WHERE seq >= $1 ORDER BY seq",
             &[Val::I(from)],
-            &LINK_KINDS,
+            LINK_COLUMNS,
         )?
         .iter()
-        .map(|r| link_of(r))
-        .collect();
+        .map(link_of)
+        .collect::<Result<_, DbError>>()?;
     let mut prev: Option<Link> = None;
     for (i, l) in links.into_iter().enumerate() {
         let expected = from.max(1) + i as i64;
@@ -712,7 +729,7 @@ pub fn quick_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, Stri
 
 /// The full check: triggers, every link against its row (rows changed, deleted or inserted
 /// outside the store), and every stored report file's bytes against its SHA-256 and size.
-pub fn full_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, String> {
+pub fn full_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, DbError> {
     let mut report = CheckReport::default();
     check_triggers(x, postgres, &mut report)?;
     // Every row's digest by (table, id), read in pages; report files re-hashed on the way.
@@ -720,7 +737,7 @@ pub fn full_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, Strin
     let mut file_problems = Vec::new();
     for t in &CHAINED {
         // ok: the table name from the constant CHAINED spec; no value in the text
-        let total = count(x, &format!("SELECT COUNT(*) FROM {}", t.name), &[])?; // ok: constant spec, no value
+        let total = count(x, &format!("SELECT COUNT(*) AS n FROM {}", t.name), &[])?; // ok: constant spec, no value
         report.rows.push((t.name.to_string(), total));
         // Pages of rows (report files hold up to 64 MiB each: a few at a time).
         let page_rows = if t.name == "report_file" { 8 } else { 256 };
@@ -731,14 +748,14 @@ pub fn full_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, Strin
         let ids_sql = format!("SELECT id FROM {name} WHERE id > $1 ORDER BY id LIMIT {page_rows}"); // ok: constants
         loop {
             // (id, the row or why it cannot be read as its columns' types)
-            let page: Vec<(i64, Result<Vec<Val>, String>)> = match x.query(&sql, &[Val::I(last)], &kinds(t)) {
-                Ok(p) => p.into_iter().map(|r| (r[0].int(), Ok(r))).collect(),
+            let page: Vec<(i64, Result<Row, DbError>)> = match x.rows(&sql, &[Val::I(last)], t.columns) {
+                Ok(p) => p.into_iter().map(|r| Ok((r.int("id")?, Ok(r)))).collect::<Result<_, DbError>>()?,
                 Err(_) => {
                     // A row of this page cannot be read (SQLite keeps any value in any column):
                     // the page row by row.
-                    let ids = x.query(&ids_sql, &[Val::I(last)], &[Kind::I])?;
+                    let ids = x.rows(&ids_sql, &[Val::I(last)], &[("id", Kind::I)])?;
                     let mut rows = Vec::new();
-                    for id in ids.iter().map(|r| r[0].int()) {
+                    for id in ids.iter().map(|r| r.int("id")).collect::<Result<Vec<_>, DbError>>()? {
                         match read_row(x, t, id) {
                             Ok(Some(r)) => rows.push((id, Ok(r))),
                             Ok(None) => {}
@@ -756,9 +773,9 @@ pub fn full_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, Strin
                 seen += 1;
                 match row {
                     Ok(row) => {
-                        digests.insert((t.name, *id), row_digest(t, row));
+                        digests.insert((t.name, *id), row_digest(t, &chained_values(t, row)?));
                         if t.name == "report_file" {
-                            check_file(row, &mut report, &mut file_problems);
+                            check_file(row, &mut report, &mut file_problems)?;
                         }
                     }
                     Err(e) => {
@@ -778,10 +795,10 @@ pub fn full_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, Strin
         }
     }
     let links: Vec<Link> = x
-        .query("SELECT seq, tbl, row_id, fields, hash FROM chain ORDER BY seq", &[], &LINK_KINDS)?
+        .rows("SELECT seq, tbl, row_id, fields, hash FROM chain ORDER BY seq", &[], LINK_COLUMNS)?
         .iter()
-        .map(|r| link_of(r))
-        .collect();
+        .map(link_of)
+        .collect::<Result<_, DbError>>()?;
     let mut prev: Option<&Link> = None;
     let mut chained: std::collections::HashSet<(String, i64)> = Default::default();
     for (i, l) in links.iter().enumerate() {
@@ -824,29 +841,29 @@ pub fn full_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, Strin
 }
 
 /// Re-hashes one stored report file (a `report_file` row as read for the chain).
-fn check_file(row: &[Val], report: &mut CheckReport, problems: &mut Vec<Problem>) {
-    let Some(packed) = row[5].bytes() else {
+fn check_file(row: &Row, report: &mut CheckReport, problems: &mut Vec<Problem>) -> Result<(), DbError> {
+    let Some(packed) = row.bytes("content_zstd")? else {
         report.files_hash_only += 1;
-        return;
+        return Ok(());
     };
-    let problem = |what: String| Problem { table: "report_file".into(), row_id: Some(row[0].int()), link: None, what };
+    let (id, name, sha256) = (row.int("id")?, row.string("name")?, row.string("sha256")?);
+    let size = row.int("size_bytes")?;
+    let problem = |what: String| Problem { table: "report_file".into(), row_id: Some(id), link: None, what };
     match zstd::stream::decode_all(packed) {
-        Err(e) => problems.push(problem(format!("{}: its stored bytes cannot be decompressed ({e})", row[2].string()))),
+        Err(e) => problems.push(problem(format!("{name}: its stored bytes cannot be decompressed ({e})"))),
         Ok(bytes) => {
             let sha = hex(&Sha256::digest(&bytes));
-            if sha != row[3].string() || bytes.len() as i64 != row[4].int() {
+            if sha != sha256 || bytes.len() as i64 != size {
                 problems.push(problem(format!(
-                    "{}: its stored bytes ({} bytes, SHA-256 {sha}) differ from its recorded SHA-256 {} ({} bytes)",
-                    row[2].string(),
+                    "{name}: its stored bytes ({} bytes, SHA-256 {sha}) differ from its recorded SHA-256 {sha256} ({size} bytes)",
                     bytes.len(),
-                    row[3].string(),
-                    row[4].int()
                 )));
             } else {
                 report.files_checked += 1;
             }
         }
     }
+    Ok(())
 }
 
 #[cfg(test)]

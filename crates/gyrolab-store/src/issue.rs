@@ -13,7 +13,7 @@
 //! retrievable (`gyrolab store report`).
 
 use crate::account::{self, Need};
-use crate::db::{Exec, Kind, Val};
+use crate::db::{returned_id, Columns, DbError, Exec, Kind, Row, Val};
 use crate::{chain, schema, sign, Actor, Store, StoreError, StoreResult};
 use ed25519_dalek::SigningKey;
 use gyrolab_io::manifest::{manifest_json, Manifest, NamedOutput, MANIFEST};
@@ -82,73 +82,71 @@ impl IssuedReport {
     }
 }
 
-const ISSUE_COLUMNS: &str = "i.id, i.evaluation_id, i.report_number, i.issued_at, i.signer_name, i.signer_display_name, \
-     i.signer_role, i.meaning, i.key_fingerprint, i.chain_head, (SELECT a.report_number FROM issue a WHERE a.id = i.amends), \
-     i.amendment_no, i.amend_reason, (SELECT s.report_number FROM issue s WHERE s.amends = i.id)";
-const ISSUE_KINDS: [Kind; 14] = [
-    Kind::I,
-    Kind::I,
-    Kind::T,
-    Kind::T,
-    Kind::T,
-    Kind::T,
-    Kind::T,
-    Kind::T,
-    Kind::T,
-    Kind::T,
-    Kind::T,
-    Kind::IOpt,
-    Kind::T,
-    Kind::T,
+const ISSUE_COLUMNS: &str = "i.id AS id, i.evaluation_id AS evaluation_id, i.report_number AS report_number, \
+     i.issued_at AS issued_at, i.signer_name AS signer_name, i.signer_display_name AS signer_display_name, \
+     i.signer_role AS signer_role, i.meaning AS meaning, i.key_fingerprint AS key_fingerprint, i.chain_head AS chain_head, \
+     (SELECT a.report_number FROM issue a WHERE a.id = i.amends) AS amends_report, i.amendment_no AS amendment_no, \
+     i.amend_reason AS amend_reason, (SELECT s.report_number FROM issue s WHERE s.amends = i.id) AS superseded_by";
+const ISSUE_KINDS: Columns<'static> = &[
+    ("id", Kind::I),
+    ("evaluation_id", Kind::I),
+    ("report_number", Kind::T),
+    ("issued_at", Kind::T),
+    ("signer_name", Kind::T),
+    ("signer_display_name", Kind::T),
+    ("signer_role", Kind::T),
+    ("meaning", Kind::T),
+    ("key_fingerprint", Kind::T),
+    ("chain_head", Kind::T),
+    ("amends_report", Kind::T),
+    ("amendment_no", Kind::IOpt),
+    ("amend_reason", Kind::T),
+    ("superseded_by", Kind::T),
 ];
 
-fn issued_of(r: &[Val]) -> IssuedReport {
-    IssuedReport {
-        id: r[0].int(),
-        evaluation_id: r[1].int(),
-        report_number: r[2].string(),
-        issued_at: r[3].string(),
-        signer: r[4].string(),
-        signer_display_name: r[5].string(),
-        signer_role: r[6].string(),
-        meaning: r[7].string(),
-        key_fingerprint: r[8].string(),
-        chain_head: r[9].string(),
-        amends_report: r[10].text().map(str::to_string),
-        amendment_no: match r[11] {
-            Val::IOpt(v) => v,
-            _ => None,
-        },
-        amend_reason: r[12].text().map(str::to_string),
-        superseded_by: r[13].text().map(str::to_string),
-    }
+fn issued_of(r: &Row) -> Result<IssuedReport, DbError> {
+    Ok(IssuedReport {
+        id: r.int("id")?,
+        evaluation_id: r.int("evaluation_id")?,
+        report_number: r.string("report_number")?,
+        issued_at: r.string("issued_at")?,
+        signer: r.string("signer_name")?,
+        signer_display_name: r.string("signer_display_name")?,
+        signer_role: r.string("signer_role")?,
+        meaning: r.string("meaning")?,
+        key_fingerprint: r.string("key_fingerprint")?,
+        chain_head: r.string("chain_head")?,
+        amends_report: r.string_opt("amends_report")?,
+        amendment_no: r.int_opt("amendment_no")?,
+        amend_reason: r.string_opt("amend_reason")?,
+        superseded_by: r.string_opt("superseded_by")?,
+    })
 }
 
 /// The issue of evaluation `id`, if it was issued.
-pub(crate) fn issue_of(x: &mut dyn Exec, id: i64) -> Result<Option<IssuedReport>, String> {
+pub(crate) fn issue_of(x: &mut dyn Exec, id: i64) -> Result<Option<IssuedReport>, DbError> {
     // ok: SQL from the module's constant column list; every value is a parameter.
     let sql = format!("SELECT {ISSUE_COLUMNS} FROM issue i WHERE i.evaluation_id = $1");
-    Ok(x.query(&sql, &[Val::I(id)], &ISSUE_KINDS)?.first().map(|r| issued_of(r)))
+    x.rows(&sql, &[Val::I(id)], ISSUE_KINDS)?.first().map(issued_of).transpose()
 }
 
 /// Every issued report, oldest first.
-pub(crate) fn all(x: &mut dyn Exec) -> Result<Vec<IssuedReport>, String> {
+pub(crate) fn all(x: &mut dyn Exec) -> Result<Vec<IssuedReport>, DbError> {
     // ok: SQL from the module's constant column list; every value is a parameter.
     let sql = format!("SELECT {ISSUE_COLUMNS} FROM issue i ORDER BY i.id");
-    Ok(x.query(&sql, &[], &ISSUE_KINDS)?.iter().map(|r| issued_of(r)).collect())
+    x.rows(&sql, &[], ISSUE_KINDS)?.iter().map(issued_of).collect()
 }
 
 /// Evaluation `id` and the revisions it supersedes, newest first (`id`, its predecessor, ...).
-pub(crate) fn lineage(x: &mut dyn Exec, id: i64) -> Result<Vec<i64>, String> {
+pub(crate) fn lineage(x: &mut dyn Exec, id: i64) -> Result<Vec<i64>, DbError> {
     let mut out = vec![id];
     let mut at = id;
     while let Some(prev) = x
-        .query("SELECT supersedes FROM evaluation WHERE id = $1", &[Val::I(at)], &[Kind::IOpt])?
+        .rows("SELECT supersedes FROM evaluation WHERE id = $1", &[Val::I(at)], &[("supersedes", Kind::IOpt)])?
         .first()
-        .and_then(|r| match r[0] {
-            Val::IOpt(v) => v,
-            _ => None,
-        })
+        .map(|r| r.int_opt("supersedes"))
+        .transpose()?
+        .flatten()
     {
         if out.contains(&prev) || out.len() > 100_000 {
             break;
@@ -161,26 +159,26 @@ pub(crate) fn lineage(x: &mut dyn Exec, id: i64) -> Result<Vec<i64>, String> {
 
 /// The accounts that stored evaluation `id` or any revision it supersedes (the audit trail:
 /// stores, corrections and re-evaluations; not approvals, issues and amendments).
-pub(crate) fn stored_by(x: &mut dyn Exec, id: i64) -> Result<Vec<i64>, String> {
+pub(crate) fn stored_by(x: &mut dyn Exec, id: i64) -> Result<Vec<i64>, DbError> {
     let mut out = Vec::new();
     for e in lineage(x, id)? {
-        for r in x.query(
+        for r in x.rows(
             "SELECT account_id FROM audit_event WHERE evaluation_id = $1 AND account_id IS NOT NULL AND action NOT IN ('issue', 'amend', 'approval')",
             &[Val::I(e)],
-            &[Kind::I],
+            &[("account_id", Kind::I)],
         )? {
-            out.push(r[0].int());
+            out.push(r.int("account_id")?);
         }
     }
     Ok(out)
 }
 
 /// The current revision of evaluation `id` (following `supersedes` forward).
-fn current_of(x: &mut dyn Exec, id: i64) -> Result<i64, String> {
+fn current_of(x: &mut dyn Exec, id: i64) -> Result<i64, DbError> {
     let mut at = id;
     for _ in 0..100_000 {
-        match x.query("SELECT id FROM evaluation WHERE supersedes = $1", &[Val::I(at)], &[Kind::I])?.first() {
-            Some(r) => at = r[0].int(),
+        match x.rows("SELECT id FROM evaluation WHERE supersedes = $1", &[Val::I(at)], &[("id", Kind::I)])?.first() {
+            Some(r) => at = r.int("id")?,
             None => break,
         }
     }
@@ -389,7 +387,7 @@ impl Store {
         // What to issue, read before the transaction (records never change; the checks that
         // decide are repeated inside it).
         let store_name = self.name().to_string();
-        let dberr = |m: String| StoreError::Database { store: store_name.clone(), message: m };
+        let dberr = |m: DbError| StoreError::Database { store: store_name.clone(), message: m.to_string() };
         let (target, prior) = self.transaction(|x| {
             let target = if req.amend_reason.is_some() { current_of(x, req.evaluation) } else { Ok(req.evaluation) }
                 .map_err(&dberr)?;
@@ -412,12 +410,12 @@ impl Store {
         let public = sign::public_hex(&verifying);
         let postgres = self.is_postgres();
         self.write(|x, store| {
-            let dberr = |m: String| StoreError::Database { store: store.to_string(), message: m };
+            let dberr = |m: DbError| StoreError::Database { store: store.to_string(), message: m.to_string() };
             let refused = |m: String| StoreError::Refused { store: store.to_string(), message: m };
             let (account_id, _) = account::check_actor(x, store, actor, Need::Approver)?;
             let account_id = account_id.ok_or_else(|| StoreError::Auth { store: store.to_string() })?;
             if x
-                .query("SELECT id FROM signing_key WHERE public_key = $1", &[Val::T(Some(public.clone()))], &[Kind::I])
+                .rows("SELECT id FROM signing_key WHERE public_key = $1", &[Val::T(Some(public.clone()))], &[("id", Kind::I)])
                 .map_err(dberr)?
                 .is_empty()
             {
@@ -427,13 +425,13 @@ impl Store {
                 )));
             }
             if let Some(r) = x
-                .query("SELECT id FROM evaluation WHERE supersedes = $1", &[Val::I(target)], &[Kind::I])
+                .rows("SELECT id FROM evaluation WHERE supersedes = $1", &[Val::I(target)], &[("id", Kind::I)])
                 .map_err(dberr)?
                 .first()
             {
                 return Err(refused(format!(
                     "evaluation {target} is superseded by evaluation {}: only a current revision is issued",
-                    r[0].int()
+                    r.int("id").map_err(dberr)?
                 )));
             }
             if let Some(i) = issue_of(x, target).map_err(dberr)? {
@@ -481,24 +479,28 @@ impl Store {
                 )));
             }
             let issued_at = x
-                .query(schema::clock_sql(postgres), &[], &[Kind::T])
+                .rows(schema::clock_sql(postgres), &[], &[("now", Kind::T)])
                 .map_err(dberr)?
                 .first()
-                .map(|r| r[0].string())
-                .ok_or_else(|| dberr("the database gave no time".into()))?;
+                .map(|r| r.string("now"))
+                .ok_or_else(|| dberr("the database gave no time".into()))?
+                .map_err(dberr)?;
             let number = match req.report_number {
                 Some(n) => n.to_string(),
                 None => {
                     let year = issued_at.get(..4).unwrap_or("0000").to_string();
-                    let mut n = x.query("SELECT COUNT(*) FROM issue", &[], &[Kind::I]).map_err(dberr)?
-                        .first()
-                        .map_or(0, |r| r[0].int())
+                    let mut n = crate::db::first_int(
+                        &x.rows("SELECT COUNT(*) AS n FROM issue", &[], &[("n", Kind::I)]).map_err(dberr)?,
+                        "n",
+                        0,
+                    )
+                    .map_err(dberr)?
                         + 1;
                     loop {
                         let candidate = format!("GL-{year}-{n:04}");
                         if x
-                            .query("SELECT id FROM issue WHERE report_number = $1", &[Val::T(Some(candidate.clone()))], &[
-                                Kind::I,
+                            .rows("SELECT id FROM issue WHERE report_number = $1", &[Val::T(Some(candidate.clone()))], &[
+                                ("id", Kind::I),
                             ])
                             .map_err(dberr)?
                             .is_empty()
@@ -562,33 +564,36 @@ impl Store {
             let superseded = match (&amendment, &old) {
                 (Some((p, reason)), Some(o)) => {
                     let (old_json, old_html) = x
-                        .query(
+                        .rows(
                             "SELECT issue_json, report_html_zstd FROM issue WHERE id = $1",
                             &[Val::I(p.id)],
-                            &[Kind::T, Kind::B],
+                            &[("issue_json", Kind::T), ("report_html_zstd", Kind::B)],
                         )
                         .map_err(dberr)?
                         .first()
-                        .map(|r| (r[0].string(), r[1].bytes().map(<[u8]>::to_vec).unwrap_or_default()))
-                        .ok_or_else(|| dberr("the replaced issue is gone".into()))?;
+                        .map(|r| -> Result<_, DbError> {
+                            Ok((r.string("issue_json")?, r.bytes("report_html_zstd")?.map(<[u8]>::to_vec).unwrap_or_default()))
+                        })
+                        .ok_or_else(|| dberr("the replaced issue is gone".into()))?
+                        .map_err(dberr)?;
                     let mut v: serde_json::Value =
-                        serde_json::from_str(&old_json).map_err(|e| dberr(format!("the replaced issue.json: {e}")))?;
+                        serde_json::from_str(&old_json).map_err(|e| dberr(format!("the replaced issue.json: {e}").into()))?;
                     v["status"] = "superseded".into();
                     v["superseded_by"] =
                         serde_json::json!({ "report_number": number, "issued_at": issued_at, "reason": reason });
                     let old_json = serde_json::to_string_pretty(&v).map(|s| s + "\n").unwrap_or_default();
                     let old_html = zstd::stream::decode_all(old_html.as_slice())
-                        .map_err(|e| dberr(format!("the replaced report.html: {e}")))?;
+                        .map_err(|e| dberr(format!("the replaced report.html: {e}").into()))?;
                     let (_, old_manifest) = issued_outputs(&o.files, &old_html, &old_json)?;
                     let old_signature = sign::sign_manifest(req.key, old_manifest.as_bytes());
                     Some((old_json, old_manifest, old_signature))
                 }
                 _ => None,
             };
-            let packed = zstd::bulk::compress(&html, 3).map_err(|e| dberr(format!("cannot compress: {e}")))?;
+            let packed = zstd::bulk::compress(&html, 3).map_err(|e| dberr(format!("cannot compress: {e}").into()))?;
             let t = |s: &str| Val::T(Some(s.to_string()));
             let rows = x
-                .query(
+                .rows(
                     "INSERT INTO issue (evaluation_id, report_number, issued_at, signer_account_id, signer_name, \
                      signer_display_name, signer_role, meaning, key_fingerprint, chain_head, issue_json, report_html_zstd, \
                      manifest, signature, amends, amendment_no, amend_reason, superseded_issue_json, superseded_manifest, \
@@ -616,19 +621,20 @@ impl Store {
                         Val::T(superseded.as_ref().map(|s| s.1.clone())),
                         Val::T(superseded.as_ref().map(|s| s.2.clone())),
                     ],
-                    &[Kind::I],
+                    &[("id", Kind::I)],
                 )
-                .map_err(|m| {
+                .map_err(|e| {
+                    let m = e.to_string();
                     if m.contains("UNIQUE") || m.contains("unique") || m.contains("duplicate") || m.contains("replaced") {
                         refused(format!(
                             "report number {number:?} or evaluation {target} is issued already, or the report it amends \
                              is amended already (the store refuses a second issue of any of them)"
                         ))
                     } else {
-                        dberr(m)
+                        dberr(e)
                     }
                 })?;
-            let id = rows.first().map(|r| r[0].int()).ok_or_else(|| dberr("no id returned".into()))?;
+            let id = returned_id(&rows).map_err(dberr)?;
             chain::append_row(x, "issue", id).map_err(dberr)?;
             let (action, detail) = match &amendment {
                 Some((p, reason)) => ("amend", format!("report {number} amends report {}: {reason}", p.report_number)),
@@ -642,13 +648,15 @@ impl Store {
     /// The issue of evaluation `id`, if it was issued.
     pub fn issue_of(&mut self, id: i64) -> StoreResult<Option<IssuedReport>> {
         let store = self.name().to_string();
-        self.transaction(|x| issue_of(x, id).map_err(|m| StoreError::Database { store: store.clone(), message: m }))
+        self.transaction(|x| {
+            issue_of(x, id).map_err(|m| StoreError::Database { store: store.clone(), message: m.to_string() })
+        })
     }
 
     /// Every issued report, oldest first.
     pub fn issued_reports(&mut self) -> StoreResult<Vec<IssuedReport>> {
         let store = self.name().to_string();
-        self.transaction(|x| all(x).map_err(|m| StoreError::Database { store: store.clone(), message: m }))
+        self.transaction(|x| all(x).map_err(|m| StoreError::Database { store: store.clone(), message: m.to_string() }))
     }
 
     /// The issued folder of evaluation `id` (its files, manifest.json and manifest.sig; the
@@ -656,29 +664,52 @@ impl Store {
     /// signature against the lab key recorded in the store; `None` for a draft.
     pub fn issued_files(&mut self, id: i64) -> StoreResult<Option<Vec<NamedFile>>> {
         let store = self.name().to_string();
-        let dberr = |m: String| StoreError::Database { store: store.clone(), message: m };
+        let dberr = |m: DbError| StoreError::Database { store: store.clone(), message: m.to_string() };
         let row = self.transaction(|x| {
             let rows = x
-                .query(
-                    "SELECT i.issue_json, i.report_html_zstd, i.manifest, i.signature, s.superseded_issue_json, \
-                     s.superseded_manifest, s.superseded_signature, i.key_fingerprint, k.public_key, i.report_number FROM issue i \
+                .rows(
+                    "SELECT i.issue_json AS issue_json, i.report_html_zstd AS report_html_zstd, i.manifest AS manifest, \
+                     i.signature AS signature, s.superseded_issue_json AS superseded_issue_json, \
+                     s.superseded_manifest AS superseded_manifest, s.superseded_signature AS superseded_signature, \
+                     i.key_fingerprint AS key_fingerprint, k.public_key AS public_key, i.report_number AS report_number FROM issue i \
                      LEFT JOIN issue s ON s.amends = i.id LEFT JOIN signing_key k ON k.fingerprint = i.key_fingerprint \
                      WHERE i.evaluation_id = $1",
                     &[Val::I(id)],
-                    &[Kind::T, Kind::B, Kind::T, Kind::T, Kind::T, Kind::T, Kind::T, Kind::T, Kind::T, Kind::T],
+                    &[
+                        ("issue_json", Kind::T),
+                        ("report_html_zstd", Kind::B),
+                        ("manifest", Kind::T),
+                        ("signature", Kind::T),
+                        ("superseded_issue_json", Kind::T),
+                        ("superseded_manifest", Kind::T),
+                        ("superseded_signature", Kind::T),
+                        ("key_fingerprint", Kind::T),
+                        ("public_key", Kind::T),
+                        ("report_number", Kind::T),
+                    ],
                 )
                 .map_err(&dberr)?;
             Ok(rows.into_iter().next())
         })?;
         let Some(r) = row else { return Ok(None) };
         let files = crate::query::report_files(self, id)?;
-        let html = zstd::stream::decode_all(r[1].bytes().unwrap_or_default())
-            .map_err(|e| dberr(format!("evaluation {id}: the issued report.html cannot be decompressed: {e}")))?;
-        let (json, manifest, signature) = match r[4].text() {
-            Some(j) => (j.to_string(), r[5].string(), r[6].string()),
-            None => (r[0].string(), r[2].string(), r[3].string()),
+        let html =
+            zstd::stream::decode_all(r.bytes("report_html_zstd").map_err(dberr)?.unwrap_or_default()).map_err(|e| {
+                dberr(format!("evaluation {id}: the issued report.html cannot be decompressed: {e}").into())
+            })?;
+        let (json, manifest, signature) = match r.text("superseded_issue_json").map_err(dberr)? {
+            Some(j) => (
+                j.to_string(),
+                r.string("superseded_manifest").map_err(dberr)?,
+                r.string("superseded_signature").map_err(dberr)?,
+            ),
+            None => (
+                r.string("issue_json").map_err(dberr)?,
+                r.string("manifest").map_err(dberr)?,
+                r.string("signature").map_err(dberr)?,
+            ),
         };
-        let number = r[9].string();
+        let number = r.string("report_number").map_err(dberr)?;
         let tampered = |what: String| StoreError::Tampered {
             store: store.clone(),
             first: format!("issued report {number} (evaluation {id}): {what}"),
@@ -696,8 +727,10 @@ impl Store {
         if signed.files.len() != outputs.len() {
             return Err(tampered("its signed manifest lists files the store does not hold".into()));
         }
-        let key = sign::public_from_hex(&r[8].string())
-            .ok_or_else(|| tampered(format!("the lab key {} is not recorded in the store", r[7].string())))?;
+        let (public, fingerprint) =
+            (r.string("public_key").map_err(dberr)?, r.string("key_fingerprint").map_err(dberr)?);
+        let key = sign::public_from_hex(&public)
+            .ok_or_else(|| tampered(format!("the lab key {fingerprint} is not recorded in the store")))?;
         if !sign::verify_manifest(&key, manifest.as_bytes(), &signature) {
             return Err(tampered("its signature does not verify with the lab key recorded in the store".into()));
         }

@@ -25,7 +25,7 @@ pub mod tables;
 
 pub use account::{Account, Actor, AuditEvent, Role};
 pub use chain::{CheckReport, Problem};
-use db::{Column, Exec, Kind, PgExec, PgStatements, SqliteExec, Val};
+use db::{Column, DbError, Exec, Kind, PgExec, PgStatements, Row, SqliteExec, Val};
 pub use location::{parse_location, Location, LocationError};
 use record::EvaluationRecord;
 use std::path::{Path, PathBuf};
@@ -110,6 +110,26 @@ pub enum StoreError {
         /// The store, password masked.
         store: String,
     },
+    /// A migration recorded in the store differs from the one this build embeds: the SQL that
+    /// made the store is not the SQL of this build's migration file (exit code 2; nothing
+    /// written). Names the version, the file and both SHA-256 checksums.
+    #[error(
+        "store {store}: schema version {version} was applied from SQL with SHA-256 {recorded}, but this gyrolab's \
+         migration {file} has SHA-256 {embedded}: refused (a migration file changed after release, or the store's \
+         version table was altered)"
+    )]
+    MigrationChecksum {
+        /// The store, password masked.
+        store: String,
+        /// The migration's version.
+        version: i64,
+        /// Its file, relative to the store crate (`migrations/sqlite/0001_records.sql`).
+        file: String,
+        /// The checksum recorded in the store.
+        recorded: String,
+        /// The checksum of this build's migration.
+        embedded: String,
+    },
     /// The database failed during an operation (exit code 1; the transaction was rolled back).
     #[error("store {store}: {message}")]
     Database {
@@ -128,7 +148,7 @@ const BUSY_TIMEOUT: Duration = Duration::from_secs(30);
 /// itself and SQLite does not run the busy handler for it, so two processes opening a new store
 /// at once (tests/integration/store.rs `two_processes_storing_at_once_both_land`) retry here, with backoff,
 /// within the busy timeout.
-fn set_wal(c: &rusqlite::Connection, budget: Duration) -> Result<(), String> {
+fn set_wal(c: &rusqlite::Connection, budget: Duration) -> Result<(), DbError> {
     let start = std::time::Instant::now();
     let mut pause = Duration::from_millis(5);
     loop {
@@ -141,7 +161,7 @@ fn set_wal(c: &rusqlite::Connection, budget: Duration) -> Result<(), String> {
         });
         match attempt {
             Ok(mode) if mode.eq_ignore_ascii_case("wal") => return Ok(()),
-            Ok(mode) => return Err(format!("cannot use write-ahead logging (journal mode stays '{mode}')")),
+            Ok(mode) => return Err(DbError::JournalMode { mode }),
             Err(rusqlite::Error::SqliteFailure(e, _))
                 if matches!(e.code, rusqlite::ErrorCode::DatabaseBusy | rusqlite::ErrorCode::DatabaseLocked)
                     && start.elapsed() < budget =>
@@ -149,7 +169,7 @@ fn set_wal(c: &rusqlite::Connection, budget: Duration) -> Result<(), String> {
                 std::thread::sleep(pause);
                 pause = (pause * 2).min(Duration::from_millis(200));
             }
-            Err(e) => return Err(e.to_string()),
+            Err(e) => return Err(e.into()),
         }
     }
 }
@@ -294,7 +314,7 @@ impl Store {
                     Store { conn: Conn::Sqlite(conn), name, location: parsed.clone(), statements: PgStatements::new() };
                 store.check_foreign_sqlite()?;
                 if let Conn::Sqlite(c) = &store.conn {
-                    set_wal(c, BUSY_TIMEOUT).map_err(|e| store.open_error(e))?;
+                    set_wal(c, BUSY_TIMEOUT).map_err(|e| store.open_error(e.to_string()))?;
                     c.pragma_update(None, "foreign_keys", "ON").map_err(|e| store.open_error(e.to_string()))?;
                     // INSERT OR REPLACE deletes the row it replaces; with recursive triggers that
                     // delete fires the DELETE-refusing triggers (the schema's BEFORE INSERT triggers
@@ -334,9 +354,10 @@ impl Store {
     fn check_foreign_sqlite(&mut self) -> StoreResult<()> {
         let Conn::Sqlite(c) = &self.conn else { return Ok(()) };
         let rows = SqliteExec(c)
-            .query("SELECT name FROM sqlite_master WHERE type = 'table'", &[], &[Kind::T])
+            .rows("SELECT name FROM sqlite_master WHERE type = 'table'", &[], &[("name", Kind::T)])
+            .and_then(|rows| rows.iter().map(|r| r.string("name")).collect::<Result<Vec<String>, DbError>>())
             .map_err(|e| self.open_error(format!("not a usable SQLite database: {e}")))?;
-        let names: Vec<String> = rows.iter().map(|r| r[0].string()).collect();
+        let names = rows;
         if !names.is_empty() && !names.iter().any(|n| n == "gyrolab_schema") {
             return Err(self.open_error(format!(
                 "an SQLite database without a gyrolab schema (tables: {}): not a gyrolab store",
@@ -370,38 +391,85 @@ impl Store {
         }
     }
 
-    /// Runs a read-only query.
-    pub(crate) fn query(&mut self, sql: &str, params: &[Val], kinds: &[Kind]) -> StoreResult<Vec<Vec<Val>>> {
+    /// Runs a read-only query, its columns read by name (see [`db::Exec::rows`]).
+    pub(crate) fn rows(&mut self, sql: &str, params: &[Val], columns: db::Columns<'_>) -> StoreResult<Vec<Row>> {
         let r = match &mut self.conn {
-            Conn::Sqlite(c) => SqliteExec(c).query(sql, params, kinds),
-            Conn::Postgres(c) => PgExec(c.as_mut(), &mut self.statements).query(sql, params, kinds),
+            Conn::Sqlite(c) => SqliteExec(c).rows(sql, params, columns),
+            Conn::Postgres(c) => PgExec(c.as_mut(), &mut self.statements).rows(sql, params, columns),
         };
-        r.map_err(|e| self.db_error(e))
+        r.map_err(|e| self.row_error(e))
+    }
+
+    /// A failure of the executor or of reading a row, as a [`StoreError::Database`].
+    pub(crate) fn row_error(&self, e: DbError) -> StoreError {
+        self.db_error(e.to_string())
     }
 
     /// The schema version in the store (0 for a new store).
     pub fn schema_version(&mut self) -> StoreResult<i64> {
-        let rows = self.query("SELECT COALESCE(MAX(version), 0) FROM gyrolab_schema", &[], &[Kind::I])?;
-        Ok(rows.first().map_or(0, |r| r[0].int()))
+        let rows =
+            self.rows("SELECT COALESCE(MAX(version), 0) AS version FROM gyrolab_schema", &[], &[("version", Kind::I)])?;
+        db::first_int(&rows, "version", 0).map_err(|e| self.row_error(e))
+    }
+
+    /// The migrations recorded in the store's `gyrolab_schema`, oldest first (their name and
+    /// checksum are null only in a store no build with checksums has opened yet).
+    pub fn recorded_migrations(&mut self) -> StoreResult<Vec<schema::RecordedMigration>> {
+        let rows = self.rows(
+            "SELECT version, name, sha256 FROM gyrolab_schema ORDER BY version",
+            &[],
+            &[("version", Kind::I), ("name", Kind::T), ("sha256", Kind::T)],
+        )?;
+        rows.iter()
+            .map(|r| {
+                Ok(schema::RecordedMigration {
+                    version: r.int("version")?,
+                    name: r.string_opt("name")?,
+                    sha256: r.string_opt("sha256")?,
+                })
+            })
+            .collect::<Result<Vec<_>, DbError>>()
+            .map_err(|e| self.row_error(e))
     }
 
     fn migrate(&mut self) -> StoreResult<()> {
         let postgres = self.is_postgres();
-        let migrations = if postgres { schema::POSTGRES_MIGRATIONS } else { schema::SQLITE_MIGRATIONS };
+        let migrations = schema::migrations(postgres);
         let store = self.name.clone();
         let now = now_rfc3339();
-        let dberr = |m: String| StoreError::Open { store: store.clone(), message: m };
+        let dberr = |m: DbError| StoreError::Open { store: store.clone(), message: m.to_string() };
         self.transaction(|x| {
             if postgres {
                 // One migrating client at a time; others wait here and then find it done.
                 x.exec("SELECT pg_advisory_xact_lock(7291835)", &[]).map_err(&dberr)?;
             }
             x.batch(schema::VERSION_TABLE).map_err(&dberr)?;
-            let found = x
-                .query("SELECT COALESCE(MAX(version), 0) FROM gyrolab_schema", &[], &[Kind::I])
-                .map_err(&dberr)?
-                .first()
-                .map_or(0, |r| r[0].int());
+            // A version table of a build before checksums lacks their columns: added here, in
+            // this transaction, and filled below (adoption).
+            let has: Vec<String> = x
+                .rows(
+                    schema::version_table_columns_sql(postgres),
+                    &[Val::T(Some("gyrolab_schema".into()))],
+                    &[("name", Kind::T)],
+                )
+                .and_then(|rows| rows.iter().map(|r| r.string("name")).collect())
+                .map_err(&dberr)?;
+            for (column, add) in schema::VERSION_TABLE_COLUMNS {
+                if !has.iter().any(|h| h == column) {
+                    x.batch(add).map_err(&dberr)?;
+                }
+            }
+            let recorded = x
+                .rows(
+                    "SELECT version, sha256 FROM gyrolab_schema ORDER BY version",
+                    &[],
+                    &[("version", Kind::I), ("sha256", Kind::T)],
+                )
+                .map_err(&dberr)?;
+            let found = match recorded.last() {
+                Some(r) => r.int("version").map_err(&dberr)?,
+                None => 0,
+            };
             if found > schema::SCHEMA_VERSION {
                 return Err(StoreError::NewerSchema {
                     store: store.clone(),
@@ -410,15 +478,48 @@ impl Store {
                     software: SOFTWARE_VERSION.to_string(),
                 });
             }
-            for (i, sql) in migrations.iter().enumerate().skip(found as usize) {
-                x.batch(sql).map_err(&dberr)?;
-                if i + 1 == 3 {
+            for r in &recorded {
+                let version = r.int("version").map_err(&dberr)?;
+                let Some(m) = usize::try_from(version - 1).ok().and_then(|i| migrations.get(i)) else {
+                    return Err(dberr(DbError::Invalid(format!("gyrolab_schema records an unknown version {version}"))));
+                };
+                let embedded = m.sha256();
+                match r.text("sha256").map_err(&dberr)? {
+                    // Applied by a build before checksums: adopted, recorded from this build.
+                    None => {
+                        x.exec(
+                            "UPDATE gyrolab_schema SET name = $1, sha256 = $2 WHERE version = $3",
+                            &[Val::T(Some(m.name.to_string())), Val::T(Some(embedded)), Val::I(version)],
+                        )
+                        .map_err(&dberr)?;
+                    }
+                    Some(recorded) if recorded != embedded => {
+                        return Err(StoreError::MigrationChecksum {
+                            store: store.clone(),
+                            version,
+                            file: m.file.to_string(),
+                            recorded: recorded.to_string(),
+                            embedded,
+                        });
+                    }
+                    Some(_) => {}
+                }
+            }
+            for m in migrations.iter().skip(found as usize) {
+                x.batch(m.sql).map_err(&dberr)?;
+                if m.version == 3 {
                     // Migration 3: the hash chain over the rows already stored.
                     chain::build_existing(x).map_err(&dberr)?;
                 }
                 x.exec(
-                    "INSERT INTO gyrolab_schema (version, applied_at, software_version) VALUES ($1, $2, $3)",
-                    &[Val::I(i as i64 + 1), Val::T(Some(now.clone())), Val::T(Some(SOFTWARE_VERSION.to_string()))],
+                    "INSERT INTO gyrolab_schema (version, applied_at, software_version, name, sha256) VALUES ($1, $2, $3, $4, $5)",
+                    &[
+                        Val::I(m.version),
+                        Val::T(Some(now.clone())),
+                        Val::T(Some(SOFTWARE_VERSION.to_string())),
+                        Val::T(Some(m.name.to_string())),
+                        Val::T(Some(m.sha256())),
+                    ],
                 )
                 .map_err(&dberr)?;
             }
@@ -449,7 +550,7 @@ impl Store {
         let store = self.name.clone();
         let found = self.transaction(|x| {
             account::authenticate(x, name, password)
-                .map_err(|m| StoreError::Database { store: store.clone(), message: m })
+                .map_err(|m| StoreError::Database { store: store.clone(), message: m.to_string() })
         })?;
         found.map(|(a, hash)| Actor::of(a, hash)).map_err(|()| StoreError::Auth { store: self.name.clone() })
     }
@@ -460,21 +561,26 @@ impl Store {
         let store = self.name.clone();
         self.transaction(|x| {
             let rows = x
-                .query(
+                .rows(
                     "SELECT id FROM evaluation WHERE serial = $1 AND results_json = $2 \
                      AND NOT EXISTS (SELECT 1 FROM evaluation later WHERE later.supersedes = evaluation.id) ORDER BY id",
                     &[Val::T(Some(serial.to_string())), Val::T(Some(results_json.to_string()))],
-                    &[Kind::I],
+                    &[("id", Kind::I)],
                 )
-                .map_err(|m| StoreError::Database { store: store.clone(), message: m })?;
-            Ok(rows.first().map(|r| r[0].int()))
+                .map_err(|m| StoreError::Database { store: store.clone(), message: m.to_string() })?;
+            rows.first()
+                .map(|r| r.int("id"))
+                .transpose()
+                .map_err(|m| StoreError::Database { store: store.clone(), message: m.to_string() })
         })
     }
 
     /// Whether the store has any account (then every write needs one).
     pub fn has_accounts(&mut self) -> StoreResult<bool> {
         let store = self.name.clone();
-        self.transaction(|x| account::any(x).map_err(|m| StoreError::Database { store: store.clone(), message: m }))
+        self.transaction(|x| {
+            account::any(x).map_err(|m| StoreError::Database { store: store.clone(), message: m.to_string() })
+        })
     }
 
     /// Every account as it stands now (no password hashes).
@@ -483,7 +589,7 @@ impl Store {
         self.transaction(|x| {
             account::accounts(x)
                 .map(|v| v.into_iter().map(|(a, _)| a).collect())
-                .map_err(|m| StoreError::Database { store: store.clone(), message: m })
+                .map_err(|m| StoreError::Database { store: store.clone(), message: m.to_string() })
         })
     }
 
@@ -491,7 +597,7 @@ impl Store {
     pub fn audit_events(&mut self, id: Option<i64>) -> StoreResult<Vec<AuditEvent>> {
         let store = self.name.clone();
         self.transaction(|x| {
-            account::events(x, id).map_err(|m| StoreError::Database { store: store.clone(), message: m })
+            account::events(x, id).map_err(|m| StoreError::Database { store: store.clone(), message: m.to_string() })
         })
     }
 
@@ -499,7 +605,7 @@ impl Store {
     pub(crate) fn write<T>(&mut self, f: impl FnOnce(&mut dyn Exec, &str) -> StoreResult<T>) -> StoreResult<T> {
         let store = self.name.clone();
         let postgres = self.is_postgres();
-        let dberr = |m: String| StoreError::Database { store: store.clone(), message: m };
+        let dberr = |m: DbError| StoreError::Database { store: store.clone(), message: m.to_string() };
         let out = self.transaction(|x| {
             if postgres {
                 x.exec("SELECT pg_advisory_xact_lock(7291836)", &[]).map_err(&dberr)?;
@@ -534,7 +640,7 @@ impl Store {
             .map_err(|m| StoreError::Refused { store: self.name.clone(), message: m })?;
         let hash = account::hash_password(password).map_err(|m| self.db_error(m))?;
         self.write(|x, store| {
-            let dberr = |m: String| StoreError::Database { store: store.to_string(), message: m };
+            let dberr = |m: DbError| StoreError::Database { store: store.to_string(), message: m.to_string() };
             let refused = |m: String| StoreError::Refused { store: store.to_string(), message: m };
             let first = !account::any(x).map_err(dberr)?;
             let (by_id, by) = if first {
@@ -552,7 +658,7 @@ impl Store {
                 return Err(refused(format!("an account named {name:?} exists already")));
             }
             let rows = x
-                .query(
+                .rows(
                     "INSERT INTO account (name, display_name, role, password_hash, created_by) VALUES ($1, $2, $3, $4, $5) RETURNING id",
                     &[
                         Val::T(Some(name.to_string())),
@@ -561,10 +667,10 @@ impl Store {
                         Val::T(Some(hash.clone())),
                         Val::T(Some(by.clone())),
                     ],
-                    &[Kind::I],
+                    &[("id", Kind::I)],
                 )
                 .map_err(dberr)?;
-            let id = rows.first().map(|r| r[0].int()).ok_or_else(|| dberr("no id returned".into()))?;
+            let id = db::returned_id(&rows).map_err(dberr)?;
             chain::append_row(x, "account", id).map_err(dberr)?;
             account::audit(x, by_id, &by, "user add", None, Some(&format!("{name} ({})", role.as_str())))
                 .map_err(dberr)?;
@@ -586,7 +692,7 @@ impl Store {
 
     fn change_account(&mut self, actor: &Actor, name: &str, password_hash: Option<String>) -> StoreResult<()> {
         self.write(|x, store| {
-            let dberr = |m: String| StoreError::Database { store: store.to_string(), message: m };
+            let dberr = |m: DbError| StoreError::Database { store: store.to_string(), message: m.to_string() };
             let (by_id, by) = account::check_actor(x, store, actor, account::Need::Admin)?;
             let by_id = by_id.ok_or_else(|| StoreError::Auth { store: store.to_string() })?;
             let Some((target, _)) = account::by_name(x, name).map_err(dberr)? else {
@@ -600,13 +706,13 @@ impl Store {
                 });
             }
             let rows = x
-                .query(
+                .rows(
                     "INSERT INTO account_change (account_id, change, password_hash, changed_by) VALUES ($1, $2, $3, $4) RETURNING id",
                     &[Val::I(target.id), Val::T(Some(change.into())), Val::T(password_hash.clone()), Val::I(by_id)],
-                    &[Kind::I],
+                    &[("id", Kind::I)],
                 )
                 .map_err(dberr)?;
-            let id = rows.first().map(|r| r[0].int()).ok_or_else(|| dberr("no id returned".into()))?;
+            let id = db::returned_id(&rows).map_err(dberr)?;
             chain::append_row(x, "account_change", id).map_err(dberr)?;
             let action = if change == "disable" { "user disable" } else { "user reset" };
             account::audit(x, Some(by_id), &by, action, None, Some(name)).map_err(dberr)?;
@@ -620,16 +726,16 @@ impl Store {
         let fingerprint = sign::fingerprint(key);
         let public = sign::public_hex(key);
         self.write(|x, store| {
-            let dberr = |m: String| StoreError::Database { store: store.to_string(), message: m };
+            let dberr = |m: DbError| StoreError::Database { store: store.to_string(), message: m.to_string() };
             let (by_id, by) = account::check_actor(x, store, actor, account::Need::Admin)?;
             let rows = x
-                .query(
+                .rows(
                     "INSERT INTO signing_key (public_key, fingerprint, added_by) VALUES ($1, $2, $3) RETURNING id",
                     &[Val::T(Some(public.clone())), Val::T(Some(fingerprint.clone())), Val::T(Some(by.clone()))],
-                    &[Kind::I],
+                    &[("id", Kind::I)],
                 )
                 .map_err(dberr)?;
-            let id = rows.first().map(|r| r[0].int()).ok_or_else(|| dberr("no id returned".into()))?;
+            let id = db::returned_id(&rows).map_err(dberr)?;
             chain::append_row(x, "signing_key", id).map_err(dberr)?;
             account::audit(x, by_id, &by, "key add", None, Some(&fingerprint)).map_err(dberr)?;
             Ok(fingerprint.clone())
@@ -652,7 +758,7 @@ impl Store {
         }
         let store = self.name.clone();
         let now = now_rfc3339();
-        let dberr = |m: String| StoreError::Database { store: store.clone(), message: m };
+        let dberr = |m: DbError| StoreError::Database { store: store.clone(), message: m.to_string() };
         let postgres = self.is_postgres();
         let id = self.transaction(|x| {
             if postgres {
@@ -698,7 +804,7 @@ impl Store {
             };
             if let Some(r) = revision {
                 let taken = x
-                    .query("SELECT id FROM evaluation WHERE supersedes = $1", &[Val::I(r.supersedes)], &[Kind::I])
+                    .rows("SELECT id FROM evaluation WHERE supersedes = $1", &[Val::I(r.supersedes)], &[("id", Kind::I)])
                     .map_err(&dberr)?;
                 if let Some(row) = taken.first() {
                     return Err(StoreError::Refused {
@@ -706,13 +812,13 @@ impl Store {
                         message: format!(
                             "evaluation {} is already superseded by {}: revise the current revision",
                             r.supersedes,
-                            row[0].int()
+                            row.int("id").map_err(&dberr)?
                         ),
                     });
                 }
             }
             let rows = x
-                .query(
+                .rows(
                     "INSERT INTO evaluation (supersedes, revision_kind, revision_by, revision_reason, stored_at, serial, model, lot, \
                      operator, approver, test_date, evaluated_at, software_version, plan_path, plan_text, plan_sha256, results_json, \
                      verdict, simulated) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12, $13, $14, $15, $16, $17, $18, $19) \
@@ -738,10 +844,10 @@ impl Store {
                         o(&record.verdict),
                         Val::I(record.simulated as i64),
                     ],
-                    &[Kind::I],
+                    &[("id", Kind::I)],
                 )
                 .map_err(&dberr)?;
-            let id = rows.first().map(|r| r[0].int()).ok_or_else(|| dberr("no id returned".into()))?;
+            let id = db::returned_id(&rows).map_err(&dberr)?;
             // One statement per table (PostgreSQL: one round trip each, the rows as arrays).
             let files = &record.inputs;
             let columns = [
@@ -762,7 +868,7 @@ impl Store {
                 .iter()
                 .map(|f| f.content.as_deref().map(|b| zstd::bulk::compress(b, 3)).transpose())
                 .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| dberr(format!("cannot compress a report file: {e}")))?;
+                .map_err(|e| dberr(format!("cannot compress a report file: {e}").into()))?;
             let columns = [
                 Column::I(vec![id; files.len()]),
                 Column::T(files.iter().map(|f| Some(f.path.clone())).collect()),
@@ -880,7 +986,8 @@ impl Store {
         let postgres = self.is_postgres();
         let store = self.name.clone();
         self.transaction(|x| {
-            chain::full_check(x, postgres).map_err(|m| StoreError::Database { store: store.clone(), message: m })
+            chain::full_check(x, postgres)
+                .map_err(|m| StoreError::Database { store: store.clone(), message: m.to_string() })
         })
     }
 
@@ -891,7 +998,8 @@ impl Store {
         let postgres = self.is_postgres();
         let store = self.name.clone();
         self.transaction(|x| {
-            chain::quick_check(x, postgres).map_err(|m| StoreError::Database { store: store.clone(), message: m })
+            chain::quick_check(x, postgres)
+                .map_err(|m| StoreError::Database { store: store.clone(), message: m.to_string() })
         })
     }
 

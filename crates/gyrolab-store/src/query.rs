@@ -7,7 +7,7 @@
 //! supersedes; for lot statistics and charts each device (serial) counts once, with its latest
 //! current evaluation (highest id), in test order (test date, else evaluation time, then id).
 
-use crate::db::{Kind, Val};
+use crate::db::{first_int, Columns, DbError, Kind, Row, Val};
 use crate::record::{EvaluationRecord, FigureRecord, FileRecord};
 use crate::{Store, StoreError, StoreResult};
 use gyrolab::control_chart::{individuals_moving_range, xbar_s, Chart};
@@ -37,33 +37,68 @@ pub struct StoredEvaluation {
     pub record: EvaluationRecord,
 }
 
-const EVALUATION_COLUMNS: &[Kind] = &[
-    Kind::I, // id
-    Kind::T, // supersedes as text (null-able integer)
-    Kind::T, // revision_kind
-    Kind::T,
-    Kind::T,
-    Kind::T, // stored_at
-    Kind::T, // serial
-    Kind::T,
-    Kind::T,
-    Kind::T,
-    Kind::T,
-    Kind::T,
-    Kind::T, // evaluated_at
-    Kind::T,
-    Kind::T,
-    Kind::T,
-    Kind::T,
-    Kind::T, // results_json
-    Kind::T, // verdict
-    Kind::I, // simulated
+/// The columns of an evaluation row, by name.
+const EVALUATION_COLUMNS: Columns<'static> = &[
+    ("id", Kind::I),
+    ("supersedes", Kind::IOpt),
+    ("revision_kind", Kind::T),
+    ("revision_by", Kind::T),
+    ("revision_reason", Kind::T),
+    ("stored_at", Kind::T),
+    ("serial", Kind::T),
+    ("model", Kind::T),
+    ("lot", Kind::T),
+    ("operator", Kind::T),
+    ("approver", Kind::T),
+    ("test_date", Kind::T),
+    ("evaluated_at", Kind::T),
+    ("software_version", Kind::T),
+    ("plan_path", Kind::T),
+    ("plan_text", Kind::T),
+    ("plan_sha256", Kind::T),
+    ("results_json", Kind::T),
+    ("verdict", Kind::T),
+    ("simulated", Kind::I),
 ];
+
+/// The columns of a figure row (the figure's own, without its evaluation), by name.
+const FIGURE_COLUMNS: Columns<'static> = &[
+    ("axis", Kind::T),
+    ("figure", Kind::T),
+    ("value", Kind::F),
+    ("unit", Kind::T),
+    ("basis", Kind::T),
+    ("expanded_uncertainty", Kind::F),
+    ("coverage_factor", Kind::F),
+    ("limit_min", Kind::F),
+    ("limit_max", Kind::F),
+    ("verdict", Kind::T),
+    ("simulated", Kind::I),
+];
+
+/// A figure read by name; `prefix` before each column's name (`f_` where the evaluation's
+/// columns share the row).
+fn figure_of(r: &Row, prefix: &str) -> Result<FigureRecord, DbError> {
+    let c = |n: &str| format!("{prefix}{n}");
+    Ok(FigureRecord {
+        axis: r.string(&c("axis"))?,
+        figure: r.string(&c("figure"))?,
+        value: r.float(&c("value"))?,
+        unit: r.string(&c("unit"))?,
+        basis: r.string(&c("basis"))?,
+        expanded_uncertainty: r.float(&c("expanded_uncertainty"))?,
+        coverage_factor: r.float(&c("coverage_factor"))?,
+        limit_min: r.float(&c("limit_min"))?,
+        limit_max: r.float(&c("limit_max"))?,
+        verdict: r.string_opt(&c("verdict"))?,
+        simulated: r.int(&c("simulated"))? != 0,
+    })
+}
 
 /// One evaluation by id.
 pub fn evaluation(store: &mut Store, id: i64) -> StoreResult<StoredEvaluation> {
-    let rows = store.query(
-        "SELECT id, CAST(supersedes AS TEXT), revision_kind, revision_by, revision_reason, stored_at, serial, model, lot, operator, \
+    let rows = store.rows(
+        "SELECT id, supersedes, revision_kind, revision_by, revision_reason, stored_at, serial, model, lot, operator, \
          approver, test_date, evaluated_at, software_version, plan_path, plan_text, plan_sha256, results_json, verdict, simulated \
          FROM evaluation WHERE id = $1",
         &[Val::I(id)],
@@ -72,21 +107,24 @@ pub fn evaluation(store: &mut Store, id: i64) -> StoreResult<StoredEvaluation> {
     let Some(r) = rows.into_iter().next() else {
         return Err(StoreError::NotFound { store: store.name().to_string(), message: format!("no evaluation {id}") });
     };
-    let later = store.query("SELECT id FROM evaluation WHERE supersedes = $1", &[Val::I(id)], &[Kind::I])?;
+    let later = store.rows("SELECT id FROM evaluation WHERE supersedes = $1", &[Val::I(id)], &[("id", Kind::I)])?;
     let files = |store: &mut Store, sql: &str| -> StoreResult<Vec<FileRecord>> {
-        Ok(store
-            .query(sql, &[Val::I(id)], &[Kind::T, Kind::T, Kind::I])?
-            .into_iter()
-            .map(|f| FileRecord {
-                path: f[0].string(),
-                sha256: f[1].string(),
-                size_bytes: f[2].int() as u64,
-                content: None,
+        let rows =
+            store.rows(sql, &[Val::I(id)], &[("name", Kind::T), ("sha256", Kind::T), ("size_bytes", Kind::I)])?;
+        rows.iter()
+            .map(|f| {
+                Ok(FileRecord {
+                    path: f.string("name")?,
+                    sha256: f.string("sha256")?,
+                    size_bytes: f.int("size_bytes")? as u64,
+                    content: None,
+                })
             })
-            .collect())
+            .collect::<Result<_, DbError>>()
+            .map_err(|e| store.row_error(e))
     };
     let inputs =
-        files(store, "SELECT path, sha256, size_bytes FROM input_file WHERE evaluation_id = $1 ORDER BY path")?;
+        files(store, "SELECT path AS name, sha256, size_bytes FROM input_file WHERE evaluation_id = $1 ORDER BY path")?;
     let mut report_files =
         files(store, "SELECT name, sha256, size_bytes FROM report_file WHERE evaluation_id = $1 ORDER BY name")?;
     let mut contents: HashMap<String, Vec<u8>> =
@@ -95,56 +133,47 @@ pub fn evaluation(store: &mut Store, id: i64) -> StoreResult<StoredEvaluation> {
         f.content = contents.remove(&f.path);
     }
     let figures = store
-        .query(
+        .rows(
             "SELECT axis, figure, value, unit, basis, expanded_uncertainty, coverage_factor, limit_min, limit_max, verdict, simulated \
              FROM figure WHERE evaluation_id = $1",
             &[Val::I(id)],
-            &[Kind::T, Kind::T, Kind::F, Kind::T, Kind::T, Kind::F, Kind::F, Kind::F, Kind::F, Kind::T, Kind::I],
+            FIGURE_COLUMNS,
         )?
-        .into_iter()
-        .map(|f| FigureRecord {
-            axis: f[0].string(),
-            figure: f[1].string(),
-            value: f[2].float(),
-            unit: f[3].string(),
-            basis: f[4].string(),
-            expanded_uncertainty: f[5].float(),
-            coverage_factor: f[6].float(),
-            limit_min: f[7].float(),
-            limit_max: f[8].float(),
-            verdict: f[9].text().map(str::to_string),
-            simulated: f[10].int() != 0,
+        .iter()
+        .map(|f| figure_of(f, ""))
+        .collect::<Result<Vec<_>, DbError>>()
+        .map_err(|e| store.row_error(e))?;
+    let read = || -> Result<StoredEvaluation, DbError> {
+        Ok(StoredEvaluation {
+            id: r.int("id")?,
+            supersedes: r.int_opt("supersedes")?,
+            superseded_by: later.first().map(|l| l.int("id")).transpose()?,
+            revision_kind: r.string("revision_kind")?,
+            revision_by: r.string_opt("revision_by")?,
+            revision_reason: r.string_opt("revision_reason")?,
+            stored_at: r.string("stored_at")?,
+            record: EvaluationRecord {
+                serial: r.string("serial")?,
+                model: r.string("model")?,
+                lot: r.string_opt("lot")?,
+                operator: r.string_opt("operator")?,
+                approver: r.string_opt("approver")?,
+                test_date: r.string_opt("test_date")?,
+                evaluated_at: r.string("evaluated_at")?,
+                software_version: r.string("software_version")?,
+                plan_path: r.string("plan_path")?,
+                plan_text: r.string("plan_text")?,
+                plan_sha256: r.string("plan_sha256")?,
+                results_json: r.string("results_json")?,
+                verdict: r.string_opt("verdict")?,
+                simulated: r.int("simulated")? != 0,
+                inputs,
+                report_files,
+                figures,
+            },
         })
-        .collect();
-    let t = |i: usize| r[i].text().map(str::to_string);
-    Ok(StoredEvaluation {
-        id: r[0].int(),
-        supersedes: r[1].text().and_then(|s| s.parse().ok()),
-        superseded_by: later.first().map(|l| l[0].int()),
-        revision_kind: r[2].string(),
-        revision_by: t(3),
-        revision_reason: t(4),
-        stored_at: r[5].string(),
-        record: EvaluationRecord {
-            serial: r[6].string(),
-            model: r[7].string(),
-            lot: t(8),
-            operator: t(9),
-            approver: t(10),
-            test_date: t(11),
-            evaluated_at: r[12].string(),
-            software_version: r[13].string(),
-            plan_path: r[14].string(),
-            plan_text: r[15].string(),
-            plan_sha256: r[16].string(),
-            results_json: r[17].string(),
-            verdict: t(18),
-            simulated: r[19].int() != 0,
-            inputs,
-            report_files,
-            figures,
-        },
-    })
+    };
+    read().map_err(|e| store.row_error(e))
 }
 
 /// One figure of one evaluation, as history lists it.
@@ -177,42 +206,38 @@ pub struct HistoryRow {
 
 /// Every figure of every evaluation (all revisions) of a serial, oldest first.
 pub fn history(store: &mut Store, serial: &str) -> StoreResult<Vec<HistoryRow>> {
-    let rows = store.query(
-        "SELECT e.id, CAST(e.supersedes AS TEXT), CAST(CASE WHEN EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id) THEN 0 ELSE 1 END AS BIGINT), \
-         e.revision_kind, COALESCE(e.test_date, e.evaluated_at), e.software_version, e.lot, e.verdict, e.simulated, \
-         f.axis, f.figure, f.value, f.unit, f.basis, f.expanded_uncertainty, f.coverage_factor, f.limit_min, f.limit_max, f.verdict, f.simulated \
+    let mut columns: Vec<(&str, Kind)> = vec![
+        ("id", Kind::I),
+        ("supersedes", Kind::IOpt),
+        ("current", Kind::I),
+        ("revision_kind", Kind::T),
+        ("tested", Kind::T),
+        ("software_version", Kind::T),
+        ("lot", Kind::T),
+        ("verdict", Kind::T),
+        ("simulated", Kind::I),
+    ];
+    let figure_columns: Vec<(String, Kind)> = FIGURE_COLUMNS.iter().map(|(n, k)| (format!("f_{n}"), *k)).collect();
+    columns.extend(figure_columns.iter().map(|(n, k)| (n.as_str(), *k)));
+    let rows = store.rows(
+        "SELECT e.id AS id, e.supersedes AS supersedes, \
+         CAST(CASE WHEN EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id) THEN 0 ELSE 1 END AS BIGINT) AS current, \
+         e.revision_kind AS revision_kind, COALESCE(e.test_date, e.evaluated_at) AS tested, e.software_version AS software_version, \
+         e.lot AS lot, e.verdict AS verdict, e.simulated AS simulated, \
+         f.axis AS f_axis, f.figure AS f_figure, f.value AS f_value, f.unit AS f_unit, f.basis AS f_basis, \
+         f.expanded_uncertainty AS f_expanded_uncertainty, f.coverage_factor AS f_coverage_factor, f.limit_min AS f_limit_min, \
+         f.limit_max AS f_limit_max, f.verdict AS f_verdict, f.simulated AS f_simulated \
          FROM evaluation e JOIN figure f ON f.evaluation_id = e.id WHERE e.serial = $1 ORDER BY e.id, f.axis, f.figure",
         &[Val::T(Some(serial.to_string()))],
-        &[
-            Kind::I,
-            Kind::T,
-            Kind::I,
-            Kind::T,
-            Kind::T,
-            Kind::T,
-            Kind::T,
-            Kind::T,
-            Kind::I,
-            Kind::T,
-            Kind::T,
-            Kind::F,
-            Kind::T,
-            Kind::T,
-            Kind::F,
-            Kind::F,
-            Kind::F,
-            Kind::F,
-            Kind::T,
-            Kind::I,
-        ],
+        &columns,
     )?;
     if rows.is_empty() {
-        let any = store.query(
-            "SELECT COUNT(*) FROM evaluation WHERE serial = $1",
+        let any = store.rows(
+            "SELECT COUNT(*) AS n FROM evaluation WHERE serial = $1",
             &[Val::T(Some(serial.to_string()))],
-            &[Kind::I],
+            &[("n", Kind::I)],
         )?;
-        if any.first().is_none_or(|r| r[0].int() == 0) {
+        if first_int(&any, "n", 0).map_err(|e| store.row_error(e))? == 0 {
             return Err(StoreError::NotFound {
                 store: store.name().to_string(),
                 message: format!("no evaluation of serial {serial:?}"),
@@ -220,49 +245,43 @@ pub fn history(store: &mut Store, serial: &str) -> StoreResult<Vec<HistoryRow>> 
         }
     }
     let issued: HashMap<i64, String> = store
-        .query(
-            "SELECT i.evaluation_id, i.report_number, (SELECT s.report_number FROM issue s WHERE s.amends = i.id) FROM issue i \
+        .rows(
+            "SELECT i.evaluation_id AS evaluation_id, i.report_number AS report_number, \
+             (SELECT s.report_number FROM issue s WHERE s.amends = i.id) AS superseded_by FROM issue i \
              JOIN evaluation e ON e.id = i.evaluation_id WHERE e.serial = $1",
             &[Val::T(Some(serial.to_string()))],
-            &[Kind::I, Kind::T, Kind::T],
+            &[("evaluation_id", Kind::I), ("report_number", Kind::T), ("superseded_by", Kind::T)],
         )?
-        .into_iter()
+        .iter()
         .map(|r| {
-            let status = match r[2].text() {
-                Some(by) => format!("SUPERSEDED {} by {by}", r[1].string()),
-                None => format!("ISSUED {}", r[1].string()),
+            let number = r.string("report_number")?;
+            let status = match r.text("superseded_by")? {
+                Some(by) => format!("SUPERSEDED {number} by {by}"),
+                None => format!("ISSUED {number}"),
             };
-            (r[0].int(), status)
+            Ok((r.int("evaluation_id")?, status))
         })
-        .collect();
-    Ok(rows
-        .into_iter()
-        .map(|r| HistoryRow {
-            report: issued.get(&r[0].int()).cloned().unwrap_or_else(|| "DRAFT".into()),
-            evaluation: r[0].int(),
-            supersedes: r[1].text().and_then(|s| s.parse().ok()),
-            current: r[2].int() == 1,
-            revision_kind: r[3].string(),
-            tested: r[4].string(),
-            software_version: r[5].string(),
-            lot: r[6].text().map(str::to_string),
-            overall_verdict: r[7].text().map(str::to_string),
-            simulated: r[8].int() != 0,
-            figure: FigureRecord {
-                axis: r[9].string(),
-                figure: r[10].string(),
-                value: r[11].float(),
-                unit: r[12].string(),
-                basis: r[13].string(),
-                expanded_uncertainty: r[14].float(),
-                coverage_factor: r[15].float(),
-                limit_min: r[16].float(),
-                limit_max: r[17].float(),
-                verdict: r[18].text().map(str::to_string),
-                simulated: r[19].int() != 0,
-            },
+        .collect::<Result<_, DbError>>()
+        .map_err(|e| store.row_error(e))?;
+    rows.iter()
+        .map(|r| {
+            let id = r.int("id")?;
+            Ok(HistoryRow {
+                report: issued.get(&id).cloned().unwrap_or_else(|| "DRAFT".into()),
+                evaluation: id,
+                supersedes: r.int_opt("supersedes")?,
+                current: r.int("current")? == 1,
+                revision_kind: r.string("revision_kind")?,
+                tested: r.string("tested")?,
+                software_version: r.string("software_version")?,
+                lot: r.string_opt("lot")?,
+                overall_verdict: r.string_opt("verdict")?,
+                simulated: r.int("simulated")? != 0,
+                figure: figure_of(r, "f_")?,
+            })
         })
-        .collect())
+        .collect::<Result<_, DbError>>()
+        .map_err(|e| store.row_error(e))
 }
 
 /// The values of one figure of one axis over a lot's devices, in test order.
@@ -294,27 +313,47 @@ pub fn lot_series(store: &mut Store, lot: Option<&str>) -> StoreResult<Vec<Figur
     // Two queries: the lot's current evaluations (one row each), then their figures (only the
     // columns that change per figure). Figures of evaluations not chosen by the first query
     // (superseded ones, or ones stored in between) are passed over.
-    const EVAL_LOT: &str = "SELECT e.id, e.serial, COALESCE(e.test_date, e.evaluated_at) FROM evaluation e \
+    const EVAL_LOT: &str =
+        "SELECT e.id AS id, e.serial AS serial, COALESCE(e.test_date, e.evaluated_at) AS tested FROM evaluation e \
          WHERE e.lot = $1 AND NOT EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id)";
-    const EVAL_ALL: &str = "SELECT e.id, e.serial, COALESCE(e.test_date, e.evaluated_at) FROM evaluation e \
+    const EVAL_ALL: &str =
+        "SELECT e.id AS id, e.serial AS serial, COALESCE(e.test_date, e.evaluated_at) AS tested FROM evaluation e \
          WHERE NOT EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id)";
     const FIG_LOT: &str =
-        "SELECT f.evaluation_id, f.axis, f.figure, f.unit, f.value, f.limit_min, f.limit_max, f.simulated \
+        "SELECT f.evaluation_id AS evaluation_id, f.axis AS axis, f.figure AS figure, f.unit AS unit, f.value AS value, \
+         f.limit_min AS limit_min, f.limit_max AS limit_max, f.simulated AS simulated \
          FROM figure f JOIN evaluation e ON e.id = f.evaluation_id WHERE e.lot = $1 AND f.value IS NOT NULL";
     const FIG_ALL: &str =
-        "SELECT f.evaluation_id, f.axis, f.figure, f.unit, f.value, f.limit_min, f.limit_max, f.simulated \
+        "SELECT f.evaluation_id AS evaluation_id, f.axis AS axis, f.figure AS figure, f.unit AS unit, f.value AS value, \
+         f.limit_min AS limit_min, f.limit_max AS limit_max, f.simulated AS simulated \
          FROM figure f WHERE f.value IS NOT NULL";
-    let eval_kinds = [Kind::I, Kind::T, Kind::T];
-    let fig_kinds = [Kind::I, Kind::T, Kind::T, Kind::T, Kind::F, Kind::F, Kind::F, Kind::I];
+    let eval_kinds: Columns<'_> = &[("id", Kind::I), ("serial", Kind::T), ("tested", Kind::T)];
+    let fig_kinds: Columns<'_> = &[
+        ("evaluation_id", Kind::I),
+        ("axis", Kind::T),
+        ("figure", Kind::T),
+        ("unit", Kind::T),
+        ("value", Kind::F),
+        ("limit_min", Kind::F),
+        ("limit_max", Kind::F),
+        ("simulated", Kind::I),
+    ];
     let lot_param = [Val::T(lot.map(str::to_string))];
     let (evals, rows) = match lot {
-        Some(_) => (store.query(EVAL_LOT, &lot_param, &eval_kinds)?, store.query(FIG_LOT, &lot_param, &fig_kinds)?),
-        None => (store.query(EVAL_ALL, &[], &eval_kinds)?, store.query(FIG_ALL, &[], &fig_kinds)?),
+        Some(_) => (store.rows(EVAL_LOT, &lot_param, eval_kinds)?, store.rows(FIG_LOT, &lot_param, fig_kinds)?),
+        None => (store.rows(EVAL_ALL, &[], eval_kinds)?, store.rows(FIG_ALL, &[], fig_kinds)?),
     };
+    let groups = group_series(&evals, &rows).map_err(|e| store.row_error(e))?;
+    Ok(groups)
+}
+
+/// The series of [`lot_series`] from its two queries' rows.
+fn group_series(evals: &[Row], rows: &[Row]) -> Result<Vec<FigureSeries>, DbError> {
     // The latest current evaluation per serial: id -> (serial, test order key).
     let mut latest: HashMap<&str, (i64, &str)> = HashMap::with_capacity(evals.len());
-    for r in &evals {
-        let (id, serial, date) = (r[0].int(), r[1].text().unwrap_or_default(), r[2].text().unwrap_or_default());
+    for r in evals {
+        let (id, serial, date) =
+            (r.int("id")?, r.text("serial")?.unwrap_or_default(), r.text("tested")?.unwrap_or_default());
         let e = latest.entry(serial).or_insert((id, date));
         if id > e.0 {
             *e = (id, date);
@@ -323,11 +362,15 @@ pub fn lot_series(store: &mut Store, lot: Option<&str>) -> StoreResult<Vec<Figur
     let chosen: HashMap<i64, (&str, &str)> = latest.into_iter().map(|(s, (id, d))| (id, (s, d))).collect();
     let mut index: HashMap<(&str, &str, &str), usize> = HashMap::new();
     let mut groups: Vec<((&str, &str, &str), Group)> = Vec::new();
-    for r in &rows {
-        let id = r[0].int();
+    for r in rows {
+        let id = r.int("evaluation_id")?;
         let Some(&(serial, date)) = chosen.get(&id) else { continue };
-        let Some(v) = r[4].float() else { continue };
-        let key = (r[1].text().unwrap_or_default(), r[2].text().unwrap_or_default(), r[3].text().unwrap_or_default());
+        let Some(v) = r.float("value")? else { continue };
+        let key = (
+            r.text("axis")?.unwrap_or_default(),
+            r.text("figure")?.unwrap_or_default(),
+            r.text("unit")?.unwrap_or_default(),
+        );
         let i = *index.entry(key).or_insert_with(|| {
             groups.push((key, (Vec::new(), None, None, i64::MIN, false)));
             groups.len() - 1
@@ -335,11 +378,11 @@ pub fn lot_series(store: &mut Store, lot: Option<&str>) -> StoreResult<Vec<Figur
         let g = &mut groups[i].1;
         g.0.push((serial, id, date, v));
         if id > g.3 {
-            g.1 = r[5].float();
-            g.2 = r[6].float();
+            g.1 = r.float("limit_min")?;
+            g.2 = r.float("limit_max")?;
             g.3 = id;
         }
-        g.4 |= r[7].int() != 0;
+        g.4 |= r.int("simulated")? != 0;
     }
     groups.sort_by(|a, b| a.0.cmp(&b.0));
     Ok(groups
@@ -499,17 +542,20 @@ pub fn control_charts(store: &mut Store, lot: Option<&str>, axis: &str, figure: 
     let values: Vec<f64> = s.values.iter().map(|v| v.2).collect();
     let im = individuals_moving_range(&values);
     // X-bar/S: every lot, devices grouped by their lot.
-    let rows = store.query(
-        "SELECT e.id, e.serial, e.lot, f.value FROM evaluation e JOIN figure f ON f.evaluation_id = e.id \
+    let rows = store.rows(
+        "SELECT e.id AS id, e.serial AS serial, e.lot AS lot, f.value AS value FROM evaluation e JOIN figure f ON f.evaluation_id = e.id \
          WHERE e.lot IS NOT NULL AND f.axis = $1 AND f.figure = $2 AND f.value IS NOT NULL \
          AND NOT EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id) ORDER BY e.id",
         &[Val::T(Some(axis.to_string())), Val::T(Some(figure.to_string()))],
-        &[Kind::I, Kind::T, Kind::T, Kind::F],
+        &[("id", Kind::I), ("serial", Kind::T), ("lot", Kind::T), ("value", Kind::F)],
     )?;
     let mut per_serial: BTreeMap<String, (String, f64, i64)> = BTreeMap::new();
     for r in rows {
-        if let Some(v) = r[3].float() {
-            per_serial.insert(r[1].string(), (r[2].string(), v, r[0].int()));
+        let read =
+            || -> Result<_, DbError> { Ok((r.float("value")?, r.string("serial")?, r.string("lot")?, r.int("id")?)) };
+        let (value, serial, lot, id) = read().map_err(|e| store.row_error(e))?;
+        if let Some(v) = value {
+            per_serial.insert(serial, (lot, v, id));
         }
     }
     let mut lots: BTreeMap<String, (i64, Vec<f64>)> = BTreeMap::new();
@@ -619,16 +665,19 @@ pub fn report_files(store: &mut Store, id: i64) -> StoreResult<Vec<(String, Vec<
 /// Every report file of evaluation `id` by name, with its bytes when stored (decompressed and
 /// checked against the recorded size and SHA-256: a mismatch is an error).
 fn read_report_files(store: &mut Store, id: i64) -> StoreResult<Vec<(String, Option<Vec<u8>>)>> {
-    let rows = store.query(
+    let rows = store.rows(
         "SELECT name, sha256, size_bytes, content_zstd FROM report_file WHERE evaluation_id = $1 ORDER BY name",
         &[Val::I(id)],
-        &[Kind::T, Kind::T, Kind::I, Kind::B],
+        &[("name", Kind::T), ("sha256", Kind::T), ("size_bytes", Kind::I), ("content_zstd", Kind::B)],
     )?;
     let name = store.name().to_string();
     let mut out = Vec::with_capacity(rows.len());
     for r in rows {
-        let (file, sha256, size) = (r[0].string(), r[1].string(), r[2].int());
-        let Some(packed) = r[3].bytes() else {
+        let read = || -> Result<_, DbError> {
+            Ok((r.string("name")?, r.string("sha256")?, r.int("size_bytes")?, r.bytes("content_zstd")?))
+        };
+        let (file, sha256, size, packed) = read().map_err(|e| store.row_error(e))?;
+        let Some(packed) = packed else {
             out.push((file, None));
             continue;
         };

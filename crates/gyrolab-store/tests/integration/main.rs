@@ -4,5 +4,6 @@
 
 mod accounts;
 mod common;
+mod migrations;
 mod store;
 mod tamper;

@@ -398,8 +398,8 @@ fn a_version_2_store_gets_its_chain_on_migration() {
             "{};\n{}\n{}\nINSERT INTO gyrolab_schema VALUES (1, 'earlier', '0.0.1'); INSERT INTO gyrolab_schema VALUES (2, \
              'earlier', '0.0.2');",
             gyrolab_store::schema::VERSION_TABLE,
-            m[0],
-            m[1]
+            m[0].sql,
+            m[1].sql
         ))
         .unwrap();
         raw.exec(
@@ -454,8 +454,8 @@ fn a_version_2_sqlite_store_with_a_dropped_trigger_still_migrates() {
         "{};\n{}\n{}\nINSERT INTO gyrolab_schema VALUES (1, 'earlier', '0.0.1'); INSERT INTO gyrolab_schema VALUES (2, \
          'earlier', '0.0.2'); DROP TRIGGER figure_kept;",
         gyrolab_store::schema::VERSION_TABLE,
-        m[0],
-        m[1]
+        m[0].sql,
+        m[1].sql
     ))
     .unwrap();
     let mut s = Store::open(&b.location, false).unwrap();

@@ -65,7 +65,9 @@ pub fn backends(test: &str) -> Vec<Backend> {
 /// Makes the store at `b` look written by a later gyrolab: a row of schema `version` in its
 /// `gyrolab_schema` table (test set-up only).
 pub fn mark_newer_schema(b: &Backend, version: i64) {
-    let row = format!("INSERT INTO gyrolab_schema VALUES ({version}, 'later', '9.9.9')");
+    let row = format!(
+        "INSERT INTO gyrolab_schema (version, applied_at, software_version) VALUES ({version}, 'later', '9.9.9')"
+    );
     if b.name == "sqlite" {
         let c = rusqlite::Connection::open(&b.location).expect("open the SQLite store");
         c.execute(&row, []).expect("insert the schema row");
@@ -80,9 +82,9 @@ pub fn mark_newer_schema(b: &Backend, version: i64) {
 pub fn make_version_1_store(b: &Backend) {
     let sqlite = b.name == "sqlite";
     let migration = if sqlite {
-        gyrolab_store::schema::SQLITE_MIGRATIONS[0]
+        gyrolab_store::schema::SQLITE_MIGRATIONS[0].sql
     } else {
-        gyrolab_store::schema::POSTGRES_MIGRATIONS[0]
+        gyrolab_store::schema::POSTGRES_MIGRATIONS[0].sql
     };
     let script = format!(
         "{};\n{migration}\nINSERT INTO gyrolab_schema VALUES (1, 'earlier', '0.0.1');",

@@ -1,0 +1,18 @@
+
+ALTER TABLE input_file ADD COLUMN id BIGINT GENERATED ALWAYS AS IDENTITY UNIQUE;
+ALTER TABLE report_file ADD COLUMN id BIGINT GENERATED ALWAYS AS IDENTITY UNIQUE;
+ALTER TABLE figure ADD COLUMN id BIGINT GENERATED ALWAYS AS IDENTITY UNIQUE;
+CREATE TABLE chain (
+    seq BIGINT PRIMARY KEY,
+    tbl TEXT NOT NULL,
+    row_id BIGINT NOT NULL,
+    fields TEXT NOT NULL,
+    hash TEXT NOT NULL,
+    UNIQUE (tbl, row_id)
+);
+CREATE TRIGGER chain_kept BEFORE UPDATE OR DELETE ON chain FOR EACH ROW EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER evaluation_not_truncated BEFORE TRUNCATE ON evaluation FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER input_file_not_truncated BEFORE TRUNCATE ON input_file FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER report_file_not_truncated BEFORE TRUNCATE ON report_file FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER figure_not_truncated BEFORE TRUNCATE ON figure FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();
+CREATE TRIGGER chain_not_truncated BEFORE TRUNCATE ON chain FOR EACH STATEMENT EXECUTE FUNCTION gyrolab_records_are_kept();

@@ -1,0 +1,1 @@
+CREATE INDEX IF NOT EXISTS evaluation_serial ON evaluation(serial);
