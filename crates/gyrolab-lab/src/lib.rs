@@ -11,12 +11,14 @@
 //! - [`batch`]: many records on every core, resumable by input hash, one result row per channel;
 //! - [`verify`]: a report folder checked against its manifest, plan and inputs;
 //! - [`issue`]: a stored evaluation issued or amended, signed, its report drawn;
+//! - [`records`]: the store's queries as tables and a serial's history as a trend plot;
 //! - [`reevaluate`]: a stored evaluation evaluated again and stored as its revision.
 
 pub mod batch;
 pub mod demo;
 pub mod issue;
 pub mod paper;
+pub mod records;
 pub mod reevaluate;
 pub mod report_folder;
 pub mod test_plan;

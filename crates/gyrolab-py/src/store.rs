@@ -4,8 +4,9 @@
 //! report folder. Each call opens the store and closes it again with the interpreter released
 //! (no connection outlives a call, so a process made by `fork` never shares one).
 
-use gyrolab_store::export::{Cell, Table};
-use gyrolab_store::{query, resolve_location, tables, Store, StoreError};
+use gyrolab_lab::records as tables;
+use gyrolab_report::table::{Cell, Table};
+use gyrolab_store::{query, resolve_location, Store, StoreError};
 use pyo3::prelude::*;
 use pyo3::types::PyList;
 use std::path::PathBuf;
@@ -65,13 +66,7 @@ pub fn store_history(
     serial: String,
     figure: Option<String>,
 ) -> PyResult<PyTable<'_>> {
-    let rows = with_store(py, location, false, |s| {
-        let mut rows = query::history(s, &serial)?;
-        if let Some(f) = &figure {
-            rows.retain(|r| &r.figure.figure == f);
-        }
-        Ok(rows)
-    })?;
+    let rows = with_store(py, location, false, |s| tables::history(s, &serial, figure.as_deref()))?;
     table_out(py, tables::history_table(&rows))
 }
 

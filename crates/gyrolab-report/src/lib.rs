@@ -12,6 +12,8 @@
 //! - [`thermal`]: the temperature-test section (soaked points, K(T), bias(T), sensitivities);
 //! - [`triad`]: three-axis calibration tables and JSON;
 //! - [`paper`]: the paper's printed tables beside the recomputation, for `gyrolab demo`;
+//! - [`table`]: tables of results as aligned text, CSV and Parquet (batch, the store's queries);
+//! - [`trend`]: trend plots of figures over evaluations (a serial's history);
 //! - [`tables_csv`]: the CSV tables of a report folder (points, runs, summary);
 //! - [`threshold`]: threshold and resolution tests (section, figures, JSON);
 
@@ -28,7 +30,9 @@ pub mod results;
 pub mod segments;
 pub mod signature;
 pub mod static_report;
+pub mod table;
 pub mod tables_csv;
 pub mod thermal;
 pub mod threshold;
+pub mod trend;
 pub mod triad;

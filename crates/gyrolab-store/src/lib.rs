@@ -6,22 +6,21 @@
 //! Layout: [`db`] the two back ends behind one interface; [`schema`] tables and migrations;
 //! [`record`] what is kept of one evaluation, read from a finished report folder; [`query`] the
 //! queries and their statistics (computed by the core crate: `gyrolab::process_capability`,
-//! `gyrolab::control_chart`, `gyrolab::two_sample`); [`tables`] query results as tables;
-//! [`export`] tables as CSV and Parquet; [`chain`] the hash chain and the checks; [`account`]
+//! `gyrolab::control_chart`, `gyrolab::two_sample`); [`chain`] the hash chain and the checks; [`account`]
 //! accounts, roles, authentication and the audit trail; [`sign`] the lab's Ed25519 key files and
-//! signatures; [`issue`] issued reports and amendments (issue 53).
+//! signatures; [`issue`] issued reports and amendments (issue 53). It evaluates and renders
+//! nothing: gyrolab-lab turns query results into tables and plots (gyrolab-report draws them)
+//! and draws an issued report's signature block.
 
 pub mod account;
 pub mod chain;
 pub mod db;
-pub mod export;
 pub mod issue;
 pub mod location;
 pub mod query;
 pub mod record;
 pub mod schema;
 pub mod sign;
-pub mod tables;
 
 pub use account::{Account, Actor, AuditEvent, Role};
 pub use chain::{CheckReport, Problem};

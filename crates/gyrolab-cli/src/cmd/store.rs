@@ -7,13 +7,11 @@ use crate::args::{prompt_password, stdin_line, AuthArgs, QueryOutput, StoreLocat
 use crate::error::{CliError, CliResult};
 use crate::output::{print, to_json, write_file};
 use clap::{Args, Subcommand, ValueEnum};
-use gyrolab::format::sig_opt;
-use gyrolab_report::plot::{Axis, Figure, Orientation, Panel, RefLine, Series, SeriesStyle};
-use gyrolab_store::export::{to_csv, to_parquet, Cell, Table};
+use gyrolab_lab::records::{chart_table, compare_table, diff_table, history_table, lot_table};
+use gyrolab_report::table::{to_csv, to_parquet, to_text, Table};
 use gyrolab_lab::issue::Issue;
 use gyrolab_lab::reevaluate;
 use gyrolab_store::issue::{IssuedReport, Meaning};
-use gyrolab_store::tables::{chart_table, compare_table, diff_table, history_table, lot_table};
 use gyrolab_store::{
     add_report_folder_as, query, resolve_location, sign, Actor, Changes, CheckReport, Revision,
     RevisionKind, Role, Store,
@@ -754,7 +752,7 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
                 r.changes.len()
             );
             if !r.changes.is_empty() {
-                out.push_str(&text_table(&diff_table(&r.changes)));
+                out.push_str(&to_text(&diff_table(&r.changes)));
             }
             print(&out)
         }
@@ -805,107 +803,27 @@ fn check_text(r: &CheckReport, name: &str) -> String {
 /// file of `--parquet` first (whole or not at all).
 fn emit(table: &Table, output: &QueryOutput, json: impl FnOnce() -> CliResult<String>) -> CliResult {
     if let Some(path) = &output.parquet {
-        write_file(path, &to_parquet(table)?, &[])?;
+        write_file(path, &to_parquet(table).map_err(|e| CliError::Usage(e.to_string()))?, &[])?;
     }
     if output.json {
         print(&json()?)
     } else if output.csv {
         print(&to_csv(table))
     } else {
-        print(&text_table(table))
+        print(&to_text(table))
     }
-}
-
-/// A table as aligned text: numbers with 6 significant digits, control characters escaped.
-fn text_table(table: &Table) -> String {
-    let shown: Vec<Vec<String>> = table
-        .rows
-        .iter()
-        .map(|r| {
-            r.iter()
-                .map(|c| match c {
-                    Cell::Number(x) => sig_opt(Some(*x), 6),
-                    Cell::Text(t) => t
-                        .chars()
-                        .flat_map(|c| if c.is_control() { c.escape_default().collect::<Vec<_>>() } else { vec![c] })
-                        .collect(),
-                    other => other.raw(),
-                })
-                .collect()
-        })
-        .collect();
-    let mut width: Vec<usize> = table.columns.iter().map(|h| h.chars().count()).collect();
-    for r in &shown {
-        for (i, f) in r.iter().enumerate() {
-            if let Some(w) = width.get_mut(i) {
-                *w = (*w).max(f.chars().count());
-            }
-        }
-    }
-    let mut out = String::new();
-    for r in std::iter::once(&table.columns).chain(shown.iter()) {
-        let line: Vec<String> =
-            r.iter().enumerate().map(|(i, f)| format!("{f:<w$}", w = width.get(i).copied().unwrap_or(0))).collect();
-        out.push_str(line.join("  ").trim_end());
-        out.push('\n');
-    }
-    out
 }
 
 fn history(a: &HistoryArgs) -> CliResult {
     let mut s = open(&a.location, false)?;
-    let mut rows = query::history(&mut s, &a.serial)?;
-    if let Some(f) = &a.figure {
-        rows.retain(|r| &r.figure.figure == f);
-    }
+    let rows = gyrolab_lab::records::history(&mut s, &a.serial, a.figure.as_deref())?;
     if let Some(path) = &a.svg {
-        write_file(path, history_svg(&a.serial, &rows)?.as_bytes(), &[])?;
+        let svg = gyrolab_lab::records::history_svg(&a.serial, &rows)
+            .map_err(|e| CliError::Output(e.to_string()))?
+            .ok_or_else(|| CliError::Usage(format!("serial {:?}: no values to plot", a.serial)))?;
+        write_file(path, svg.as_bytes(), &[])?;
     }
     emit(&history_table(&rows), &a.format, || to_json(&rows))
-}
-
-/// The trend plot of a history: one panel per (axis, figure), value against evaluation number,
-/// limits as horizontal lines; SIMULATED in the title when any value is.
-fn history_svg(serial: &str, rows: &[query::HistoryRow]) -> CliResult<String> {
-    let mut keys: Vec<(String, String, String)> = Vec::new();
-    for r in rows {
-        let k = (r.figure.axis.clone(), r.figure.figure.clone(), r.figure.unit.clone());
-        if !keys.contains(&k) {
-            keys.push(k);
-        }
-    }
-    let mut panels = Vec::new();
-    for (axis, fig, unit) in &keys {
-        let pts: Vec<&query::HistoryRow> =
-            rows.iter().filter(|r| r.figure.axis == *axis && r.figure.figure == *fig).collect();
-        let points: Vec<(f64, f64)> =
-            pts.iter().filter_map(|r| r.figure.value.map(|v| (r.evaluation as f64, v))).collect();
-        if points.is_empty() {
-            continue;
-        }
-        let mut p = Panel::new(Axis::linear("evaluation id"), Axis::linear(format!("{fig} ({unit})")));
-        p.caption = format!("axis {axis}: {fig}");
-        p.series.push(Series::new(fig.clone(), points, SeriesStyle::LineMarkers, 0));
-        let last = pts.last();
-        for (at, label) in
-            [(last.and_then(|r| r.figure.limit_min), "limit min"), (last.and_then(|r| r.figure.limit_max), "limit max")]
-        {
-            if let Some(at) = at {
-                p.ref_lines.push(RefLine { orientation: Orientation::Horizontal, at, label: label.into() });
-            }
-        }
-        panels.push(p);
-    }
-    if panels.is_empty() {
-        return Err(CliError::Usage(format!("serial {serial:?}: no values to plot")));
-    }
-    let simulated = if rows.iter().any(|r| r.figure.simulated) { " (SIMULATED)" } else { "" };
-    let height = 60 + 260 * panels.len() as u32;
-    let f = Figure { title: format!("History of serial {serial}{simulated}"), panels, width: 760, height };
-    let svg = f.to_svg().map_err(|e| CliError::Output(e.to_string()))?;
-    let svg =
-        if svg.contains("xmlns=") { svg } else { svg.replacen("<svg", "<svg xmlns=\"http://www.w3.org/2000/svg\"", 1) };
-    Ok(format!("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n{svg}\n"))
 }
 
 fn show_text(e: &query::StoredEvaluation) -> String {

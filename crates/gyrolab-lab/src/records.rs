@@ -1,10 +1,12 @@
-//! Query results as [`Table`]s, one builder per query, shared by every front end (the command
-//! line prints or exports them; Python turns them into DataFrames). Column names are the keys of
-//! the JSON output; units are in a `unit` column beside each value.
+//! The records store's queries for every front end: their results as [`Table`]s (the command
+//! line prints or exports them; Python turns them into DataFrames) and a serial's history as a
+//! trend plot. Column names are the keys of the JSON output; units are in a `unit` column beside
+//! each value. The store queries; gyrolab-report renders; this module joins them.
 
-use crate::export::ColumnKind::{self, Count as C, Number as N, Text as T};
-use crate::export::{Cell, Table};
-use crate::query;
+use gyrolab_report::table::ColumnKind::{self, Count as C, Number as N, Text as T};
+use gyrolab_report::table::{Cell, Table};
+use gyrolab_report::trend::{trend_svg, TrendPanel};
+use gyrolab_store::{query, Store, StoreResult};
 
 fn num(v: Option<f64>) -> Cell {
     Cell::number(v)
@@ -290,4 +292,45 @@ pub fn figures_table(series: &[query::FigureSeries]) -> Table {
         }
     }
     Table { columns: head, kinds, rows: body }
+}
+
+/// The history of a serial (every figure of every evaluation, all revisions, oldest first), only
+/// `figure` when given.
+pub fn history(store: &mut Store, serial: &str, figure: Option<&str>) -> StoreResult<Vec<query::HistoryRow>> {
+    let mut rows = query::history(store, serial)?;
+    if let Some(f) = figure {
+        rows.retain(|r| r.figure.figure == f);
+    }
+    Ok(rows)
+}
+
+/// The trend plot of a history as an SVG document: one panel per (axis, figure), value against
+/// evaluation id, the latest evaluation's limits as horizontal lines; SIMULATED in the title when
+/// any value is. `Ok(None)`: no value to plot.
+pub fn history_svg(serial: &str, rows: &[query::HistoryRow]) -> Result<Option<String>, gyrolab_report::plot::PlotError> {
+    let mut keys: Vec<(&str, &str, &str)> = Vec::new();
+    for r in rows {
+        let k = (r.figure.axis.as_str(), r.figure.figure.as_str(), r.figure.unit.as_str());
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    let panels: Vec<TrendPanel> = keys
+        .into_iter()
+        .map(|(axis, figure, unit)| {
+            let pts: Vec<&query::HistoryRow> =
+                rows.iter().filter(|r| r.figure.axis == axis && r.figure.figure == figure).collect();
+            let last = pts.last();
+            TrendPanel {
+                axis: axis.to_string(),
+                figure: figure.to_string(),
+                unit: unit.to_string(),
+                points: pts.iter().filter_map(|r| r.figure.value.map(|v| (r.evaluation as f64, v))).collect(),
+                limit_min: last.and_then(|r| r.figure.limit_min),
+                limit_max: last.and_then(|r| r.figure.limit_max),
+            }
+        })
+        .collect();
+    let simulated = if rows.iter().any(|r| r.figure.simulated) { " (SIMULATED)" } else { "" };
+    trend_svg(&format!("History of serial {serial}{simulated}"), &panels)
 }

@@ -1,9 +1,18 @@
-//! Query results as tables, and their export: CSV text (RFC 4180 quoting) and Parquet files
-//! (one row group, zstd). Every `gyrolab store` query is turned into a [`Table`] by the front
-//! end; the writers live here so that the command line and Python share them (the command line
-//! reaches Parquet only through this module).
+//! Tables of results and their renderings: aligned text, CSV (RFC 4180 quoting) and Parquet
+//! files (one row group, zstd, through gyrolab-io's writer). The records store's queries become
+//! [`Table`]s in the lab layer; the command line prints or exports them and Python turns them
+//! into DataFrames, all through this module (no front end imports a table or Parquet crate).
 
-use crate::{StoreError, StoreResult};
+use gyrolab::format::sig_opt;
+
+/// A table that cannot be written as Parquet (cells of the wrong kind or count, or the writer's
+/// error).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("Parquet export: {message}")]
+pub struct TableError {
+    /// What is wrong, naming the row and column.
+    pub message: String,
+}
 
 /// One cell of a table.
 #[derive(Debug, Clone, PartialEq)]
@@ -101,9 +110,9 @@ pub fn to_csv(table: &Table) -> String {
 /// The table as a Parquet file (bytes): one optional column per table column, of the same name,
 /// typed by its [`ColumnKind`] (text UTF-8, numbers DOUBLE, counts INT64; a text cell in a
 /// number column is an error), empty cells null; one row group, zstd.
-pub fn to_parquet(table: &Table) -> StoreResult<Vec<u8>> {
+pub fn to_parquet(table: &Table) -> Result<Vec<u8>, TableError> {
     use gyrolab_io::parquet_table::{write_table, ColumnValues};
-    let failed = |message: String| StoreError::Input { path: "Parquet export".into(), message };
+    let failed = |message: String| TableError { message };
     if table.kinds.len() != table.columns.len() {
         return Err(failed(format!("{} column kinds for {} columns", table.kinds.len(), table.columns.len())));
     }
@@ -167,6 +176,43 @@ pub fn to_parquet(table: &Table) -> StoreResult<Vec<u8>> {
         })
         .collect();
     write_table("gyrolab_store_query", &columns).map_err(|e| failed(format!("cannot write the Parquet table: {e}")))
+}
+
+/// The table as aligned text: numbers with 6 significant digits, control characters escaped,
+/// columns two spaces apart, trailing spaces trimmed.
+pub fn to_text(table: &Table) -> String {
+    let shown: Vec<Vec<String>> = table
+        .rows
+        .iter()
+        .map(|r| {
+            r.iter()
+                .map(|c| match c {
+                    Cell::Number(x) => sig_opt(Some(*x), 6),
+                    Cell::Text(t) => t
+                        .chars()
+                        .flat_map(|c| if c.is_control() { c.escape_default().collect::<Vec<_>>() } else { vec![c] })
+                        .collect(),
+                    other => other.raw(),
+                })
+                .collect()
+        })
+        .collect();
+    let mut width: Vec<usize> = table.columns.iter().map(|h| h.chars().count()).collect();
+    for r in &shown {
+        for (i, f) in r.iter().enumerate() {
+            if let Some(w) = width.get_mut(i) {
+                *w = (*w).max(f.chars().count());
+            }
+        }
+    }
+    let mut out = String::new();
+    for r in std::iter::once(&table.columns).chain(shown.iter()) {
+        let line: Vec<String> =
+            r.iter().enumerate().map(|(i, f)| format!("{f:<w$}", w = width.get(i).copied().unwrap_or(0))).collect();
+        out.push_str(line.join("  ").trim_end());
+        out.push('\n');
+    }
+    out
 }
 
 #[cfg(test)]
@@ -235,6 +281,17 @@ mod tests {
         let r = SerializedFileReader::new(std::fs::File::open(&p).unwrap()).unwrap();
         let col = r.metadata().file_metadata().schema_descr().column(1);
         assert_eq!(col.physical_type(), parquet::basic::Type::DOUBLE);
+    }
+
+    #[test]
+    fn text_aligns_columns_rounds_numbers_and_escapes_control_characters() {
+        let mut t = table();
+        t.rows[1][0] = Cell::Text("SN-2\x1b[31m".into());
+        let text = to_text(&t);
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[0], "serial           value  n  note");
+        assert_eq!(lines[1], "SN-1, \"a\"       0.3    3  '; DROP TABLE figure; --");
+        assert_eq!(lines[2], "SN-2\\u{1b}[31m");
     }
 
     #[test]
