@@ -5,7 +5,7 @@
 //!
 //! Layout (one module per request type):
 //! - [`rate`]: rate-table records (long, wide, raw logs) to evaluated axes and calibrations;
-//! - [`raw_log`]: raw rate-table logs segmented into plateaus, strokes and runs;
+//!   ([`rate::raw_log`]: raw rate-table logs segmented into plateaus, strokes and runs);
 //! - [`triad`]: three-axis calibration sets;
 //! - [`static_test`]: static tests (bias, bias stability, repeatability, drift, temperature);
 //! - [`allan`]: Allan-variance analyses of time series, with noise terms;
@@ -35,7 +35,6 @@ pub mod outcome;
 pub mod program_sim;
 pub mod progress;
 pub mod rate;
-pub mod raw_log;
 pub mod record_length;
 pub mod recording;
 pub mod reference;

@@ -2,7 +2,7 @@
 //! scale factors, misalignments and biases (12 parameters, [`gyrolab::triad`]; docs/METHODS.md).
 
 use crate::error::{EvalError, EvalResult};
-use crate::raw_log::{rate_column, SegmentationRequest};
+use crate::rate::raw_log::{rate_column, SegmentationRequest};
 use gyrolab::segment::find_steady_segments;
 use gyrolab::triad::{fit_triad, plateaus_from_segments, TableAxis, TriadError, TriadFit, TriadOptions, TriadPlateau};
 use gyrolab::units::OutputUnit;

@@ -33,7 +33,7 @@ impl DataError {
     /// A problem with a file as a whole.
     ///
     /// A message longer than [`MAX_MESSAGE_CHARS`] is cut (a safety net: readers quote fields
-    /// through [`crate::text::excerpt`]).
+    /// through [`excerpt`]).
     pub fn new(file: impl AsRef<Path>, message: impl Into<String>) -> Self {
         let mut message: String = message.into();
         if message.len() > MAX_MESSAGE_CHARS {
@@ -54,7 +54,7 @@ impl DataError {
 
     /// Locates the problem in a column (1-based index and optional header name).
     pub fn at_column(mut self, index: usize, name: Option<&str>) -> Self {
-        self.column = Some(ColumnRef { index, name: name.map(crate::text::excerpt) });
+        self.column = Some(ColumnRef { index, name: name.map(excerpt) });
         self
     }
 
@@ -98,6 +98,27 @@ impl fmt::Display for DataError {
 }
 
 impl std::error::Error for DataError {}
+
+/// Most characters of a field quoted in an error message (longer fields end in "...").
+pub const MAX_EXCERPT_CHARS: usize = 60;
+
+/// A field as quoted in messages: at most [`MAX_EXCERPT_CHARS`] characters, control characters
+/// shown as `\u{..}`, "..." when cut.
+pub fn excerpt(field: &str) -> String {
+    let mut out = String::new();
+    for (n, c) in field.chars().enumerate() {
+        if n == MAX_EXCERPT_CHARS {
+            out.push_str("...");
+            break;
+        }
+        if c.is_control() {
+            out.extend(c.escape_unicode());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
 
 #[cfg(test)]
 mod tests {

@@ -3,6 +3,7 @@
 //! - [`error`]: the [`DataError`] every reader returns;
 //! - [`atomic`]: outputs written to a temporary file and renamed into place;
 //! - [`manifest`]: a report folder's outputs and their manifest (names, SHA-256, sizes);
+//! - [`sniff`]: what a file is, by its first bytes;
 //! - [`text`]: a small delimited-text parser with line numbers;
 //! - [`rate_table`]: rate-table records in the long and wide layouts;
 //! - [`calibration`]: calibration files (TOML) written by `gyrolab rate --cal-out`;
@@ -33,6 +34,7 @@ pub mod raw_log;
 pub mod recording;
 pub mod series;
 pub mod sim_csv;
+pub mod sniff;
 pub mod text;
 pub mod threshold_record;
 

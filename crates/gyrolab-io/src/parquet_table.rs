@@ -30,11 +30,11 @@ fn perr(path: &Path, e: impl std::fmt::Display) -> DataError {
 /// Reads the numeric columns (INT32, INT64, FLOAT, DOUBLE; nulls as missing cells) of a
 /// Parquet file as a time series; other columns are skipped with a note.
 pub fn read_parquet(path: &Path, options: &SeriesOptions) -> Result<SeriesData, DataError> {
-    let (file, _, _) = crate::recording::open_sniffed(path)?;
+    let (file, _, _) = crate::sniff::open_sniffed(path)?;
     read_parquet_file(path, file, options)
 }
 
-/// [`read_parquet`] of a file already opened (once, by [`crate::recording::open_sniffed`]).
+/// [`read_parquet`] of a file already opened (once, by [`crate::sniff::open_sniffed`]).
 /// The footer's schema is checked first ([`check_footer`]): the `parquet` crate reserves room
 /// for a group's declared children before reading them.
 pub fn read_parquet_file(

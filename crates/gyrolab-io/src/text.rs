@@ -21,26 +21,7 @@ pub const MAX_TABLE_BYTES: u64 = 256 << 20;
 /// values stay finite; a value beyond it is a corrupt cell, never a gyro output or a time.
 pub const MAX_MAGNITUDE: f64 = 1e150;
 
-/// Most characters of a field quoted in an error message (longer fields end in "...").
-pub const MAX_EXCERPT_CHARS: usize = 60;
-
-/// A field as quoted in messages: at most [`MAX_EXCERPT_CHARS`] characters, control characters
-/// shown as `\u{..}`, "..." when cut.
-pub fn excerpt(field: &str) -> String {
-    let mut out = String::new();
-    for (n, c) in field.chars().enumerate() {
-        if n == MAX_EXCERPT_CHARS {
-            out.push_str("...");
-            break;
-        }
-        if c.is_control() {
-            out.extend(c.escape_unicode());
-        } else {
-            out.push(c);
-        }
-    }
-    out
-}
+pub use crate::error::{excerpt, MAX_EXCERPT_CHARS};
 
 /// Most characters of a parser's message (a TOML error) quoted in an error.
 pub const MAX_QUOTED_MESSAGE_CHARS: usize = 300;

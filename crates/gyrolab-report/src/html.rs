@@ -11,6 +11,7 @@ use gyrolab::figures::{known_figure, AxisFigures, FigureGroup, FIGURES};
 use gyrolab::format::{sig, sig_opt};
 use gyrolab::limits::{check_limits, overall, DecisionRule, Limit, LimitCheck, Overall, Support, Verdict};
 use crate::plot::PlotError;
+use crate::results::{CalibrationStatus, EquipmentRow, TestConditions};
 use gyrolab_eval::outcome::rate::AxisReport;
 use crate::rate_plots::{calibration_plot, hysteresis_plot, scale_factor_plot};
 use gyrolab::units::{ratio_to_pct, ratio_to_ppm};
@@ -61,70 +62,6 @@ pub struct ReportHeader {
     pub issue_date: String,
     /// The plan and the inputs with their SHA-256 (empty for built-in data).
     pub integrity: crate::results::IntegrityJson,
-}
-
-/// The conditions of a test, for the header and the sign-off block.
-#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
-pub struct TestConditions {
-    /// Who ran the test.
-    pub operator: Option<String>,
-    /// Who approves the report.
-    pub approver: Option<String>,
-    /// Date of the test, `YYYY-MM-DD`.
-    pub test_date: Option<String>,
-    /// Laboratory or site.
-    pub site: Option<String>,
-    /// Procedure or standard followed.
-    pub procedure: Option<String>,
-    /// Ambient temperature, degC.
-    pub ambient_temperature_c: Option<f64>,
-    /// Ambient relative humidity, %.
-    pub ambient_humidity_pct: Option<f64>,
-    /// The customer.
-    pub customer: Option<String>,
-    /// The item's condition when received.
-    pub item_condition: Option<String>,
-    /// The date the item was received, `YYYY-MM-DD`.
-    pub receipt_date: Option<String>,
-    /// Deviations from, additions to or exclusions from the method.
-    pub deviations: Option<String>,
-    /// The last date of a test over several days, `YYYY-MM-DD`.
-    pub test_date_end: Option<String>,
-    /// The laboratory's name.
-    pub laboratory: Option<String>,
-    /// The laboratory's address.
-    pub laboratory_address: Option<String>,
-    /// The customer's contact information.
-    pub customer_contact: Option<String>,
-    /// Reference to the sampling plan and method.
-    pub sampling: Option<String>,
-}
-
-/// Whether a piece of equipment was within its calibration on the test date.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum CalibrationStatus {
-    /// Due on or after the test date.
-    Valid,
-    /// Due before the test date.
-    Expired,
-    /// No due date given.
-    NotStated,
-}
-
-/// One piece of test equipment.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct EquipmentRow {
-    /// What it is.
-    pub name: String,
-    /// Make and model.
-    pub model: Option<String>,
-    /// Asset number or serial.
-    pub id: String,
-    /// Calibration due date, `YYYY-MM-DD`.
-    pub calibration_due: Option<String>,
-    /// Its status on the test date.
-    pub status: CalibrationStatus,
 }
 
 /// One row of a section's figure table.

@@ -289,8 +289,9 @@ mod tests {
         t.rows[1][0] = Cell::Text("SN-2\x1b[31m".into());
         let text = to_text(&t);
         let lines: Vec<&str> = text.lines().collect();
-        assert_eq!(lines[0], "serial           value  n  note");
-        assert_eq!(lines[1], "SN-1, \"a\"       0.3    3  '; DROP TABLE figure; --");
+        assert_eq!(lines.len(), 3, "{text}");
+        assert_eq!(lines[0], "serial          value     n  note");
+        assert_eq!(lines[1], "SN-1, \"a\"       0.300000  3  '; DROP TABLE figure; --");
         assert_eq!(lines[2], "SN-2\\u{1b}[31m");
     }
 

@@ -7,7 +7,6 @@
 //! `migrations/postgres/NNNN_name.sql`, embedded at build time. A migration's file is never
 //! edited once released: a store that recorded its checksum would be refused.
 
-use sha2::{Digest, Sha256};
 
 /// One migration: its version, its name and its SQL (embedded from its file).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -25,7 +24,7 @@ pub struct Migration {
 impl Migration {
     /// SHA-256 of its SQL text, lower-case hex (what `gyrolab_schema.sha256` records).
     pub fn sha256(&self) -> String {
-        crate::chain::hex(&Sha256::digest(self.sql.as_bytes()))
+        gyrolab_io::input_file::sha256_hex(self.sql.as_bytes())
     }
 }
 

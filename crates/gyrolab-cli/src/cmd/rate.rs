@@ -7,7 +7,7 @@ use clap::Args;
 use gyrolab::triad::TableAxis;
 use gyrolab::units::{OutputUnit, RateUnit};
 use gyrolab_eval::rate::{calibration_file, evaluate_rates, EvaluatedAxis, RateRequest, RateSettings};
-use gyrolab_eval::raw_log::SegmentationRequest;
+use gyrolab_eval::rate::raw_log::SegmentationRequest;
 use gyrolab_eval::triad::{evaluate_triad, TriadRequest};
 use gyrolab_io::atomic::{write_outputs, OutputFile};
 use gyrolab_io::rate_table::RateColumns;

@@ -13,7 +13,7 @@ pub mod uncertainty;
 use gyrolab_eval::error::EvalResult;
 use gyrolab_eval::progress::Progress;
 use gyrolab_eval::rate::{evaluate_record, is_raw_log, EvaluatedAxis, RateSettings};
-use gyrolab_eval::raw_log::{evaluate_channels, segment_file, SegmentationRequest, SegmentedLog};
+use gyrolab_eval::rate::raw_log::{evaluate_channels, segment_file, SegmentationRequest, SegmentedLog};
 use crate::report_folder::{assemble_report, ReportFolder, ReportInputs};
 use gyrolab_eval::triad::{evaluate_triad, TriadRequest};
 use gyrolab_eval::EvalError;
@@ -357,7 +357,7 @@ fn evaluate_marked(plan: &TestPlan, plan_file: &str, progress: &dyn Progress) ->
     let expired: Vec<String> = header
         .equipment
         .iter()
-        .filter(|e| e.status == gyrolab_report::html::CalibrationStatus::Expired)
+        .filter(|e| e.status == gyrolab_report::results::CalibrationStatus::Expired)
         .map(|e| format!("{} ({}, due {})", e.name, e.id, e.calibration_due.as_deref().unwrap_or("?")))
         .collect();
     let withheld = (!expired.is_empty()
@@ -366,7 +366,7 @@ fn evaluate_marked(plan: &TestPlan, plan_file: &str, progress: &dyn Progress) ->
             let ids: Vec<&str> = header
                 .equipment
                 .iter()
-                .filter(|e| e.status == gyrolab_report::html::CalibrationStatus::Expired)
+                .filter(|e| e.status == gyrolab_report::results::CalibrationStatus::Expired)
                 .map(|e| e.id.as_str())
                 .collect();
             format!("equipment used past its calibration due date ({})", ids.join(", "))
@@ -413,9 +413,9 @@ fn conditions(
     test: &gyrolab_io::test_plan::TestInfo,
     equipment: &[gyrolab_io::test_plan::Equipment],
     created: &str,
-) -> (gyrolab_report::html::TestConditions, Vec<gyrolab_report::html::EquipmentRow>) {
+) -> (gyrolab_report::results::TestConditions, Vec<gyrolab_report::results::EquipmentRow>) {
     use gyrolab_io::test_plan::parse_date;
-    use gyrolab_report::html::{CalibrationStatus, EquipmentRow, TestConditions};
+    use gyrolab_report::results::{CalibrationStatus, EquipmentRow, TestConditions};
     // In calibration through the test's last day (its range's end where it took several days).
     let on = test
         .date_end

@@ -3,7 +3,7 @@
 //! output channel (docs/METHODS.md section 5).
 
 use crate::error::{EvalError, EvalResult};
-use crate::rate::{evaluate_record, EvaluatedAxis};
+use super::{evaluate_record, EvaluatedAxis};
 use gyrolab::rate_test::{RateTable, RateTestOptions};
 use gyrolab::segment::{
     rate_observations, segment_log, segments_from_manual, PlateauReduction, Segment, SegmentError, SegmentOptions,

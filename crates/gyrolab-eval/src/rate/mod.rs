@@ -2,8 +2,10 @@
 //! outputs) segmented into plateaus, one axis per file or per output column of a raw log.
 //! Figures: paper eq. 1-9 as implemented by [`gyrolab::rate_test`] (docs/METHODS.md section 1).
 
+pub mod raw_log;
+
 use crate::error::{EvalError, EvalResult};
-use crate::raw_log::{evaluate_channels, segment_file, SegmentationRequest, SegmentedLog};
+use raw_log::{evaluate_channels, segment_file, SegmentationRequest, SegmentedLog};
 use gyrolab::rate_test::{evaluate, RateEvaluation, RateTestOptions};
 use gyrolab::validate;
 use gyrolab_io::calibration::{AxisCalibration, CalibrationFile, PolynomialModel, CALIBRATION_FORMAT};
