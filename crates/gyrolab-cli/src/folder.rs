@@ -40,7 +40,7 @@ pub fn write_and_finish(out: &Path, folder: &ReportFolder, quiet: bool, pdf: boo
         print(&s)?;
     }
     if pdf {
-        match crate::pdf::print_report(out) {
+        match gyrolab_report::pdf::print_report(out) {
             Ok((path, size)) => {
                 if !quiet {
                     print(&format!("Printed report.html to {} ({} kB)\n", path.display(), size.div_ceil(1024)))?;

@@ -1,17 +1,17 @@
-//! The `gyrolab` command-line program: parses arguments into requests, calls `gyrolab-eval`,
-//! prints, and sets the exit code. No domain logic lives here.
+//! The `gyrolab` command-line program: parses arguments into requests, calls `gyrolab-eval` and
+//! the lab layer `gyrolab-lab`, prints what `gyrolab-report` renders, and sets the exit code. No
+//! domain logic lives here.
 //!
 //! Layout: `cmd/` one module per subcommand (none imports another); [`args`] argument types
 //! shared by several commands; [`error`] exit codes and the flag of each request field;
-//! [`output`] standard output and atomic files; [`folder`] report folders; [`pdf`] printing a
-//! report to PDF with headless Chromium; [`progress`] the terminal progress bar.
+//! [`output`] standard output and atomic files; [`folder`] report folders; [`progress`] the
+//! terminal progress bar.
 
 mod args;
 mod cmd;
 mod error;
 mod folder;
 mod output;
-mod pdf;
 mod progress;
 
 use clap::{Parser, Subcommand};
@@ -64,7 +64,7 @@ fn main() -> ExitCode {
     // replace stay as they were), then stop with the usual 130.
     let _ = ctrlc::set_handler(|| {
         gyrolab_io::atomic::remove_temporaries();
-        pdf::remove_temporaries();
+        gyrolab_report::pdf::remove_temporaries();
         std::process::exit(130);
     });
     let result = match &cli.command {

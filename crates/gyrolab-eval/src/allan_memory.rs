@@ -161,6 +161,28 @@ pub struct StreamingSummary {
     pub channels: Vec<StreamedChannel>,
 }
 
+impl StreamingSummary {
+    /// The line that says a record was streamed, with its stride and EDF loss.
+    pub fn note(&self, file: &str) -> String {
+        let s = self;
+        let loss =
+            s.max_edf_loss.map_or("not evaluated (no confidence level)".to_string(), |l| format!("{:.1} %", 100.0 * l));
+        let how = if s.stride == 1 {
+            "every tau at full resolution".to_string()
+        } else {
+            format!(
+                "taus with m < {} at full resolution, longer ones from every {}th angle point (largest EDF loss {loss})",
+                s.full_resolution_below_m, s.stride
+            )
+        };
+        format!(
+            "{file}: streamed (about {} in memory, above the ceiling {}; --memory raises it): {how}",
+            size_text(s.estimated_in_memory_bytes),
+            size_text(s.memory_ceiling_bytes)
+        )
+    }
+}
+
 /// The streamed taus of one channel.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct StreamedChannel {

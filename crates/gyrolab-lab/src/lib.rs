@@ -10,12 +10,14 @@
 //! - [`demo`]: the paper's worked example and its report folder ([`paper`]: its printed tables);
 //! - [`batch`]: many records on every core, resumable by input hash, one result row per channel;
 //! - [`verify`]: a report folder checked against its manifest, plan and inputs;
+//! - [`exports`]: the Kalibr and imu_utils noise files of an Allan run;
 //! - [`issue`]: a stored evaluation issued or amended, signed, its report drawn;
 //! - [`records`]: the store's queries as tables and a serial's history as a trend plot;
 //! - [`reevaluate`]: a stored evaluation evaluated again and stored as its revision.
 
 pub mod batch;
 pub mod demo;
+pub mod exports;
 pub mod issue;
 pub mod paper;
 pub mod records;

@@ -1,12 +1,15 @@
 //! The records store's queries for every front end: their results as [`Table`]s (the command
-//! line prints or exports them; Python turns them into DataFrames) and a serial's history as a
-//! trend plot. Column names are the keys of the JSON output; units are in a `unit` column beside
+//! line prints or exports them; Python turns them into DataFrames), a serial's history as a
+//! trend plot, and the plain-text summaries of stored evaluations, checks, accounts and
+//! re-evaluations. Column names are the keys of the JSON output; units are in a `unit` column beside
 //! each value. The store queries; gyrolab-report renders; this module joins them.
 
 use gyrolab_report::table::ColumnKind::{self, Count as C, Number as N, Text as T};
 use gyrolab_report::table::{Cell, Table};
 use gyrolab_report::trend::{trend_svg, TrendPanel};
-use gyrolab_store::{query, Store, StoreResult};
+use gyrolab_report::table::to_text;
+use gyrolab_store::issue::IssuedReport;
+use gyrolab_store::{query, Account, AuditEvent, CheckReport, Store, StoreResult};
 
 fn num(v: Option<f64>) -> Cell {
     Cell::number(v)
@@ -333,4 +336,150 @@ pub fn history_svg(serial: &str, rows: &[query::HistoryRow]) -> Result<Option<St
         .collect();
     let simulated = if rows.iter().any(|r| r.figure.simulated) { " (SIMULATED)" } else { "" };
     trend_svg(&format!("History of serial {serial}{simulated}"), &panels)
+}
+
+/// A stored evaluation as text (`gyrolab store show`): its device, revisions, plan, inputs and
+/// figures, its report's issue (or DRAFT) and its audit trail.
+pub fn evaluation_text(e: &query::StoredEvaluation, issued: Option<&IssuedReport>, events: &[AuditEvent]) -> String {
+    let mut text = show_text(&e);
+    match issued {
+        Some(r) => text.push_str(&issue_line(r)),
+        None => text.push_str("report: DRAFT (not issued: gyrolab store issue)\n"),
+    }
+    text.push_str("audit trail (the store's clock):\n");
+    if events.is_empty() {
+        text.push_str("  (none: stored before schema version 4)\n");
+    }
+    for ev in events {
+        text.push_str(&format!(
+            "  {} {} by {}{}\n",
+            ev.at,
+            ev.action,
+            ev.actor,
+            ev.detail.as_deref().map_or_else(String::new, |d| format!(": {d:?}"))
+        ));
+    }
+    text
+}
+
+/// The issue line of `store show`.
+fn issue_line(r: &IssuedReport) -> String {
+    let mut s = format!(
+        "report {} {} {}: {} by {} ({}, {}), key {}\n",
+        r.report_number,
+        r.status(),
+        r.issued_at,
+        r.meaning,
+        r.signer_display_name,
+        r.signer,
+        r.signer_role,
+        r.key_fingerprint
+    );
+    if let (Some(old), Some(n)) = (&r.amends_report, r.amendment_no) {
+        s.push_str(&format!("amendment {n} to report {old}: {}\n", r.amend_reason.as_deref().unwrap_or_default()));
+    }
+    s
+}
+
+/// The check report of `gyrolab store check` as text.
+pub fn check_text(r: &CheckReport, name: &str) -> String {
+    let rows: Vec<String> = r.rows.iter().map(|(t, n)| format!("{t} {n}")).collect();
+    let mut out = format!(
+        "store {name}\ntriggers: {} of {} present and unaltered\nrows: {}\nchain: {} of {} link(s) re-verified against \
+         their rows\nreport files: {} re-hashed equal to their SHA-256, {} stored as hashes only\nchain head: {}\n",
+        r.triggers_ok.len(),
+        r.triggers_expected,
+        rows.join(", "),
+        r.links_checked,
+        r.links,
+        r.files_checked,
+        r.files_hash_only,
+        r.head.as_deref().unwrap_or("(empty store)")
+    );
+    if r.problems.is_empty() {
+        out.push_str("whole: nothing changed, deleted or inserted outside the store\n");
+    }
+    for p in &r.problems {
+        out.push_str(&format!("BROKEN: {p}\n"));
+    }
+    out
+}
+
+
+/// The accounts of a store as text (`gyrolab store user list`).
+pub fn accounts_text(accounts: &[Account]) -> String {
+    let mut out = String::from("name\tdisplay name\trole\tstate\tcreated\tcreated by\n");
+    for x in accounts {
+        out.push_str(&format!(
+            "{}\t{}\t{}\t{}\t{}\t{}\n",
+            x.name,
+            x.display_name,
+            x.role.as_str(),
+            if x.disabled { "DISABLED" } else { "active" },
+            x.created_at,
+            x.created_by
+        ));
+    }
+    if accounts.is_empty() {
+        out.push_str("(no accounts: writes to this store need no authentication)\n");
+    }
+    out
+}
+
+/// The outcome of a re-evaluation as text, its report in `out` (`gyrolab store reevaluate`).
+pub fn reevaluation_text(r: &crate::reevaluate::Reevaluation, out_dir: &std::path::Path) -> String {
+    let mut out = format!(
+        "re-evaluated evaluation {} (gyrolab {}) under gyrolab {}: evaluation {}, report in {}\n\
+         overall verdict: {} -> {}\n{} figure(s) changed\n",
+        r.superseded,
+        r.software_before,
+        r.software_after,
+        r.revision,
+        out_dir.display(),
+        r.verdict_before.as_deref().unwrap_or("none"),
+        r.verdict_after.as_deref().unwrap_or("none"),
+        r.changes.len()
+    );
+    if !r.changes.is_empty() {
+        out.push_str(&to_text(&diff_table(&r.changes)));
+    }
+    out
+}
+
+/// The text of a stored evaluation without its issue and audit trail.
+fn show_text(e: &query::StoredEvaluation) -> String {
+    let r = &e.record;
+    let o = |v: &Option<String>| v.clone().unwrap_or_else(|| "-".into());
+    let mut s = format!(
+        "evaluation {} ({}{}{})\n",
+        e.id,
+        e.revision_kind,
+        e.supersedes.map_or_else(String::new, |x| format!(", supersedes {x}")),
+        e.superseded_by.map_or_else(|| ", current".to_string(), |x| format!(", superseded by {x}"))
+    );
+    if let (Some(by), Some(why)) = (&e.revision_by, &e.revision_reason) {
+        s.push_str(&format!("revision by {by:?}: {why:?}\n"));
+    }
+    s.push_str(&format!(
+        "stored {}\ndevice {:?} serial {:?} lot {}\noperator {} approver {} tested {}\nevaluated {} with gyrolab {}\nplan {} (SHA-256 {})\nverdict {}{}\n",
+        e.stored_at,
+        r.model,
+        r.serial,
+        o(&r.lot),
+        o(&r.operator),
+        o(&r.approver),
+        o(&r.test_date),
+        r.evaluated_at,
+        r.software_version,
+        r.plan_path,
+        r.plan_sha256,
+        o(&r.verdict),
+        if r.simulated { " (SIMULATED inputs)" } else { "" }
+    ));
+    s.push_str("inputs:\n");
+    for f in &r.inputs {
+        s.push_str(&format!("  {} {} bytes SHA-256 {}\n", f.path, f.size_bytes, f.sha256));
+    }
+    s.push_str(&format!("{} figures, {} report files\n", r.figures.len(), r.report_files.len()));
+    s
 }

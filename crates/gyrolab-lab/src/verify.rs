@@ -9,6 +9,7 @@ use gyrolab_eval::error::EvalResult;
 use gyrolab_io::input_file::sha256_file;
 use gyrolab_io::DataError;
 use gyrolab_report::results::IntegrityJson;
+use gyrolab_store::sign::{self, VerifyingKey};
 use std::path::{Path, PathBuf};
 
 /// What a file is to the report.
@@ -198,4 +199,165 @@ pub fn verify_folder(dir: &Path, plan_dir: Option<&Path>) -> EvalResult<Verifica
         None => (None, Vec::new(), Vec::new()),
     };
     Ok(Verification { report_number, checks, outputs, extra, uncovered })
+}
+
+/// A report folder verified whole ([`verify_report`]): its lines to print and its problems.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VerifyReport {
+    /// The report number (with its status when issued: `GL-2026-0001, ISSUED`).
+    pub number: String,
+    /// One line per check (the signature, the plan and inputs, each output), headed by the report.
+    pub text: String,
+    /// Every file or signature that changed, is missing or was added (empty: none).
+    pub problems: Vec<String>,
+    /// The signature of an issued folder was checked (false: issued, no key given).
+    pub signature_checked: bool,
+    /// The outputs were checked against a manifest.
+    pub outputs_checked: bool,
+    /// Files checked (plan, inputs, outputs, added files).
+    pub files: usize,
+}
+
+/// A file's bytes, refused past `limit` bytes (a hostile folder cannot exhaust memory).
+fn read_bounded(p: &std::path::Path, limit: u64) -> Result<Vec<u8>, String> {
+    use std::io::Read;
+    // Only a regular file is opened (a FIFO would wait for a writer forever).
+    let meta = std::fs::metadata(p).map_err(|e| format!("{}: cannot read: {e}", p.display()))?;
+    if !meta.is_file() {
+        return Err(format!("{}: not a regular file", p.display()));
+    }
+    let f = std::fs::File::open(p).map_err(|e| format!("{}: cannot read: {e}", p.display()))?;
+    let mut bytes = Vec::new();
+    f.take(limit + 1).read_to_end(&mut bytes).map_err(|e| format!("{}: cannot read: {e}", p.display()))?;
+    if bytes.len() as u64 > limit {
+        return Err(format!("{}: larger than {limit} bytes", p.display()));
+    }
+    Ok(bytes)
+}
+
+/// The signature of an issued folder: (a line to print, the problem when it does not verify,
+/// whether it was checked). A folder with neither issue.json nor manifest.sig is a draft.
+fn check_signature(dir: &Path, key: Option<&VerifyingKey>) -> (Option<String>, Option<String>, bool) {
+    let sig_path = dir.join(sign::SIGNATURE_FILE);
+    let issued = dir.join(sign::ISSUE_FILE).exists() || sig_path.exists();
+    if !issued {
+        return match key {
+            Some(_) => (
+                Some("  NOT SIGNED: a draft (no issue.json, no manifest.sig): never issued".into()),
+                Some("the folder is not an issued report: it has no manifest.sig".into()),
+                true,
+            ),
+            None => (None, None, true),
+        };
+    }
+    let Some(key) = key else {
+        return (
+            Some("  NOT CHECKED: the signature of manifest.json (an issued report: give the lab's key, --public-key LAB.pub)".into()),
+            None,
+            false,
+        );
+    };
+    let read = |p: &std::path::Path| read_bounded(p, gyrolab_io::text::MAX_TABLE_BYTES);
+    let detached: Result<sign::DetachedSignature, String> = read(&sig_path)
+        .and_then(|b| serde_json::from_slice(&b).map_err(|e| format!("manifest.sig: not a gyrolab signature: {e}")));
+    let manifest = read(&dir.join("manifest.json"));
+    let fp = sign::fingerprint(key);
+    match (detached, manifest) {
+        (Ok(d), Ok(m)) if sign::verify_manifest(key, &m, &d.signature) => {
+            (Some(format!("  SIGNED    manifest.json: Ed25519 signature valid, key {fp}")), None, true)
+        }
+        (Ok(d), Ok(_)) => {
+            let why = if d.key_fingerprint != fp {
+                format!("manifest.sig names key {}, not the given key {fp}", d.key_fingerprint)
+            } else {
+                "manifest.json or manifest.sig changed since the report was issued".into()
+            };
+            let line = format!("  FORGED    manifest.json: the signature does NOT verify with key {fp} ({why})");
+            (Some(line), Some(format!("manifest.json: the signature does NOT verify ({why})")), true)
+        }
+        (Err(e), _) | (_, Err(e)) => {
+            (Some(format!("  MISSING   signature: {e}")), Some(format!("the signature cannot be checked: {e}")), true)
+        }
+    }
+}
+
+/// Verifies the report folder `dir` (`gyrolab verify`): an issued folder's Ed25519 signature of
+/// its manifest.json (with `key`; without it NOT CHECKED), then [`verify_folder`]: the plan,
+/// inputs (from `plan_dir`, default the plan's folder as results.json names it) and outputs.
+pub fn verify_report(dir: &Path, plan_dir: Option<&Path>, key: Option<&VerifyingKey>) -> EvalResult<VerifyReport> {
+    let (sig_line, sig_problem, sig_checked) = check_signature(dir, key);
+    let mut v = verify_folder(dir, plan_dir)?;
+    // The detached signature is not in the manifest it signs.
+    v.extra.retain(|e| e != sign::SIGNATURE_FILE);
+    let issued_number = read_bounded(&dir.join(sign::ISSUE_FILE), 16 << 20)
+        .ok()
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+        .and_then(|j| {
+            let n = j["report_number"].as_str()?.to_string();
+            let status = j["status"].as_str().unwrap_or_default().to_uppercase();
+            Some(format!("{n}, {status}"))
+        });
+    let number = issued_number.unwrap_or_else(|| v.report_number.clone());
+    let mut s = format!("Report {number} ({}):\n", dir.display());
+    let mut bad = Vec::new();
+    if let Some(l) = &sig_line {
+        s.push_str(l);
+        s.push('\n');
+    }
+    if let Some(p) = sig_problem {
+        bad.push(p);
+    }
+    for c in &v.checks {
+        let (word, detail) = match &c.state {
+            FileState::Unchanged => ("unchanged", String::new()),
+            FileState::Changed { sha256, size_bytes } => {
+                ("CHANGED", format!(" (SHA-256 now {sha256}, {size_bytes} bytes; recorded {})", c.recorded_sha256))
+            }
+            FileState::Missing { reason } => ("MISSING", format!(" ({reason})")),
+        };
+        let line = format!("{word:<9} {:<9} {}{detail}", c.role.word(), c.path.display());
+        if c.state != FileState::Unchanged {
+            bad.push(format!("{} {}", c.role.word(), c.path.display()));
+        }
+        s.push_str(&format!("  {line}\n"));
+    }
+    match &v.outputs {
+        Some(outputs) => {
+            for o in outputs {
+                let (word, detail) = match &o.state {
+                    FileState::Unchanged => ("unchanged", String::new()),
+                    FileState::Changed { sha256, size_bytes } => (
+                        "CHANGED",
+                        format!(" (SHA-256 now {sha256}, {size_bytes} bytes; manifest {})", o.recorded_sha256),
+                    ),
+                    FileState::Missing { reason } => ("MISSING", format!(" ({reason})")),
+                };
+                if o.state != FileState::Unchanged {
+                    bad.push(format!("output {}", o.name));
+                }
+                s.push_str(&format!("  {word:<9} {:<9} {}{detail}\n", "output", o.name));
+            }
+            for e in &v.extra {
+                bad.push(format!("added {e}"));
+                s.push_str(&format!("  {:<9} {:<9} {e} (in the folder, not in its manifest)\n", "ADDED", "file"));
+            }
+            for u in &v.uncovered {
+                s.push_str(&format!(
+                    "  {:<9} {:<9} {u} (printed from report.html after the manifest: not covered by it)\n",
+                    "uncovered", "file"
+                ));
+            }
+        }
+        None => s.push_str(
+            "  NOT CHECKED: the outputs (the folder has no manifest.json: written by a gyrolab before 0.3)\n",
+        ),
+    }
+    Ok(VerifyReport {
+        files: v.checks.len() + v.outputs.as_ref().map_or(0, Vec::len) + v.extra.len(),
+        outputs_checked: v.outputs_checked(),
+        number,
+        text: s,
+        problems: bad,
+        signature_checked: sig_checked,
+    })
 }

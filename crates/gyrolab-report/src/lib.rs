@@ -5,6 +5,7 @@
 //! - [`rate`]: rate-table evaluation tables and JSON (keys in docs/JSON.md);
 //! - [`plot`]: SVG plot building blocks; [`rate_plots`]: the rate-table plots;
 //! - [`html`]: the self-contained HTML report (header, summary, sections, methods appendix);
+//! - [`pdf`]: report.html printed to report.pdf with headless Chromium (whole or not at all);
 //! - [`signature`]: the signature block of an issued report (who issued it, when, with what key);
 //! - [`inventory`]: the topics of a recording (`gyrolab inspect`);
 //! - [`results`]: the results.json document of `gyrolab eval`;
@@ -22,6 +23,7 @@ pub mod bias;
 pub mod html;
 pub mod inventory;
 pub mod paper;
+pub mod pdf;
 pub mod plot;
 pub mod power_ups;
 pub mod rate;

@@ -7,11 +7,11 @@ use crate::output::{print, simulated_lines, to_json};
 use crate::progress::Bar;
 use clap::Args;
 use gyrolab_eval::allan::AllanRequest;
-use gyrolab_eval::allan_memory::{analyse_records_within, default_memory_bytes, parse_memory, size_text, MemoryPath};
+use gyrolab_eval::allan_memory::{analyse_records_within, default_memory_bytes, parse_memory, MemoryPath};
 use gyrolab_eval::filter_export::{check_inflate, export_files, parse_target, same_path, Estimator, ExportRequest};
 use gyrolab_eval::simulate::reference_from_headers;
 use gyrolab_eval::EvalError;
-use gyrolab_report::allan::{allan_csv, allan_document, allan_text, imu_utils_yaml, kalibr_yaml};
+use gyrolab_report::allan::{allan_csv, allan_document, allan_text};
 use std::path::PathBuf;
 
 /// Options of `gyrolab allan`.
@@ -160,12 +160,11 @@ pub fn run(args: &AllanArgs) -> CliResult {
     }
     let streamed = match &path {
         MemoryPath::Streaming(s) => {
-            eprintln!("note: {}", streaming_note(&args.file.display().to_string(), s));
+            eprintln!("note: {}", s.note(&args.file.display().to_string()));
             Some(s)
         }
         MemoryPath::InMemory { .. } => None,
     };
-    let several = outcomes.len() > 1;
     for outcome in &outcomes {
         for n in &outcome.notes {
             let level = if n.is_warning() { "warning" } else { "note" };
@@ -173,26 +172,8 @@ pub fn run(args: &AllanArgs) -> CliResult {
         }
     }
     // Every file of the run made first, then written together: all or none, never over the record.
-    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
-    let mut warnings: Vec<String> = Vec::new();
-    let motion = gyrolab_eval::filter_export::recording_motion(&outcomes);
-    for (path, imu_utils) in [(&args.kalibr_yaml, false), (&args.imu_utils_yaml, true)] {
-        let Some(path) = path else { continue };
-        let writer = if imu_utils { imu_utils_yaml } else { kalibr_yaml };
-        for outcome in &outcomes {
-            // One file per topic when there are several: imu.yaml -> imu_<topic>.yaml.
-            let target = match (&outcome.topic, several) {
-                (Some(t), true) => gyrolab_eval::recording::per_topic_path(path, &t.topic),
-                _ => path.clone(),
-            };
-            let file = writer(&outcome.analyses, 1.0 / outcome.sample_interval_s).ok_or_else(|| {
-                let whose = outcome.topic.as_ref().map_or(String::new(), |t| format!("topic {}: ", t.topic));
-                EvalError::conflict(format!("{whose}no noise terms could be read from the curves (give the gyro channels a unit such as --unit rad/s, or calibrate outputs with --cal or --scale-factor, and use --kind oadev); no output file was written"))
-            })?;
-            files.push((target, gyrolab_eval::filter_export::with_motion(file.text, &motion).into_bytes()));
-            warnings.extend(file.warnings);
-        }
-    }
+    let (mut files, mut warnings) =
+        gyrolab_lab::exports::stack_files(&outcomes, args.kalibr_yaml.as_deref(), args.imu_utils_yaml.as_deref())?;
     if let Some(request) = &export {
         let (export_files, export_warnings) = export_files(&outcomes, &args.file, request)?;
         files.extend(export_files);
@@ -210,21 +191,8 @@ pub fn run(args: &AllanArgs) -> CliResult {
     }
     let analyses: Vec<_> = outcomes.into_iter().flat_map(|o| o.analyses).collect();
     let analyses = &analyses;
-    for a in analyses {
-        if is_flat(a) {
-            eprintln!(
-                "warning: {} ({}): every sample has the same value (the Allan deviation is 0 at every tau): no \
-                 noise term can be read from a record without noise; a stuck sensor, or a simulation without \
-                 noise terms?",
-                a.file, a.channel
-            );
-        } else if a.slope_lines.is_none() && a.quantity == gyrolab::units::Quantity::SensorOutput {
-            eprintln!(
-                "hint: {} ({}): the data are in {}: give --scale-factor K (output units per deg/s) and --null F, \
-                 or --cal FILE.toml (from `gyrolab rate --cal-out`), for noise terms in deg units",
-                a.file, a.channel, a.rate_unit
-            );
-        }
+    for line in analyses.iter().filter_map(|a| a.advice()) {
+        eprintln!("{line}");
     }
     if args.json {
         let doc = allan_document(analyses).ok_or_else(|| EvalError::conflict("no channel to analyse"))?;
@@ -237,7 +205,7 @@ pub fn run(args: &AllanArgs) -> CliResult {
     let simulated = simulated_lines(std::slice::from_ref(&args.file));
     let mut text: Vec<String> = analyses.iter().map(allan_text).collect();
     if let Some(s) = streamed {
-        text.push(format!("memory: {}", streaming_note(&args.file.display().to_string(), s)));
+        text.push(format!("memory: {}", s.note(&args.file.display().to_string())));
     }
     print(&(simulated + &text.join("\n") + "\n"))
 }
@@ -250,28 +218,3 @@ struct WithMemory<'a, D: serde::Serialize> {
     memory: &'a MemoryPath,
 }
 
-/// The line that says a record was streamed, with its stride and EDF loss.
-fn streaming_note(file: &str, s: &gyrolab_eval::allan_memory::StreamingSummary) -> String {
-    let loss =
-        s.max_edf_loss.map_or("not evaluated (no confidence level)".to_string(), |l| format!("{:.1} %", 100.0 * l));
-    let how = if s.stride == 1 {
-        "every tau at full resolution".to_string()
-    } else {
-        format!(
-            "taus with m < {} at full resolution, longer ones from every {}th angle point (largest EDF loss {loss})",
-            s.full_resolution_below_m, s.stride
-        )
-    };
-    format!(
-        "{file}: streamed (about {} in memory, above the ceiling {}; --memory raises it): {how}",
-        size_text(s.estimated_in_memory_bytes),
-        size_text(s.memory_ceiling_bytes)
-    )
-}
-
-/// Whether a channel's curve is flat at zero: every deviation at or below 1e-9 (in the
-/// channel's unit: far below any sensor's noise, above the rounding of a constant record's
-/// angle sums), i.e. every sample has the same value.
-fn is_flat(a: &gyrolab_eval::outcome::allan::ChannelAnalysis) -> bool {
-    !a.curve.points.is_empty() && a.curve.points.iter().all(|p| p.deviation.abs() <= 1e-9)
-}

@@ -15,14 +15,14 @@ use clap::Args;
 use gyrolab::validate;
 use gyrolab_eval::allan::AllanRequest;
 use gyrolab_lab::batch::{
-    collect_inputs, journal_header, journal_line, journal_rows, options_fingerprint, results_csv, results_parquet,
-    run_batch, BatchRequest, BatchSink, Cell, DoneInput, FailedInput, Journal, ResultRow, Skipped,
+    collect_inputs, journal_line, journal_rows, options_fingerprint, results_csv, results_parquet,
+    run_batch, BatchRequest, BatchSink, DoneInput, FailedInput, Skipped,
 };
+use gyrolab_lab::batch::{failure_text, failures_csv, open_journal, summary_text};
 use gyrolab_eval::{EvalError, Progress};
 use indicatif::{ProgressBar, ProgressStyle};
-use std::collections::BTreeMap;
 use std::io::{IsTerminal, Write};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Mutex;
 
 /// The journal's file name in the output folder.
@@ -111,55 +111,8 @@ impl BatchSink for JournalSink<'_> {
         f.write_all(line.as_bytes()).map_err(|e| format!("cannot append to the journal: {e}"))
     }
     fn failed(&self, input: &FailedInput) {
-        self.bar.line(&format!("failed: {}", failure_text(input)));
+        self.bar.line(&format!("failed: {}", failure_text(input, &flag)));
     }
-}
-
-/// `FILE: reason`, the file named once.
-fn failure_text(input: &FailedInput) -> String {
-    let reason = input.error.render(&flag);
-    let file = input.file.display().to_string();
-    if reason.starts_with(&file) {
-        reason
-    } else {
-        format!("{file}: {reason}")
-    }
-}
-
-/// Opens (or starts) the journal of `out`: the entries of earlier runs and the file to append to.
-fn open_journal(out: &Path, options: &str) -> CliResult<(Journal, std::fs::File)> {
-    let path = out.join(JOURNAL);
-    let io = |e: std::io::Error| CliError::Output(format!("{}: {e}", path.display()));
-    std::fs::create_dir_all(out)
-        .map_err(|e| CliError::Output(format!("{}: cannot create the folder: {e}", out.display())))?;
-    let journal = match std::fs::read(&path) {
-        Ok(bytes) => {
-            let text = String::from_utf8_lossy(&bytes);
-            let journal = Journal::parse(&text, &path)?;
-            if journal.options.as_deref() != Some(options) {
-                return Err(EvalError::conflict(format!(
-                    "{}: this folder holds a batch run with other options or by another gyrolab version; give another --out, or delete {} to start the batch over",
-                    out.display(),
-                    path.display()
-                ))
-                .into());
-            }
-            let mut f = std::fs::OpenOptions::new().append(true).open(&path).map_err(io)?;
-            if !text.ends_with('\n') {
-                // The last line was cut short by a killed run: end it, so the next entry starts
-                // on a line of its own (the cut line is passed over when read).
-                f.write_all(b"\n").map_err(io)?;
-            }
-            journal
-        }
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            gyrolab_io::atomic::write_atomic(&path, journal_header(options).as_bytes()).map_err(io)?;
-            Journal { options: Some(options.to_string()), ..Journal::default() }
-        }
-        Err(e) => return Err(io(e)),
-    };
-    let file = std::fs::OpenOptions::new().append(true).open(&path).map_err(io)?;
-    Ok((journal, file))
 }
 
 /// Runs `gyrolab batch`.
@@ -179,7 +132,7 @@ pub fn run(args: &BatchArgs) -> CliResult {
         );
     }
     let options = options_fingerprint(&allan);
-    let (mut journal, file) = open_journal(&args.out, &options)?;
+    let (mut journal, file) = open_journal(&args.out, JOURNAL, &options)?;
     if journal.unreadable_lines > 0 {
         eprintln!(
             "note: {} line(s) of {} were cut short by an interrupted run; their records are evaluated again",
@@ -213,14 +166,7 @@ pub fn run(args: &BatchArgs) -> CliResult {
     let rows = journal_rows(&journal);
     let csv = results_csv(&rows);
     let parquet = results_parquet(&rows)?;
-    let failures_csv = (!outcome.failures.is_empty()).then(|| {
-        let mut s = String::from("file,reason\n");
-        for f in &outcome.failures {
-            let reason = f.error.render(&flag).replace('"', "\"\"");
-            s.push_str(&format!("\"{}\",\"{reason}\"\n", gyrolab_io::text::path_text(&f.file).replace('"', "\"\"")));
-        }
-        s
-    });
+    let failures_csv = failures_csv(&outcome.failures, &flag);
     let mut files: Vec<(&str, &[u8])> = vec![("results.csv", csv.as_bytes()), ("results.parquet", &parquet)];
     if let Some(f) = &failures_csv {
         files.push(("failures.csv", f.as_bytes()));
@@ -250,7 +196,7 @@ pub fn run(args: &BatchArgs) -> CliResult {
             request.inputs.len(),
             outcome.failures.len()
         );
-        s.push_str(&summary_table(&rows));
+        s.push_str(&summary_text(&rows));
         s.push_str(&format!(
             "Wrote {} ({} rows), {}{}\n",
             args.out.join("results.csv").display(),
@@ -276,76 +222,3 @@ pub fn run(args: &BatchArgs) -> CliResult {
     Ok(())
 }
 
-/// The fleet at a glance: per channel name and noise term, how many records resolved it and
-/// the median, smallest and largest value.
-fn summary_table(rows: &[ResultRow]) -> String {
-    const TERMS: [&str; 6] = [
-        "arw_deg_rt_h",
-        "bias_instability_dph",
-        "rrw_deg_h_rt_h",
-        "vrw_m_s_rt_h",
-        "bias_instability_ug",
-        "accel_random_walk_m_s2_rt_h",
-    ];
-    let simulated = rows.iter().filter(|r| matches!(r.get("simulated"), Some(Cell::Text(_)))).count();
-    let mut groups: BTreeMap<(String, &str), (usize, Vec<f64>)> = BTreeMap::new();
-    for r in rows {
-        let channel = match (r.get("topic"), r.get("channel")) {
-            (Some(Cell::Text(t)), Some(Cell::Text(c))) => format!("{t}/{c}"),
-            (_, Some(Cell::Text(c))) => c.clone(),
-            _ => String::new(),
-        };
-        for term in TERMS {
-            let applies = match term {
-                "vrw_m_s_rt_h" | "bias_instability_ug" | "accel_random_walk_m_s2_rt_h" => {
-                    matches!(r.get("vrw_basis"), Some(Cell::Text(_)))
-                }
-                _ => matches!(r.get("arw_basis"), Some(Cell::Text(_))),
-            };
-            if !applies {
-                continue;
-            }
-            let g = groups.entry((channel.clone(), term)).or_default();
-            g.0 += 1;
-            if let Some(x) = r.get(term).and_then(Cell::number) {
-                g.1.push(x);
-            }
-        }
-    }
-    if groups.is_empty() {
-        return "No noise terms (no channel in deg/s or m/s^2; give --unit or a calibration).\n".into();
-    }
-    let mut lines =
-        vec![["channel".to_string(), "term".into(), "resolved".into(), "median".into(), "min".into(), "max".into()]];
-    let g4 = |x: f64| format!("{x:.4e}");
-    for ((channel, term), (n, mut v)) in groups {
-        v.sort_by(f64::total_cmp);
-        let median = match v.len() {
-            0 => None,
-            k if k % 2 == 1 => Some(v[k / 2]),
-            k => Some(0.5 * (v[k / 2 - 1] + v[k / 2])),
-        };
-        lines.push([
-            channel,
-            term.to_string(),
-            format!("{}/{n}", v.len()),
-            median.map_or("-".into(), g4),
-            v.first().map_or("-".into(), |x| g4(*x)),
-            v.last().map_or("-".into(), |x| g4(*x)),
-        ]);
-    }
-    let widths: Vec<usize> = (0..6).map(|i| lines.iter().map(|l| l[i].chars().count()).max().unwrap_or(0)).collect();
-    let mut s = String::new();
-    for l in &lines {
-        let cells: Vec<String> = l.iter().zip(&widths).map(|(c, w)| format!("{c:<w$}")).collect();
-        s.push_str(cells.join("  ").trim_end());
-        s.push('\n');
-    }
-    if simulated > 0 {
-        s.push_str(&format!(
-            "SIMULATED: {simulated} of {} rows come from simulated records (column `simulated`)\n",
-            rows.len()
-        ));
-    }
-    s
-}

@@ -7,13 +7,15 @@ use crate::args::{prompt_password, stdin_line, AuthArgs, QueryOutput, StoreLocat
 use crate::error::{CliError, CliResult};
 use crate::output::{print, to_json, write_file};
 use clap::{Args, Subcommand, ValueEnum};
-use gyrolab_lab::records::{chart_table, compare_table, diff_table, history_table, lot_table};
+use gyrolab_lab::records::{
+    accounts_text, chart_table, check_text, compare_table, evaluation_text, history_table, lot_table, reevaluation_text,
+};
 use gyrolab_report::table::{to_csv, to_parquet, to_text, Table};
 use gyrolab_lab::issue::Issue;
 use gyrolab_lab::reevaluate;
-use gyrolab_store::issue::{IssuedReport, Meaning};
+use gyrolab_store::issue::Meaning;
 use gyrolab_store::{
-    add_report_folder_as, query, resolve_location, sign, Actor, Changes, CheckReport, Revision,
+    add_report_folder_as, query, resolve_location, sign, Actor, Changes, Revision,
     RevisionKind, Role, Store,
 };
 use std::path::PathBuf;
@@ -531,22 +533,7 @@ fn user(cmd: &UserCommand) -> CliResult {
             if a.json {
                 return print(&to_json(&accounts)?);
             }
-            let mut out = String::from("name\tdisplay name\trole\tstate\tcreated\tcreated by\n");
-            for x in &accounts {
-                out.push_str(&format!(
-                    "{}\t{}\t{}\t{}\t{}\t{}\n",
-                    x.name,
-                    x.display_name,
-                    x.role.as_str(),
-                    if x.disabled { "DISABLED" } else { "active" },
-                    x.created_at,
-                    x.created_by
-                ));
-            }
-            if accounts.is_empty() {
-                out.push_str("(no accounts: writes to this store need no authentication)\n");
-            }
-            print(&out)
+            print(&accounts_text(&accounts))
         }
         UserCommand::Disable(a) => {
             let mut s = open_for_writing(&a.location)?;
@@ -588,25 +575,6 @@ fn key_init(a: &KeyInitArgs) -> CliResult {
     ))
 }
 
-/// The issue line of `store show`.
-fn issue_line(r: &IssuedReport) -> String {
-    let mut s = format!(
-        "report {} {} {}: {} by {} ({}, {}), key {}\n",
-        r.report_number,
-        r.status(),
-        r.issued_at,
-        r.meaning,
-        r.signer_display_name,
-        r.signer,
-        r.signer_role,
-        r.key_fingerprint
-    );
-    if let (Some(old), Some(n)) = (&r.amends_report, r.amendment_no) {
-        s.push_str(&format!("amendment {n} to report {old}: {}\n", r.amend_reason.as_deref().unwrap_or_default()));
-    }
-    s
-}
-
 /// Runs `gyrolab store`.
 pub fn run(cmd: &StoreCommand) -> CliResult {
     match cmd {
@@ -637,25 +605,7 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
                 v["audit"] = serde_json::to_value(&events).map_err(|e| CliError::Output(e.to_string()))?;
                 return print(&to_json(&v)?);
             }
-            let mut text = show_text(&e);
-            match &issued {
-                Some(r) => text.push_str(&issue_line(r)),
-                None => text.push_str("report: DRAFT (not issued: gyrolab store issue)\n"),
-            }
-            text.push_str("audit trail (the store's clock):\n");
-            if events.is_empty() {
-                text.push_str("  (none: stored before schema version 4)\n");
-            }
-            for ev in &events {
-                text.push_str(&format!(
-                    "  {} {} by {}{}\n",
-                    ev.at,
-                    ev.action,
-                    ev.actor,
-                    ev.detail.as_deref().map_or_else(String::new, |d| format!(": {d:?}"))
-                ));
-            }
-            print(&text)
+            print(&evaluation_text(&e, issued.as_ref(), &events))
         }
         StoreCommand::Report(a) => {
             let mut s = open(&a.location, false)?;
@@ -739,22 +689,7 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
             if a.json {
                 return print(&to_json(&r)?);
             }
-            let mut out = format!(
-                "re-evaluated evaluation {} (gyrolab {}) under gyrolab {}: evaluation {}, report in {}\n\
-                 overall verdict: {} -> {}\n{} figure(s) changed\n",
-                r.superseded,
-                r.software_before,
-                r.software_after,
-                r.revision,
-                a.out.display(),
-                r.verdict_before.as_deref().unwrap_or("none"),
-                r.verdict_after.as_deref().unwrap_or("none"),
-                r.changes.len()
-            );
-            if !r.changes.is_empty() {
-                out.push_str(&to_text(&diff_table(&r.changes)));
-            }
-            print(&out)
+            print(&reevaluation_text(&r, &a.out))
         }
     }
 }
@@ -773,30 +708,6 @@ fn check(a: &CheckArgs) -> CliResult {
             r.problems.len()
         ))),
     }
-}
-
-/// The check report as text.
-fn check_text(r: &CheckReport, name: &str) -> String {
-    let rows: Vec<String> = r.rows.iter().map(|(t, n)| format!("{t} {n}")).collect();
-    let mut out = format!(
-        "store {name}\ntriggers: {} of {} present and unaltered\nrows: {}\nchain: {} of {} link(s) re-verified against \
-         their rows\nreport files: {} re-hashed equal to their SHA-256, {} stored as hashes only\nchain head: {}\n",
-        r.triggers_ok.len(),
-        r.triggers_expected,
-        rows.join(", "),
-        r.links_checked,
-        r.links,
-        r.files_checked,
-        r.files_hash_only,
-        r.head.as_deref().unwrap_or("(empty store)")
-    );
-    if r.problems.is_empty() {
-        out.push_str("whole: nothing changed, deleted or inserted outside the store\n");
-    }
-    for p in &r.problems {
-        out.push_str(&format!("BROKEN: {p}\n"));
-    }
-    out
 }
 
 /// Prints a query's table as text, CSV or JSON (`json` makes the JSON), and writes the Parquet
@@ -826,39 +737,3 @@ fn history(a: &HistoryArgs) -> CliResult {
     emit(&history_table(&rows), &a.format, || to_json(&rows))
 }
 
-fn show_text(e: &query::StoredEvaluation) -> String {
-    let r = &e.record;
-    let o = |v: &Option<String>| v.clone().unwrap_or_else(|| "-".into());
-    let mut s = format!(
-        "evaluation {} ({}{}{})\n",
-        e.id,
-        e.revision_kind,
-        e.supersedes.map_or_else(String::new, |x| format!(", supersedes {x}")),
-        e.superseded_by.map_or_else(|| ", current".to_string(), |x| format!(", superseded by {x}"))
-    );
-    if let (Some(by), Some(why)) = (&e.revision_by, &e.revision_reason) {
-        s.push_str(&format!("revision by {by:?}: {why:?}\n"));
-    }
-    s.push_str(&format!(
-        "stored {}\ndevice {:?} serial {:?} lot {}\noperator {} approver {} tested {}\nevaluated {} with gyrolab {}\nplan {} (SHA-256 {})\nverdict {}{}\n",
-        e.stored_at,
-        r.model,
-        r.serial,
-        o(&r.lot),
-        o(&r.operator),
-        o(&r.approver),
-        o(&r.test_date),
-        r.evaluated_at,
-        r.software_version,
-        r.plan_path,
-        r.plan_sha256,
-        o(&r.verdict),
-        if r.simulated { " (SIMULATED inputs)" } else { "" }
-    ));
-    s.push_str("inputs:\n");
-    for f in &r.inputs {
-        s.push_str(&format!("  {} {} bytes SHA-256 {}\n", f.path, f.size_bytes, f.sha256));
-    }
-    s.push_str(&format!("{} figures, {} report files\n", r.figures.len(), r.report_files.len()));
-    s
-}

@@ -5,6 +5,10 @@ use gyrolab::allan::AllanCurve;
 use gyrolab::noise::{ModelFitResult, SlopeLineResult};
 use gyrolab::units::Quantity;
 
+/// The largest Allan deviation of a flat curve, in the channel's unit: far below any sensor's
+/// noise, above the rounding of a constant record's angle sums.
+pub const FLAT_DEVIATION: f64 = 1e-9;
+
 /// One analysed channel.
 #[derive(Debug, Clone)]
 pub struct ChannelAnalysis {
@@ -84,6 +88,32 @@ impl LazyGmwm {
 }
 
 impl ChannelAnalysis {
+    /// Whether the channel's curve is flat at zero: every deviation at or below
+    /// [`FLAT_DEVIATION`] (every sample has the same value).
+    pub fn is_flat(&self) -> bool {
+        !self.curve.points.is_empty() && self.curve.points.iter().all(|p| p.deviation.abs() <= FLAT_DEVIATION)
+    }
+
+    /// A warning for a flat channel, or a hint for a channel left in output units (no noise
+    /// terms), as a line (`warning: ...`, `hint: ...`); `None` otherwise.
+    pub fn advice(&self) -> Option<String> {
+        if self.is_flat() {
+            Some(format!(
+                "warning: {} ({}): every sample has the same value (the Allan deviation is 0 at every tau): no \
+                 noise term can be read from a record without noise; a stuck sensor, or a simulation without \
+                 noise terms?",
+                self.file, self.channel
+            ))
+        } else if self.slope_lines.is_none() && self.quantity == Quantity::SensorOutput {
+            Some(format!(
+                "hint: {} ({}): the data are in {}: give --scale-factor K (output units per deg/s) and --null F, \
+                 or --cal FILE.toml (from `gyrolab rate --cal-out`), for noise terms in deg units",
+                self.file, self.channel, self.rate_unit
+            ))
+        } else {
+            None
+        }
+    }
     /// The GMWM fit of the channel's curve, computed on the first call ([`LazyGmwm`]).
     pub fn gmwm(&self) -> Option<&gyrolab::gmwm::GmwmFit> {
         self.gmwm.get(&self.curve)

@@ -1,12 +1,13 @@
 //! Printing a report folder's report.html to report.pdf with headless Chromium (`--pdf` of
-//! `gyrolab eval` and `gyrolab demo --out`). File output only, no domain logic: finds the browser,
+//! `gyrolab eval` and `gyrolab demo --out`), the last rendering of a report folder. File output
+//! only, no domain logic: finds the browser,
 //! runs it with a time limit, and renames the PDF into place only when it is complete, so that
 //! report.pdf is either a whole new PDF or left as it was.
 //!
 //! The browser: the path in the environment variable `GYROLAB_CHROMIUM` when it is set (and only
 //! that), else `/usr/bin/chromium`, else the first of `chromium`, `chromium-browser`,
 //! `google-chrome` found on `PATH`. The page layout (A4, margins, page breaks) comes from the
-//! report's print CSS (`gyrolab_report::html`).
+//! report's print CSS ([`crate::html`]).
 
 use std::io::{Read, Seek};
 use std::path::{Path, PathBuf};
