@@ -34,3 +34,26 @@ pub fn issue(store: &mut Store, actor: &Actor, what: &Issue<'_>) -> StoreResult<
     };
     store.issue(actor, &req)
 }
+
+/// What `gyrolab store issue` and `amend` print: the report issued (an amendment's number and
+/// the report it supersedes), by whom, with which key, and how to write and check the folder.
+pub fn issued_text(r: &IssuedReport) -> String {
+    let what = match (&r.amends_report, r.amendment_no) {
+        (Some(old), Some(n)) => format!("amendment {n} to report {old} (now SUPERSEDED), "),
+        _ => String::new(),
+    };
+    format!(
+        "issued evaluation {} as report {} ({what}{} by {} ({}), {} UTC), signed with key {}\nstore chain head at \
+         issue: {}\nwrite the issued folder: gyrolab store report {} --out DIR; check it: gyrolab verify DIR \
+         --public-key LAB.pub\n",
+        r.evaluation_id,
+        r.report_number,
+        r.meaning,
+        r.signer_display_name,
+        r.signer,
+        r.issued_at,
+        r.key_fingerprint,
+        r.chain_head,
+        r.evaluation_id
+    )
+}

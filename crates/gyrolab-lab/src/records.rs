@@ -483,3 +483,61 @@ fn show_text(e: &query::StoredEvaluation) -> String {
     s.push_str(&format!("{} figures, {} report files\n", r.figures.len(), r.report_files.len()));
     s
 }
+
+/// Stores finished report folders (`gyrolab store add`) as the account `credentials` (name,
+/// password) authenticates: one line per folder (stored, or stored already with its id).
+pub fn add_folders(
+    dirs: &[std::path::PathBuf],
+    plan: Option<&std::path::Path>,
+    location: Option<&str>,
+    credentials: Option<(&str, &str)>,
+) -> StoreResult<String> {
+    let mut out = String::new();
+    for d in dirs {
+        match gyrolab_store::add_report_folder_as(d, plan, location, credentials) {
+            Ok((id, name)) => out.push_str(&format!("stored {} as evaluation {id} in {name}\n", d.display())),
+            Err(gyrolab_store::StoreError::AlreadyStored { store, id }) => out.push_str(&format!(
+                "{} is stored already as evaluation {id} in {store} (the same results.json): nothing added\n",
+                d.display()
+            )),
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(out)
+}
+
+/// What `gyrolab store report` wrote: `n` files of evaluation `id` to `out`, issued (the signed
+/// manifest checked) or a draft.
+pub fn written_report_text(store: &mut Store, id: i64, n: usize, out: &std::path::Path) -> StoreResult<String> {
+    let what = match store.issue_of(id)? {
+        Some(r) => format!(
+            "issued report {} ({}): each file equal to its signed manifest, the signature verified with the \
+             store's lab key {}; check it with the lab's own public key: gyrolab verify {} --public-key LAB.pub",
+            r.report_number,
+            r.status(),
+            r.key_fingerprint,
+            out.display()
+        ),
+        None => "a DRAFT: each equal to its stored SHA-256".into(),
+    };
+    Ok(format!(
+        "wrote the {} report file(s) of evaluation {} to {} ({what})\n",
+        n,
+        id,
+        out.display()
+    ))
+}
+
+/// The note printed when a revision supersedes an issued evaluation: the new revision is a
+/// draft, issued only as an amendment (empty otherwise).
+pub fn draft_note(s: &mut Store, superseded: i64, revision: i64) -> StoreResult<String> {
+    Ok(match s.issue_of(superseded)? {
+        Some(r) => format!(
+            "evaluation {superseded} is issued as report {}, which stays as issued: evaluation {revision} is a DRAFT \
+             until an approver issues it as an amendment (gyrolab store amend {revision} --reason ...)\n",
+            r.report_number
+        ),
+        None => String::new(),
+    })
+}
+

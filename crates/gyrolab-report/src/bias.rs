@@ -1,6 +1,7 @@
 //! Reports of static (bias) tests: the summary table, data-quality findings and JSON
 //! (keys in docs/JSON.md).
 
+use gyrolab_eval::static_test::FileQuality;
 use gyrolab_eval::outcome::static_test::{ChannelRepeatability, TestReport, WarmupReport};
 use gyrolab::format::{short, sig, sig_opt};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Cell, CellAlignment, Table};
@@ -289,4 +290,68 @@ pub fn bias_table(tests: &[TestReport], repeatability: &[ChannelRepeatability]) 
         s.push_str(&format!("\nbias stability is quoted at a smoothing time of {q} s (window means, n-1)."));
     }
     s
+}
+
+/// The warnings and notes of static tests, one line each as `gyrolab bias` prints them on stderr:
+/// missing cells and dropout rows per file, each test's data-quality findings and notes, and a
+/// record whose every sample has the same value.
+pub fn warning_lines(files: &[FileQuality], tests: &[TestReport]) -> Vec<String> {
+    let mut out = Vec::new();
+    for f in files {
+        if let Some(c) = f.quality.first_missing.first() {
+            out.push(format!(
+                "warning: {}:{}:{}: {} missing cell(s) (NaN or empty) excluded, first in column '{}'",
+                f.file, c.line, c.column, f.quality.missing_cells, c.name
+            ));
+        }
+        if let Some(l) = f.quality.first_zero_rows.first() {
+            out.push(format!(
+                "warning: {}:{l}: {} dropout row(s) (every channel exactly zero, far more often than chance) left out of every figure",
+                f.file, f.quality.zero_rows
+            ));
+        }
+        if let Some(l) = f.quality.first_repeated_rows.first() {
+            out.push(format!(
+                "warning: {}:{l}: {} dropout row(s) (every channel equal to the row before, far more often than chance) left out of every figure",
+                f.file, f.quality.repeated_rows
+            ));
+        }
+    }
+    for t in tests {
+        for line in quality_lines(t) {
+            out.push(format!("warning: {} ({}): {line}", t.file, t.result.channel));
+        }
+        for note in &t.result.notes {
+            out.push(format!("note: {} ({}): {note}", t.file, t.result.channel));
+        }
+        let r = &t.result;
+        if r.valid_samples > 1 && r.std_output <= 1e-12 * r.mean_output.abs() {
+            out.push(format!(
+                "warning: {} ({}): every sample has the same value ({} {}): the bias is that value, but no \
+                 stability or noise figure can be read from a record without noise; a stuck sensor, or a \
+                 simulation without noise terms?",
+                t.file, r.channel, r.mean_output, r.output_unit
+            ));
+        }
+    }
+    out
+}
+
+/// The closing notes of the static-test table: whether the earth rate was subtracted (or no
+/// latitude was given) and whether the figures are in output units only (no reference).
+pub fn figure_notes(tests: &[TestReport], latitude_given: bool, has_reference: bool) -> String {
+    let mut text = String::new();
+    if tests.iter().any(|t| t.result.earth_rate_subtracted) {
+        text.push_str("The earth-rate component for a vertical input axis was subtracted from the bias.\n");
+    } else if !latitude_given && tests.iter().any(|t| t.result.bias_dph.is_some()) {
+        text.push_str(
+            "No latitude given: the bias includes the earth-rate component (give --latitude to remove it).\n",
+        );
+    }
+    if !has_reference && tests.iter().any(|t| t.result.bias_dps.is_none()) {
+        text.push_str(
+            "No scale factor given (--cal FILE.toml, or --scale-factor K --null F): figures are in output units only.\n",
+        );
+    }
+    text
 }

@@ -2,7 +2,9 @@
 //! JSON keys are documented in docs/JSON.md; each key names its unit or says it is in output
 //! units (the axis's `output_unit`).
 
+use crate::segments::segmentation_text;
 use gyrolab_eval::outcome::rate::AxisReport;
+use gyrolab_eval::outcome::segments::SegmentationReport;
 use gyrolab::format::{short, sig, sig_opt};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Cell, CellAlignment, Table};
 use gyrolab::rate_test::{RateEvaluation, RestReferenceSource};
@@ -377,3 +379,34 @@ pub fn rate_figures(a: &AxisJson) -> AxisFigures {
     f
 }
 
+/// The text of `gyrolab rate`: each raw log's segmentation, where the segments were written, the
+/// summary table, the per-point tables (`points`), and where the calibration was written.
+pub fn rate_text(
+    reports: &[AxisReport<'_>],
+    seg_reports: &[SegmentationReport<'_>],
+    points: bool,
+    segments_out: Option<&std::path::Path>,
+    cal_out: Option<&std::path::Path>,
+) -> String {
+    let mut text = String::new();
+    for r in seg_reports {
+        text.push_str(&segmentation_text(r));
+        text.push('\n');
+    }
+    if let Some(out) = segments_out {
+        text.push_str(&format!("Segments written to {}\n\n", out.display()));
+    }
+    text.push_str(&rate_summary_table(reports));
+    text.push('\n');
+    if points {
+        for r in reports {
+            text.push_str(&format!("\nAxis {} ({}): per-point means and residuals\n", r.name, r.file));
+            text.push_str(&rate_points_table(r));
+            text.push('\n');
+        }
+    }
+    if let Some(cal) = cal_out {
+        text.push_str(&format!("\nCalibration written to {}\n", cal.display()));
+    }
+    text
+}

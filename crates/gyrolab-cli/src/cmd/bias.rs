@@ -8,7 +8,7 @@ use clap::Args;
 use gyrolab::units::OutputUnit;
 use gyrolab_eval::simulate::reference_from_headers;
 use gyrolab_eval::static_test::{evaluate_static_tests, StaticTestRequest};
-use gyrolab_report::bias::{bias_json, bias_table, quality_lines};
+use gyrolab_report::bias::{bias_json, bias_table, figure_notes, warning_lines};
 use std::path::PathBuf;
 
 /// Options of `gyrolab bias`.
@@ -89,43 +89,9 @@ pub fn run(args: &BiasArgs) -> CliResult {
     for (file, note) in &outcome.notes {
         eprintln!("note: {file}: {}", note.render(&crate::error::flag));
     }
-    for f in &outcome.files {
-        if let Some(c) = f.quality.first_missing.first() {
-            eprintln!(
-                "warning: {}:{}:{}: {} missing cell(s) (NaN or empty) excluded, first in column '{}'",
-                f.file, c.line, c.column, f.quality.missing_cells, c.name
-            );
-        }
-        if let Some(l) = f.quality.first_zero_rows.first() {
-            eprintln!(
-                "warning: {}:{l}: {} dropout row(s) (every channel exactly zero, far more often than chance) left out of every figure",
-                f.file, f.quality.zero_rows
-            );
-        }
-        if let Some(l) = f.quality.first_repeated_rows.first() {
-            eprintln!(
-                "warning: {}:{l}: {} dropout row(s) (every channel equal to the row before, far more often than chance) left out of every figure",
-                f.file, f.quality.repeated_rows
-            );
-        }
-    }
     let tests = outcome.tests;
-    for t in &tests {
-        for line in quality_lines(t) {
-            eprintln!("warning: {} ({}): {line}", t.file, t.result.channel);
-        }
-        for note in &t.result.notes {
-            eprintln!("note: {} ({}): {note}", t.file, t.result.channel);
-        }
-        let r = &t.result;
-        if r.valid_samples > 1 && r.std_output <= 1e-12 * r.mean_output.abs() {
-            eprintln!(
-                "warning: {} ({}): every sample has the same value ({} {}): the bias is that value, but no \
-                 stability or noise figure can be read from a record without noise; a stuck sensor, or a \
-                 simulation without noise terms?",
-                t.file, r.channel, r.mean_output, r.output_unit
-            );
-        }
+    for line in warning_lines(&outcome.files, &tests) {
+        eprintln!("{line}");
     }
     if args.json {
         return print(&to_json(&bias_json(tests, outcome.repeatability, &outcome.warmup))?);
@@ -134,17 +100,6 @@ pub fn run(args: &BiasArgs) -> CliResult {
     text.push_str(&bias_table(&tests, &outcome.repeatability));
     text.push('\n');
     text.push_str(&gyrolab_report::bias::warmup_text(&outcome.warmup));
-    if tests.iter().any(|t| t.result.earth_rate_subtracted) {
-        text.push_str("The earth-rate component for a vertical input axis was subtracted from the bias.\n");
-    } else if args.latitude.is_none() && tests.iter().any(|t| t.result.bias_dph.is_some()) {
-        text.push_str(
-            "No latitude given: the bias includes the earth-rate component (give --latitude to remove it).\n",
-        );
-    }
-    if outcome.reference.is_none() && tests.iter().any(|t| t.result.bias_dps.is_none()) {
-        text.push_str(
-            "No scale factor given (--cal FILE.toml, or --scale-factor K --null F): figures are in output units only.\n",
-        );
-    }
+    text.push_str(&figure_notes(&tests, args.latitude.is_some(), !outcome.reference.is_none()));
     print(&text)
 }

@@ -11,9 +11,9 @@ use gyrolab_eval::rate::raw_log::SegmentationRequest;
 use gyrolab_eval::triad::{evaluate_triad, TriadRequest};
 use gyrolab_io::atomic::{write_outputs, OutputFile};
 use gyrolab_io::rate_table::RateColumns;
-use gyrolab_report::rate::{rate_json, rate_points_table, rate_summary_table};
+use gyrolab_report::rate::{rate_json, rate_text};
 use gyrolab_eval::outcome::rate::AxisReport;
-use gyrolab_report::segments::{segmentation_text, SegmentationJson};
+use gyrolab_report::segments::SegmentationJson;
 use gyrolab_eval::outcome::segments::SegmentationReport;
 use gyrolab_report::triad::{triad_json, triad_text};
 use std::path::Path;
@@ -179,27 +179,7 @@ pub fn run(args: &RateArgs) -> CliResult {
         doc.segmentation = seg_reports.iter().map(SegmentationJson::new).collect();
         return print(&to_json(&doc)?);
     }
-    let mut text = String::new();
-    for r in &seg_reports {
-        text.push_str(&segmentation_text(r));
-        text.push('\n');
-    }
-    if let Some(out) = &args.segments_out {
-        text.push_str(&format!("Segments written to {}\n\n", out.display()));
-    }
-    text.push_str(&rate_summary_table(&reports));
-    text.push('\n');
-    if args.points {
-        for r in &reports {
-            text.push_str(&format!("\nAxis {} ({}): per-point means and residuals\n", r.name, r.file));
-            text.push_str(&rate_points_table(r));
-            text.push('\n');
-        }
-    }
-    if let Some(cal) = &args.cal_out {
-        text.push_str(&format!("\nCalibration written to {}\n", cal.display()));
-    }
-    print(&text)
+    print(&rate_text(&reports, &seg_reports, args.points, args.segments_out.as_deref(), args.cal_out.as_deref()))
 }
 
 /// Runs the three-axis mode of `gyrolab rate`.

@@ -15,7 +15,7 @@ use gyrolab_lab::issue::Issue;
 use gyrolab_lab::reevaluate;
 use gyrolab_store::issue::Meaning;
 use gyrolab_store::{
-    add_report_folder_as, query, resolve_location, sign, Actor, Changes, Revision,
+    query, resolve_location, sign, Actor, Changes, Revision,
     RevisionKind, Role, Store,
 };
 use std::path::PathBuf;
@@ -426,19 +426,6 @@ fn read_key(path: &std::path::Path) -> CliResult<gyrolab_store::sign::SigningKey
     sign::read_signing_key(path).map_err(CliError::Usage)
 }
 
-/// The note printed when a revision supersedes an issued evaluation: the new revision is a
-/// draft, issued only as an amendment (empty otherwise).
-fn draft_note(s: &mut Store, superseded: i64, revision: i64) -> CliResult<String> {
-    Ok(match s.issue_of(superseded)? {
-        Some(r) => format!(
-            "evaluation {superseded} is issued as report {}, which stays as issued: evaluation {revision} is a DRAFT \
-             until an approver issues it as an amendment (gyrolab store amend {revision} --reason ...)\n",
-            r.report_number
-        ),
-        None => String::new(),
-    })
-}
-
 /// `gyrolab store issue` and `amend`.
 /// `store issue` (no reason) or `store amend` (its reason) of evaluation `id`.
 fn signed(id: i64, m: MeaningArg, amend_reason: Option<&str>, a: &SigningArgs) -> CliResult {
@@ -463,24 +450,7 @@ fn issue(location: &StoreLocation, auth: &AuthArgs, req: &Issue) -> CliResult {
     };
     let actor = s.authenticate(&user, &password)?;
     let r = gyrolab_lab::issue::issue(&mut s, &actor, req)?;
-    let what = match (&r.amends_report, r.amendment_no) {
-        (Some(old), Some(n)) => format!("amendment {n} to report {old} (now SUPERSEDED), "),
-        _ => String::new(),
-    };
-    print(&format!(
-        "issued evaluation {} as report {} ({what}{} by {} ({}), {} UTC), signed with key {}\nstore chain head at \
-         issue: {}\nwrite the issued folder: gyrolab store report {} --out DIR; check it: gyrolab verify DIR \
-         --public-key LAB.pub\n",
-        r.evaluation_id,
-        r.report_number,
-        r.meaning,
-        r.signer_display_name,
-        r.signer,
-        r.issued_at,
-        r.key_fingerprint,
-        r.chain_head,
-        r.evaluation_id
-    ))
+    print(&gyrolab_lab::issue::issued_text(&r))
 }
 
 /// The new password of `store user add` and `reset`: standard input, GYROLAB_NEW_PASSWORD, or
@@ -579,20 +549,9 @@ fn key_init(a: &KeyInitArgs) -> CliResult {
 pub fn run(cmd: &StoreCommand) -> CliResult {
     match cmd {
         StoreCommand::Add(a) => {
-            let mut out = String::new();
             let credentials = a.auth.credentials(true)?;
             let credentials = credentials.as_ref().map(|(u, p)| (u.as_str(), p.as_str()));
-            for d in &a.dirs {
-                match add_report_folder_as(d, a.plan.as_deref(), a.location.store.as_deref(), credentials) {
-                    Ok((id, name)) => out.push_str(&format!("stored {} as evaluation {id} in {name}\n", d.display())),
-                    Err(gyrolab_store::StoreError::AlreadyStored { store, id }) => out.push_str(&format!(
-                        "{} is stored already as evaluation {id} in {store} (the same results.json): nothing added\n",
-                        d.display()
-                    )),
-                    Err(e) => return Err(e.into()),
-                }
-            }
-            print(&out)
+            print(&gyrolab_lab::records::add_folders(&a.dirs, a.plan.as_deref(), a.location.store.as_deref(), credentials)?)
         }
         StoreCommand::Show(a) => {
             let mut s = open(&a.location, false)?;
@@ -610,23 +569,7 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
         StoreCommand::Report(a) => {
             let mut s = open(&a.location, false)?;
             let written = s.write_report(a.id, &a.out)?;
-            let what = match s.issue_of(a.id)? {
-                Some(r) => format!(
-                    "issued report {} ({}): each file equal to its signed manifest, the signature verified with the \
-                     store's lab key {}; check it with the lab's own public key: gyrolab verify {} --public-key LAB.pub",
-                    r.report_number,
-                    r.status(),
-                    r.key_fingerprint,
-                    a.out.display()
-                ),
-                None => "a DRAFT: each equal to its stored SHA-256".into(),
-            };
-            print(&format!(
-                "wrote the {} report file(s) of evaluation {} to {} ({what})\n",
-                written.len(),
-                a.id,
-                a.out.display()
-            ))
+            print(&gyrolab_lab::records::written_report_text(&mut s, a.id, written.len(), &a.out)?)
         }
         StoreCommand::History(a) => history(a),
         StoreCommand::Lot(a) => {
@@ -664,7 +607,7 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
             let actor = actor(&mut s, &a.auth)?;
             let r = Revision { supersedes: a.id, kind, by: by(&actor, a.by.as_deref())?, reason: a.reason.clone() };
             let id = s.revise_as(&r, &changes, None, &actor)?;
-            let note = draft_note(&mut s, a.id, id)?;
+            let note = gyrolab_lab::records::draft_note(&mut s, a.id, id)?;
             print(&format!(
                 "stored {} of evaluation {} as evaluation {id} in {}\n{note}",
                 kind.as_str(),
@@ -682,7 +625,7 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
             let actor = actor(&mut s, &a.auth)?;
             let who = by(&actor, a.by.as_deref())?;
             let r = reevaluate::reevaluate_as(&mut s, a.id, &who, &a.reason, &a.out, &actor)?;
-            let note = draft_note(&mut s, a.id, r.revision)?;
+            let note = gyrolab_lab::records::draft_note(&mut s, a.id, r.revision)?;
             if !note.is_empty() {
                 eprint!("{note}");
             }
