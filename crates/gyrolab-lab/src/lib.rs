@@ -10,6 +10,7 @@
 //! - [`demo`]: the paper's worked example and its report folder ([`paper`]: its printed tables);
 //! - [`batch`]: many records on every core, resumable by input hash, one result row per channel;
 //! - [`verify`]: a report folder checked against its manifest, plan and inputs;
+//! - [`evaluate`]: evaluate and store (the store checked before anything is written);
 //! - [`exports`]: the Kalibr and imu_utils noise files of an Allan run;
 //! - [`issue`]: a stored evaluation issued or amended, signed, its report drawn;
 //! - [`records`]: the store's queries as tables and a serial's history as a trend plot;
@@ -17,6 +18,7 @@
 
 pub mod batch;
 pub mod demo;
+pub mod evaluate;
 pub mod exports;
 pub mod issue;
 pub mod paper;

@@ -9,8 +9,9 @@ use crate::folder::write_and_finish;
 use crate::progress::Bar;
 use clap::Args;
 use gyrolab_lab::test_plan::{evaluate_test_plan, read_test_plan};
-use gyrolab_store::record::{from_report_folder_with, hash_plan_inputs};
-use gyrolab_store::{resolve_location, Actor, Store, StoreError};
+use gyrolab_lab::evaluate::{prepare_store, store_report_folder};
+use gyrolab_store::record::hash_plan_inputs;
+use gyrolab_store::resolve_location;
 use std::path::PathBuf;
 
 /// Options of `gyrolab eval`.
@@ -42,23 +43,6 @@ pub struct EvalArgs {
     pub auth: AuthArgs,
 }
 
-/// Whether an SQLite store can be created at `location` (a path): its folder exists and takes a
-/// new file. A usage error (exit 2) naming the folder otherwise.
-fn creatable(location: &str) -> CliResult<()> {
-    let path = std::path::Path::new(location);
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => std::path::Path::new("."),
-    };
-    tempfile::Builder::new().prefix(".gyrolab-store-check-").tempfile_in(dir).map(drop).map_err(|e| {
-        CliError::Usage(format!(
-            "{}: the store does not exist and cannot be created in its folder: {}; nothing was written",
-            gyrolab_store::mask_location(location),
-            e.kind()
-        ))
-    })
-}
-
 /// Runs `gyrolab eval`.
 pub fn run(args: &EvalArgs) -> CliResult {
     let plan = read_test_plan(&args.plan)?;
@@ -80,33 +64,7 @@ pub fn run(args: &EvalArgs) -> CliResult {
     let (folder, prepared) = std::thread::scope(|scope| {
         let preparing = location.as_deref().map(|l| {
             scope.spawn(move || {
-                let store = match Store::open_for_writing(l, false) {
-                    Ok(mut s) => match &credentials {
-                        Some((user, password)) => {
-                            s.authenticate(user, password).map(|a| Some((s, a))).map_err(CliError::from)
-                        }
-                        None => match s.has_accounts() {
-                            Ok(false) => Ok(Some((s, Actor::unauthenticated()))),
-                            Ok(true) => Err(CliError::from(StoreError::Refused {
-                                store: s.name().to_string(),
-                                message:
-                                    "this store has accounts: every write needs one (--user NAME or GYROLAB_USER, \
-                                          the password from GYROLAB_PASSWORD, --password-stdin or a prompt); nothing \
-                                          was written"
-                                        .into(),
-                            })),
-                            Err(e) => Err(CliError::from(e)),
-                        },
-                    },
-                    // A new store has no account to authenticate.
-                    Err(StoreError::NotFound { store, .. }) if credentials.is_some() => {
-                        Err(CliError::from(StoreError::Auth { store }))
-                    }
-                    // Created once the folder is written: its folder must take a new file now,
-                    // so that a store that cannot be made ends the run before anything is written.
-                    Err(StoreError::NotFound { .. }) => creatable(l).map(|()| None),
-                    Err(e) => Err(CliError::from(e)),
-                };
+                let store = prepare_store(l, credentials.as_ref()).map_err(CliError::from);
                 (store, hash_plan_inputs(&args.plan))
             })
         });
@@ -114,7 +72,7 @@ pub fn run(args: &EvalArgs) -> CliResult {
         (folder, preparing.map(|h| h.join()))
     });
     bar.finish();
-    let (mut store, inputs) = match prepared {
+    let (store, inputs) = match prepared {
         None => (None, None),
         Some(Ok((store, inputs))) => (store?, Some(inputs)),
         Some(Err(_)) => return Err(CliError::Output("the thread opening the store failed".into())),
@@ -127,14 +85,9 @@ pub fn run(args: &EvalArgs) -> CliResult {
             Some(hashed) => Some(hashed?),
             None => None,
         };
-        let record = from_report_folder_with(&args.out, Some(&args.plan), inputs)?;
-        let (mut s, actor) = match store.take() {
-            Some(s) => s,
-            None => (Store::open_for_writing(l, true)?, Actor::unauthenticated()),
-        };
-        let id = s.add_as(&record, &actor)?;
+        let (id, name) = store_report_folder(l, store, &args.out, &args.plan, inputs)?;
         if !args.quiet {
-            eprintln!("Stored as evaluation {id} in {}", s.name());
+            eprintln!("Stored as evaluation {id} in {name}");
         }
     }
     result
