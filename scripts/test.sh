@@ -36,6 +36,8 @@ for dir in crates/*/tests; do
         fi
     done
 done
+# The workspace's direction (docs/LAYOUT.md): dependencies, SQL, front ends, module circles.
+python3 scripts/check_architecture.py
 bash scripts/install-test-deps.sh
 if [ "${GYROLAB_SKIP_BROWSER:-}" != "1" ] && ! bash scripts/install-test-deps.sh --browser; then
     export GYROLAB_SKIP_BROWSER=1

@@ -25,6 +25,8 @@
 //! their sources); the readers and writers in `gyrolab-io`; rendering in `gyrolab-report`; the
 //! workflows that combine them (a test plan into a report folder, batches, verify) in `gyrolab-lab`.
 
+#![deny(missing_docs)]
+
 pub mod allan;
 pub mod allan_memory;
 pub mod apply;

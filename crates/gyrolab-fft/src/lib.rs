@@ -14,6 +14,8 @@
 //! Here they are compiled once, beside the other dependencies, behind non-generic functions
 //! (docs/PERFORMANCE.md, issue 32).
 
+#![deny(missing_docs)]
+
 use realfft::num_complex::Complex;
 use realfft::RealFftPlanner;
 

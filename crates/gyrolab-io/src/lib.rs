@@ -18,6 +18,8 @@
 //! - [`threshold_record`]: threshold and resolution records (rate, output per sample);
 //! - [`test_plan`]: test plans (TOML) for `gyrolab eval`.
 
+#![deny(missing_docs)]
+
 pub mod apply_csv;
 pub mod atomic;
 pub mod calibration;

@@ -16,6 +16,8 @@
 //! - [`records`]: the store's queries as tables and a serial's history as a trend plot;
 //! - [`reevaluate`]: a stored evaluation evaluated again and stored as its revision.
 
+#![deny(missing_docs)]
+
 pub mod batch;
 pub mod demo;
 pub mod evaluate;

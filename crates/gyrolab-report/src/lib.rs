@@ -18,6 +18,8 @@
 //! - [`tables_csv`]: the CSV tables of a report folder (points, runs, summary);
 //! - [`threshold`]: threshold and resolution tests (section, figures, JSON);
 
+#![deny(missing_docs)]
+
 pub mod allan;
 pub mod bias;
 pub mod html;

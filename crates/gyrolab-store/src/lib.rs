@@ -12,6 +12,8 @@
 //! nothing: gyrolab-lab turns query results into tables and plots (gyrolab-report draws them)
 //! and draws an issued report's signature block.
 
+#![deny(missing_docs)]
+
 pub mod account;
 pub mod chain;
 pub mod db;

@@ -32,6 +32,8 @@
 //!
 //! Formulas and their sources are listed in `docs/METHODS.md`.
 
+#![deny(missing_docs)]
+
 pub mod allan;
 pub mod apply;
 pub mod conformity;

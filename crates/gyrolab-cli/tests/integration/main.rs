@@ -12,6 +12,7 @@ mod common;
 mod defaults;
 mod eval;
 mod export;
+mod golden;
 mod hostile;
 mod imu_logs;
 mod issue;
