@@ -284,3 +284,54 @@ pub fn apply_to(
 ) -> Result<ApplySummary, StreamError> {
     apply_file(input, plan, out, progress)
 }
+
+/// Streams the input through the plan into the file `out`, written whole or not at all and never
+/// over one of `inputs` (the record, the calibration); `progress` gets the rows done so far.
+pub fn apply_into(
+    input: &Path,
+    plan: &ApplyPlan,
+    out: &Path,
+    inputs: &[&Path],
+    progress: &mut dyn FnMut(u64),
+) -> EvalResult<ApplySummary> {
+    let (mut data_error, mut done) = (None, None);
+    let output = gyrolab_io::atomic::OutputFile::stream(out, |w| match apply_to(input, plan, w, progress) {
+        Ok(s) => {
+            done = Some(s);
+            Ok(())
+        }
+        Err(StreamError::Write(e)) => Err(e),
+        Err(StreamError::Data(d)) => {
+            data_error = Some(d);
+            Err(std::io::Error::other("bad input"))
+        }
+    });
+    let r = gyrolab_io::atomic::write_outputs(vec![output], inputs);
+    if let Some(d) = data_error {
+        return Err(EvalError::Data(d));
+    }
+    r?;
+    Ok(done.unwrap_or_default())
+}
+
+/// The lines `gyrolab apply` prints on stderr: the rows applied (to `out`) and flagged, and the
+/// rows compensated for temperature.
+pub fn summary_lines(s: &ApplySummary, out: Option<&Path>) -> Vec<String> {
+    let mut lines = Vec::new();
+    let flagged = s.below + s.above + s.not_finite;
+    if flagged > 0 || out.is_some() {
+        let dest = out.map_or_else(String::new, |p| format!(" to {}", p.display()));
+        lines.push(format!(
+            "applied the calibration to {} rows{dest}; flagged: {} below, {} above the calibrated range, {} not finite",
+            s.rows, s.below, s.above, s.not_finite
+        ));
+    }
+    if s.temperature_compensated > 0 {
+        lines.push(format!(
+            "note: {} rows compensated for temperature (the calibration's [axis.temperature]); {} of them outside \
+             the model's temperature range, where the range's end was used",
+            s.temperature_compensated, s.temperature_outside
+        ));
+    }
+    lines
+}

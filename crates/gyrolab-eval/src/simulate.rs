@@ -462,3 +462,46 @@ pub fn simulate_static_samples(cfg: &SimConfig) -> EvalResult<StaticSamples> {
     }
     Ok(out)
 }
+
+/// The error of a simulated record not written: the system's (an output failure) or the
+/// parameters' (a conflict).
+fn sim_error(e: SimCsvError) -> EvalError {
+    match e {
+        SimCsvError::Io(io) => EvalError::Output(format!("cannot write the simulated record: {io}")),
+        other => EvalError::conflict(format!("invalid simulation parameters: {other}")),
+    }
+}
+
+/// Writes a simulated record with `write`: into `out` whole or not at all (never a part of a
+/// record left behind), else to standard output (a closed pipe ends it quietly).
+pub fn write_simulated(
+    out: Option<&std::path::Path>,
+    write: impl FnOnce(&mut (dyn Write + Send)) -> Result<(), SimCsvError>,
+) -> EvalResult<()> {
+    match out {
+        Some(path) => {
+            let mut failure = None;
+            let r = gyrolab_io::atomic::write_atomic_with(path, |w| {
+                write(w).map_err(|e| {
+                    let msg = e.to_string();
+                    failure = Some(e);
+                    std::io::Error::other(msg)
+                })
+            });
+            match (r, failure) {
+                (_, Some(e)) => Err(sim_error(e)),
+                (Err(e), None) => Err(EvalError::Output(format!("{}: cannot write the file: {e}", path.display()))),
+                (Ok(()), None) => Ok(()),
+            }
+        }
+        None => {
+            // Not locked: the writer may hand the output to a thread of its own (blocks of 64 KiB
+            // or more go out in one write each).
+            let mut stdout = std::io::stdout();
+            match write(&mut stdout) {
+                Err(SimCsvError::Io(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+                r => r.map_err(sim_error),
+            }
+        }
+    }
+}

@@ -827,6 +827,159 @@ pub fn summary_text(rows: &[ResultRow]) -> String {
     s
 }
 
+/// A batch written into a folder (`gyrolab batch`): the inputs (files, folders, glob patterns,
+/// and list files), the output folder and its journal's name, the analysis and the workers.
+pub struct BatchFolderRequest<'a> {
+    /// Files, folders or glob patterns.
+    pub inputs: &'a [String],
+    /// Files listing inputs, one per line.
+    pub lists: &'a [PathBuf],
+    /// The output folder (results.csv, results.parquet, failures.csv, the journal).
+    pub out: &'a Path,
+    /// Follow symbolic links in folders.
+    pub follow_links: bool,
+    /// The analysis of each record.
+    pub allan: AllanRequest,
+    /// Workers (default: every core).
+    pub jobs: Option<usize>,
+    /// The journal's file name in `out`.
+    pub journal: &'a str,
+}
+
+/// What a batch into a folder did: the summary to print (counts, the fleet table, the files
+/// written) and, when inputs failed, the message saying so (the others are written).
+pub struct BatchFolderOutcome {
+    /// The summary.
+    pub summary: String,
+    /// `Some(message)` when some inputs failed.
+    pub failed: Option<String>,
+}
+
+/// Appends each input done to the journal (one line, one write, under a lock) and shows each
+/// failure.
+struct JournalSink<'a> {
+    file: Mutex<std::fs::File>,
+    show: &'a (dyn Fn(&str) + Sync),
+    flag: &'a (dyn Fn(&str) -> String + Sync),
+}
+
+impl BatchSink for JournalSink<'_> {
+    fn done(&self, input: &DoneInput) -> Result<(), String> {
+        let line = journal_line(input);
+        let mut f = self.file.lock().unwrap_or_else(|p| p.into_inner());
+        std::io::Write::write_all(&mut *f, line.as_bytes()).map_err(|e| format!("cannot append to the journal: {e}"))
+    }
+    fn failed(&self, input: &FailedInput) {
+        (self.show)(&format!("failed: {}", failure_text(input, self.flag)));
+    }
+}
+
+/// Runs a batch into its folder: inputs collected, the journal opened (a batch started again
+/// passes over what it finished), every record evaluated on the workers, the union of this run
+/// and earlier ones written whole (results.csv, results.parquet, failures.csv when inputs
+/// failed). `show` prints notes and failure lines as they come; `flag` spells request fields.
+pub fn batch_folder(
+    request: &BatchFolderRequest<'_>,
+    progress: &dyn Progress,
+    show: &(dyn Fn(&str) + Sync),
+    flag: &(dyn Fn(&str) -> String + Sync),
+) -> EvalResult<BatchFolderOutcome> {
+    let collected = collect_inputs(request.inputs, request.lists, Some(request.out), request.follow_links)?;
+    for (path, why) in &collected.passed_over {
+        show(&format!("note: {}: passed over: {why}", gyrolab_io::text::path_text(path)));
+    }
+    let inputs = collected.files;
+    if inputs.is_empty() {
+        return Err(EvalError::conflict("no record to evaluate: give files, folders, glob patterns or --list FILE"));
+    }
+    let options = options_fingerprint(&request.allan);
+    let (mut journal, file) = open_journal(request.out, request.journal, &options)?;
+    if journal.unreadable_lines > 0 {
+        show(&format!(
+            "note: {} line(s) of {} were cut short by an interrupted run; their records are evaluated again",
+            journal.unreadable_lines,
+            request.out.join(request.journal).display()
+        ));
+    }
+    let sink = JournalSink { file: Mutex::new(file), show, flag };
+    let batch = BatchRequest { inputs, allan: request.allan.clone(), jobs: request.jobs };
+    let outcome = run_batch(&batch, &journal, &sink, progress)?;
+    let file = sink.file.into_inner().unwrap_or_else(|p| p.into_inner());
+    file.sync_data().map_err(|e| EvalError::Output(format!("{}: {e}", request.out.join(request.journal).display())))?;
+    let now = outcome.evaluated.len();
+    // The batch's inputs, which no table may overwrite (`--out .` among the records).
+    let input_files: Vec<PathBuf> = outcome
+        .evaluated
+        .iter()
+        .map(|d| d.file.clone())
+        .chain(outcome.failures.iter().map(|f| f.file.clone()))
+        .chain(outcome.skipped.iter().map(|s| match s {
+            Skipped::AlreadyDone { file } | Skipped::SameAs { file, .. } => file.clone(),
+        }))
+        .collect();
+    for d in outcome.evaluated {
+        journal.entries.insert(d.sha256.clone(), d);
+    }
+    // The union of this run and the earlier ones, in file order: complete or untouched.
+    let rows = journal_rows(&journal);
+    let csv = results_csv(&rows);
+    let parquet = results_parquet(&rows)?;
+    let failures_csv = failures_csv(&outcome.failures, flag);
+    let mut files: Vec<(&str, &[u8])> = vec![("results.csv", csv.as_bytes()), ("results.parquet", &parquet)];
+    if let Some(f) = &failures_csv {
+        files.push(("failures.csv", f.as_bytes()));
+    }
+    let inputs: Vec<&std::path::Path> = input_files.iter().map(PathBuf::as_path).collect();
+    gyrolab_io::atomic::write_folder(request.out, &files, &inputs)?;
+    if failures_csv.is_none() {
+        // A list of failures from an earlier run would no longer be true.
+        let _ = std::fs::remove_file(request.out.join("failures.csv"));
+    }
+    // Byte-identical inputs: one row, both names said.
+    for s in &outcome.skipped {
+        if let Skipped::SameAs { file, original } = s {
+            show(&format!(
+                "note: {}: the same bytes as {}: evaluated once, its rows are {}'s",
+                gyrolab_io::text::path_text(file),
+                gyrolab_io::text::path_text(original),
+                gyrolab_io::text::path_text(original)
+            ));
+        }
+    }
+    let done_before = outcome.skipped.iter().filter(|s| matches!(s, Skipped::AlreadyDone { .. })).count();
+    let duplicates = outcome.skipped.len() - done_before;
+    let summary = {
+        let mut s = format!(
+            "{} inputs: {now} evaluated now, {done_before} already done (journal), {duplicates} same bytes as another input, {} failed\n",
+            batch.inputs.len(),
+            outcome.failures.len()
+        );
+        s.push_str(&summary_text(&rows));
+        s.push_str(&format!(
+            "Wrote {} ({} rows), {}{}\n",
+            request.out.join("results.csv").display(),
+            rows.len(),
+            request.out.join("results.parquet").display(),
+            if failures_csv.is_some() {
+                format!(", {}", request.out.join("failures.csv").display())
+            } else {
+                String::new()
+            }
+        ));
+        s
+    };
+    let failed = (!outcome.failures.is_empty()).then(|| {
+        format!(
+            "{} of {} inputs failed (listed above and in {}); the others are in {}",
+            outcome.failures.len(),
+            batch.inputs.len(),
+            request.out.join("failures.csv").display(),
+            request.out.join("results.csv").display()
+        )
+    });
+    Ok(BatchFolderOutcome { summary, failed })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,11 +2,10 @@
 
 use crate::error::{CliError, CliResult};
 use clap::Args;
-use gyrolab_eval::apply::{apply_to, prepare_apply, stage_input, ApplyRequest};
-use gyrolab_io::apply_csv::{ApplySummary, StreamError};
-use gyrolab_io::atomic::{write_outputs, OutputFile};
+use gyrolab_eval::apply::{apply_into, apply_to, prepare_apply, stage_input, summary_lines, ApplyRequest};
+use gyrolab_io::apply_csv::StreamError;
 use std::io::{IsTerminal, Write};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Options of `gyrolab apply`.
 #[derive(Debug, Args)]
@@ -58,27 +57,10 @@ pub fn run(args: &ApplyArgs) -> CliResult {
     let mut progress = |rows: u64| bar.set_message(format!("{rows} rows"));
     let summary = match &args.out {
         Some(path) => {
-            let (mut data_error, mut done) = (None, None);
             // Never over the record or the calibration file it applies.
-            let inputs = [args.input.as_path(), args.cal.as_path()];
-            let output = OutputFile::stream(path, |w| match apply_to(&input, &plan, w, &mut progress) {
-                Ok(s) => {
-                    done = Some(s);
-                    Ok(())
-                }
-                Err(StreamError::Write(e)) => Err(e),
-                Err(StreamError::Data(d)) => {
-                    data_error = Some(d);
-                    Err(std::io::Error::other("bad input"))
-                }
-            });
-            let r = write_outputs(vec![output], &inputs);
+            let r = apply_into(&input, &plan, path, &[args.input.as_path(), args.cal.as_path()], &mut progress);
             bar.finish_and_clear();
-            if let Some(d) = data_error {
-                return Err(d.into());
-            }
-            r.map_err(crate::output::output_error)?;
-            done.unwrap_or_default()
+            r?
         }
         None => {
             let stdout = std::io::stdout();
@@ -98,24 +80,8 @@ pub fn run(args: &ApplyArgs) -> CliResult {
             }
         }
     };
-    report(&summary, args.out.as_deref());
+    for line in summary_lines(&summary, args.out.as_deref()) {
+        eprintln!("{line}");
+    }
     Ok(())
-}
-
-fn report(s: &ApplySummary, out: Option<&Path>) {
-    let flagged = s.below + s.above + s.not_finite;
-    if flagged > 0 || out.is_some() {
-        let dest = out.map_or_else(String::new, |p| format!(" to {}", p.display()));
-        eprintln!(
-            "applied the calibration to {} rows{dest}; flagged: {} below, {} above the calibrated range, {} not finite",
-            s.rows, s.below, s.above, s.not_finite
-        );
-    }
-    if s.temperature_compensated > 0 {
-        eprintln!(
-            "note: {} rows compensated for temperature (the calibration's [axis.temperature]); {} of them outside \
-             the model's temperature range, where the range's end was used",
-            s.temperature_compensated, s.temperature_outside
-        );
-    }
 }

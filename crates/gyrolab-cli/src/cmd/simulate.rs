@@ -1,16 +1,14 @@
 //! `gyrolab simulate static|rate-table|test-program`: records with known truth, in exactly the
 //! layouts that `gyrolab bias`, `gyrolab allan`, `gyrolab rate` and `gyrolab eval` read.
 
-use crate::error::{CliError, CliResult};
+use crate::error::CliResult;
 use clap::{Args, Subcommand};
 use gyrolab::sim::Preset;
 use gyrolab::units::OutputUnit;
 use gyrolab_eval::simulate::{
     check_record_size, csv_options, sim_config, simulate_to, static_sim_config, write_test_program_folder,
-    SimOverrides, SimRecord, DEFAULT_MAX_SAMPLES, TEST_PROGRAM_SEED,
+    write_simulated, SimOverrides, SimRecord, DEFAULT_MAX_SAMPLES, TEST_PROGRAM_SEED,
 };
-use gyrolab_io::sim_csv::SimCsvError;
-use std::io::Write;
 use std::path::PathBuf;
 
 /// What to simulate.
@@ -173,13 +171,6 @@ fn parse_max_samples(s: &str) -> Result<u64, String> {
     }
 }
 
-fn sim_error(e: SimCsvError) -> CliError {
-    match e {
-        SimCsvError::Io(io) => CliError::Output(format!("cannot write the simulated record: {io}")),
-        other => gyrolab_eval::EvalError::conflict(format!("invalid simulation parameters: {other}")).into(),
-    }
-}
-
 fn overrides(c: &CommonArgs) -> SimOverrides {
     SimOverrides {
         config: c.config.clone(),
@@ -256,33 +247,5 @@ pub fn run(cmd: &SimulateCommand) -> CliResult {
         comments.push(format!("defaults: {} (no preset and no noise flag given)", t.describe()));
     }
     let opts = csv_options(common.decimals, comments)?;
-    emit(&common.out, |w| simulate_to(record, &cfg, &opts, w))
-}
-fn emit(out: &Option<PathBuf>, write: impl FnOnce(&mut (dyn Write + Send)) -> Result<(), SimCsvError>) -> CliResult {
-    match out {
-        Some(path) => {
-            let mut failure = None;
-            let r = gyrolab_io::atomic::write_atomic_with(path, |w| {
-                write(w).map_err(|e| {
-                    let msg = e.to_string();
-                    failure = Some(e);
-                    std::io::Error::other(msg)
-                })
-            });
-            match (r, failure) {
-                (_, Some(e)) => Err(sim_error(e)),
-                (Err(e), None) => Err(CliError::Output(format!("{}: cannot write the file: {e}", path.display()))),
-                (Ok(()), None) => Ok(()),
-            }
-        }
-        None => {
-            // Not locked: the writer may hand the output to a thread of its own (blocks of 64 KiB
-            // or more go out in one write each).
-            let mut stdout = std::io::stdout();
-            match write(&mut stdout) {
-                Err(SimCsvError::Io(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-                r => r.map_err(sim_error),
-            }
-        }
-    }
+    Ok(write_simulated(common.out.as_deref(), |w| simulate_to(record, &cfg, &opts, w))?)
 }
