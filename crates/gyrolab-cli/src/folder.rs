@@ -5,8 +5,8 @@
 
 use crate::error::{CliError, CliResult};
 use crate::output::{print, write_folder};
-use gyrolab_lab::report_folder::ReportFolder;
 use gyrolab::limits::Overall;
+use gyrolab_lab::report_folder::{print_pdf, written_text, ReportFolder};
 use std::path::Path;
 
 /// Writes the folder whole, prints what was written (unless quiet), prints report.html to
@@ -19,50 +19,12 @@ use std::path::Path;
 pub fn write_and_finish(out: &Path, folder: &ReportFolder, quiet: bool, pdf: bool) -> CliResult {
     let files = write_folder(out, &folder.outputs, &folder.inputs)?;
     if !quiet {
-        let mut s = format!("Wrote {} files to {}:\n", files.len(), out.display());
-        for f in &files {
-            s.push_str(&format!(
-                "  {}\n",
-                f.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned())
-            ));
-        }
-        match folder.verdict {
-            Some(v) if folder.simulated => s.push_str(&format!("Spec limits: {} (on SIMULATED data)\n", v.text())),
-            Some(v) => s.push_str(&format!("Spec limits: {}\n", v.text())),
-            None => s.push_str("Spec limits: none in the plan\n"),
-        }
-        for f in &folder.failures {
-            s.push_str(&format!("  FAIL {f}\n"));
-        }
-        for f in &folder.undecided {
-            s.push_str(&format!("  {f}\n"));
-        }
-        print(&s)?;
+        print(&written_text(out, &files, folder))?;
     }
     if pdf {
-        match gyrolab_report::pdf::print_report(out) {
-            Ok((path, size)) => {
-                if !quiet {
-                    print(&format!("Printed report.html to {} ({} kB)\n", path.display(), size.div_ceil(1024)))?;
-                }
-            }
-            Err(e) => {
-                let mut message = e.message(out);
-                let stale = out.join("report.pdf");
-                if stale.exists() && std::fs::remove_file(&stale).is_ok() {
-                    message.push_str(
-                        " (The older report.pdf of this folder, which showed an earlier report, was removed.)",
-                    );
-                }
-                if folder.verdict == Some(Overall::Fail) {
-                    message.push_str(&format!(
-                        " Also {} spec limit check(s) failed: {}",
-                        folder.failures.len(),
-                        folder.failures.join("; ")
-                    ));
-                }
-                return Err(CliError::Output(message));
-            }
+        let printed = print_pdf(out, folder).map_err(CliError::Output)?;
+        if !quiet {
+            print(&printed)?;
         }
     }
     match folder.verdict {

@@ -4,6 +4,7 @@
 
 use crate::error::{EvalError, EvalResult};
 use crate::layout::LogLayout;
+use crate::outcome::allan::{ChannelAnalysis, LazyGmwm};
 use crate::reference::{Conversion, Reference, ReferenceRequest};
 use gyrolab::allan::gap_fill::{fill_isolated, FillCount, MAX_FILLED_SHARE};
 use gyrolab::allan::{
@@ -19,7 +20,6 @@ use gyrolab_io::recording::{read_records, TopicMeta};
 use gyrolab_io::series::{ChannelInfo, SeriesData, SeriesOptions};
 use gyrolab_io::series::{LineMap, RowKind, SkipReason, SkippedColumn, UnitSource};
 use gyrolab_io::DataError;
-use crate::outcome::allan::{ChannelAnalysis, LazyGmwm};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 

@@ -6,11 +6,11 @@
 
 use crate::allan::AllanOutcome;
 use crate::error::{EvalError, EvalResult};
+use crate::outcome::allan::ChannelAnalysis;
 use gyrolab::gmwm::{gauss_markov_filter_bound, overbound_factors, MarkovBound, Process};
 use gyrolab::noise::Reading;
 use gyrolab::units::{self, Quantity};
 use gyrolab_io::noise_export::{real_text, ExportTerm, NoiseExport, Stack, TermSource};
-use crate::outcome::allan::ChannelAnalysis;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 

@@ -2,9 +2,9 @@
 //! inspect`) and their IMU topics written as CSV or Parquet (`gyrolab convert`).
 
 use crate::error::{EvalError, EvalResult};
+use crate::outcome::inventory::{Inventory, TopicInventory};
 use gyrolab::sampling::estimate_interval;
 use gyrolab_io::recording::{open, RecordingOptions};
-use crate::outcome::inventory::{Inventory, TopicInventory};
 use std::path::{Path, PathBuf};
 
 /// Rate, duration, gaps of a topic's stamps (ns, any order).

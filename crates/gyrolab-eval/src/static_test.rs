@@ -3,13 +3,13 @@
 //! across the files (docs/METHODS.md section 2). "Static" names the test, "bias" its main figure.
 
 use crate::error::{EvalError, EvalResult};
+use crate::outcome::static_test::{ChannelRepeatability, TestReport};
 use crate::reference::{Reference, ReferenceRequest};
 use gyrolab::dropout::{DropoutTally, DropoutVerdict};
 use gyrolab::static_test::{bias_repeatability, StaticTestConfig, StaticTestResult};
 use gyrolab::units::OutputUnit;
 use gyrolab::validate;
 use gyrolab_io::series::{evaluate_static_file, ReaderQuality, SeriesOptions, SeriesSummary};
-use crate::outcome::static_test::{ChannelRepeatability, TestReport};
 use std::path::{Path, PathBuf};
 
 /// Static tests, one file per test.
@@ -290,7 +290,11 @@ fn evaluate_warmups(
                     format!("channel '{}': warm-up: {e}", gyrolab_io::text::excerpt(&info.name)),
                 ))
             })?;
-            out.push(crate::outcome::static_test::WarmupReport { file: shown.clone(), channel: info.name.clone(), result });
+            out.push(crate::outcome::static_test::WarmupReport {
+                file: shown.clone(),
+                channel: info.name.clone(),
+                result,
+            });
         }
     }
     Ok(out)

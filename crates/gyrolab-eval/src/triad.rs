@@ -2,6 +2,7 @@
 //! scale factors, misalignments and biases (12 parameters, [`gyrolab::triad`]; docs/METHODS.md).
 
 use crate::error::{EvalError, EvalResult};
+use crate::outcome::triad::TriadReport;
 use crate::rate::raw_log::{rate_column, SegmentationRequest};
 use gyrolab::segment::find_steady_segments;
 use gyrolab::triad::{fit_triad, plateaus_from_segments, TableAxis, TriadError, TriadFit, TriadOptions, TriadPlateau};
@@ -9,7 +10,6 @@ use gyrolab::units::OutputUnit;
 use gyrolab_io::calibration::{CalibrationFile, TriadSection, CALIBRATION_FORMAT};
 use gyrolab_io::raw_log::read_raw_log;
 use gyrolab_io::DataError;
-use crate::outcome::triad::TriadReport;
 use std::path::PathBuf;
 
 /// A three-axis calibration set.

@@ -54,4 +54,3 @@ pub fn manifest_json(outputs: &[NamedOutput]) -> Result<String, serde_json::Erro
     // Pretty JSON, a final newline, and the blank line every earlier build wrote after it.
     serde_json::to_string_pretty(&manifest).map(|s| s + "\n\n")
 }
-

@@ -87,4 +87,3 @@ pub fn format_of(head: &[u8]) -> FileFormat {
         FileFormat::Text
     }
 }
-

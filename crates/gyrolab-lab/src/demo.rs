@@ -3,18 +3,18 @@
 //! Allan sections on SIMULATED records of the same gyro family (the paper did not publish its
 //! raw static records).
 
-use gyrolab_eval::error::{EvalError, EvalResult};
 use crate::paper;
-use gyrolab_eval::progress::Progress;
-use gyrolab_eval::rate::{evaluate_text, EvaluatedAxis};
 use crate::report_folder::{assemble_report, ReportFolder, ReportInputs};
 use crate::test_plan::static_part::{evaluate_static, static_null_of, StaticContext, StaticParts};
+use gyrolab::format::sig;
 use gyrolab::rate_test::{RateEvaluation, RateTestOptions};
 use gyrolab::sim::{Preset, SensorModel, StaticSpec, TemperatureProfile};
 use gyrolab::validate::InvalidOption;
+use gyrolab_eval::error::{EvalError, EvalResult};
+use gyrolab_eval::progress::Progress;
+use gyrolab_eval::rate::{evaluate_text, EvaluatedAxis};
 use gyrolab_io::sim_csv::{write_static_csv, SimCsvOptions};
 use gyrolab_io::test_plan::StaticAxisPlan;
-use gyrolab::format::sig;
 use gyrolab_report::html::ReportHeader;
 use gyrolab_report::paper::{compare_table2, compare_table6, paper_section, ClaimVerdict, ClaimedTable6};
 use gyrolab_report::paper::{PrintedTable5Row, Table2Comparison};

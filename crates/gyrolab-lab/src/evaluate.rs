@@ -61,11 +61,11 @@ fn creatable(location: &str) -> StoreResult<()> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => std::path::Path::new("."),
     };
-    tempfile::Builder::new().prefix(".gyrolab-store-check-").tempfile_in(dir).map(drop).map_err(|e| {
-        StoreError::Input {
-            path: gyrolab_store::mask_location(location),
-            message: format!("the store does not exist and cannot be created in its folder: {}; nothing was written", e.kind()),
-        }
+    tempfile::Builder::new().prefix(".gyrolab-store-check-").tempfile_in(dir).map(drop).map_err(|e| StoreError::Input {
+        path: gyrolab_store::mask_location(location),
+        message: format!(
+            "the store does not exist and cannot be created in its folder: {}; nothing was written",
+            e.kind()
+        ),
     })
 }
-

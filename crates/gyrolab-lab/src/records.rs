@@ -4,12 +4,12 @@
 //! re-evaluations. Column names are the keys of the JSON output; units are in a `unit` column beside
 //! each value. The store queries; gyrolab-report renders; this module joins them.
 
+use gyrolab_report::table::to_text;
 use gyrolab_report::table::ColumnKind::{self, Count as C, Number as N, Text as T};
 use gyrolab_report::table::{Cell, Table};
 use gyrolab_report::trend::{trend_svg, TrendPanel};
-use gyrolab_report::table::to_text;
 use gyrolab_store::issue::IssuedReport;
-use gyrolab_store::{query, Account, AuditEvent, CheckReport, Store, StoreResult};
+use gyrolab_store::{query, Account, Actor, AuditEvent, Changes, CheckReport, Revision, Store, StoreResult};
 
 fn num(v: Option<f64>) -> Cell {
     Cell::number(v)
@@ -310,7 +310,10 @@ pub fn history(store: &mut Store, serial: &str, figure: Option<&str>) -> StoreRe
 /// The trend plot of a history as an SVG document: one panel per (axis, figure), value against
 /// evaluation id, the latest evaluation's limits as horizontal lines; SIMULATED in the title when
 /// any value is. `Ok(None)`: no value to plot.
-pub fn history_svg(serial: &str, rows: &[query::HistoryRow]) -> Result<Option<String>, gyrolab_report::plot::PlotError> {
+pub fn history_svg(
+    serial: &str,
+    rows: &[query::HistoryRow],
+) -> Result<Option<String>, gyrolab_report::plot::PlotError> {
     let mut keys: Vec<(&str, &str, &str)> = Vec::new();
     for r in rows {
         let k = (r.figure.axis.as_str(), r.figure.figure.as_str(), r.figure.unit.as_str());
@@ -404,7 +407,6 @@ pub fn check_text(r: &CheckReport, name: &str) -> String {
     }
     out
 }
-
 
 /// The accounts of a store as text (`gyrolab store user list`).
 pub fn accounts_text(accounts: &[Account]) -> String {
@@ -520,12 +522,7 @@ pub fn written_report_text(store: &mut Store, id: i64, n: usize, out: &std::path
         ),
         None => "a DRAFT: each equal to its stored SHA-256".into(),
     };
-    Ok(format!(
-        "wrote the {} report file(s) of evaluation {} to {} ({what})\n",
-        n,
-        id,
-        out.display()
-    ))
+    Ok(format!("wrote the {} report file(s) of evaluation {} to {} ({what})\n", n, id, out.display()))
 }
 
 /// The note printed when a revision supersedes an issued evaluation: the new revision is a
@@ -541,3 +538,65 @@ pub fn draft_note(s: &mut Store, superseded: i64, revision: i64) -> StoreResult<
     })
 }
 
+/// Who a revision is recorded as made by: the account (a different `--by` refused), else `--by`.
+pub fn revision_author(actor: &Actor, given: Option<&str>) -> Result<String, String> {
+    match (actor.account(), given) {
+        (Some(a), Some(b)) if b != a.name => {
+            Err(format!("--by {b:?}: the revision is made by the authenticated account {:?} (leave --by out)", a.name))
+        }
+        (Some(a), _) => Ok(a.name.clone()),
+        (None, Some(b)) => Ok(b.to_string()),
+        (None, None) => Err("a revision needs who made it (--by NAME, or --user NAME)".into()),
+    }
+}
+
+/// Stores the revision `r` (a correction or an approval) with `changes` as `actor`: the line
+/// saying so, and the draft note when it supersedes an issued evaluation.
+pub fn revise(store: &mut Store, r: &Revision, changes: &Changes, actor: &Actor) -> StoreResult<String> {
+    let id = store.revise_as(r, changes, None, actor)?;
+    let note = draft_note(store, r.supersedes, id)?;
+    Ok(format!(
+        "stored {} of evaluation {} as evaluation {id} in {}\n{note}",
+        r.kind.as_str(),
+        r.supersedes,
+        store.name()
+    ))
+}
+
+/// A stored evaluation as the JSON of `gyrolab store show --json`: its record with its issue and
+/// audit trail.
+pub fn evaluation_json(
+    e: &query::StoredEvaluation,
+    issued: Option<&IssuedReport>,
+    events: &[AuditEvent],
+) -> Result<serde_json::Value, serde_json::Error> {
+    let mut v = serde_json::to_value(e)?;
+    v["issue"] = serde_json::to_value(issued)?;
+    v["audit"] = serde_json::to_value(events)?;
+    Ok(v)
+}
+
+/// Adds the account `name` (`gyrolab store user add`) as `actor`: the line saying so.
+pub fn add_account(
+    store: &mut Store,
+    actor: &Actor,
+    name: &str,
+    display: &str,
+    role: gyrolab_store::Role,
+    password: &str,
+) -> StoreResult<String> {
+    store.add_account(actor, name, display, role, password)?;
+    Ok(format!("added account {name} ({display}, {}) to {}\n", role.as_str(), store.name()))
+}
+
+/// Disables the account `name` as `actor`: the line saying so.
+pub fn disable_account(store: &mut Store, actor: &Actor, name: &str) -> StoreResult<String> {
+    store.disable_account(actor, name)?;
+    Ok(format!("disabled account {name} in {}\n", store.name()))
+}
+
+/// Sets a new password of the account `name` as `actor`: the line saying so.
+pub fn reset_password(store: &mut Store, actor: &Actor, name: &str, password: &str) -> StoreResult<String> {
+    store.reset_password(actor, name, password)?;
+    Ok(format!("set a new password of account {name} in {}\n", store.name()))
+}

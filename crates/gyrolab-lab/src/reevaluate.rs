@@ -3,10 +3,10 @@
 //! evaluation); the new report folder is written, stored as a revision of kind `reevaluation`,
 //! and every changed figure and verdict is listed.
 
+use crate::test_plan::{evaluate_test_plan, read_test_plan};
 use gyrolab_store::query::{diff_figures, FigureChange};
 use gyrolab_store::record::{from_report_folder, hash_bytes, hash_file};
 use gyrolab_store::{Changes, Revision, RevisionKind, Store, StoreError, StoreResult};
-use crate::test_plan::{evaluate_test_plan, read_test_plan};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 

@@ -3,19 +3,19 @@
 //! writes the outputs (the command line with `gyrolab_io::atomic::write_folder`, whole or not
 //! at all).
 
+use gyrolab::figures::AxisFigures;
+use gyrolab::limits::{Limit, Overall, Verdict};
 use gyrolab_eval::error::{EvalError, EvalResult};
+use gyrolab_eval::outcome::rate::AxisReport;
+use gyrolab_eval::outcome::triad::TriadReport;
 use gyrolab_eval::progress::Progress;
 use gyrolab_eval::rate::{calibration_file, EvaluatedAxis};
-use gyrolab_report::rate::rate_figures;
-use gyrolab::figures::AxisFigures;
+use gyrolab_io::manifest::{manifest_json, NamedOutput, MANIFEST};
 use gyrolab_report::html::{rate_section, render_html, Report, ReportHeader, ReportSection, SummaryTable};
-use gyrolab::limits::{Limit, Overall, Verdict};
+use gyrolab_report::rate::rate_figures;
 use gyrolab_report::rate::AxisJson;
-use gyrolab_eval::outcome::rate::AxisReport;
 use gyrolab_report::results::{DecisionRuleJson, DeviceJson, LimitJson, ResultsJson};
 use gyrolab_report::tables_csv::{points_csv, runs_csv, summary_csv};
-use gyrolab_eval::outcome::triad::TriadReport;
-use gyrolab_io::manifest::{manifest_json, NamedOutput, MANIFEST};
 use std::collections::BTreeMap;
 
 /// An assembled report folder.
@@ -214,4 +214,50 @@ pub fn assemble_report(inputs: ReportInputs<'_>, progress: &dyn Progress) -> Eva
     let manifest = manifest_json(&outputs).map_err(|e| EvalError::Output(format!("cannot serialise JSON: {e}")))?;
     outputs.push(NamedOutput { name: MANIFEST.into(), bytes: manifest.into_bytes() });
     Ok(ReportFolder { outputs, verdict, failures, undecided, simulated, inputs: Vec::new() })
+}
+
+/// What writing a report folder printed: the files written to `out` and the verdict of the spec
+/// limits (on SIMULATED data when it is), each failed and undecided check on a line.
+pub fn written_text(out: &std::path::Path, files: &[std::path::PathBuf], folder: &ReportFolder) -> String {
+    let mut s = format!("Wrote {} files to {}:\n", files.len(), out.display());
+    for f in files {
+        s.push_str(&format!("  {}\n", f.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned())));
+    }
+    match folder.verdict {
+        Some(v) if folder.simulated => s.push_str(&format!("Spec limits: {} (on SIMULATED data)\n", v.text())),
+        Some(v) => s.push_str(&format!("Spec limits: {}\n", v.text())),
+        None => s.push_str("Spec limits: none in the plan\n"),
+    }
+    for f in &folder.failures {
+        s.push_str(&format!("  FAIL {f}\n"));
+    }
+    for f in &folder.undecided {
+        s.push_str(&format!("  {f}\n"));
+    }
+    s
+}
+
+/// Prints the folder's report.html to report.pdf (headless Chromium): the line saying so, or
+/// the message of why not (an older report.pdf, which showed an earlier report, removed; the
+/// failed spec limits named too).
+pub fn print_pdf(out: &std::path::Path, folder: &ReportFolder) -> Result<String, String> {
+    match gyrolab_report::pdf::print_report(out) {
+        Ok((path, size)) => Ok(format!("Printed report.html to {} ({} kB)\n", path.display(), size.div_ceil(1024))),
+        Err(e) => {
+            let mut message = e.message(out);
+            let stale = out.join("report.pdf");
+            if stale.exists() && std::fs::remove_file(&stale).is_ok() {
+                message
+                    .push_str(" (The older report.pdf of this folder, which showed an earlier report, was removed.)");
+            }
+            if folder.verdict == Some(Overall::Fail) {
+                message.push_str(&format!(
+                    " Also {} spec limit check(s) failed: {}",
+                    folder.failures.len(),
+                    folder.failures.join("; ")
+                ));
+            }
+            Err(message)
+        }
+    }
 }

@@ -664,7 +664,8 @@ fn bias(
         gyrolab_eval::static_test::evaluate_samples(&block, &config, &reference)
     })?
     .map_err(err)?;
-    serde_json::to_string(&gyrolab_eval::outcome::static_test::TestReport { file: "<array>".into(), result }).map_err(json_err)
+    serde_json::to_string(&gyrolab_eval::outcome::static_test::TestReport { file: "<array>".into(), result })
+        .map_err(json_err)
 }
 
 /// Rate-table evaluation of observations (rates deg/s, outputs, runs, strokes `fwd`/`rev`):

@@ -1,15 +1,15 @@
 //! Reports of Allan-variance analyses: the deviation table, CSV, JSON (keys in docs/JSON.md),
 //! the noise-coefficient summary and Kalibr's imu.yaml gyroscope entries.
 
-use gyrolab_eval::outcome::allan::ChannelAnalysis;
-use gyrolab::format::{short, sig, sig_opt};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Cell, CellAlignment, Table};
+use gyrolab::format::{short, sig, sig_opt};
 use gyrolab::noise::{
     combine_kalibr, combine_kalibr_accelerometer, kalibr_accelerometer_from_readings, kalibr_from_readings, FitQuality,
-    KalibrAccelerometer, KalibrBasis, KalibrGyroscope, NoiseCoefficients, Reading, SlopeLineResult,
-    Unresolved, FIT_RMS_LIMIT,
+    KalibrAccelerometer, KalibrBasis, KalibrGyroscope, NoiseCoefficients, Reading, SlopeLineResult, Unresolved,
+    FIT_RMS_LIMIT,
 };
 use gyrolab::units::{self, Quantity};
+use gyrolab_eval::outcome::allan::ChannelAnalysis;
 
 /// sqrt(2 ln 2 / pi): Allan minimum per unit IEEE bias instability.
 const BIAS_FACTOR: f64 = gyrolab::noise::BIAS_INSTABILITY_FACTOR;
@@ -1069,12 +1069,39 @@ pub fn has_terms(c: &NoiseCoefficients) -> bool {
     c.arw_deg_rt_h.is_some() || c.bias_instability_dph.is_some() || c.rrw_deg_h_rt_h.is_some()
 }
 
+/// The text of `gyrolab plan static`: the record a noise term's precision needs (`precision_pct`
+/// at `confidence`, as asked), with its EDF and interval and their sources.
+pub fn record_length_text(plan: &gyrolab::record_length::RecordLength, precision_pct: f64, confidence: f64) -> String {
+    use gyrolab::record_length::NoiseTerm;
+    let term = match plan.request.term {
+        NoiseTerm::BiasInstability => "bias instability (flicker rate noise, alpha = -1)",
+        NoiseTerm::AngleRandomWalk => "angle random walk (white rate noise, alpha = 0)",
+    };
+    format!(
+        "To measure {term} from the overlapping Allan deviation at tau = {:.4} s (m = {}, {} Hz)\n\
+         within +-{} % at {} % confidence, record at least {} samples: {:.0} s = {:.2} h.\n\
+         Such a record gives {:.1} equivalent degrees of freedom and an interval of {:.3} to {:.3} times the value.\n\
+         (EDF by Greenhall & Riley 2004; chi-squared bounds, NIST SP 1065 section 5.3.)\n",
+        plan.request.tau_s,
+        plan.m,
+        plan.request.sample_rate_hz,
+        precision_pct,
+        100.0 * confidence,
+        plan.samples,
+        plan.duration_s,
+        plan.duration_h,
+        plan.required_edf,
+        plan.relative_interval.0,
+        plan.relative_interval.1
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use gyrolab::allan::{AllanCurve, AllanPoint, DeviationKind};
-    use gyrolab_eval::outcome::allan::LazyGmwm;
     use gyrolab::noise::{fit_noise_model, slope_line_terms};
+    use gyrolab_eval::outcome::allan::LazyGmwm;
 
     /// A hand-made white-noise curve (sigma = 1e-3 / sqrt(tau), edf 1000), optionally with a 30 %
     /// bump at three taus.

@@ -1,13 +1,11 @@
 //! Reports of static (bias) tests: the summary table, data-quality findings and JSON
 //! (keys in docs/JSON.md).
 
-use gyrolab_eval::static_test::FileQuality;
-use gyrolab_eval::outcome::static_test::{ChannelRepeatability, TestReport, WarmupReport};
-use gyrolab::format::{short, sig, sig_opt};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Cell, CellAlignment, Table};
-use gyrolab::static_test::{
-    reported_smoothing_times, smoothing_key, QualityIssue, StaticTestResult,
-};
+use gyrolab::format::{short, sig, sig_opt};
+use gyrolab::static_test::{reported_smoothing_times, smoothing_key, QualityIssue, StaticTestResult};
+use gyrolab_eval::outcome::static_test::{ChannelRepeatability, TestReport, WarmupReport};
+use gyrolab_eval::static_test::FileQuality;
 use serde::Serialize;
 
 /// JSON document of `gyrolab bias --json`.

@@ -7,14 +7,14 @@
 //! simulated-data flag, a figure table, data tables, plots), so the static-bias and Allan
 //! sections are added by building more `ReportSection`s: the page template does not change.
 
+use crate::plot::PlotError;
+use crate::rate_plots::{calibration_plot, hysteresis_plot, scale_factor_plot};
+use crate::results::{CalibrationStatus, EquipmentRow, TestConditions};
 use gyrolab::figures::{known_figure, AxisFigures, FigureGroup, FIGURES};
 use gyrolab::format::{sig, sig_opt};
 use gyrolab::limits::{check_limits, overall, DecisionRule, Limit, LimitCheck, Overall, Support, Verdict};
-use crate::plot::PlotError;
-use crate::results::{CalibrationStatus, EquipmentRow, TestConditions};
-use gyrolab_eval::outcome::rate::AxisReport;
-use crate::rate_plots::{calibration_plot, hysteresis_plot, scale_factor_plot};
 use gyrolab::units::{ratio_to_pct, ratio_to_ppm};
+use gyrolab_eval::outcome::rate::AxisReport;
 use std::fmt::Write;
 
 /// Escapes text for HTML element content and attribute values.

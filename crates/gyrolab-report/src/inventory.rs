@@ -1,10 +1,10 @@
 //! The inventory of a recording (`gyrolab inspect`): its topics with their message types,
 //! counts, rates, time spans and gaps, as a text table or JSON.
 
-use gyrolab_eval::outcome::inventory::Inventory;
-use gyrolab::format::short;
 use comfy_table::presets::UTF8_FULL_CONDENSED;
 use comfy_table::{Cell, CellAlignment, Table};
+use gyrolab::format::short;
+use gyrolab_eval::outcome::inventory::Inventory;
 
 /// The inventory as a text table.
 pub fn inventory_text(inv: &Inventory) -> String {

@@ -4,10 +4,10 @@
 //! data do not support a printed figure, the report says so and shows why, computed from the
 //! data (it never adjusts a formula to match a printed value).
 
-use gyrolab::format::sig;
 use crate::html::{DataTable, ReportSection};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Cell, CellAlignment, Table};
 use gyrolab::fit;
+use gyrolab::format::sig;
 use gyrolab::published::PrintedValue;
 use gyrolab::rate_test::RateEvaluation;
 use gyrolab::units::ratio_to_pct;

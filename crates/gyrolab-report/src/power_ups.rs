@@ -3,14 +3,14 @@
 //! plot. Formulas: [`gyrolab::power_ups`], [`gyrolab::warmup`]; docs/METHODS.md.
 
 use crate::bias::{warmup_text, WarmupJson};
-use gyrolab_eval::outcome::static_test::WarmupReport;
-use gyrolab::figures::{known_figure, AxisFigures};
-use gyrolab::format::{short, sig};
 use crate::html::{DataTable, FigureRow, PlotBlock, ReportSection};
-use gyrolab::limits::Limit;
 use crate::plot::{Axis, Figure, LegendCorner, Panel, PlotError, Series, SeriesStyle};
 use crate::static_report::ReferenceJson;
+use gyrolab::figures::{known_figure, AxisFigures};
+use gyrolab::format::{short, sig};
+use gyrolab::limits::Limit;
 use gyrolab::power_ups::PowerUpSpread;
+use gyrolab_eval::outcome::static_test::WarmupReport;
 use serde::Serialize;
 
 /// One figure across power-ups: the per-record values and their spread (or why none).

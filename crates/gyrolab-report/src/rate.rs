@@ -3,13 +3,13 @@
 //! units (the axis's `output_unit`).
 
 use crate::segments::segmentation_text;
-use gyrolab_eval::outcome::rate::AxisReport;
-use gyrolab_eval::outcome::segments::SegmentationReport;
-use gyrolab::format::{short, sig, sig_opt};
 use comfy_table::{presets::UTF8_FULL_CONDENSED, Cell, CellAlignment, Table};
+use gyrolab::figures::AxisFigures;
+use gyrolab::format::{short, sig, sig_opt};
 use gyrolab::rate_test::{RateEvaluation, RestReferenceSource};
 use gyrolab::units::{ratio_to_pct, ratio_to_ppm, OutputUnit};
-use gyrolab::figures::AxisFigures;
+use gyrolab_eval::outcome::rate::AxisReport;
+use gyrolab_eval::outcome::segments::SegmentationReport;
 use serde::Serialize;
 
 /// JSON document of `gyrolab rate --json`.

@@ -1,8 +1,8 @@
 //! The rate-table plots of one axis: calibration curve with residuals (the paper's Figures 1 to
 //! 3), hysteresis (forward and reverse stroke means minus the line) and scale factor per run.
 
-use gyrolab::format::sig;
 use crate::plot::{Axis, Figure, Orientation, Panel, PlotError, RefLine, Series, SeriesStyle};
+use gyrolab::format::sig;
 use gyrolab_eval::outcome::rate::AxisReport;
 
 /// Unit and factor for small output differences (volts shown in mV).

@@ -2,8 +2,8 @@
 //! rate-table figure per axis (the `gyrolab rate --json` axis objects), the limits and their
 //! verdicts. The static (bias) and Allan sections (and the demo's `paper`) go under their own key in `sections`.
 
-use gyrolab::limits::{DecisionRule, Limit, LimitCheck, Overall};
 use crate::rate::AxisJson;
+use gyrolab::limits::{DecisionRule, Limit, LimitCheck, Overall};
 use serde::Serialize;
 use std::collections::BTreeMap;
 

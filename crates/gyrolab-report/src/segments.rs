@@ -1,8 +1,8 @@
 //! Segmentation summaries of raw rate-table logs (`gyrolab rate` on raw logs): text and JSON.
 
-use gyrolab_eval::outcome::segments::SegmentationReport;
 use gyrolab::rate_test::Stroke;
 use gyrolab::segment::SegmentKind;
+use gyrolab_eval::outcome::segments::SegmentationReport;
 use serde::Serialize;
 use std::fmt::Write as _;
 

@@ -3,18 +3,18 @@
 //! noise asymptotes and N, B, K read-offs), their summary figures, JSON and CSV tables.
 
 use crate::allan::{allan_csv, allan_json};
-use gyrolab_eval::outcome::allan::ChannelAnalysis;
-use gyrolab_eval::outcome::static_test::TestReport;
-use gyrolab::figures::AxisFigures;
-use gyrolab::format::{short, sig, sig_opt};
 use crate::html::{DataTable, FigureRow, PlotBlock, ReportSection};
-use gyrolab::limits::Limit;
 use crate::plot::{
     scatter_fit_plot, Annotation, Axis, Figure, LegendCorner, Orientation, Panel, PlotError, RefLine, Series,
     SeriesStyle,
 };
+use gyrolab::figures::AxisFigures;
+use gyrolab::format::{short, sig, sig_opt};
+use gyrolab::limits::Limit;
 use gyrolab::static_test::{reported_smoothing_times, smoothing_key, BiasRepeatability};
 use gyrolab::window_means::WindowMean;
+use gyrolab_eval::outcome::allan::ChannelAnalysis;
+use gyrolab_eval::outcome::static_test::TestReport;
 use serde::Serialize;
 
 /// The ADEV flat level of bias instability: sigma_min = 0.6643 B (IEEE 952; the one constant).

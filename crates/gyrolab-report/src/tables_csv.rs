@@ -1,10 +1,10 @@
 //! The CSV tables of a report folder: per-point means of each rate-table axis, per-run scale
 //! factors, and the summary of every figure with its unit, limit and verdict.
 
-use gyrolab::figures::AxisFigures;
 use crate::html::SummaryTable;
-use gyrolab::limits::Limit;
 use crate::rate::AxisJson;
+use gyrolab::figures::AxisFigures;
+use gyrolab::limits::Limit;
 
 fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n']) {

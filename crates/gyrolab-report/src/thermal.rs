@@ -2,12 +2,12 @@
 //! point with their models, the temperature sensitivities and thermal hysteresis, plots of both
 //! against temperature, results.json `sections.temperature.<axis>` and the CSV table.
 
-use gyrolab::figures::AxisFigures;
-use gyrolab::format::{sig, sig_opt};
 use crate::html::{DataTable, PlotBlock, ReportSection};
-use gyrolab::limits::Limit;
 use crate::plot::{Axis, Figure, Panel, PlotError, Series, SeriesStyle};
 use crate::static_report::figure_rows;
+use gyrolab::figures::AxisFigures;
+use gyrolab::format::{sig, sig_opt};
+use gyrolab::limits::Limit;
 use gyrolab::thermal::{Hysteresis, NotResolved, Phase, Sensitivity, TemperatureModel};
 use serde::Serialize;
 

@@ -4,9 +4,9 @@
 //! `sections.resolution.<axis>` (docs/JSON.md). Definitions: docs/METHODS.md, "Threshold and
 //! resolution" (GJB 2426A-2004, IEEE Std 528).
 
+use crate::html::{DataTable, FigureRow, ReportSection};
 use gyrolab::figures::AxisFigures;
 use gyrolab::format::{short, sig};
-use crate::html::{DataTable, FigureRow, ReportSection};
 use gyrolab::limits::{check_limits, Limit};
 use gyrolab::threshold::{StepEstimate, Support, MARGINAL_STANDARD_ERRORS, PASS_FRACTION};
 use serde_json::json;

@@ -61,10 +61,15 @@ mod tests {
             limit_min: None,
             limit_max: Some(0.5),
         };
-        let svg = trend_svg("History of serial SN-1", &[p("nonlinearity_pct", vec![(1.0, 0.1), (2.0, 0.2)]), p("empty", vec![])])
-            .unwrap()
-            .unwrap();
-        assert!(svg.starts_with("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\""));
+        let svg = trend_svg(
+            "History of serial SN-1",
+            &[p("nonlinearity_pct", vec![(1.0, 0.1), (2.0, 0.2)]), p("empty", vec![])],
+        )
+        .unwrap()
+        .unwrap();
+        assert!(
+            svg.starts_with("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\"")
+        );
         assert!(svg.contains("axis x: nonlinearity_pct") && svg.contains("limit max"), "{svg}");
         assert!(!svg.contains("limit min") && !svg.contains("axis x: empty"));
         assert_eq!(trend_svg("t", &[p("empty", vec![])]).unwrap(), None);

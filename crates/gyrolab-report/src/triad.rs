@@ -1,10 +1,10 @@
 //! Reports of three-axis (triad) calibrations (`gyrolab rate --triad`): text and JSON. Keys name
 //! their unit; output-valued keys are in `output_unit`.
 
-use gyrolab_eval::outcome::triad::TriadReport;
-use gyrolab::format::sig;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, CellAlignment, Table};
+use gyrolab::format::sig;
 use gyrolab::triad::TableAxis;
+use gyrolab_eval::outcome::triad::TriadReport;
 use serde::Serialize;
 
 /// A record of the set in JSON.

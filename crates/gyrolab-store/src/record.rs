@@ -459,9 +459,7 @@ pub fn from_report_folder_with(
     if let Some(m) = &manifest {
         names.retain(|p| {
             let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-            name == gyrolab_io::manifest::MANIFEST
-                || name == "report.pdf"
-                || m.files.iter().any(|f| f.name == name)
+            name == gyrolab_io::manifest::MANIFEST || name == "report.pdf" || m.files.iter().any(|f| f.name == name)
         });
         for f in &m.files {
             if !names.iter().any(|p| p.file_name().is_some_and(|n| n.to_string_lossy() == f.name)) {

@@ -7,7 +7,6 @@
 //! `migrations/postgres/NNNN_name.sql`, embedded at build time. A migration's file is never
 //! edited once released: a store that recorded its checksum would be refused.
 
-
 /// One migration: its version, its name and its SQL (embedded from its file).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Migration {

@@ -4,10 +4,10 @@
 //! [`crate::conformity`] (ILAC-G8:09/2019 4.2, JCGM 106:2012 8, ISO/IEC 17025:2017 7.8.6); this
 //! module only pairs limits with figures.
 
-use crate::figures::{known_figure, AxisFigures};
-use crate::format::{short, sig};
 use crate::conformity::{consistent_digits, decide};
 pub use crate::conformity::{DecisionRule, Known, Overall, Support, Verdict};
+use crate::figures::{known_figure, AxisFigures};
+use crate::format::{short, sig};
 use serde::Serialize;
 
 /// A spec limit on one figure: the value must lie within [min, max] (either bound optional),

@@ -26,4 +26,3 @@ pub struct SignOff<'a> {
     /// The store's chain head at issue.
     pub head: &'a str,
 }
-

@@ -217,4 +217,3 @@ struct WithMemory<'a, D: serde::Serialize> {
     doc: &'a D,
     memory: &'a MemoryPath,
 }
-

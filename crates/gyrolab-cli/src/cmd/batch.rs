@@ -14,8 +14,8 @@ use crate::output::print;
 use clap::Args;
 use gyrolab::validate;
 use gyrolab_eval::allan::AllanRequest;
-use gyrolab_lab::batch::{batch_folder, BatchFolderRequest};
 use gyrolab_eval::Progress;
+use gyrolab_lab::batch::{batch_folder, BatchFolderRequest};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -119,4 +119,3 @@ pub fn run(args: &BatchArgs) -> CliResult {
     }
     Ok(())
 }
-

@@ -5,11 +5,11 @@ use crate::folder::write_and_finish;
 use crate::output::{print, to_json};
 use crate::progress::Bar;
 use clap::Args;
-use gyrolab_lab::demo::{evaluate_paper, paper_report_folder, PaperReportRequest};
+use gyrolab_eval::outcome::rate::AxisReport;
 use gyrolab_eval::rate::EvaluatedAxis;
+use gyrolab_lab::demo::{evaluate_paper, paper_report_folder, PaperReportRequest};
 use gyrolab_report::paper::{demo_text, DemoJson};
 use gyrolab_report::rate::{rate_json, rate_summary_table};
-use gyrolab_eval::outcome::rate::AxisReport;
 use std::path::PathBuf;
 
 /// Options of `gyrolab demo`.

@@ -63,25 +63,5 @@ pub fn run(cmd: &PlanCommand) -> CliResult {
     if a.json {
         return print(&to_json(&plan)?);
     }
-    let term = match a.term {
-        NoiseTerm::BiasInstability => "bias instability (flicker rate noise, alpha = -1)",
-        NoiseTerm::AngleRandomWalk => "angle random walk (white rate noise, alpha = 0)",
-    };
-    print(&format!(
-        "To measure {term} from the overlapping Allan deviation at tau = {:.4} s (m = {}, {} Hz)\n\
-         within +-{} % at {} % confidence, record at least {} samples: {:.0} s = {:.2} h.\n\
-         Such a record gives {:.1} equivalent degrees of freedom and an interval of {:.3} to {:.3} times the value.\n\
-         (EDF by Greenhall & Riley 2004; chi-squared bounds, NIST SP 1065 section 5.3.)\n",
-        plan.request.tau_s,
-        plan.m,
-        plan.request.sample_rate_hz,
-        a.precision_pct,
-        100.0 * a.confidence,
-        plan.samples,
-        plan.duration_s,
-        plan.duration_h,
-        plan.required_edf,
-        plan.relative_interval.0,
-        plan.relative_interval.1
-    ))
+    print(&gyrolab_report::allan::record_length_text(&plan, a.precision_pct, a.confidence))
 }

@@ -6,8 +6,8 @@ use clap::{Args, Subcommand};
 use gyrolab::sim::Preset;
 use gyrolab::units::OutputUnit;
 use gyrolab_eval::simulate::{
-    check_record_size, csv_options, sim_config, simulate_to, static_sim_config, write_test_program_folder,
-    write_simulated, SimOverrides, SimRecord, DEFAULT_MAX_SAMPLES, TEST_PROGRAM_SEED,
+    check_record_size, csv_options, sim_config, simulate_to, static_sim_config, write_simulated,
+    write_test_program_folder, SimOverrides, SimRecord, DEFAULT_MAX_SAMPLES, TEST_PROGRAM_SEED,
 };
 use std::path::PathBuf;
 

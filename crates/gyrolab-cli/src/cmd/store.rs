@@ -7,17 +7,15 @@ use crate::args::{prompt_password, stdin_line, AuthArgs, QueryOutput, StoreLocat
 use crate::error::{CliError, CliResult};
 use crate::output::{print, to_json, write_file};
 use clap::{Args, Subcommand, ValueEnum};
-use gyrolab_lab::records::{
-    accounts_text, chart_table, check_text, compare_table, evaluation_text, history_table, lot_table, reevaluation_text,
-};
-use gyrolab_report::table::{to_csv, to_parquet, to_text, Table};
 use gyrolab_lab::issue::Issue;
-use gyrolab_lab::reevaluate;
-use gyrolab_store::issue::Meaning;
-use gyrolab_store::{
-    query, resolve_location, sign, Actor, Changes, Revision,
-    RevisionKind, Role, Store,
+use gyrolab_lab::records::{
+    accounts_text, chart_table, check_text, compare_table, evaluation_json, evaluation_text, history_table, lot_table,
+    reevaluation_text, revision_author,
 };
+use gyrolab_lab::reevaluate;
+use gyrolab_report::table::{to_csv, to_parquet, to_text, Table};
+use gyrolab_store::issue::Meaning;
+use gyrolab_store::{query, resolve_location, sign, Actor, Changes, Revision, RevisionKind, Role, Store};
 use std::path::PathBuf;
 
 /// Kinds of manual revision.
@@ -402,19 +400,6 @@ fn actor(s: &mut Store, auth: &AuthArgs) -> CliResult<Actor> {
     })
 }
 
-/// Who a revision is recorded as made by: the account (a different `--by` refused), else `--by`.
-fn by(actor: &Actor, given: Option<&str>) -> CliResult<String> {
-    match (actor.account(), given) {
-        (Some(a), Some(b)) if b != a.name => Err(CliError::Usage(format!(
-            "--by {b:?}: the revision is made by the authenticated account {:?} (leave --by out)",
-            a.name
-        ))),
-        (Some(a), _) => Ok(a.name.clone()),
-        (None, Some(b)) => Ok(b.to_string()),
-        (None, None) => Err(CliError::Usage("a revision needs who made it (--by NAME, or --user NAME)".into())),
-    }
-}
-
 fn meaning(m: MeaningArg) -> Meaning {
     match m {
         MeaningArg::Approved => Meaning::Approved,
@@ -493,9 +478,8 @@ fn user(cmd: &UserCommand) -> CliResult {
                 RoleArg::Approver => Role::Approver,
                 RoleArg::Admin => Role::Admin,
             };
-            let display = a.display_name.clone().unwrap_or_else(|| a.name.clone());
-            s.add_account(&actor, &a.name, &display, role, &password)?;
-            print(&format!("added account {} ({}, {}) to {}\n", a.name, display, role.as_str(), s.name()))
+            let display = a.display_name.as_deref().unwrap_or(&a.name);
+            print(&gyrolab_lab::records::add_account(&mut s, &actor, &a.name, display, role, &password)?)
         }
         UserCommand::List(a) => {
             let mut s = open(&a.location, false)?;
@@ -508,15 +492,13 @@ fn user(cmd: &UserCommand) -> CliResult {
         UserCommand::Disable(a) => {
             let mut s = open_for_writing(&a.location)?;
             let actor = admin(&mut s, &a.admin)?;
-            s.disable_account(&actor, &a.name)?;
-            print(&format!("disabled account {} in {}\n", a.name, s.name()))
+            print(&gyrolab_lab::records::disable_account(&mut s, &actor, &a.name)?)
         }
         UserCommand::Reset(a) => {
             let mut s = open_for_writing(&a.location)?;
             let actor = admin(&mut s, &a.admin)?;
             let password = new_password(a.password_stdin, &a.name)?;
-            s.reset_password(&actor, &a.name, &password)?;
-            print(&format!("set a new password of account {} in {}\n", a.name, s.name()))
+            print(&gyrolab_lab::records::reset_password(&mut s, &actor, &a.name, &password)?)
         }
     }
 }
@@ -551,7 +533,12 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
         StoreCommand::Add(a) => {
             let credentials = a.auth.credentials(true)?;
             let credentials = credentials.as_ref().map(|(u, p)| (u.as_str(), p.as_str()));
-            print(&gyrolab_lab::records::add_folders(&a.dirs, a.plan.as_deref(), a.location.store.as_deref(), credentials)?)
+            print(&gyrolab_lab::records::add_folders(
+                &a.dirs,
+                a.plan.as_deref(),
+                a.location.store.as_deref(),
+                credentials,
+            )?)
         }
         StoreCommand::Show(a) => {
             let mut s = open(&a.location, false)?;
@@ -559,9 +546,7 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
             let issued = s.issue_of(a.id)?;
             let events = s.audit_events(Some(a.id))?;
             if a.json {
-                let mut v = serde_json::to_value(&e).map_err(|e| CliError::Output(e.to_string()))?;
-                v["issue"] = serde_json::to_value(&issued).map_err(|e| CliError::Output(e.to_string()))?;
-                v["audit"] = serde_json::to_value(&events).map_err(|e| CliError::Output(e.to_string()))?;
+                let v = evaluation_json(&e, issued.as_ref(), &events).map_err(|e| CliError::Output(e.to_string()))?;
                 return print(&to_json(&v)?);
             }
             print(&evaluation_text(&e, issued.as_ref(), &events))
@@ -605,15 +590,9 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
                 test_date: a.test_date.clone(),
             };
             let actor = actor(&mut s, &a.auth)?;
-            let r = Revision { supersedes: a.id, kind, by: by(&actor, a.by.as_deref())?, reason: a.reason.clone() };
-            let id = s.revise_as(&r, &changes, None, &actor)?;
-            let note = gyrolab_lab::records::draft_note(&mut s, a.id, id)?;
-            print(&format!(
-                "stored {} of evaluation {} as evaluation {id} in {}\n{note}",
-                kind.as_str(),
-                a.id,
-                s.name()
-            ))
+            let by = revision_author(&actor, a.by.as_deref()).map_err(CliError::Usage)?;
+            let r = Revision { supersedes: a.id, kind, by, reason: a.reason.clone() };
+            print(&gyrolab_lab::records::revise(&mut s, &r, &changes, &actor)?)
         }
         StoreCommand::Check(a) => check(a),
         StoreCommand::User(u) => user(u),
@@ -623,7 +602,7 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
         StoreCommand::Reevaluate(a) => {
             let mut s = open_for_writing(&a.location)?;
             let actor = actor(&mut s, &a.auth)?;
-            let who = by(&actor, a.by.as_deref())?;
+            let who = revision_author(&actor, a.by.as_deref()).map_err(CliError::Usage)?;
             let r = reevaluate::reevaluate_as(&mut s, a.id, &who, &a.reason, &a.out, &actor)?;
             let note = gyrolab_lab::records::draft_note(&mut s, a.id, r.revision)?;
             if !note.is_empty() {
@@ -679,4 +658,3 @@ fn history(a: &HistoryArgs) -> CliResult {
     }
     emit(&history_table(&rows), &a.format, || to_json(&rows))
 }
-

@@ -29,7 +29,8 @@ pub struct VerifyArgs {
 
 /// Runs `gyrolab verify`.
 pub fn run(args: &VerifyArgs) -> CliResult {
-    let key = args.public_key.as_deref().map(gyrolab_store::sign::read_public_key).transpose().map_err(CliError::Usage)?;
+    let key =
+        args.public_key.as_deref().map(gyrolab_store::sign::read_public_key).transpose().map_err(CliError::Usage)?;
     let r = verify_report(&args.dir, args.plan_dir.as_deref(), key.as_ref())?;
     print(&r.text)?;
     let number = &r.number;

@@ -45,4 +45,3 @@ pub struct Inventory {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub truncated: Option<String>,
 }
-

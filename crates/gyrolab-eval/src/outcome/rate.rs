@@ -19,4 +19,3 @@ pub struct AxisReport<'a> {
     /// The evaluation.
     pub evaluation: &'a RateEvaluation,
 }
-

@@ -16,4 +16,3 @@ pub struct SegmentationReport<'a> {
     /// Source line of each sample.
     pub lines: &'a [u64],
 }
-

@@ -34,4 +34,3 @@ pub struct WarmupReport {
     /// The figures, in deg/h.
     pub result: gyrolab::warmup::WarmupResult,
 }
-

@@ -15,4 +15,3 @@ pub struct TriadReport<'a> {
     /// The fit.
     pub fit: &'a TriadFit,
 }
-

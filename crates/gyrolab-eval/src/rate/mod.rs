@@ -5,13 +5,13 @@
 pub mod raw_log;
 
 use crate::error::{EvalError, EvalResult};
-use raw_log::{evaluate_channels, segment_file, SegmentationRequest, SegmentedLog};
+use crate::outcome::rate::AxisReport;
 use gyrolab::rate_test::{evaluate, RateEvaluation, RateTestOptions};
 use gyrolab::validate;
 use gyrolab_io::calibration::{AxisCalibration, CalibrationFile, PolynomialModel, CALIBRATION_FORMAT};
 use gyrolab_io::rate_table::{parse_rate_table, read_rate_table, RateColumns, RateLayout, RateTableFile};
 use gyrolab_io::raw_log::{detect_raw_log, header_names};
-use crate::outcome::rate::AxisReport;
+use raw_log::{evaluate_channels, segment_file, SegmentationRequest, SegmentedLog};
 use std::path::{Path, PathBuf};
 
 /// Evaluation options of a rate-table test, as a front end gives them (checked by

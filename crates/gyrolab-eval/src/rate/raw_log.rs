@@ -2,8 +2,9 @@
 //! [`gyrolab::segment`] (or read from a manual segment file), then one rate-table record per
 //! output channel (docs/METHODS.md section 5).
 
-use crate::error::{EvalError, EvalResult};
 use super::{evaluate_record, EvaluatedAxis};
+use crate::error::{EvalError, EvalResult};
+use crate::outcome::segments::SegmentationReport;
 use gyrolab::rate_test::{RateTable, RateTestOptions};
 use gyrolab::segment::{
     rate_observations, segment_log, segments_from_manual, PlateauReduction, Segment, SegmentError, SegmentOptions,
@@ -13,7 +14,6 @@ use gyrolab::validate;
 use gyrolab_io::rate_table::{RateLayout, RateTableFile};
 use gyrolab_io::raw_log::{header_names, read_manual_segments, read_raw_log, segments_csv, table_rate_column, RawLog};
 use gyrolab_io::DataError;
-use crate::outcome::segments::SegmentationReport;
 use std::path::{Path, PathBuf};
 
 /// How raw logs are segmented; `None` keeps the default of [`SegmentOptions`].

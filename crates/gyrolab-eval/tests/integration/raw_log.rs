@@ -9,8 +9,8 @@
 use crate::common;
 use common::{flag, single_axis_log, sxx, F0, K, MIN_PLATEAU_SAMPLES, SIGMA_U};
 use gyrolab::segment::SegmentKind;
-use gyrolab_eval::rate::{evaluate_rates, RateRequest};
 use gyrolab_eval::rate::raw_log::SegmentationMode;
+use gyrolab_eval::rate::{evaluate_rates, RateRequest};
 use gyrolab_eval::EvalError;
 use gyrolab_io::rate_table::RateLayout;
 

@@ -22,8 +22,8 @@ pub mod ulog;
 
 use crate::error::DataError;
 pub use crate::input_file::{check_regular, open_regular};
-pub use crate::sniff::{format_of, open_sniffed, sniff_format, FileFormat};
 use crate::series::{series_from_columns, RowKind, SeriesData, SeriesOptions};
+pub use crate::sniff::{format_of, open_sniffed, sniff_format, FileFormat};
 use std::path::Path;
 
 /// Largest magnitude of a value read from a recording: 1e100. Beyond it, squares and sums of

@@ -5,20 +5,20 @@
 //! of results.json and a CSV table.
 
 use super::static_part::{reference_of, StaticContext};
-use gyrolab_eval::error::{EvalError, EvalResult};
-use gyrolab_eval::progress::Progress;
-use gyrolab_eval::static_test::evaluate_file;
+use gyrolab::figures::AxisFigures;
+use gyrolab::format::sig;
 use gyrolab::g_sensitivity::{
     fit_g_sensitivity, Coefficient, GRecord, GSensitivityConfig, GSensitivityFit, MagnitudeKind, NoStdError, SensorAxis,
 };
+use gyrolab::limits::{check_limits, Limit};
 use gyrolab::static_test::StaticTestConfig;
+use gyrolab_eval::error::{EvalError, EvalResult};
+use gyrolab_eval::progress::Progress;
+use gyrolab_eval::static_test::evaluate_file;
 use gyrolab_io::series::SeriesOptions;
 use gyrolab_io::test_plan::GSensitivityAxisPlan;
 use gyrolab_io::DataError;
-use gyrolab::figures::AxisFigures;
-use gyrolab::format::sig;
 use gyrolab_report::html::{DataTable, FigureRow, ReportSection};
-use gyrolab::limits::{check_limits, Limit};
 use gyrolab_report::static_report::ReferenceJson;
 use serde_json::{json, Map, Value};
 use std::path::Path;

@@ -5,15 +5,15 @@
 
 use super::static_part::{motion_of_static_record, reference_of, shown, StaticContext, StaticParts};
 use super::{evaluate_plan_rates, PlanRates};
-use gyrolab_eval::error::{EvalError, EvalResult};
-use gyrolab_eval::progress::{Progress, Silent};
-use gyrolab_eval::static_test::evaluate_file;
 use gyrolab::static_test::StaticTestConfig;
 use gyrolab::warmup::{evaluate_warmup, WarmupConfig};
+use gyrolab_eval::error::{EvalError, EvalResult};
+use gyrolab_eval::outcome::static_test::WarmupReport;
+use gyrolab_eval::progress::{Progress, Silent};
+use gyrolab_eval::static_test::evaluate_file;
 use gyrolab_io::series::{read_series_all, SeriesOptions};
 use gyrolab_io::test_plan::{PowerUpsPlan, RateAxisPlan, SegmentationPlan, TestPlan, WarmupPlan};
 use gyrolab_io::DataError;
-use gyrolab_eval::outcome::static_test::WarmupReport;
 use gyrolab_report::power_ups::{power_ups_section, warmup_section, PowerUpFigure, PowerUpsReport, WarmupAxisReport};
 
 /// Number of progress steps of these sections.
@@ -179,7 +179,8 @@ pub fn evaluate_warmup_axis(plan: &TestPlan, w: &WarmupPlan, ctx: &StaticContext
     let data = read_series_all(&w.file, &options).map_err(|e| locate(EvalError::Data(e), &key("file")))?;
     let dt = 1.0 / w.sample_rate_hz;
     if let Some(t) = &data.time {
-        if let Some(msg) = gyrolab_eval::allan::rate_disagreement(t, w.sample_rate_hz, &key("sample_rate_hz"), &w.file) {
+        if let Some(msg) = gyrolab_eval::allan::rate_disagreement(t, w.sample_rate_hz, &key("sample_rate_hz"), &w.file)
+        {
             return Err(EvalError::conflict(msg));
         }
     }

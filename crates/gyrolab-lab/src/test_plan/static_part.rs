@@ -2,24 +2,24 @@
 //! `[static.<axis>]` records (the same code path for both) and returns the report sections,
 //! summary figures, results.json sections and CSV files.
 
+use gyrolab::allan::{AllanOptions, DeviationKind};
+use gyrolab::figures::{name_matches, AxisFigures};
+use gyrolab::limits::Limit;
+use gyrolab::rate_test::RestReferenceSource;
+use gyrolab::static_test::{bias_repeatability, smoothing_key, StaticTestConfig};
 use gyrolab_eval::allan::{analyse_channel, ChannelSetup};
 use gyrolab_eval::error::{EvalError, EvalResult};
+use gyrolab_eval::outcome::allan::ChannelAnalysis;
+use gyrolab_eval::outcome::static_test::TestReport;
 use gyrolab_eval::progress::Progress;
 use gyrolab_eval::rate::EvaluatedAxis;
 use gyrolab_eval::reference::Reference;
 use gyrolab_eval::static_test::{evaluate_file, stillness_of_file};
-use gyrolab::allan::{AllanOptions, DeviationKind};
-use gyrolab::rate_test::RestReferenceSource;
-use gyrolab::static_test::{bias_repeatability, smoothing_key, StaticTestConfig};
 use gyrolab_io::calibration::read_calibration;
 use gyrolab_io::series::{read_series_all, window_means_file, SeriesOptions};
 use gyrolab_io::test_plan::StaticAxisPlan;
 use gyrolab_io::DataError;
-use gyrolab_eval::outcome::allan::ChannelAnalysis;
-use gyrolab_eval::outcome::static_test::TestReport;
-use gyrolab::figures::{name_matches, AxisFigures};
 use gyrolab_report::html::ReportSection;
-use gyrolab::limits::Limit;
 use gyrolab_report::static_report::{
     allan_axis_csv, allan_section, bias_tests_csv, bias_windows_csv, static_section, ReferenceJson, StaticAxisReport,
     TestWindows,

@@ -3,14 +3,14 @@
 //! temperature sensitivities and thermal hysteresis ([`gyrolab::thermal`]), and the compensation
 //! written into calibration.toml.
 
-use gyrolab_eval::error::{EvalError, EvalResult};
-use gyrolab_eval::progress::Progress;
-use gyrolab_eval::rate::{evaluate_record, EvaluatedAxis};
-use gyrolab_eval::reference::Reference;
 use crate::test_plan::static_part::{reference_of, static_null_of, StaticContext};
 use gyrolab::rate_test::RateTestOptions;
 use gyrolab::thermal::{fit_model, hysteresis, sensitivity, NotResolved, PointSeries};
 use gyrolab::units::OutputUnit;
+use gyrolab_eval::error::{EvalError, EvalResult};
+use gyrolab_eval::progress::Progress;
+use gyrolab_eval::rate::{evaluate_record, EvaluatedAxis};
+use gyrolab_eval::reference::Reference;
 use gyrolab_io::calibration::TemperatureSection;
 use gyrolab_io::rate_table::read_rate_table;
 use gyrolab_io::series::{read_series, SeriesOptions};

@@ -3,17 +3,17 @@
 //! "Threshold and resolution", the summary figures `threshold_dps` / `resolution_dps`, the
 //! results.json sections `threshold` and `resolution` (keyed by axis) and a CSV of the rates tried.
 
+use gyrolab::figures::AxisFigures;
+use gyrolab::limits::Limit;
+use gyrolab::threshold::{self as core, ThresholdError};
 use gyrolab_eval::error::{EvalError, EvalResult};
 use gyrolab_eval::progress::Progress;
 use gyrolab_eval::rate::EvaluatedAxis;
-use gyrolab::threshold::{self as core, ThresholdError};
 use gyrolab_io::calibration::read_calibration;
 use gyrolab_io::test_plan::{NominalScaleFactor, StepTestPlan};
 use gyrolab_io::threshold_record::{read_step_record, StepRecord};
 use gyrolab_io::DataError;
-use gyrolab::figures::AxisFigures;
 use gyrolab_report::html::ReportSection;
-use gyrolab::limits::Limit;
 use gyrolab_report::threshold::{step_figures, step_section, StepKind, StepReport};
 use std::collections::BTreeMap;
 use std::path::Path;

@@ -4,7 +4,8 @@
 //! docs/METHODS.md, "Measurement uncertainty"): the report section, summary figures and the
 //! results.json section `uncertainty`.
 
-use gyrolab_eval::rate::EvaluatedAxis;
+use gyrolab::figures::AxisFigures;
+use gyrolab::format::sig;
 use gyrolab::noise::Reading;
 use gyrolab::rate_test::RestReferenceSource;
 use gyrolab::uncertainty::{
@@ -12,9 +13,8 @@ use gyrolab::uncertainty::{
     std_of_sample_std, Budget, Component, Correlation, Coverage, EvaluationType, LineUncertainty,
 };
 use gyrolab::units;
+use gyrolab_eval::rate::EvaluatedAxis;
 use gyrolab_io::test_plan::uncertainty::UncertaintyPlan;
-use gyrolab::figures::AxisFigures;
-use gyrolab::format::sig;
 use gyrolab_report::html::{DataTable, ReportSection};
 use gyrolab_report::static_report::StaticAxisReport;
 use serde_json::{json, Map, Value};

@@ -4,15 +4,15 @@
 //! through the reference null, unresolved components absent with their reason, a limit on
 //! `g_sensitivity_dph_per_g`, and bad plans naming the key and line.
 
+use gyrolab::limits::Overall;
 use gyrolab::units::EARTH_RATE_DPH;
 use gyrolab_eval::program_sim::g_sensitivity::{
     write_g_sensitivity_records, write_rate_table_record, BIAS_DPH, LATITUDE_DEG, TRUTH_G_DPH_PER_G,
 };
 use gyrolab_eval::progress::Silent;
+use gyrolab_eval::EvalError;
 use gyrolab_lab::report_folder::ReportFolder;
 use gyrolab_lab::test_plan::{evaluate_test_plan, read_test_plan};
-use gyrolab_eval::EvalError;
-use gyrolab::limits::Overall;
 use std::path::Path;
 
 fn output<'a>(folder: &'a ReportFolder, name: &str) -> &'a [u8] {

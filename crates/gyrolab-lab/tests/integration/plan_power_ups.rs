@@ -7,8 +7,8 @@ use gyrolab_eval::program_sim::power_ups::{
     write_power_up_records, write_warmup_records, WARMUP_AMPLITUDE_DPH, WARMUP_TIME_CONSTANT_S,
 };
 use gyrolab_eval::progress::Silent;
-use gyrolab_lab::test_plan::{evaluate_test_plan, read_test_plan};
 use gyrolab_eval::EvalError;
+use gyrolab_lab::test_plan::{evaluate_test_plan, read_test_plan};
 use std::path::Path;
 
 const DEVICE: &str = "[device]\nmodel = \"simulated\"\nserial = \"P-1\"\naxes = [\"x\"]\n\n";

@@ -8,9 +8,9 @@ use gyrolab::sim::{SensorModel, StaticSpec, TemperatureProfile, TemperatureStep}
 use gyrolab_eval::apply::{apply_to, prepare_apply, ApplyRequest};
 use gyrolab_eval::program_sim::temperature::{sensor, write_temperature_records, POINTS, TRUTH};
 use gyrolab_eval::progress::Silent;
+use gyrolab_io::sim_csv::{write_static_csv, SimCsvOptions};
 use gyrolab_lab::report_folder::ReportFolder;
 use gyrolab_lab::test_plan::{evaluate_test_plan, read_test_plan};
-use gyrolab_io::sim_csv::{write_static_csv, SimCsvOptions};
 use serde_json::Value;
 use std::path::Path;
 

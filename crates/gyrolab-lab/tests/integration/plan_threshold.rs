@@ -3,14 +3,14 @@
 //! the threshold recovered between the tried rates that bracket the dead zone, the report
 //! section, results.json and limits; bad plans give errors naming the key and its line.
 
+use gyrolab::limits::Overall;
 use gyrolab_eval::program_sim::threshold::{
     write_threshold_records, BASE_RATE_DPS, DEAD_ZONE_DPS, RESOLUTION_STEPS_DPS, THRESHOLD_RATES_DPS,
 };
 use gyrolab_eval::progress::Silent;
+use gyrolab_eval::EvalError;
 use gyrolab_lab::report_folder::ReportFolder;
 use gyrolab_lab::test_plan::{evaluate_test_plan, read_test_plan};
-use gyrolab_eval::EvalError;
-use gyrolab::limits::Overall;
 use std::path::{Path, PathBuf};
 
 fn repo_root() -> PathBuf {

@@ -9,9 +9,9 @@ use gyrolab::sim::{SensorModel, StaticSpec};
 use gyrolab::units::OutputUnit;
 use gyrolab_eval::program_sim::uncertainty::write_uncertainty_section;
 use gyrolab_eval::progress::Silent;
+use gyrolab_io::sim_csv::{write_static_csv, SimCsvOptions};
 use gyrolab_lab::report_folder::ReportFolder;
 use gyrolab_lab::test_plan::{evaluate_test_plan, read_test_plan};
-use gyrolab_io::sim_csv::{write_static_csv, SimCsvOptions};
 use serde_json::Value;
 
 fn output<'a>(folder: &'a ReportFolder, name: &str) -> &'a [u8] {

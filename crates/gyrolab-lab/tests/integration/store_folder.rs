@@ -4,8 +4,8 @@
 //! a changed input is refused before anything is written.
 
 use crate::store_common::backends;
-use gyrolab_store::record::{from_report_folder, hash_file};
 use gyrolab_lab::reevaluate::reevaluate;
+use gyrolab_store::record::{from_report_folder, hash_file};
 use gyrolab_store::{add_report_folder, Store, StoreError};
 use std::path::{Path, PathBuf};
 

@@ -4,13 +4,13 @@
 
 use crate::common;
 use common::{repo_root, s_true, single_axis_log, triad_log, F0, K, MIN_PLATEAU_SAMPLES, SIGMA_U};
+use gyrolab::limits::Overall;
 use gyrolab::sim::{SensorModel, StaticSpec};
 use gyrolab::units::OutputUnit;
 use gyrolab_eval::progress::Silent;
+use gyrolab_io::sim_csv::{write_static_csv, SimCsvOptions};
 use gyrolab_lab::report_folder::ReportFolder;
 use gyrolab_lab::test_plan::{evaluate_test_plan, read_test_plan};
-use gyrolab_io::sim_csv::{write_static_csv, SimCsvOptions};
-use gyrolab::limits::Overall;
 use std::path::Path;
 
 const RATES: [f64; 7] = [-300.0, -100.0, -30.0, 0.0, 30.0, 100.0, 300.0];

@@ -3,10 +3,10 @@
 //! (`program_sim::write_test_program`), the plan it writes must be the committed one, and the
 //! evaluation gives every section, labelled SIMULATED, with the spec limits met.
 
+use gyrolab::limits::Overall;
 use gyrolab_eval::program_sim::write_test_program;
 use gyrolab_eval::progress::Silent;
 use gyrolab_lab::test_plan::{evaluate_test_plan, read_test_plan};
-use gyrolab::limits::Overall;
 use serde_json::Value;
 use std::path::Path;
 
