@@ -1096,6 +1096,25 @@ pub fn record_length_text(plan: &gyrolab::record_length::RecordLength, precision
     )
 }
 
+/// The document of `gyrolab allan --json` with the `memory` object (which path the analysis
+/// took; docs/JSON.md) after its keys.
+#[derive(Debug, Clone, Serialize)]
+pub struct AllanMemoryDocument<'a> {
+    /// The channels' document.
+    #[serde(flatten)]
+    pub doc: AllanDocument,
+    /// In memory or streamed, with the estimates.
+    pub memory: &'a gyrolab_eval::allan_memory::MemoryPath,
+}
+
+/// [`allan_document`] with the memory path of the analysis; `None` without channels.
+pub fn allan_document_in<'a>(
+    channels: &[ChannelAnalysis],
+    memory: &'a gyrolab_eval::allan_memory::MemoryPath,
+) -> Option<AllanMemoryDocument<'a>> {
+    allan_document(channels).map(|doc| AllanMemoryDocument { doc, memory })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -119,8 +119,8 @@ fn matrix_table(title: &str, rows: &[String; 3], m: &[[f64; 3]; 3], digits: usiz
 }
 
 /// The three-axis calibration as text: S, b, scale factors, cross-axis %, misalignment mrad,
-/// residual RMS and condition numbers.
-pub fn triad_text(r: &TriadReport<'_>) -> String {
+/// residual RMS and condition numbers; and where the calibration was written (`cal_out`).
+pub fn triad_text(r: &TriadReport<'_>, cal_out: Option<&std::path::Path>) -> String {
     let f = r.fit;
     let u = r.output_unit.symbol();
     let mut s = String::from("Three-axis calibration u = S omega + b (12 parameters)\n");
@@ -165,5 +165,8 @@ pub fn triad_text(r: &TriadReport<'_>) -> String {
         sig(f.design_condition, 3),
         sig(f.matrix_condition, 4)
     ));
+    if let Some(cal) = cal_out {
+        s.push_str(&format!("\nCalibration ([triad]) written to {}\n", cal.display()));
+    }
     s
 }

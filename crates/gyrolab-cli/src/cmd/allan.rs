@@ -11,7 +11,7 @@ use gyrolab_eval::allan_memory::{analyse_records_within, default_memory_bytes, p
 use gyrolab_eval::filter_export::{check_inflate, export_files, parse_target, same_path, Estimator, ExportRequest};
 use gyrolab_eval::simulate::reference_from_headers;
 use gyrolab_eval::EvalError;
-use gyrolab_report::allan::{allan_csv, allan_document, allan_text};
+use gyrolab_report::allan::{allan_csv, allan_document_in, allan_text};
 use std::path::PathBuf;
 
 /// Options of `gyrolab allan`.
@@ -195,9 +195,8 @@ pub fn run(args: &AllanArgs) -> CliResult {
         eprintln!("{line}");
     }
     if args.json {
-        let doc = allan_document(analyses).ok_or_else(|| EvalError::conflict("no channel to analyse"))?;
-        let value = WithMemory { doc: &doc, memory: &path };
-        return print(&to_json(&value)?);
+        let doc = allan_document_in(analyses, &path).ok_or_else(|| EvalError::conflict("no channel to analyse"))?;
+        return print(&to_json(&doc)?);
     }
     if args.csv {
         return print(&allan_csv(analyses));
@@ -208,12 +207,4 @@ pub fn run(args: &AllanArgs) -> CliResult {
         text.push(format!("memory: {}", s.note(&args.file.display().to_string())));
     }
     print(&(simulated + &text.join("\n") + "\n"))
-}
-
-/// The JSON document with the `memory` object (which path; docs/JSON.md) after its keys.
-#[derive(serde::Serialize)]
-struct WithMemory<'a, D: serde::Serialize> {
-    #[serde(flatten)]
-    doc: &'a D,
-    memory: &'a MemoryPath,
 }

@@ -205,9 +205,5 @@ fn run_triad(args: &RateArgs) -> CliResult {
     if args.json {
         return print(&to_json(&triad_json(&report))?);
     }
-    let mut text = triad_text(&report);
-    if let Some(cal) = &args.cal_out {
-        text.push_str(&format!("\nCalibration ([triad]) written to {}\n", cal.display()));
-    }
-    print(&text)
+    print(&triad_text(&report, args.cal_out.as_deref()))
 }
