@@ -55,6 +55,8 @@ step_done "cargo test (build and run)"
 # The documentation examples (left out above): each public formula's example
 # with its published or hand value runs here.
 cargo test --workspace --doc
+# The libraries' documentation builds without a warning (the binary's doc comments are its --help).
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --lib --quiet
 step_done "doctests"
 bin=target/debug/gyrolab
 # The binary is built by `cargo test --workspace` (should a cargo version not leave it

@@ -616,7 +616,7 @@ pub fn with_motion(text: String, motion: &[String]) -> String {
 }
 
 /// The export files of every record of a run (one file per topic when there are several:
-/// imu.yaml -> imu_<topic>.yaml), made and checked but not written, and the warnings.
+/// `imu.yaml` -> `imu_<topic>.yaml`), made and checked but not written, and the warnings.
 #[allow(clippy::type_complexity)]
 pub fn export_files(
     outcomes: &[AllanOutcome],

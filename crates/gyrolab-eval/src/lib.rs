@@ -15,7 +15,7 @@
 //! - [`record_length`]: the record length a noise term's precision needs;
 //! - [`recording`]: recordings (MCAP, ROS 1 bags, ULog): inventories and conversion to CSV/Parquet;
 //! - [`program_sim`]: SIMULATED records with known truth of a lab's test program (temperature, ...);
-//! - [`reference`]: the output-to-rate reference (K, null, unit): the one place outputs become rates;
+//! - [`reference`](mod@reference): the output-to-rate reference (K, null, unit): the one place outputs become rates;
 //! - [`outcome`]: the typed outcomes the requests return and gyrolab-report renders;
 //! - [`progress`]: the progress trait front ends implement;
 //! - [`error`]: [`EvalError`], whose option errors name request fields for each front end to spell.

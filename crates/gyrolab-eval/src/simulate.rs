@@ -15,7 +15,7 @@ use std::path::PathBuf;
 /// Overrides of a simulator set-up; `None` keeps the configuration's (or the default) value.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SimOverrides {
-    /// A TOML set-up (seed, preset, [sensor], [static_record], [rate_table]).
+    /// A TOML set-up (seed, preset, `[sensor]`, `[static_record]`, `[rate_table]`).
     pub config: Option<PathBuf>,
     /// Seed (default 1).
     pub seed: Option<u64>,

@@ -599,7 +599,7 @@ pub const SKIP_COLUMN: u32 = u32::MAX;
 /// Reads rows of numbers from `start` (each: fields separated by `layout.delim`, the last ending
 /// in `\n` or, with `layout.crlf`, `\r\n`; no spaces or empty cells; each number a plain decimal of
 /// at most 15 digits, an integer of at most 19, or at most 15 digits with an exponent that
-/// leaves a power of ten within 10^±22, as [`scanned_field`] takes them), pushing field `ci`'s value onto `cols[targets[ci]]` (none for [`SKIP_COLUMN`]), until
+/// leaves a power of ten within 10^±22, as `scanned_field` takes them), pushing field `ci`'s value onto `cols[targets[ci]]` (none for [`SKIP_COLUMN`]), until
 /// a row does not fit, `b` ends, or `room` rows are read. `shapes` (one per field, carried from
 /// call to call) remembers each column's last layout. Returns where it stopped and the rows read.
 pub fn read_rows(

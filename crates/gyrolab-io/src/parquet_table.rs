@@ -35,7 +35,7 @@ pub fn read_parquet(path: &Path, options: &SeriesOptions) -> Result<SeriesData, 
 }
 
 /// [`read_parquet`] of a file already opened (once, by [`crate::sniff::open_sniffed`]).
-/// The footer's schema is checked first ([`check_footer`]): the `parquet` crate reserves room
+/// The footer's schema is checked first (`check_footer`): the `parquet` crate reserves room
 /// for a group's declared children before reading them.
 pub fn read_parquet_file(
     path: &Path,

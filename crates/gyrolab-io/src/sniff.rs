@@ -44,7 +44,7 @@ impl FileFormat {
 }
 
 /// The format of a file by its first bytes (`-`, standard input, is text). A FIFO, socket or
-/// device is refused before it is opened ([`check_regular`]).
+/// device is refused before it is opened ([`crate::input_file::check_regular`]).
 pub fn sniff_format(path: &Path) -> Result<FileFormat, DataError> {
     if path.as_os_str() == "-" {
         return Ok(FileFormat::Text);
@@ -52,7 +52,7 @@ pub fn sniff_format(path: &Path) -> Result<FileFormat, DataError> {
     Ok(open_sniffed(path)?.1)
 }
 
-/// Opens a regular file once ([`check_regular`] first), reads its first bytes for the format
+/// Opens a regular file once ([`crate::input_file::check_regular`] first), reads its first bytes for the format
 /// and rewinds it: (the file, its format, its size in bytes).
 pub fn open_sniffed(path: &Path) -> Result<(std::fs::File, FileFormat, u64), DataError> {
     use std::io::{Seek, SeekFrom};

@@ -10,13 +10,16 @@ use gyrolab_eval::{EvalError, EvalResult};
 use gyrolab_report::allan::{imu_utils_yaml, kalibr_yaml};
 use std::path::{Path, PathBuf};
 
+/// A file of a run: where it goes and its bytes.
+pub type NoiseFile = (PathBuf, Vec<u8>);
+
 /// The Kalibr (`kalibr`) and imu_utils (`imu_utils`) files of `outcomes`, with the writers'
 /// warnings. A topic whose curves give no noise term is an error naming it (no file is made).
 pub fn stack_files(
     outcomes: &[AllanOutcome],
     kalibr: Option<&Path>,
     imu_utils: Option<&Path>,
-) -> EvalResult<(Vec<(PathBuf, Vec<u8>)>, Vec<String>)> {
+) -> EvalResult<(Vec<NoiseFile>, Vec<String>)> {
     let mut files = Vec::new();
     let mut warnings = Vec::new();
     let several = outcomes.len() > 1;

@@ -344,7 +344,7 @@ pub fn history_svg(
 /// A stored evaluation as text (`gyrolab store show`): its device, revisions, plan, inputs and
 /// figures, its report's issue (or DRAFT) and its audit trail.
 pub fn evaluation_text(e: &query::StoredEvaluation, issued: Option<&IssuedReport>, events: &[AuditEvent]) -> String {
-    let mut text = show_text(&e);
+    let mut text = show_text(e);
     match issued {
         Some(r) => text.push_str(&issue_line(r)),
         None => text.push_str("report: DRAFT (not issued: gyrolab store issue)\n"),

@@ -4,7 +4,7 @@
 //! `--json` output; the Python package (`python/gyrolab`) wraps them in result objects.
 //!
 //! Long computations run with the interpreter released (`Python::detach`) on the package's own
-//! thread pool, which a process made by `fork` builds again (see [`POOL`]): gyrolab works in
+//! thread pool, which a process made by `fork` builds again (see `POOL`): gyrolab works in
 //! the workers of a fork-based `multiprocessing.Pool` after a call in the parent. Every failure
 //! is a `gyrolab.Error` (a `ValueError` defined in `gyrolab/_errors.py`, so that it pickles)
 //! carrying the evaluation's located message, with request fields spelled as the Python

@@ -1052,7 +1052,7 @@ fn filter_file(channels: &[ChannelAnalysis], update_rate_hz: f64, imu_utils: boo
 }
 
 /// Kalibr imu.yaml for the analysed channels (gyro and accelerometer entries, `update_rate`,
-/// `rostopic`); see [`filter_file`]. `None` when no channel has noise terms.
+/// `rostopic`); see `filter_file`. `None` when no channel has noise terms.
 pub fn kalibr_yaml(channels: &[ChannelAnalysis], update_rate_hz: f64) -> Option<KalibrFile> {
     filter_file(channels, update_rate_hz, false)
 }

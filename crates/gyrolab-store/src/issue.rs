@@ -7,7 +7,7 @@
 //! sign-off block replaced by the signature block, plus `issue.json` (the issue record), a new
 //! `manifest.json` over all of them and `manifest.sig`. The `issue` row keeps the signed manifest,
 //! the signature, issue.json and the issued report.html; it is a record like every other (never
-//! changed, chained). [`crate::Store::amend`] issues a later revision of an issued evaluation as
+//! changed, chained). `Store::amend` issues a later revision of an issued evaluation as
 //! "Amendment N to report R" (ISO/IEC 17025 7.8.8), naming what changed, and re-signs the
 //! replaced report's folder with its issue.json marked superseded; the replaced report stays
 //! retrievable (`gyrolab store report`).

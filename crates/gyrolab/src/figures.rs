@@ -52,7 +52,7 @@ pub struct FigureDef {
     pub group: FigureGroup,
     /// Formula in plain text.
     pub formula: &'static str,
-    /// Source label ([P], [GJB], [IEEE], [GB/T 18459], [SP1065]).
+    /// Source label (`[P]`, `[GJB]`, `[IEEE]`, `[GB/T 18459]`, `[SP1065]`).
     pub source: &'static str,
 }
 

@@ -21,7 +21,7 @@
 //! - [`figures`]: the catalogue of reportable figures (limit names, units, formulas, sources) and
 //!   the figures of an axis;
 //! - [`limits`]: spec limits checked against the figures (PASS, FAIL, NOT EVALUATED);
-//! - [`format`]: numbers to significant digits and to their uncertainty's digits;
+//! - [`format`](mod@format): numbers to significant digits and to their uncertainty's digits;
 //! - [`conformity`]: decision rules, guard bands, verdicts and rounding that never contradicts them;
 //! - [`sampling`]: the sampling interval of a record from its time stamps (one estimator);
 //! - [`validate`]: validators of option values (errors name the request field);

@@ -119,9 +119,9 @@ pub struct RateTable {
     pub rates_dps: Vec<f64>,
     /// Run labels, ascending.
     pub runs: Vec<u32>,
-    /// Forward-stroke output per [point][run] (mean of its samples, eq. 4).
+    /// Forward-stroke output per `[point][run]` (mean of its samples, eq. 4).
     pub forward: Vec<Vec<f64>>,
-    /// Reverse-stroke output per [point][run].
+    /// Reverse-stroke output per `[point][run]`.
     pub reverse: Vec<Vec<f64>>,
     /// Number of samples averaged into each forward cell.
     pub forward_samples: Vec<Vec<usize>>,

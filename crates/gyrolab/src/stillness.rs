@@ -8,7 +8,7 @@
 //!   [`MIN_WINDOW_SAMPLES`] samples), and the last partial window is judged when it holds at
 //!   least half a window;
 //! - the white-noise level sigma (per sample) is estimated from the data itself by the
-//!   first-difference estimator sigma = rms(x[i+1] - x[i]) / sqrt(2) (von Neumann et al. 1941,
+//!   first-difference estimator sigma = rms(x\[i+1\] - x\[i\]) / sqrt(2) (von Neumann et al. 1941,
 //!   "Distribution of the ratio of the mean square successive difference to the variance",
 //!   Ann. Math. Stat. 12; insensitive to slow bias changes), computed within each window and
 //!   made robust to moving windows by taking the median over windows (the median of the
@@ -273,7 +273,7 @@ impl StillnessAccumulator {
     /// Adds a block of samples (in the rule's unit; NaN for a missing sample).
     ///
     /// Whole windows of finite samples that start at a window's start are summed
-    /// [`LANES`] windows at a time ([`whole_windows`]): each window's sums are formed in the
+    /// `LANES` windows at a time (`whole_windows`): each window's sums are formed in the
     /// same order as sample by sample, so the check is the same bit for bit, in a quarter of the
     /// time (the sums of one window are chains of dependent additions; those of different
     /// windows are not; issue 56).

@@ -113,7 +113,7 @@ fn static_null(
     }
 }
 
-/// The static null of an evaluated rate-table axis (see [`static_null`]).
+/// The static null of an evaluated rate-table axis (see `static_null`).
 pub fn static_null_of(axis: &EvaluatedAxis) -> f64 {
     let c = axis.calibration();
     static_null(c.rest_reference, Some(axis.evaluation.rest_reference_source), c.zero_offset).0
