@@ -23,6 +23,7 @@ from typing import Any, Dict, List, Optional, Tuple, Union
 import numpy as np
 
 from . import _gyrolab
+from ._errors import Error
 
 __all__ = ["Store", "DEFAULT_FILE", "STORE_ENV"]
 
@@ -89,6 +90,16 @@ class Store:
         ``gyrolab``, ``axis``, ``figure``, ``value``, ``unit``, ``basis``, ``U``, ``k``,
         ``limit_min``, ``limit_max``, ``verdict``, ``simulated``); only ``figure`` when given."""
         return _frame(_gyrolab.store_history(self.location, serial, figure), f"history {serial}", self._name())
+
+    def history_svg(self, serial: str, figure: Optional[str] = None) -> str:
+        """The trend plot of ``serial``'s history as an SVG document, one panel per axis and
+        figure (value against evaluation id, the latest limits as lines; SIMULATED in the title
+        when any value is): the same bytes as ``gyrolab store history SERIAL --svg FILE``. Only
+        ``figure`` when given; a serial without values raises :class:`gyrolab.Error`."""
+        svg = _gyrolab.store_history_svg(self.location, serial, figure)
+        if svg is None:
+            raise Error(f"serial {serial!r}: no values to plot")
+        return svg
 
     def lot(self, lot: str, confidence: float = 0.95) -> Any:
         """Statistics of each figure over the current evaluations of ``lot`` (each device once):

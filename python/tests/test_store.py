@@ -147,6 +147,20 @@ def test_every_table_equals_the_command_lines_csv(filled, cli):
     )
 
 
+def test_history_svg_is_the_command_lines_file(filled, cli, tmp_path):
+    store, _ = filled
+    out = tmp_path / "history.svg"
+    subprocess.run([cli, "store", "history", "PY-2", "--store", store.location, "--svg", str(out)], check=True,
+                   capture_output=True)
+    svg = store.history_svg("PY-2")
+    assert svg == out.read_text(), "the Python plot and the command line's are the same bytes"
+    assert svg.startswith("<?xml") and "History of serial PY-2" in svg
+    one = store.history_svg("PY-2", figure="scale_factor")
+    assert "axis x: scale_factor" in one and one.count("axis x: ") == 1 < svg.count("axis x: ")
+    with pytest.raises(gyrolab.Error, match="NO-SUCH-SERIAL"):
+        store.history_svg("NO-SUCH-SERIAL")
+
+
 def test_history_has_every_summary_row_and_evaluation_json(filled):
     store, folders = filled
     h = store.history("PY-1")

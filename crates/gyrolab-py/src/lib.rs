@@ -918,6 +918,7 @@ fn _gyrolab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(evaluate_plan, m)?)?;
     m.add_function(wrap_pyfunction!(apply, m)?)?;
     m.add_function(wrap_pyfunction!(store::store_history, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_history_svg, m)?)?;
     m.add_function(wrap_pyfunction!(store::store_lot, m)?)?;
     m.add_function(wrap_pyfunction!(store::store_compare, m)?)?;
     m.add_function(wrap_pyfunction!(store::store_chart, m)?)?;

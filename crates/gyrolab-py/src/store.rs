@@ -70,6 +70,20 @@ pub fn store_history(
     table_out(py, tables::history_table(&rows))
 }
 
+/// The trend plot of a serial's history as an SVG document (the `--svg` file of `gyrolab store
+/// history`); only `figure` when given. `None`: no value to plot.
+#[pyfunction]
+#[pyo3(signature = (location, serial, figure=None))]
+pub fn store_history_svg(
+    py: Python<'_>,
+    location: Option<String>,
+    serial: String,
+    figure: Option<String>,
+) -> PyResult<Option<String>> {
+    let rows = with_store(py, location, false, |s| tables::history(s, &serial, figure.as_deref()))?;
+    tables::history_svg(&serial, &rows).map_err(|e| crate::error(e.to_string()))
+}
+
 /// Lot statistics per figure (capability intervals at `confidence`).
 #[pyfunction]
 #[pyo3(signature = (location, lot, confidence))]

@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 /// How raw logs are segmented; `None` keeps the default of [`SegmentOptions`].
 ///
 /// ```
-/// use gyrolab_eval::{raw_log::SegmentationRequest, EvalError};
+/// use gyrolab_eval::{rate::raw_log::SegmentationRequest, EvalError};
 /// # fn main() -> Result<(), EvalError> {
 /// let request = SegmentationRequest { settling_s: Some(2.0), min_plateau_s: Some(5.0), ..Default::default() };
 /// let o = request.options()?;
