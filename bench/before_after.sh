@@ -16,18 +16,7 @@ DATA=bench/.data
 mkdir -p "$DATA"
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs); load $(cut -d' ' -f1-3 /proc/loadavg)"
 
-best() {
-    local runs=$1 b="" t0 t1 s
-    shift
-    for _ in $(seq "$runs"); do
-        t0=$(date +%s%N)
-        "$@" >/dev/null 2>"$DATA/ba_err.txt" || { cat "$DATA/ba_err.txt" >&2; exit 1; }
-        t1=$(date +%s%N)
-        s=$(awk -v a="$t0" -v b="$t1" 'BEGIN{printf "%.4f", (b - a) / 1e9}')
-        if [ -z "$b" ] || awk -v a="$s" -v c="$b" 'BEGIN{exit !(a<c)}'; then b=$s; fi
-    done
-    echo "$b"
-}
+source bench/timing.sh
 row() { # name old new
     printf "| %s | %s | %s | %s |\n" "$1" "$2" "$3" "$(awk -v a="$2" -v b="$3" 'BEGIN{printf "%+.1f %%", (b / a - 1) * 100}')"
 }

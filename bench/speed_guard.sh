@@ -58,19 +58,7 @@ for name, n, rg, ra in (("python_60k", 60_000, 300, 300), ("python_10m", 10_000_
 PY
 )
 
-# wall seconds of a command, best of N (output discarded)
-best() {
-    local runs=$1 b="" t0 t1 s
-    shift
-    for _ in $(seq "$runs"); do
-        t0=$(date +%s%N)
-        "$@" >/dev/null 2>"$DATA/guard_err.txt" || { cat "$DATA/guard_err.txt" >&2; exit 1; }
-        t1=$(date +%s%N)
-        s=$(awk -v a="$t0" -v b="$t1" 'BEGIN{printf "%.4f", (b - a) / 1e9}')
-        if [ -z "$b" ] || awk -v a="$s" -v c="$b" 'BEGIN{exit !(a<c)}'; then b=$s; fi
-    done
-    echo "$b"
-}
+source bench/timing.sh
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN{printf "%.2f", a / b}'; }
 
 # The 10 M-line CSV (bench/allan_csv_vs_pandas.sh's case 1).
