@@ -2,7 +2,7 @@
 //! or a report folder.
 
 use crate::error::{CliError, CliResult};
-use gyrolab_io::manifest::NamedOutput;
+use gyrolab_io::provenance::NamedOutput;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -68,7 +68,7 @@ pub fn to_json<T: serde::Serialize>(value: &T) -> CliResult<String> {
 pub fn simulated_lines(files: &[PathBuf]) -> String {
     files
         .iter()
-        .filter(|f| gyrolab_eval::filter_export::is_simulated_record(f))
+        .filter(|f| gyrolab_io::provenance::is_gyrolab_simulation(f))
         .map(|f| {
             format!("SIMULATED: {} is a simulated record (gyrolab simulate), not a measured sensor\n", f.display())
         })

@@ -569,11 +569,6 @@ pub fn same_path(a: &Path, b: &Path) -> bool {
     gyrolab_io::atomic::same_written_path(a, b)
 }
 
-/// Whether a file was written by gyrolab's simulator (the SIMULATED mark of its exports).
-pub fn is_simulated_record(path: &Path) -> bool {
-    gyrolab_io::noise_export::is_gyrolab_simulation(path)
-}
-
 /// The noise export of one record (an outcome of [`crate::allan::analyse_records`]) and the
 /// warnings to show (terms that are bounds, not estimated, overbound factors).
 pub fn noise_export(
@@ -588,7 +583,7 @@ pub fn noise_export(
             None => file.display().to_string(),
         },
         rate_hz: 1.0 / outcome.sample_interval_s,
-        simulated: is_simulated_record(file),
+        simulated: gyrolab_io::provenance::is_gyrolab_simulation(file),
         rostopic: outcome.topic.as_ref().map(|t| t.topic.clone()),
         motion: outcome.analyses.iter().filter_map(|a| a.motion_line()).collect(),
     };

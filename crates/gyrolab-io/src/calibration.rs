@@ -168,7 +168,10 @@ impl CalibrationFile {
     pub fn to_toml(&self) -> Result<String, toml::ser::Error> {
         let body = toml::to_string_pretty(self)?;
         let mark = match &self.simulated {
-            Some(how) => format!("# SIMULATED DATA: this calibration comes from simulated records ({how}).\n"),
+            Some(how) => format!(
+                "{}: this calibration comes from simulated records ({how}).\n",
+                crate::provenance::SIMULATED_DATA_MARK
+            ),
             None => String::new(),
         };
         Ok(format!(

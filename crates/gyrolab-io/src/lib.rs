@@ -2,7 +2,8 @@
 //!
 //! - [`error`]: the [`DataError`] every reader returns;
 //! - [`atomic`]: outputs written to a temporary file and renamed into place;
-//! - [`manifest`]: a report folder's outputs and their manifest (names, SHA-256, sizes);
+//! - [`provenance`]: where outputs come from: the SIMULATED marks of records and outputs, a
+//!   report folder's outputs and their manifest (names, SHA-256, sizes);
 //! - [`sniff`]: what a file is, by its first bytes;
 //! - [`text`]: a small delimited-text parser with line numbers;
 //! - [`rate_table`]: rate-table records in the long and wide layouts;
@@ -27,10 +28,10 @@ pub mod contained;
 pub mod decimal;
 pub mod error;
 pub mod input_file;
-pub mod manifest;
 pub mod noise_export;
 pub mod pages;
 pub mod parquet_table;
+pub mod provenance;
 pub mod rate_table;
 pub mod raw_log;
 pub mod recording;

@@ -17,6 +17,7 @@ use gyrolab_eval::error::{EvalError, EvalResult};
 use gyrolab_eval::progress::Progress;
 use gyrolab_io::DataError;
 use gyrolab_report::allan::{allan_json_with, AllanJson};
+use gyrolab_report::table::csv_field;
 use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 use std::collections::{BTreeMap, HashMap};
@@ -27,9 +28,6 @@ use std::sync::{Arc, Mutex};
 /// File name extensions a folder or a glob contributes as records (other files are passed
 /// over); a file named on its own or in a list is taken whatever its name.
 pub const RECORD_EXTENSIONS: [&str; 9] = ["csv", "tsv", "txt", "dat", "parquet", "mcap", "bag", "ulg", "log"];
-
-/// The first line of every record `gyrolab simulate` writes: such records are marked SIMULATED.
-pub const SIMULATED_MARK: &[u8] = b"# gyrolab simulated";
 
 /// The type of a result column.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -304,7 +302,8 @@ fn hex(bytes: &[u8]) -> String {
 }
 
 /// SHA-256 of a file's bytes (lower-case hex) and whether it is a SIMULATED record (its first
-/// line starts with [`SIMULATED_MARK`]: then that line, without `# `).
+/// line says the simulator wrote it: then that line, without `# `;
+/// [`gyrolab_io::provenance::simulator_title`]).
 pub fn hash_file(path: &Path) -> Result<(String, Option<String>), DataError> {
     let err = |e: std::io::Error| DataError::new(path, format!("cannot read the file: {e}"));
     // A regular file only (a FIFO named among the inputs would block).
@@ -322,11 +321,7 @@ pub fn hash_file(path: &Path) -> Result<(String, Option<String>), DataError> {
         }
         hasher.update(&buf[..n]);
     }
-    let simulated = first.starts_with(SIMULATED_MARK).then(|| {
-        let line = first.split(|&b| b == b'\n').next().unwrap_or(&[]); // ok: split yields at least one piece
-        String::from_utf8_lossy(&line[2..]).trim_end().to_string()
-    });
-    Ok((hex(&hasher.finalize()), simulated))
+    Ok((hex(&hasher.finalize()), gyrolab_io::provenance::simulator_title(&first)))
 }
 
 /// The inputs a batch found, and the entries it passed over with the reason.
@@ -653,14 +648,6 @@ pub fn results_csv(rows: &[ResultRow]) -> String {
         s.push('\n');
     }
     s
-}
-
-fn csv_field(t: &str) -> String {
-    if t.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", t.replace('"', "\"\""))
-    } else {
-        t.to_string()
-    }
 }
 
 /// The results as a Parquet file (one row group, zstd): the [`COLUMNS`] as optional UTF-8,

@@ -276,7 +276,7 @@ const PROGRAM_SEED: u64 = 2026;
 /// The whole test program of a lab on SIMULATED records ([`gyrolab_eval::program_sim`]): its plan and
 /// records written to a temporary folder, evaluated as `gyrolab eval` does, and its report folder's
 /// files named `program_<file>` (the plan itself as `program_plan.toml`).
-fn program_outputs(progress: &dyn Progress) -> EvalResult<Vec<gyrolab_io::manifest::NamedOutput>> {
+fn program_outputs(progress: &dyn Progress) -> EvalResult<Vec<gyrolab_io::provenance::NamedOutput>> {
     progress.message("simulating and evaluating a whole test program");
     let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.subsec_nanos());
     let dir = TempDir(std::env::temp_dir().join(format!("gyrolab-program-{}-{nanos}", std::process::id())));
@@ -285,12 +285,12 @@ fn program_outputs(progress: &dyn Progress) -> EvalResult<Vec<gyrolab_io::manife
     let plan = crate::test_plan::read_test_plan(&dir.0.join("plan.toml"))?;
     let folder = crate::test_plan::evaluate_test_plan(&plan, "program_plan.toml", &gyrolab_eval::progress::Silent)?;
     let mut outputs =
-        vec![gyrolab_io::manifest::NamedOutput { name: "program_plan.toml".into(), bytes: plan_text.into_bytes() }];
+        vec![gyrolab_io::provenance::NamedOutput { name: "program_plan.toml".into(), bytes: plan_text.into_bytes() }];
     outputs.extend(
         folder
             .outputs
             .into_iter()
-            .map(|o| gyrolab_io::manifest::NamedOutput { name: format!("program_{}", o.name), bytes: o.bytes }),
+            .map(|o| gyrolab_io::provenance::NamedOutput { name: format!("program_{}", o.name), bytes: o.bytes }),
     );
     Ok(outputs)
 }

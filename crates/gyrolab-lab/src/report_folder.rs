@@ -10,7 +10,7 @@ use gyrolab_eval::outcome::rate::AxisReport;
 use gyrolab_eval::outcome::triad::TriadReport;
 use gyrolab_eval::progress::Progress;
 use gyrolab_eval::rate::{calibration_file, EvaluatedAxis};
-use gyrolab_io::manifest::{manifest_json, NamedOutput, MANIFEST};
+use gyrolab_io::provenance::{manifest_json, NamedOutput, MANIFEST};
 use gyrolab_report::html::{rate_section, render_html, Report, ReportHeader, ReportSection, SummaryTable};
 use gyrolab_report::rate::rate_figures;
 use gyrolab_report::rate::AxisJson;
@@ -51,7 +51,7 @@ fn mark_simulated_csvs(outputs: &mut [NamedOutput], simulated_device: Option<&st
             continue;
         }
         let line = match simulated_device {
-            Some(how) => format!("# SIMULATED DATA: {}\n", how.replace('\n', " ")),
+            Some(how) => format!("{}: {}\n", gyrolab_io::provenance::SIMULATED_DATA_MARK, how.replace('\n', " ")),
             None => SIMULATED_INPUTS_LINE.to_string(),
         };
         o.bytes.splice(0..0, line.into_bytes());

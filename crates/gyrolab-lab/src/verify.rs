@@ -115,7 +115,7 @@ impl Verification {
 /// without a manifest. A manifest that cannot be read is an error naming it.
 #[allow(clippy::type_complexity)]
 fn check_outputs(dir: &Path) -> EvalResult<Option<(Vec<OutputCheck>, Vec<String>, Vec<String>)>> {
-    use gyrolab_io::manifest::{Manifest, MANIFEST};
+    use gyrolab_io::provenance::{Manifest, MANIFEST};
     let path = dir.join(MANIFEST);
     if !path.exists() {
         return Ok(None);

@@ -609,7 +609,7 @@ fn render_export(
     let export_record = ExportRecord {
         record: record.to_string(),
         rate_hz,
-        simulated: gyrolab_eval::filter_export::is_simulated_record(Path::new(record)),
+        simulated: gyrolab_io::provenance::is_gyrolab_simulation(Path::new(record)),
         rostopic: None,
         motion,
     };

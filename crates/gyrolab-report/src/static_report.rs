@@ -8,6 +8,7 @@ use crate::plot::{
     scatter_fit_plot, Annotation, Axis, Figure, LegendCorner, Orientation, Panel, PlotError, RefLine, Series,
     SeriesStyle,
 };
+use crate::table::csv_field;
 use gyrolab::figures::AxisFigures;
 use gyrolab::format::{short, sig, sig_opt};
 use gyrolab::limits::Limit;
@@ -221,15 +222,7 @@ impl StaticAxisReport {
 }
 
 fn simulated_comment(r: &StaticAxisReport) -> String {
-    r.simulated.as_ref().map_or_else(String::new, |s| format!("# SIMULATED DATA: {s}\n"))
-}
-
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
+    r.simulated.as_ref().map_or_else(String::new, |s| format!("{}: {s}\n", gyrolab_io::provenance::SIMULATED_DATA_MARK))
 }
 
 /// `bias_tests.csv`: one row per static test of every axis.

@@ -84,7 +84,9 @@ pub struct Table {
     pub rows: Vec<Vec<Cell>>,
 }
 
-fn csv_field(s: &str) -> String {
+/// A CSV field (RFC 4180): quoted when it holds a comma, a quote or a line break (CR or LF),
+/// quotes doubled. The one quoting of every CSV gyrolab writes.
+pub fn csv_field(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", s.replace('"', "\"\""))
     } else {

@@ -3,16 +3,9 @@
 
 use crate::html::SummaryTable;
 use crate::rate::AxisJson;
+use crate::table::csv_field;
 use gyrolab::figures::AxisFigures;
 use gyrolab::limits::Limit;
-
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
 
 fn opt(v: Option<f64>) -> String {
     v.map_or_else(String::new, |x| x.to_string())

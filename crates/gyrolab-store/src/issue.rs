@@ -16,7 +16,7 @@ use crate::account::{self, Need};
 use crate::db::{returned_id, Columns, DbError, Exec, Kind, Row, Val};
 use crate::{chain, schema, sign, Actor, Store, StoreError, StoreResult};
 use ed25519_dalek::SigningKey;
-use gyrolab_io::manifest::{manifest_json, Manifest, NamedOutput, MANIFEST};
+use gyrolab_io::provenance::{manifest_json, Manifest, NamedOutput, MANIFEST};
 use serde::Serialize;
 
 /// The meaning of an issuing signature.

@@ -398,8 +398,8 @@ fn hash_inputs(parsed: &gyrolab_io_plan::TestPlan) -> StoreResult<Vec<FileRecord
 }
 
 /// The report folder's manifest, when it has one (a folder written before 0.3 has none).
-fn read_manifest(dir: &Path) -> StoreResult<Option<gyrolab_io::manifest::Manifest>> {
-    let path = dir.join(gyrolab_io::manifest::MANIFEST);
+fn read_manifest(dir: &Path) -> StoreResult<Option<gyrolab_io::provenance::Manifest>> {
+    let path = dir.join(gyrolab_io::provenance::MANIFEST);
     if !path.is_file() {
         return Ok(None);
     }
@@ -459,7 +459,7 @@ pub fn from_report_folder_with(
     if let Some(m) = &manifest {
         names.retain(|p| {
             let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-            name == gyrolab_io::manifest::MANIFEST || name == "report.pdf" || m.files.iter().any(|f| f.name == name)
+            name == gyrolab_io::provenance::MANIFEST || name == "report.pdf" || m.files.iter().any(|f| f.name == name)
         });
         for f in &m.files {
             if !names.iter().any(|p| p.file_name().is_some_and(|n| n.to_string_lossy() == f.name)) {

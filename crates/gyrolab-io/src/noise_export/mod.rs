@@ -588,22 +588,6 @@ impl NoiseExport {
     }
 }
 
-/// Whether a file was written by gyrolab's simulator, or is a gyrolab output made from simulated
-/// records (a calibration.toml, a report's CSV table: its first line says so), for the
-/// SIMULATED mark of the exports; `false` when it cannot be read.
-pub fn is_gyrolab_simulation(path: &std::path::Path) -> bool {
-    use std::io::Read;
-    let mut head = [0u8; 64];
-    // A regular file only: a FIFO among the inputs must not block here.
-    let Ok((mut f, _)) = crate::input_file::open_regular(path) else { return false };
-    let n = f.read(&mut head).unwrap_or(0);
-    let text = String::from_utf8_lossy(&head[..n]);
-    let text = text.trim_start_matches('\u{feff}');
-    // The simulator's records, and gyrolab's outputs made from simulated records (a
-    // calibration.toml, the CSV tables of a report folder).
-    text.starts_with("# gyrolab simulated") || text.starts_with("# SIMULATED DATA")
-}
-
 #[cfg(test)]
 mod tests;
 

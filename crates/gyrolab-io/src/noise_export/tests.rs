@@ -210,12 +210,12 @@ fn simulated_marks_are_read_from_the_first_line() {
     for (name, text, want) in cases {
         let p = dir.path().join(name);
         std::fs::write(&p, text).unwrap();
-        assert_eq!(super::is_gyrolab_simulation(&p), want, "{name}");
+        assert_eq!(crate::provenance::is_gyrolab_simulation(&p), want, "{name}");
     }
-    assert!(!super::is_gyrolab_simulation(&dir.path().join("missing.csv")));
+    assert!(!crate::provenance::is_gyrolab_simulation(&dir.path().join("missing.csv")));
     let fifo = dir.path().join("fifo.csv");
     let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
     // SAFETY: a valid NUL-terminated path; mkfifo only creates the node.
     assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
-    assert!(!super::is_gyrolab_simulation(&fifo));
+    assert!(!crate::provenance::is_gyrolab_simulation(&fifo));
 }

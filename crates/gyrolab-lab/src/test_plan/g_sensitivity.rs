@@ -373,7 +373,7 @@ fn axis_json(a: &AxisResult<'_>, base: &Path) -> Value {
 fn records_csv(axes: &[AxisResult<'_>], base: &Path) -> String {
     let mut s = String::new();
     if axes.iter().any(|a| a.simulated.is_some()) {
-        s.push_str("# SIMULATED DATA\n");
+        s.push_str(&format!("{}\n", gyrolab_io::provenance::SIMULATED_DATA_MARK));
     }
     s.push_str(
         "axis,orientation,f_x_g,f_y_g,f_z_g,file,bias_dph,earth_rate_removed_dph,corrected_bias_dph,residual_dph\n",

@@ -164,7 +164,7 @@ pub fn evaluate_test_plan(plan: &TestPlan, plan_file: &str, progress: &dyn Progr
         let simulated: Vec<String> = plan
             .input_files()
             .into_iter()
-            .filter(|f| gyrolab_io::noise_export::is_gyrolab_simulation(f))
+            .filter(|f| gyrolab_io::provenance::is_gyrolab_simulation(f))
             .map(|f| f.file_name().map_or_else(|| f.display().to_string(), |n| n.to_string_lossy().into_owned()))
             .collect();
         if !simulated.is_empty() {

@@ -286,7 +286,7 @@ pub fn evaluate_power_ups(
 fn warmup_csv(r: &WarmupAxisReport) -> String {
     let mut s = String::new();
     if let Some(sim) = &r.simulated {
-        s.push_str(&format!("# SIMULATED DATA: {sim}\n"));
+        s.push_str(&format!("{}: {sim}\n", gyrolab_io::provenance::SIMULATED_DATA_MARK));
     }
     s.push_str("time_from_power_on_s,window_mean_bias_dph\n");
     for (t, b) in &r.report.result.windows {

@@ -147,10 +147,15 @@ fn evaluate_one(
         None => core::threshold(&record.groups, k),
     }
     .map_err(|e| located(plan_file, t, &record, e))?;
-    let simulated = record.comments.first().filter(|c| c.starts_with("gyrolab simulated")).map(|_| {
-        let truth: Vec<&str> = record.comments.iter().filter(|c| c.starts_with("truth.")).map(String::as_str).collect();
-        format!("{} ({})", t.file_as_written, if truth.is_empty() { "simulator".into() } else { truth.join("; ") })
-    });
+    let simulated = record
+        .comments
+        .first()
+        .filter(|c| c.starts_with(gyrolab_io::provenance::SIMULATOR_MARK.trim_start_matches("# ")))
+        .map(|_| {
+            let truth: Vec<&str> =
+                record.comments.iter().filter(|c| c.starts_with("truth.")).map(String::as_str).collect();
+            format!("{} ({})", t.file_as_written, if truth.is_empty() { "simulator".into() } else { truth.join("; ") })
+        });
     Ok(StepReport {
         kind,
         axis: t.axis.clone(),
@@ -166,7 +171,7 @@ fn evaluate_one(
 fn rates_csv(reports: &[StepReport]) -> String {
     // Rows from simulated records say so on the first line (issue 33), as the other CSVs do.
     let mut s = match reports.iter().find_map(|r| r.simulated.as_deref()) {
-        Some(how) => format!("# SIMULATED DATA: {}\n", how.replace('\n', " ")),
+        Some(how) => format!("{}: {}\n", gyrolab_io::provenance::SIMULATED_DATA_MARK, how.replace('\n', " ")),
         None => String::new(),
     };
     s.push_str(
