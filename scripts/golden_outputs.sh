@@ -2,7 +2,7 @@
 # The deterministic outputs of one gyrolab build, for the golden comparison of issue 52
 # (crates/gyrolab-cli/tests/integration/golden.rs runs the same commands): the paper's demo
 # folder, the simulated test program's report folder, the export files of every filter stack,
-# a batch table, rate and bias JSON, and the store's rows of a stored report.
+# a batch table, rate and bias JSON, and the store's rows and trend plot of a stored report.
 # Usage: scripts/golden_outputs.sh GYROLAB_BINARY OUT_DIR   (OUT_DIR must not exist)
 set -u
 # Every command runs in OUT_DIR with relative paths, as `gyrolab` found on PATH (the records'
@@ -32,5 +32,6 @@ run rate rate paper_rate_table_x.csv --json
 run bias bias "static.csv" --json
 run store_add store add "program_report" --store "store.db"
 run store_history store history SIM-0001 --csv --store "store.db"
+run store_svg store history SIM-0001 --store "store.db" --svg history.svg
 run store_show store show 1 --json --store "store.db"
 rm -rf store.db batch/batch-journal.jsonl .bin

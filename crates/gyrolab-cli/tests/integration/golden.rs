@@ -1,8 +1,8 @@
 //! The same outputs before and after (issue 52): `scripts/golden_outputs.sh` runs the paper's
 //! demo, the simulated test program's evaluation, the export files of every filter stack, a batch,
-//! rate and bias JSON and a stored report's rows with this build, and every output (72 files) must
-//! have the SHA-256 recorded in `tests/data/golden_outputs.sha256`, byte for byte once the parts
-//! that change from run to run are masked ([`normalise`]: times, dates, generated report numbers,
+//! rate and bias JSON and a stored report's rows and trend plot with this build, and every output
+//! (74 files) must have the SHA-256 recorded in `tests/data/golden_outputs.sha256`, byte for byte
+//! once the parts that change from run to run are masked ([`normalise`]: times, dates, generated report numbers,
 //! and the hashes in manifests and store listings of files that hold them).
 //!
 //! The digests were made by the build before the workspace was restructured (commit c9b9e47):
