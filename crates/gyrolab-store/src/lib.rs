@@ -757,23 +757,10 @@ impl Store {
                 return Err(StoreError::Refused { store: self.name.clone(), message: m });
             }
         }
-        let store = self.name.clone();
         let now = now_rfc3339();
-        let dberr = |m: DbError| StoreError::Database { store: store.clone(), message: m.to_string() };
-        let postgres = self.is_postgres();
-        let id = self.transaction(|x| {
-            if postgres {
-                // One writer at a time appends to the chain.
-                x.exec("SELECT pg_advisory_xact_lock(7291836)", &[]).map_err(&dberr)?;
-            }
-            let quick = chain::quick_check(x, postgres).map_err(&dberr)?;
-            if let Some(first) = quick.problems.first() {
-                let more = match quick.problems.len() - 1 {
-                    0 => String::new(),
-                    n => format!(" (and {n} more)"),
-                };
-                return Err(StoreError::Tampered { store: store.clone(), first: first.to_string(), more });
-            }
+        // The chain's lock and the quick check first ([`Store::write`]).
+        self.write(|x, store| {
+            let dberr = |m: DbError| StoreError::Database { store: store.to_string(), message: m.to_string() };
             let need = match revision.map(|r| r.kind) {
                 Some(RevisionKind::Approval) => account::Need::Approver,
                 _ => account::Need::Store,
@@ -784,11 +771,11 @@ impl Store {
             } else {
                 need
             };
-            let (account_id, actor_name) = account::check_actor(x, &store, actor, need)?;
+            let (account_id, actor_name) = account::check_actor(x, store, actor, need)?;
             if let (Some(r), Some(me)) = (revision, account_id) {
                 if r.kind == RevisionKind::Approval && issue::stored_by(x, r.supersedes).map_err(&dberr)?.contains(&me) {
                     return Err(StoreError::Refused {
-                        store: store.clone(),
+                        store: store.to_string(),
                         message: format!(
                             "self-approval refused: account {actor_name:?} stored evaluation {} or a revision of it; \
                              another approver must approve it",
@@ -809,7 +796,7 @@ impl Store {
                     .map_err(&dberr)?;
                 if let Some(row) = taken.first() {
                     return Err(StoreError::Refused {
-                        store: store.clone(),
+                        store: store.to_string(),
                         message: format!(
                             "evaluation {} is already superseded by {}: revise the current revision",
                             r.supersedes,
@@ -920,10 +907,6 @@ impl Store {
             account::audit(x, account_id, &actor_name, action, Some(id), detail.as_deref()).map_err(&dberr)?;
             pause_for_test();
             Ok(id)
-        });
-        id.map_err(|e| match e {
-            StoreError::Database { store, message } => StoreError::Database { store, message: self.mask(message) },
-            other => other,
         })
     }
 
