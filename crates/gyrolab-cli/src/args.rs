@@ -173,7 +173,7 @@ pub fn stated_reference_note(file: &str, r: &gyrolab_eval::simulate::StatedRefer
 #[derive(Debug, Clone, Args)]
 pub struct StoreLocation {
     /// The store: an SQLite file or a postgres:// URL (default: GYROLAB_STORE, else gyrolab.db
-    /// in the current folder; for `store add`, beside the plan).
+    /// in the current folder, for every command).
     #[arg(long = "store", value_name = "PATH|URL")]
     pub store: Option<String>,
 }

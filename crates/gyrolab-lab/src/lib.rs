@@ -24,6 +24,7 @@ pub mod evaluate;
 pub mod exports;
 pub mod issue;
 pub mod paper;
+pub mod raw_records;
 pub mod records;
 pub mod reevaluate;
 pub mod report_folder;

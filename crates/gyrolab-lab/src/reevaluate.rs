@@ -1,14 +1,40 @@
-//! Re-evaluation: the stored plan and inputs evaluated again under this build, hash-checked
-//! first (the plan file and every input must still have the SHA-256 stored with the
-//! evaluation); the new report folder is written, stored as a revision of kind `reevaluation`,
-//! and every changed figure and verdict is listed.
+//! Re-evaluation: the stored plan and inputs evaluated again under this build: where they are,
+//! when the plan file and every input still have the SHA-256 stored with the evaluation, else
+//! from the raw records the store keeps ([`crate::raw_records`]); the new report folder is
+//! written, stored as a revision of kind `reevaluation`, and every changed figure and verdict
+//! is listed.
 
 use crate::test_plan::{evaluate_test_plan, read_test_plan};
 use gyrolab_store::query::{diff_figures, FigureChange};
-use gyrolab_store::record::{from_report_folder, hash_bytes, hash_file};
+use gyrolab_store::record::{from_report_folder, from_report_folder_with, hash_bytes, hash_file, EvaluationRecord};
 use gyrolab_store::{Changes, Revision, RevisionKind, Store, StoreError, StoreResult};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
+
+/// Why evaluation `id`'s plan and inputs cannot be evaluated where they were: the first one
+/// missing or changed since (its SHA-256 and size against the stored ones).
+fn in_place(rec: &EvaluationRecord, id: i64) -> Result<(), String> {
+    let plan_bytes =
+        std::fs::read(&rec.plan_path).map_err(|e| format!("{}: cannot read the plan's file: {e}", rec.plan_path))?;
+    if hash_bytes(&plan_bytes) != rec.plan_sha256 {
+        return Err(format!(
+            "{}: changed since evaluation {id} (SHA-256 {} stored, {} now)",
+            rec.plan_path,
+            rec.plan_sha256,
+            hash_bytes(&plan_bytes)
+        ));
+    }
+    for f in &rec.inputs {
+        let (sha, size) = hash_file(Path::new(&f.path)).map_err(|e| e.to_string())?;
+        if sha != f.sha256 || size != f.size_bytes {
+            return Err(format!(
+                "{}: changed since evaluation {id} (SHA-256 {}, {} bytes stored; {sha}, {size} bytes now)",
+                f.path, f.sha256, f.size_bytes
+            ));
+        }
+    }
+    Ok(())
+}
 
 /// The outcome of a re-evaluation.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -53,33 +79,29 @@ pub fn reevaluate_as(
     }
     let rec = &old.record;
     let plan_path = PathBuf::from(&rec.plan_path);
-    let plan_bytes = std::fs::read(&plan_path).map_err(|e| StoreError::Input {
-        path: rec.plan_path.clone(),
-        message: format!("cannot read the stored plan's file: {e}"),
-    })?;
-    if hash_bytes(&plan_bytes) != rec.plan_sha256 {
-        return Err(StoreError::Input {
-            path: rec.plan_path.clone(),
-            message: format!(
-                "changed since evaluation {id} (SHA-256 {} stored, {} now): not re-evaluated",
-                rec.plan_sha256,
-                hash_bytes(&plan_bytes)
-            ),
-        });
-    }
-    for f in &rec.inputs {
-        let (sha, size) = hash_file(Path::new(&f.path))?;
-        if sha != f.sha256 || size != f.size_bytes {
-            return Err(StoreError::Input {
-                path: f.path.clone(),
-                message: format!(
-                    "changed since evaluation {id} (SHA-256 {}, {} bytes stored; {sha}, {size} bytes now): not re-evaluated",
-                    f.sha256, f.size_bytes
-                ),
-            });
+    // In place when the plan and every input are still where they were, with the hashes
+    // stored; else from the raw records the store keeps (schema 6), laid out in a temporary
+    // folder as they stood relative to the plan. The report names the original plan either way.
+    let in_place = in_place(rec, id);
+    let staged;
+    let (eval_plan, inputs_from_store) = match in_place {
+        Ok(()) => (plan_path.clone(), None),
+        Err(why) => {
+            staged =
+                tempfile::Builder::new().prefix("gyrolab-reevaluate-").tempdir().map_err(|e| StoreError::Input {
+                    path: std::env::temp_dir().display().to_string(),
+                    message: format!("cannot write: {e}"),
+                })?;
+            let restored = crate::raw_records::restore_into(store, id, staged.path()).map_err(|e| match e {
+                StoreError::Refused { store, message } => {
+                    StoreError::Refused { store, message: format!("{why}; and from the store: {message}") }
+                }
+                e => e,
+            })?;
+            (restored.plan, Some(rec.inputs.clone()))
         }
-    }
-    let plan = read_test_plan(&plan_path)
+    };
+    let plan = read_test_plan(&eval_plan)
         .map_err(|e| StoreError::Input { path: rec.plan_path.clone(), message: e.to_string() })?;
     let folder = evaluate_test_plan(&plan, &rec.plan_path, &gyrolab_eval::Silent)
         .map_err(|e| StoreError::Input { path: rec.plan_path.clone(), message: e.to_string() })?;
@@ -87,7 +109,15 @@ pub fn reevaluate_as(
     let inputs: Vec<&Path> = folder.inputs.iter().map(PathBuf::as_path).collect();
     gyrolab_io::atomic::write_folder(out, &files, &inputs)
         .map_err(|e| StoreError::Input { path: e.path.display().to_string(), message: e.to_string() })?;
-    let mut new = from_report_folder(out, Some(&plan_path))?;
+    let mut new = match inputs_from_store {
+        // The raw records are the store's already: hashed again here, not packed twice.
+        Some(stored) => {
+            let mut new = from_report_folder_with(out, Some(&eval_plan), Some(stored), false)?;
+            new.plan_path = rec.plan_path.clone();
+            new
+        }
+        None => from_report_folder(out, Some(&plan_path))?,
+    };
     // The facts recorded about the device stay those of the revision superseded (corrections
     // included); the figures are the new ones.
     new.serial = rec.serial.clone();

@@ -29,7 +29,7 @@ fn with_store<T: Send>(
     query: impl FnOnce(&mut Store) -> Result<T, StoreError> + Send,
 ) -> PyResult<T> {
     py.detach(|| {
-        let mut store = Store::open(&resolve_location(location.as_deref(), None), create)?;
+        let mut store = Store::open(&resolve_location(location.as_deref()), create)?;
         query(&mut store)
     })
     .map_err(store_err)

@@ -1,7 +1,7 @@
 //! The hash chain over every stored record (issue 53; docs/STORE.md "Threat model and checks").
 //!
 //! Every row the store inserts into a record table ([`CHAINED`]: `evaluation`, `input_file`,
-//! `report_file`, `figure`; approvals and corrections are `evaluation` rows; from schema version
+//! `report_file`, `figure`, from schema version 6 `input_content`; approvals and corrections are `evaluation` rows; from schema version
 //! 4 also `account`, `account_change`, `audit_event`, `signing_key` and `issue`) gets one link in the
 //! append-only table `chain` (`seq`, `tbl`, `row_id`, `fields`, `hash`), computed here in Rust,
 //! inside the transaction that inserts the row, from the row **as read back** from the database:
@@ -22,7 +22,7 @@
 //! the check names the columns that differ.
 //!
 //! Links are appended per evaluation in one order: the `evaluation` row, then its `input_file`,
-//! `report_file` and `figure` rows, each by `id`, then its audit event; an account, an account
+//! `report_file`, `figure` and `input_content` rows, each by `id`, then its audit event; an account, an account
 //! change, a signing key or an issue is chained when it is inserted, then its audit event
 //! ([`append_row`]). Migration 3 builds the chain over the rows of an existing store in that
 //! order, evaluations by `id` ([`build_existing`]).
@@ -44,7 +44,7 @@ pub struct ChainedTable {
 use Kind::{IOpt, B, F, T};
 
 /// Every table whose rows are records, in the order an evaluation's rows are chained.
-pub const CHAINED: [ChainedTable; 9] = [
+pub const CHAINED: [ChainedTable; 10] = [
     ChainedTable {
         name: "evaluation",
         columns: &[
@@ -102,6 +102,13 @@ pub const CHAINED: [ChainedTable; 9] = [
             ("verdict", T),
             ("simulated", IOpt),
         ],
+    },
+    // Schema version 6: the raw records, one row per SHA-256, chained after the figures of the
+    // evaluation that first brought them (an evaluation before version 6 has none, so its links
+    // are unchanged).
+    ChainedTable {
+        name: "input_content",
+        columns: &[("id", IOpt), ("evaluation_id", IOpt), ("sha256", T), ("size_bytes", IOpt), ("content_zstd", B)],
     },
     // Schema version 4 (issue 53): accounts, their changes, the audit trail, the lab's public
     // keys and issued reports, each row chained when the store inserts it ([`append_row`]).
@@ -173,7 +180,7 @@ pub const CHAINED: [ChainedTable; 9] = [
 ];
 
 /// How many of [`CHAINED`]'s tables (the first ones) hold an evaluation's rows.
-pub const EVALUATION_TABLES: usize = 4;
+pub const EVALUATION_TABLES: usize = 5;
 
 /// How many of the last links the quick check (every write) verifies.
 pub const QUICK_LINKS: i64 = 32;
@@ -278,9 +285,13 @@ fn columns_sql(t: &ChainedTable) -> String {
 
 /// The rows of one evaluation in chain order: (table, row).
 #[allow(clippy::type_complexity)]
-fn evaluation_rows(x: &mut dyn Exec, eval_id: i64) -> Result<Vec<(&'static ChainedTable, i64, Vec<Val>)>, DbError> {
+fn evaluation_rows(
+    x: &mut dyn Exec,
+    eval_id: i64,
+    tables: usize,
+) -> Result<Vec<(&'static ChainedTable, i64, Vec<Val>)>, DbError> {
     let mut out = Vec::new();
-    for t in &CHAINED[..EVALUATION_TABLES] {
+    for t in &CHAINED[..tables] {
         let filter = if t.name == "evaluation" { "id" } else { "evaluation_id" };
         // ok: table and column names from the constant CHAINED spec, the id a bound parameter
         let sql = format!("SELECT {} FROM {} WHERE {filter} = $1 ORDER BY id", columns_sql(t), t.name); // ok: constant spec, no value
@@ -330,8 +341,16 @@ fn head(x: &mut dyn Exec) -> Result<(i64, [u8; 32]), DbError> {
 /// Appends the links of evaluation `eval_id` and its rows (inside the transaction that inserted
 /// them); the new head.
 pub fn append_evaluation(x: &mut dyn Exec, eval_id: i64) -> Result<String, DbError> {
+    append_evaluation_tables(x, eval_id, EVALUATION_TABLES)
+}
+
+/// The evaluation tables a store had when migration 3 built its chain (`input_content` came
+/// with version 6).
+const TABLES_AT_VERSION_3: usize = 4;
+
+fn append_evaluation_tables(x: &mut dyn Exec, eval_id: i64, tables: usize) -> Result<String, DbError> {
     let (mut seq, mut prev) = head(x)?;
-    let rows = evaluation_rows(x, eval_id)?;
+    let rows = evaluation_rows(x, eval_id, tables)?;
     let (mut seqs, mut tbls, mut ids, mut fields, mut hashes) = (vec![], vec![], vec![], vec![], vec![]);
     for (t, id, row) in &rows {
         seq += 1;
@@ -384,7 +403,7 @@ pub fn current_head(x: &mut dyn Exec) -> Result<Option<String>, DbError> {
 pub fn build_existing(x: &mut dyn Exec) -> Result<(), DbError> {
     let ids = x.rows("SELECT id FROM evaluation ORDER BY id", &[], &[("id", Kind::I)])?;
     for r in ids {
-        append_evaluation(x, r.int("id")?)?;
+        append_evaluation_tables(x, r.int("id")?, TABLES_AT_VERSION_3)?;
     }
     Ok(())
 }
@@ -431,7 +450,8 @@ pub struct CheckReport {
     pub links_checked: i64,
     /// Rows per chained table (table, rows); full check only.
     pub rows: Vec<(String, i64)>,
-    /// Report files whose stored bytes were re-hashed and found equal to their SHA-256 and size.
+    /// Report files and raw records whose stored bytes were re-hashed and found equal to their
+    /// SHA-256 and size.
     pub files_checked: i64,
     /// Report files stored as hashes only (no bytes to check: schema version 1, over 64 MiB).
     pub files_hash_only: i64,
@@ -740,7 +760,11 @@ pub fn full_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, DbErr
         let total = count(x, &format!("SELECT COUNT(*) AS n FROM {}", t.name), &[])?; // ok: constant spec, no value
         report.rows.push((t.name.to_string(), total));
         // Pages of rows (report files hold up to 64 MiB each: a few at a time).
-        let page_rows = if t.name == "report_file" { 8 } else { 256 };
+        let page_rows = match t.name {
+            "report_file" => 8,
+            "input_content" => 1, // a raw record each (up to MAX_KEPT_INPUT_BYTES before compression)
+            _ => 256,
+        };
         let (cols, name) = (columns_sql(t), t.name);
         let sql = format!("SELECT {cols} FROM {name} WHERE id > $1 ORDER BY id LIMIT {page_rows}"); // ok: constants
         let mut last = i64::MIN;
@@ -774,8 +798,8 @@ pub fn full_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, DbErr
                 match row {
                     Ok(row) => {
                         digests.insert((t.name, *id), row_digest(t, &chained_values(t, row)?));
-                        if t.name == "report_file" {
-                            check_file(row, &mut report, &mut file_problems)?;
+                        if t.name == "report_file" || t.name == "input_content" {
+                            check_file(t.name, row, &mut report, &mut file_problems)?;
                         }
                     }
                     Err(e) => {
@@ -840,15 +864,19 @@ pub fn full_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, DbErr
     Ok(report)
 }
 
-/// Re-hashes one stored report file (a `report_file` row as read for the chain).
-fn check_file(row: &Row, report: &mut CheckReport, problems: &mut Vec<Problem>) -> Result<(), DbError> {
+/// Re-hashes one stored file (a `report_file` or `input_content` row as read for the chain).
+fn check_file(table: &str, row: &Row, report: &mut CheckReport, problems: &mut Vec<Problem>) -> Result<(), DbError> {
     let Some(packed) = row.bytes("content_zstd")? else {
         report.files_hash_only += 1;
         return Ok(());
     };
-    let (id, name, sha256) = (row.int("id")?, row.string("name")?, row.string("sha256")?);
+    let (id, sha256) = (row.int("id")?, row.string("sha256")?);
+    let name = match table {
+        "report_file" => row.string("name")?,
+        _ => format!("raw record {}", &sha256[..sha256.len().min(16)]),
+    };
     let size = row.int("size_bytes")?;
-    let problem = |what: String| Problem { table: "report_file".into(), row_id: Some(id), link: None, what };
+    let problem = |what: String| Problem { table: table.into(), row_id: Some(id), link: None, what };
     match zstd::stream::decode_all(packed) {
         Err(e) => problems.push(problem(format!("{name}: its stored bytes cannot be decompressed ({e})"))),
         Ok(bytes) => {
@@ -930,6 +958,6 @@ mod tests {
         assert_eq!(s.iter().filter(|(_, n, _)| n == "figure_kept").count(), 1);
         let p = expected_triggers(true);
         assert!(p.iter().any(|(t, n, _)| t == "figure" && n == "figure_not_truncated"));
-        assert_eq!(p.len(), 20);
+        assert_eq!(p.len(), 22);
     }
 }

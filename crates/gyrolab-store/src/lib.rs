@@ -191,12 +191,13 @@ pub const SOFTWARE_VERSION: &str = env!("CARGO_PKG_VERSION");
 /// The environment variable naming the default store.
 pub const STORE_ENV: &str = "GYROLAB_STORE";
 
-/// The default store's file name, beside the plan.
+/// The default store's file name, in the current folder.
 pub const DEFAULT_FILE: &str = "gyrolab.db";
 
-/// Where the store is: `explicit` (a path or a `postgres://` URL), else `GYROLAB_STORE`, else
-/// `gyrolab.db` in `plan_dir` (the current folder without one).
-pub fn resolve_location(explicit: Option<&str>, plan_dir: Option<&Path>) -> String {
+/// Where the store is, the same for every command and front end (issue 53: `eval --store` wrote
+/// beside the plan while the queries looked in the current folder): `explicit` (a path or a
+/// `postgres://` URL), else `GYROLAB_STORE`, else `gyrolab.db` in the current folder.
+pub fn resolve_location(explicit: Option<&str>) -> String {
     if let Some(e) = explicit.filter(|e| !e.is_empty()) {
         return e.to_string();
     }
@@ -205,8 +206,7 @@ pub fn resolve_location(explicit: Option<&str>, plan_dir: Option<&Path>) -> Stri
             return env;
         }
     }
-    let dir = plan_dir.map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from("."));
-    dir.join(DEFAULT_FILE).display().to_string()
+    DEFAULT_FILE.to_string()
 }
 
 /// True when `location` names a PostgreSQL server (a `postgres://`/`postgresql://` URL in any
@@ -851,6 +851,31 @@ impl Store {
                 &columns,
             )
             .map_err(&dberr)?;
+            // The raw records (schema 6): one compressed copy per SHA-256 in the whole store.
+            let mut kept: Vec<&str> = Vec::new();
+            for f in record.inputs.iter().filter(|f| f.packed.is_some()) {
+                if kept.contains(&f.sha256.as_str())
+                    || !x
+                        .rows("SELECT id FROM input_content WHERE sha256 = $1", &[t(&f.sha256)], &[("id", Kind::I)])
+                        .map_err(&dberr)?
+                        .is_empty()
+                {
+                    continue;
+                }
+                kept.push(&f.sha256);
+                x.insert_columns(
+                    "INSERT INTO input_content (id, evaluation_id, sha256, size_bytes, content_zstd) VALUES ((SELECT COALESCE(MAX(id), 0) + 1 FROM input_content), $1, $2, $3, $4)",
+                    "INSERT INTO input_content (evaluation_id, sha256, size_bytes, content_zstd) \
+                     SELECT * FROM unnest($1::bigint[], $2::text[], $3::bigint[], $4::bytea[])",
+                    &[
+                        Column::I(vec![id]),
+                        Column::T(vec![Some(f.sha256.clone())]),
+                        Column::I(vec![f.size_bytes as i64]),
+                        Column::B(vec![f.packed.clone()]),
+                    ],
+                )
+                .map_err(&dberr)?;
+            }
             let files = &record.report_files;
             let packed = files
                 .iter()
@@ -1009,7 +1034,7 @@ impl Store {
 }
 
 /// Stores one finished report folder in the store at `location` (see [`resolve_location`]; the
-/// default is `gyrolab.db` beside the plan), created when missing: the evaluation's id and the
+/// default is `gyrolab.db` in the current folder), created when missing: the evaluation's id and the
 /// store's name (password masked). Shared by `gyrolab store add` and `gyrolab eval --store`.
 pub fn add_report_folder(dir: &Path, plan: Option<&Path>, location: Option<&str>) -> StoreResult<(i64, String)> {
     add_report_folder_as(dir, plan, location, None)
@@ -1024,8 +1049,7 @@ pub fn add_report_folder_as(
     credentials: Option<(&str, &str)>,
 ) -> StoreResult<(i64, String)> {
     let rec = record::from_report_folder(dir, plan)?;
-    let plan_dir = Path::new(&rec.plan_path).parent().filter(|p| !p.as_os_str().is_empty()).map(Path::to_path_buf);
-    let mut store = Store::open_for_writing(&resolve_location(location, plan_dir.as_deref()), true)?;
+    let mut store = Store::open_for_writing(&resolve_location(location), true)?;
     let actor = match credentials {
         Some((user, password)) => store.authenticate(user, password)?,
         None => Actor::unauthenticated(),

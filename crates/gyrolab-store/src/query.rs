@@ -118,6 +118,7 @@ pub fn evaluation(store: &mut Store, id: i64) -> StoreResult<StoredEvaluation> {
                     sha256: f.string("sha256")?,
                     size_bytes: f.int("size_bytes")? as u64,
                     content: None,
+                    packed: None,
                 })
             })
             .collect::<Result<_, DbError>>()
@@ -709,4 +710,48 @@ pub fn write_report(store: &mut Store, id: i64, out: &std::path::Path) -> StoreR
     let refs: Vec<(&str, &[u8])> = files.iter().map(|(n, b)| (n.as_str(), b.as_slice())).collect();
     gyrolab_io::atomic::write_folder(out, &refs, &[])
         .map_err(|e| StoreError::Input { path: e.path.display().to_string(), message: e.to_string() })
+}
+
+/// Writes the raw record of SHA-256 `sha256` kept in the store (schema 6, `input_content`) to
+/// `out`, decompressed on the way and checked against its SHA-256 and size: `Ok(false)` when the
+/// store holds no copy (an input over [`crate::record::MAX_KEPT_INPUT_BYTES`], or stored before
+/// version 6), an error when the copy does not match.
+pub fn write_input_content(store: &mut Store, sha256: &str, out: &mut dyn std::io::Write) -> StoreResult<bool> {
+    use sha2::Digest;
+    let rows = store.rows(
+        "SELECT size_bytes, content_zstd FROM input_content WHERE sha256 = $1",
+        &[Val::T(Some(sha256.to_string()))],
+        &[("size_bytes", Kind::I), ("content_zstd", Kind::B)],
+    )?;
+    let Some(r) = rows.into_iter().next() else { return Ok(false) };
+    let read = || -> Result<_, DbError> { Ok((r.int("size_bytes")?, r.bytes("content_zstd")?.unwrap_or_default())) };
+    let (size, packed) = read().map_err(|e| store.row_error(e))?;
+    let name = store.name().to_string();
+    let broken = |why: String| StoreError::Database {
+        store: name.clone(),
+        message: format!("the kept raw record of SHA-256 {sha256} {why}"),
+    };
+    let mut decoder =
+        zstd::stream::Decoder::new(packed).map_err(|e| broken(format!("cannot be decompressed ({e})")))?;
+    let mut hasher = sha2::Sha256::new();
+    let mut block = vec![0u8; 1 << 20];
+    let mut total = 0i64;
+    loop {
+        let n = std::io::Read::read(&mut decoder, &mut block)
+            .map_err(|e| broken(format!("cannot be decompressed ({e})")))?;
+        if n == 0 {
+            break;
+        }
+        total += n as i64;
+        if total > size {
+            return Err(broken(format!("is longer than its recorded {size} bytes")));
+        }
+        hasher.update(&block[..n]);
+        out.write_all(&block[..n]).map_err(|e| broken(format!("cannot be written out ({e})")))?;
+    }
+    let sha: String = hasher.finalize().iter().map(|b| format!("{b:02x}")).collect();
+    if sha != sha256 || total != size {
+        return Err(broken(format!("does not match: {total} bytes, SHA-256 {sha} ({size} bytes recorded)")));
+    }
+    Ok(true)
 }

@@ -13,6 +13,10 @@ pub const MAX_TEXT_BYTES: usize = 16 << 20;
 /// Largest report file whose bytes the store keeps (larger ones are hashed only): 64 MiB.
 pub const MAX_KEPT_FILE_BYTES: u64 = 64 << 20;
 
+/// Largest input record whose bytes the store keeps (larger ones are hashed only, and
+/// `store reevaluate` needs them on disk): 256 MiB.
+pub const MAX_KEPT_INPUT_BYTES: u64 = 256 << 20;
+
 /// A file of an evaluation: an input record or a report file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FileRecord {
@@ -26,6 +30,11 @@ pub struct FileRecord {
     /// which are hashed only, and larger report files).
     #[serde(skip)]
     pub content: Option<Vec<u8>>,
+    /// An input's bytes, zstd-compressed, read when the evaluation is stored and checked
+    /// against [`FileRecord::sha256`] (the bytes evaluated); `None`: report files, inputs over
+    /// [`MAX_KEPT_INPUT_BYTES`], and inputs of a revision (already in the store).
+    #[serde(skip)]
+    pub packed: Option<Vec<u8>>,
 }
 
 /// One figure of one axis.
@@ -375,14 +384,21 @@ fn json_text(v: &serde_json::Value, keys: &[&str]) -> Option<String> {
     cur.as_str().map(str::to_string)
 }
 
+/// `path` made absolute against the current folder, lexically (links are not resolved: the
+/// path stays the one the lab named), or as it is when the current folder cannot be read.
+pub fn absolute(path: &Path) -> PathBuf {
+    std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf())
+}
+
 /// Reads the record of a finished report folder. `plan`: the plan file (default: the
 /// `plan_file` results.json names, as written, relative to the current folder).
 pub fn from_report_folder(dir: &Path, plan: Option<&Path>) -> StoreResult<EvaluationRecord> {
-    from_report_folder_with(dir, plan, None)
+    from_report_folder_with(dir, plan, None, true)
 }
 
 /// SHA-256 and size of every input file the plan at `plan_path` names, in plan order.
 pub fn hash_plan_inputs(plan_path: &Path) -> StoreResult<Vec<FileRecord>> {
+    let plan_path = &absolute(plan_path);
     let parsed = read_test_plan(plan_path)
         .map_err(|e| StoreError::Input { path: plan_path.display().to_string(), message: e.to_string() })?;
     hash_inputs(&parsed)
@@ -392,9 +408,48 @@ fn hash_inputs(parsed: &gyrolab_io_plan::TestPlan) -> StoreResult<Vec<FileRecord
     let mut inputs = Vec::new();
     for p in plan_inputs(parsed) {
         let (sha256, size_bytes) = hash_file(&p)?;
-        inputs.push(FileRecord { path: p.display().to_string(), sha256, size_bytes, content: None });
+        inputs.push(FileRecord { path: p.display().to_string(), sha256, size_bytes, content: None, packed: None });
     }
     Ok(inputs)
+}
+
+/// Reads every input of `inputs` (up to [`MAX_KEPT_INPUT_BYTES`]) into [`FileRecord::packed`],
+/// compressed on the way (the file read once, in blocks: the memory held is the compressed
+/// copy), and checks it is still the bytes hashed when it was evaluated: an input changed since
+/// is refused, naming it, and nothing is stored.
+pub fn pack_inputs(inputs: &mut [FileRecord]) -> StoreResult<()> {
+    use sha2::Digest;
+    use std::io::{Read, Write};
+    for f in inputs.iter_mut().filter(|f| f.size_bytes <= MAX_KEPT_INPUT_BYTES) {
+        let input = |m: String| StoreError::Input { path: f.path.clone(), message: m };
+        let mut file = std::fs::File::open(&f.path).map_err(|e| input(format!("cannot read: {e}")))?;
+        let mut encoder =
+            zstd::stream::Encoder::new(Vec::new(), 3).map_err(|e| input(format!("cannot compress: {e}")))?;
+        let mut hasher = sha2::Sha256::new();
+        let mut block = vec![0u8; 1 << 20];
+        let mut size = 0u64;
+        loop {
+            let n = file.read(&mut block).map_err(|e| input(format!("cannot read: {e}")))?;
+            if n == 0 {
+                break;
+            }
+            size += n as u64;
+            if size > MAX_KEPT_INPUT_BYTES {
+                break;
+            }
+            hasher.update(&block[..n]);
+            encoder.write_all(&block[..n]).map_err(|e| input(format!("cannot compress: {e}")))?;
+        }
+        let sha: String = hasher.finalize().iter().map(|b| format!("{b:02x}")).collect();
+        if sha != f.sha256 || size != f.size_bytes {
+            return Err(input(format!(
+                "changed since it was evaluated (SHA-256 {}, {} bytes then; {sha}, {size} bytes now): not stored",
+                f.sha256, f.size_bytes
+            )));
+        }
+        f.packed = Some(encoder.finish().map_err(|e| input(format!("cannot compress: {e}")))?);
+    }
+    Ok(())
 }
 
 /// The report folder's manifest, when it has one (a folder written before 0.3 has none).
@@ -412,11 +467,13 @@ fn read_manifest(dir: &Path) -> StoreResult<Option<gyrolab_io::provenance::Manif
 
 /// [`from_report_folder`] with the inputs' hashes already made by [`hash_plan_inputs`] of the
 /// same plan (`gyrolab eval --store` makes them on a second thread while it evaluates); `None`:
-/// hashed here.
+/// hashed here. `pack`: the inputs' bytes read into [`FileRecord::packed`] ([`pack_inputs`]);
+/// false for a re-evaluation of raw records the store keeps already.
 pub fn from_report_folder_with(
     dir: &Path,
     plan: Option<&Path>,
     inputs: Option<Vec<FileRecord>>,
+    pack: bool,
 ) -> StoreResult<EvaluationRecord> {
     let results_path = dir.join("results.json");
     let results_json = read_text(&results_path)?;
@@ -438,13 +495,19 @@ pub fn from_report_folder_with(
             plan_path.display()
         )));
     }
+    // Kept as an absolute path, so that `store reevaluate` finds it from any folder (issue 53).
+    let plan_path = absolute(&plan_path);
     let plan_text = read_text(&plan_path)?;
     let parsed = read_test_plan(&plan_path)
         .map_err(|e| StoreError::Input { path: plan_path.display().to_string(), message: e.to_string() })?;
-    let inputs = match inputs {
+    let mut inputs = match inputs {
         Some(i) => i,
         None => hash_inputs(&parsed)?,
     };
+    // The raw records kept with the evaluation (issue 53), the bytes evaluated.
+    if pack {
+        pack_inputs(&mut inputs)?;
+    }
     let mut report_files = Vec::new();
     let mut names: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|e| StoreError::Input { path: dir.display().to_string(), message: format!("cannot list: {e}") })?
@@ -496,10 +559,11 @@ pub fn from_report_folder_with(
                 sha256: hash_bytes(&bytes),
                 size_bytes: bytes.len() as u64,
                 content: Some(bytes),
+                packed: None,
             });
         } else {
             let (sha256, size_bytes) = hash_file(&p)?;
-            report_files.push(FileRecord { path: name, sha256, size_bytes, content: None });
+            report_files.push(FileRecord { path: name, sha256, size_bytes, content: None, packed: None });
         }
     }
     let simulated = parsed.device.simulated.is_some();

@@ -71,6 +71,10 @@ pub const SQLITE_MIGRATIONS: &[Migration] = &[
     // 5 (issue 53): no change on SQLite, whose indexes take a text of any length (the serial
     // and lot indexes are made hash indexes on PostgreSQL, whose B-tree rows stop at 2.7 KB).
     migration!("sqlite", 5, "serial_lot_hash_indexes", "0005_serial_lot_hash_indexes.sql"),
+    // 6 (issue 53): the raw records kept, content-addressed: one zstd-compressed copy per
+    // SHA-256 (`input_content`, chained with the evaluation that first brought it), so that an
+    // audit or `store reevaluate` reproduces a report from the store alone.
+    migration!("sqlite", 6, "input_contents", "0006_input_contents.sql"),
 ];
 
 /// PostgreSQL migrations, by version (index 0 = version 1).
@@ -90,6 +94,8 @@ pub const POSTGRES_MIGRATIONS: &[Migration] = &[
     // about 2.7 KB, so a longer serial (SQLite takes 16 MiB) was refused; every query of them is
     // an equality.
     migration!("postgres", 5, "serial_lot_hash_indexes", "0005_serial_lot_hash_indexes.sql"),
+    // 6 (issue 53): the raw records kept, content-addressed (see SQLITE_MIGRATIONS).
+    migration!("postgres", 6, "input_contents", "0006_input_contents.sql"),
 ];
 
 /// The schema version this build writes and reads: the number of migrations.

@@ -34,7 +34,8 @@ pub struct EvalArgs {
     #[arg(long)]
     pub pdf: bool,
     /// Also keep the evaluation in the records store (docs/STORE.md): an SQLite file or a
-    /// postgres:// URL; without a value GYROLAB_STORE, else gyrolab.db beside the plan. Stored
+    /// postgres:// URL; without a value GYROLAB_STORE, else gyrolab.db in the current folder (where
+    /// `gyrolab store` looks too). Stored
     /// after the folder is written, also when a limit fails.
     #[arg(long, value_name = "PATH|URL", num_args = 0..=1, default_missing_value = "")]
     pub store: Option<String>,
@@ -50,10 +51,7 @@ pub fn run(args: &EvalArgs) -> CliResult {
     // the inputs while the plan is evaluated. A corrupt, foreign or newer store, or a server that
     // is down or refuses the password, ends the run with exit 2 before the report folder is
     // written. A store that does not exist yet is created once the folder is written.
-    let location = args.store.as_deref().map(|s| {
-        let plan_dir = args.plan.parent().filter(|p| !p.as_os_str().is_empty());
-        resolve_location(Some(s), plan_dir)
-    });
+    let location = args.store.as_deref().map(|s| resolve_location(Some(s)));
     // The password is read here, before the evaluation (a prompt, standard input, or
     // GYROLAB_PASSWORD); the account is authenticated with the store's check, before any output.
     let credentials = match &location {

@@ -355,6 +355,10 @@ pub struct ReportArgs {
     /// Folder to write the report files into (all of them or none).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+    /// Write the evaluation's plan and raw records instead, as the store keeps them, laid out as
+    /// they stood relative to the plan (a new folder; each checked against its SHA-256).
+    #[arg(long)]
+    pub inputs: bool,
     #[command(flatten)]
     pub location: StoreLocation,
 }
@@ -383,12 +387,12 @@ pub struct ReevaluateArgs {
 }
 
 fn open(location: &StoreLocation, create: bool) -> CliResult<Store> {
-    Ok(Store::open(&resolve_location(location.store.as_deref(), None), create)?)
+    Ok(Store::open(&resolve_location(location.store.as_deref()), create)?)
 }
 
 /// Opens a store to write to: the quick check first (exit 2 when it fails).
 fn open_for_writing(location: &StoreLocation) -> CliResult<Store> {
-    Ok(Store::open_for_writing(&resolve_location(location.store.as_deref(), None), false)?)
+    Ok(Store::open_for_writing(&resolve_location(location.store.as_deref()), false)?)
 }
 
 /// The actor of a write: the account `auth` names, authenticated, else no account (which a
@@ -469,7 +473,7 @@ fn admin(s: &mut Store, a: &AdminArgs) -> CliResult<Actor> {
 fn user(cmd: &UserCommand) -> CliResult {
     match cmd {
         UserCommand::Add(a) => {
-            let mut s = Store::open_for_writing(&resolve_location(a.location.store.as_deref(), None), true)?;
+            let mut s = Store::open_for_writing(&resolve_location(a.location.store.as_deref()), true)?;
             let actor = admin(&mut s, &a.admin)?;
             let password = new_password(a.password_stdin, &a.name)?;
             let role = match a.role {
@@ -505,7 +509,7 @@ fn user(cmd: &UserCommand) -> CliResult {
 
 /// `gyrolab store key init`: the actor checked before any file is written.
 fn key_init(a: &KeyInitArgs) -> CliResult {
-    let mut s = Store::open_for_writing(&resolve_location(a.location.store.as_deref(), None), true)?;
+    let mut s = Store::open_for_writing(&resolve_location(a.location.store.as_deref()), true)?;
     let actor = actor(&mut s, &a.auth)?;
     let allowed = match actor.account() {
         Some(acc) => acc.role == Role::Admin,
@@ -553,6 +557,9 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
         }
         StoreCommand::Report(a) => {
             let mut s = open(&a.location, false)?;
+            if a.inputs {
+                return print(&gyrolab_lab::raw_records::restored_text(&mut s, a.id, &a.out)?);
+            }
             let written = s.write_report(a.id, &a.out)?;
             print(&gyrolab_lab::records::written_report_text(&mut s, a.id, written.len(), &a.out)?)
         }

@@ -226,22 +226,46 @@ fn eval_store_then_queries_revisions_and_reevaluation() {
 }
 
 #[test]
-fn the_default_store_is_beside_the_plan_or_gyrolab_store() {
+fn every_command_defaults_to_gyrolab_db_in_the_current_folder_or_gyrolab_store() {
+    // Issue 53: `eval --store` wrote gyrolab.db beside the plan while `store history` looked in
+    // the current folder, so a newcomer's first query said "no store here".
     let dir = tempfile::tempdir().unwrap();
-    let p = plan(dir.path(), "D1", "L");
-    eval(&p, &dir.path().join("r"), Some(""));
+    let plans = dir.path().join("plans");
+    let work = dir.path().join("work");
+    std::fs::create_dir_all(&plans).unwrap();
+    std::fs::create_dir_all(&work).unwrap();
+    let p = plan(&plans, "D1", "L");
+    for out in ["r", "r2"] {
+        gyrolab()
+            .current_dir(&work)
+            .args(["eval", p.to_str().unwrap(), "--out", dir.path().join(out).to_str().unwrap(), "-q", "--store"])
+            .assert()
+            .code(3);
+    }
+    assert!(work.join("gyrolab.db").is_file(), "gyrolab.db in the current folder");
+    assert!(!plans.join("gyrolab.db").exists(), "nothing beside the plan");
+    // The queries find it without --store, from the same folder.
+    let out = gyrolab().current_dir(&work).args(["store", "history", "D1", "--json"]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let rows: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let ids: std::collections::BTreeSet<i64> =
+        rows.as_array().unwrap().iter().map(|r| r["evaluation"].as_i64().unwrap()).collect();
+    assert_eq!(ids.len(), 2, "{rows}");
+    // store add, without --store, into the same default (a folder of another serial).
+    let p3 = plan(&plans, "D3", "L");
+    eval(&p3, &dir.path().join("r3"), None);
     gyrolab()
-        .args(["eval", p.to_str().unwrap(), "--out", dir.path().join("r2").to_str().unwrap(), "-q", "--store"])
+        .current_dir(&work)
+        .args(["store", "add", dir.path().join("r3").to_str().unwrap()])
         .assert()
-        .code(3);
-    let db = dir.path().join("gyrolab.db");
-    assert!(db.is_file(), "gyrolab.db beside the plan");
-    assert_eq!(history_ids(db.to_str().unwrap(), "D1").len(), 2);
+        .success()
+        .stdout(predicates::str::contains("in gyrolab.db"));
+    gyrolab().current_dir(&work).args(["store", "history", "D3"]).assert().success();
     // GYROLAB_STORE is the default of eval --store and of the queries.
     let env_db = dir.path().join("env.db");
     gyrolab()
         .env("GYROLAB_STORE", &env_db)
-        .args(["eval", p.to_str().unwrap(), "--out", dir.path().join("r3").to_str().unwrap(), "-q", "--store"])
+        .args(["eval", p.to_str().unwrap(), "--out", dir.path().join("r4").to_str().unwrap(), "-q", "--store"])
         .assert()
         .code(3);
     gyrolab().env("GYROLAB_STORE", &env_db).args(["store", "history", "D1"]).assert().success();
@@ -462,7 +486,12 @@ fn a_store_of_a_newer_schema_exits_2_naming_both_versions_and_writes_nothing() {
             .unwrap_or_else(|e| panic!("{}: {e}", b.name));
         assert_eq!(o.status.code(), Some(2), "{}", b.name);
         let err = String::from_utf8_lossy(&o.stderr);
-        assert!(err.contains("schema version 9") && err.contains("up to 5"), "{}: {err}", b.name);
+        assert!(
+            err.contains("schema version 9")
+                && err.contains(&format!("up to {}", gyrolab_store::schema::SCHEMA_VERSION)),
+            "{}: {err}",
+            b.name
+        );
         assert!(!report.exists(), "{}: nothing written", b.name);
         for args in [vec!["store", "lot", "L"], vec!["store", "history", "N1"]] {
             gyrolab()
@@ -797,4 +826,67 @@ fn a_long_serial_is_stored_on_both_back_ends() {
         let lot = json_of(&["store", "lot", &serial], &b.location);
         assert!(!lot.as_array().unwrap().is_empty(), "{}", b.name);
     }
+}
+
+#[test]
+fn the_raw_records_are_kept_and_a_report_is_reproduced_from_the_store_alone() {
+    // Issue 53: "Raw records are hashed, not kept"; "paths are stored relative to the working
+    // folder, so store reevaluate fails from another folder".
+    let dir = tempfile::tempdir().unwrap();
+    let lab = dir.path().join("lab");
+    let data = lab.join("data");
+    std::fs::create_dir_all(&data).unwrap();
+    for axis in ["x", "y", "z"] {
+        let name = format!("paper_rate_table_{axis}.csv");
+        std::fs::copy(repo().join("data/paper").join(&name), data.join(&name)).unwrap();
+    }
+    let plans = lab.join("plans");
+    std::fs::create_dir_all(&plans).unwrap();
+    let text = std::fs::read_to_string(repo().join("examples/paper_plan.toml")).unwrap();
+    std::fs::write(plans.join("plan.toml"), text.replace("../data/paper/", "../data/")).unwrap();
+    let db = dir.path().join("lab.db");
+    gyrolab()
+        .current_dir(&lab)
+        .args(["eval", "plans/plan.toml", "--out", "report", "-q", "--store", db.to_str().unwrap()])
+        .assert()
+        .code(3);
+    // The plan and its raw records out of the store, as they stood relative to the plan.
+    let audit = dir.path().join("audit");
+    gyrolab()
+        .args(["store", "report", "1", "--inputs", "--out", audit.to_str().unwrap(), "--store", db.to_str().unwrap()])
+        .assert()
+        .success()
+        .stdout(predicates::str::contains("3 raw record(s)"));
+    assert_eq!(std::fs::read(audit.join("_/plan.toml")).unwrap(), std::fs::read(plans.join("plan.toml")).unwrap());
+    for axis in ["x", "y", "z"] {
+        let name = format!("paper_rate_table_{axis}.csv");
+        assert_eq!(std::fs::read(audit.join("data").join(&name)).unwrap(), std::fs::read(data.join(&name)).unwrap());
+    }
+    // The restored plan evaluates to the same figures.
+    gyrolab()
+        .args([
+            "eval",
+            audit.join("_/plan.toml").to_str().unwrap(),
+            "--out",
+            dir.path().join("again").to_str().unwrap(),
+        ])
+        .arg("-q")
+        .assert()
+        .code(3);
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("again/summary.csv")).unwrap(),
+        std::fs::read_to_string(lab.join("report/summary.csv")).unwrap()
+    );
+    // The lab's folders gone: re-evaluated from another folder, from the store alone.
+    std::fs::remove_dir_all(&lab).unwrap();
+    let out = gyrolab()
+        .current_dir(dir.path())
+        .args(["store", "reevaluate", "1", "--out", "re", "--by", "CI", "--reason", "audit", "--json"])
+        .args(["--store", db.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(r["changes"].as_array().unwrap().len(), 0, "{r}");
+    assert_eq!(r["revision"], 2);
 }

@@ -1,9 +1,11 @@
 //! A real report folder (the paper's plan, evaluated by the lab layer) stored on both back ends:
 //! every figure of summary.csv, the plan's hash and every input's hash and size kept; a
 //! re-evaluation under this build writes a revision and lists exactly the figures that changed;
-//! a changed input is refused before anything is written.
+//! the raw records are kept and laid out again from the store alone; a changed input is
+//! re-evaluated from the store's copy, and refused when the store keeps none.
 
 use crate::store_common::backends;
+use gyrolab_lab::raw_records::restore_inputs;
 use gyrolab_lab::reevaluate::reevaluate;
 use gyrolab_store::record::{from_report_folder, hash_file};
 use gyrolab_store::{add_report_folder, Store, StoreError};
@@ -80,19 +82,52 @@ fn a_report_folder_is_kept_whole_and_reevaluated_with_a_diff() {
         ));
     }
 
-    // The one path shared with `eval --store`: default store beside the plan.
+    // The one path shared with `eval --store`: a store named explicitly.
     let (id, name) =
         add_report_folder(&out, Some(&plan), Some(dir.path().join("shared.db").to_str().unwrap())).unwrap();
     assert_eq!(id, 1);
     assert!(name.ends_with("shared.db"));
 
-    // A changed input is refused, naming the file, and nothing is stored.
+    // The raw records are kept: laid out again from the store alone, byte for byte, beside
+    // their plan (issue 53).
+    let mut s = Store::open(dir.path().join("shared.db").to_str().unwrap(), false).unwrap();
+    let restored = restore_inputs(&mut s, 1, &dir.path().join("audit")).unwrap();
+    assert_eq!(restored.plan, dir.path().join("audit/plan.toml"));
+    assert_eq!(std::fs::read(&restored.plan).unwrap(), std::fs::read(&plan).unwrap());
+    assert_eq!(restored.inputs.len(), 3);
+    for (file, path) in &restored.inputs {
+        assert_eq!(std::fs::read(path).unwrap(), std::fs::read(dir.path().join(file)).unwrap(), "{file}");
+    }
+    assert!(restore_inputs(&mut s, 1, &dir.path().join("audit")).is_err(), "an existing folder is not written into");
+
+    // A changed input: the re-evaluation runs on the store's copy, the bytes first evaluated,
+    // and finds the same figures (before schema 6 it was refused).
     let x = dir.path().join("paper_rate_table_x.csv");
     let mut text = std::fs::read_to_string(&x).unwrap();
-    text.push('\n');
+    text.push_str("1,2,3\n");
     std::fs::write(&x, text).unwrap();
-    let mut s = Store::open(dir.path().join("shared.db").to_str().unwrap(), false).unwrap();
-    let e = reevaluate(&mut s, 1, "lab", "r", &dir.path().join("re-changed")).unwrap_err();
-    assert!(e.to_string().contains("paper_rate_table_x.csv") && e.to_string().contains("changed since"), "{e}");
-    assert!(s.evaluation(2).is_err());
+    std::fs::remove_file(&plan).unwrap();
+    let r = reevaluate(&mut s, 1, "lab", "r", &dir.path().join("re-changed")).unwrap();
+    assert!(r.changes.is_empty(), "{:?}", r.changes);
+    let e = s.evaluation(r.revision).unwrap();
+    let first = s.evaluation(1).unwrap();
+    assert_eq!(e.record.plan_path, first.record.plan_path, "the report names the original plan");
+    let hashes = |r: &gyrolab_store::record::EvaluationRecord| {
+        let mut v: Vec<(String, String)> = r.inputs.iter().map(|f| (f.path.clone(), f.sha256.clone())).collect();
+        v.sort();
+        v
+    };
+    assert_eq!(hashes(&e.record), hashes(&first.record));
+
+    // A store that keeps no copy (an evaluation stored before schema 6, here one without the
+    // bytes): refused, naming the input and why, and nothing is stored.
+    let mut bare = rec.clone();
+    bare.serial = "no-copy".into();
+    bare.inputs.iter_mut().for_each(|f| f.packed = None);
+    let mut t = Store::open(dir.path().join("bare.db").to_str().unwrap(), true).unwrap();
+    let id = t.add(&bare).unwrap();
+    let e = reevaluate(&mut t, id, "lab", "r", &dir.path().join("re-bare")).unwrap_err();
+    let text = e.to_string();
+    assert!(text.contains("plan.toml") && text.contains("keeps no copy of input"), "{text}");
+    assert!(t.evaluation(id + 1).is_err());
 }

@@ -372,6 +372,52 @@ fn a_report_file_replaced_is_found() {
 }
 
 #[test]
+fn a_raw_record_replaced_is_found_and_refused_when_read() {
+    for b in backends("tamper_raw_record") {
+        let mut s = Store::open(&b.location, true).unwrap();
+        let bytes = b"time_s,rate_dps\n0,0.1\n0.01,0.2\n".to_vec();
+        let mut rec = record("SN1", Some("L"), &[("x", "bias_dph", 10.0)]);
+        rec.inputs[0].sha256 = gyrolab_store::record::hash_bytes(&bytes);
+        rec.inputs[0].size_bytes = bytes.len() as u64;
+        rec.inputs[0].packed = Some(zstd::bulk::compress(&bytes, 3).unwrap());
+        s.add(&rec).unwrap();
+        // The same bytes again (another evaluation): kept once, content-addressed.
+        let mut again = rec.clone();
+        again.serial = "SN2".into();
+        s.add(&again).unwrap();
+        let mut raw = Raw::open(&b);
+        assert_eq!(raw.int("SELECT COUNT(*) FROM input_content"), 1, "{}", b.name);
+        let r = s.check().unwrap();
+        assert!(r.is_whole(), "{}: {:?}", b.name, r.problems);
+        assert_eq!(r.files_checked, 3, "{}: two report files and the raw record re-hashed", b.name);
+        let mut out = Vec::new();
+        assert!(query::write_input_content(&mut s, &rec.inputs[0].sha256, &mut out).unwrap());
+        assert_eq!(out, bytes);
+        // Refused by the schema...
+        let e = raw.exec("UPDATE input_content SET size_bytes = 1").unwrap_err();
+        assert!(e.contains("gyrolab records are never"), "{}: {e}", b.name);
+        if b.name == "sqlite" {
+            let e = raw.exec("REPLACE INTO input_content SELECT * FROM input_content").unwrap_err();
+            assert!(e.contains("gyrolab records are never"), "{e}");
+        } else {
+            let e = raw.exec("TRUNCATE input_content").unwrap_err();
+            assert!(e.contains("gyrolab records are never"), "{e}");
+        }
+        // ...and, behind the triggers, found by the check and refused when read.
+        let forged = zstd::bulk::compress(b"time_s,rate_dps\n0,9.9\n0.01,9.9\n", 3).unwrap();
+        let hex: String = forged.iter().map(|x| format!("{x:02x}")).collect();
+        let blob = if b.name == "sqlite" { format!("X'{hex}'") } else { format!("'\\x{hex}'::bytea") };
+        raw.behind_the_triggers(&["input_content"], &format!("UPDATE input_content SET content_zstd = {blob};"));
+        let r = s.check().unwrap();
+        assert_eq!(r.problems[0].table, "input_content", "{}: {:?}", b.name, r.problems);
+        assert!(r.problems[0].what.contains("content_zstd"), "{:?}", r.problems);
+        assert!(r.problems.iter().any(|p| p.what.contains("raw record")), "{}: {:?}", b.name, r.problems);
+        let e = query::write_input_content(&mut s, &rec.inputs[0].sha256, &mut Vec::new()).unwrap_err();
+        assert!(e.to_string().contains("does not match"), "{}: {e}", b.name);
+    }
+}
+
+#[test]
 fn rows_deleted_behind_the_triggers_are_found() {
     for b in backends("tamper_deleted") {
         let mut s = two_evaluations(&b);

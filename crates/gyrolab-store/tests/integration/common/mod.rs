@@ -121,12 +121,14 @@ pub fn record(serial: &str, lot: Option<&str>, figures: &[(&str, &str, f64)]) ->
             sha256: "ab".repeat(32),
             size_bytes: 1234,
             content: None,
+            packed: None,
         }],
         report_files: vec![FileRecord {
             path: "results.json".into(),
             sha256: gyrolab_store::record::hash_bytes(b"{}"),
             size_bytes: 2,
             content: Some(b"{}".to_vec()),
+            packed: None,
         }],
         figures: figures
             .iter()
