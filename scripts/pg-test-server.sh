@@ -58,8 +58,11 @@ gyrolab_pg_start() {
         return 1
     }
     PGPASSWORD="$pw" psql -q -h 127.0.0.1 -p "$port" -U postgres -d postgres \
-        -c "CREATE ROLE gyrolab LOGIN PASSWORD '$pw'" -c "CREATE DATABASE gyrolab OWNER gyrolab" >/dev/null
+        -c "CREATE ROLE gyrolab LOGIN PASSWORD '$pw'" -c "CREATE DATABASE gyrolab OWNER gyrolab" \
+        -c "CREATE ROLE gyrolab_app LOGIN PASSWORD '$pw'" >/dev/null
     export GYROLAB_TEST_PG_URL="postgres://gyrolab:$pw@127.0.0.1:$port/gyrolab"
+    # A role with no privilege of its own: the least-privilege tests grant it SELECT and INSERT.
+    export GYROLAB_TEST_PG_APP_URL="postgres://gyrolab_app:$pw@127.0.0.1:$port/gyrolab"
     echo "pg-test-server: PostgreSQL on 127.0.0.1:$port (folder $dir)" >&2
 }
 
@@ -71,7 +74,7 @@ gyrolab_pg_stop() {
     bin=$(pg_bin) || return 0
     as_root runuser -u postgres -- "$bin/pg_ctl" -D "$dir/data" -m immediate -w stop >/dev/null 2>&1 || true
     rm -rf "$dir"
-    unset GYROLAB_TEST_PG_DIR GYROLAB_TEST_PG_URL
+    unset GYROLAB_TEST_PG_DIR GYROLAB_TEST_PG_URL GYROLAB_TEST_PG_APP_URL
 }
 
 case "${1:-}" in

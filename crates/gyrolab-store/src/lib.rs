@@ -444,7 +444,15 @@ impl Store {
                 // One migrating client at a time; others wait here and then find it done.
                 x.exec("SELECT pg_advisory_xact_lock(7291835)", &[]).map_err(&dberr)?;
             }
-            x.batch(schema::VERSION_TABLE).map_err(&dberr)?;
+            // A store already made is read without any DDL, so that a role with SELECT and
+            // INSERT only (docs/STORE.md, "Least privilege") opens it; the owner migrates it.
+            let exists = !x
+                .rows(schema::version_table_exists_sql(postgres), &[], &[("one", Kind::I)])
+                .map_err(&dberr)?
+                .is_empty();
+            if !exists {
+                x.batch(schema::VERSION_TABLE).map_err(&dberr)?;
+            }
             // A version table of a build before checksums lacks their columns: added here, in
             // this transaction, and filled below (adoption).
             let has: Vec<String> = x
@@ -507,7 +515,14 @@ impl Store {
                 }
             }
             for m in migrations.iter().skip(found as usize) {
-                x.batch(m.sql).map_err(&dberr)?;
+                x.batch(m.sql).map_err(|e| match e {
+                    DbError::Postgres(m) if m.contains("permission denied") => dberr(DbError::Postgres(format!(
+                        "{m}: this role may not migrate the store's schema (version {found} to {}); let the owner role \
+                         open it once with this gyrolab (docs/STORE.md, \"Least privilege\")",
+                        schema::SCHEMA_VERSION
+                    ))),
+                    e => dberr(e),
+                })?;
                 if m.version == 3 {
                     // Migration 3: the hash chain over the rows already stored.
                     chain::build_existing(x).map_err(&dberr)?;
@@ -986,6 +1001,81 @@ impl Store {
     /// Writes the stored report folder of evaluation `id` to `out` (see [`query::write_report`]).
     pub fn write_report(&mut self, id: i64, out: &Path) -> StoreResult<Vec<PathBuf>> {
         query::write_report(self, id, out)
+    }
+
+    /// PostgreSQL only, run as the owner of the store's tables: gives the existing login `role`
+    /// USAGE on the store's schema, SELECT and INSERT on every record table and the chain,
+    /// SELECT on `gyrolab_schema`, and revokes UPDATE, DELETE, TRUNCATE, REFERENCES and TRIGGER
+    /// on them, so that gyrolab run as `role` can store and read but neither change, empty nor
+    /// disable a trigger (only the owner can). The tables granted, in order. The statements are
+    /// made by the server's `format()` with `%I` (the role and table names quoted as
+    /// identifiers), never spliced here.
+    pub fn grant_least_privilege(&mut self, role: &str) -> StoreResult<Vec<String>> {
+        let store = self.name.clone();
+        if !self.is_postgres() {
+            return Err(StoreError::Refused {
+                store,
+                message: "an SQLite store is a file: its file permissions are its access control (grant is for \
+                          PostgreSQL)"
+                    .into(),
+            });
+        }
+        let refused = |m: String| StoreError::Refused { store: store.clone(), message: m };
+        let dberr = |m: DbError| StoreError::Database { store: store.clone(), message: m.to_string() };
+        let r = Val::T(Some(role.to_string()));
+        self.transaction(|x| {
+            let found = x
+                .rows(
+                    "SELECT (CASE WHEN rolsuper THEN 1 ELSE 0 END)::int8 AS superuser FROM pg_roles WHERE rolname = $1",
+                    std::slice::from_ref(&r),
+                    &[("superuser", Kind::I)],
+                )
+                .map_err(&dberr)?;
+            match found.first().map(|f| f.int("superuser")).transpose().map_err(&dberr)? {
+                None => return Err(refused(format!("no PostgreSQL role {role:?}: create it first (CREATE ROLE ... LOGIN)"))),
+                Some(1) => {
+                    return Err(refused(format!("{role:?} is a superuser, whom no privilege limits: use an ordinary role")))
+                }
+                Some(_) => {}
+            }
+            // Only the owner grants: PostgreSQL turns another role's GRANT into a warning.
+            let owner = x
+                .rows(
+                    "SELECT 1::int8 AS one FROM pg_tables WHERE schemaname = current_schema() AND tablename = 'evaluation' \
+                     AND pg_has_role(tableowner, 'MEMBER')",
+                    &[],
+                    &[("one", Kind::I)],
+                )
+                .map_err(&dberr)?;
+            if owner.is_empty() {
+                return Err(refused("grant is run as the owner of the store's tables, which this role is not".into()));
+            }
+            let mut tables: Vec<&str> = chain::CHAINED.iter().map(|t| t.name).collect();
+            tables.push("chain");
+            let statement = |x: &mut dyn Exec, sql: &str, params: &[Val]| -> StoreResult<()> {
+                let rows = x.rows(sql, params, &[("sql", Kind::T)]).map_err(&dberr)?;
+                let text = rows.first().map(|r| r.string("sql")).transpose().map_err(&dberr)?.unwrap_or_default();
+                x.batch(&text).map_err(|e| match e {
+                    DbError::Postgres(m) if m.contains("must be owner") || m.contains("permission denied") => {
+                        refused(format!("{m}: grant is run as the owner of the store's tables"))
+                    }
+                    e => dberr(e),
+                })
+            };
+            statement(x, "SELECT format('GRANT USAGE ON SCHEMA %I TO %I', current_schema(), $1::text) AS sql", &[r.clone()])?;
+            for t in &tables {
+                let t = Val::T(Some(t.to_string()));
+                statement(
+                    x,
+                    "SELECT format('REVOKE UPDATE, DELETE, TRUNCATE, REFERENCES, TRIGGER ON %I FROM %I', $1::text, $2::text) AS sql",
+                    &[t.clone(), r.clone()],
+                )?;
+                statement(x, "SELECT format('GRANT SELECT, INSERT ON %I TO %I', $1::text, $2::text) AS sql", &[t, r.clone()])?;
+            }
+            statement(x, "SELECT format('REVOKE ALL ON gyrolab_schema FROM %I', $1::text) AS sql", &[r.clone()])?;
+            statement(x, "SELECT format('GRANT SELECT ON gyrolab_schema TO %I', $1::text) AS sql", &[r.clone()])?;
+            Ok(tables.iter().map(|t| t.to_string()).collect())
+        })
     }
 
     /// The full check (`gyrolab store check`): the protecting triggers, every chain link against

@@ -130,6 +130,16 @@ pub const VERSION_TABLE_COLUMNS: &[(&str, &str)] = &[
     ("sha256", "ALTER TABLE gyrolab_schema ADD COLUMN sha256 TEXT"),
 ];
 
+/// One row (`one` = 1) when the version table exists, none otherwise: a look-up that needs no
+/// privilege beyond reading the catalogue.
+pub fn version_table_exists_sql(postgres: bool) -> &'static str {
+    if postgres {
+        "SELECT 1::bigint AS one WHERE to_regclass('gyrolab_schema') IS NOT NULL"
+    } else {
+        "SELECT 1 AS one FROM sqlite_master WHERE type = 'table' AND name = 'gyrolab_schema'"
+    }
+}
+
 /// The columns of `gyrolab_schema` as the store has them (parameter `$1`: the table's name).
 pub fn version_table_columns_sql(postgres: bool) -> &'static str {
     if postgres {

@@ -46,10 +46,12 @@ pub enum StoreCommand {
     Chart(ChartArgs),
     /// Store a correction or an approval as a new revision of an evaluation.
     Revise(ReviseArgs),
-    /// Re-run a stored evaluation's plan and inputs (hash-checked) under this version: new revision and diff.
+    /// Re-run a stored evaluation's plan and inputs (where they are when unchanged, else the store's copies) under this version: new revision and diff.
     Reevaluate(ReevaluateArgs),
     /// Re-verify the store: its hash chain link by link against the rows, every stored file against its SHA-256, the protecting triggers (exit 3 when broken).
     Check(CheckArgs),
+    /// PostgreSQL, run as the owner: give ROLE SELECT and INSERT only, to run gyrolab as (least privilege).
+    Grant(GrantArgs),
     /// Accounts: add, list, disable, reset a password (the first account is an admin; then an admin manages them).
     #[command(subcommand)]
     User(UserCommand),
@@ -219,6 +221,15 @@ pub struct CheckArgs {
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub location: StoreLocation,
+}
+
+/// Options of `gyrolab store grant`.
+#[derive(Debug, Args)]
+pub struct GrantArgs {
+    /// The PostgreSQL role (an existing login role) gyrolab will run as.
+    pub role: String,
     #[command(flatten)]
     pub location: StoreLocation,
 }
@@ -511,24 +522,7 @@ fn user(cmd: &UserCommand) -> CliResult {
 fn key_init(a: &KeyInitArgs) -> CliResult {
     let mut s = Store::open_for_writing(&resolve_location(a.location.store.as_deref()), true)?;
     let actor = actor(&mut s, &a.auth)?;
-    let allowed = match actor.account() {
-        Some(acc) => acc.role == Role::Admin,
-        None => !s.has_accounts()?,
-    };
-    if !allowed {
-        return Err(CliError::Usage(
-            "the lab key is recorded by an admin: --user NAME of an admin account, with its password".into(),
-        ));
-    }
-    let key = sign::create_key_files(&a.out).map_err(CliError::Usage)?;
-    let fingerprint = s.add_signing_key(&actor, &key)?;
-    print(&format!(
-        "wrote the private key {} (mode 0600: keep it secret, outside the store) and the public key {}\nrecorded \
-         public key {fingerprint} in {}\n",
-        a.out.display(),
-        sign::public_path_for(&a.out).display(),
-        s.name()
-    ))
+    print(&gyrolab_lab::issue::init_key(&mut s, &actor, &a.out)?)
 }
 
 /// Runs `gyrolab store`.
@@ -602,6 +596,7 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
             print(&gyrolab_lab::records::revise(&mut s, &r, &changes, &actor)?)
         }
         StoreCommand::Check(a) => check(a),
+        StoreCommand::Grant(a) => print(&gyrolab_lab::issue::grant_text(&mut open(&a.location, false)?, &a.role)?),
         StoreCommand::User(u) => user(u),
         StoreCommand::Key(KeyCommand::Init(a)) => key_init(a),
         StoreCommand::Issue(a) => signed(a.id, a.meaning, None, &a.signing),

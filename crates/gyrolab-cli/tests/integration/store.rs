@@ -890,3 +890,20 @@ fn the_raw_records_are_kept_and_a_report_is_reproduced_from_the_store_alone() {
     assert_eq!(r["changes"].as_array().unwrap().len(), 0, "{r}");
     assert_eq!(r["revision"], 2);
 }
+
+#[test]
+fn store_grant_gives_a_postgres_role_select_and_insert_and_refuses_an_sqlite_file() {
+    for b in backends("cli_grant") {
+        let dir = tempfile::tempdir().unwrap();
+        eval(&plan(dir.path(), "G1", "L"), &dir.path().join("r"), Some(&b.location));
+        let out = gyrolab().args(["store", "grant", "gyrolab_app", "--store", &b.location]).output().unwrap();
+        let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+        if b.name == "sqlite" {
+            assert_eq!(out.status.code(), Some(2), "{stderr}");
+            assert!(stderr.contains("file permissions"), "{stderr}");
+        } else {
+            assert!(out.status.success(), "{stderr}");
+            assert!(stdout.contains("SELECT and INSERT") && !stdout.contains("gyrolab-test-"), "{stdout}");
+        }
+    }
+}

@@ -4,6 +4,7 @@
 
 mod accounts;
 mod common;
+mod least_privilege;
 mod migrations;
 mod store;
 mod tamper;
