@@ -484,6 +484,43 @@ pub fn expected_triggers(postgres: bool) -> Vec<(String, String, String)> {
     out
 }
 
+/// SQLite only: the database file's own structure, every page read (issue 53: a file with 4 KiB
+/// of flipped bytes past its header accepted new evaluations). The quick check runs SQLite's
+/// `PRAGMA quick_check` (b-tree pages, their order and free lists: linear in the file's size,
+/// 0.21 s for a 275 MB file, warm); the full one `PRAGMA integrity_check` (indexes
+/// against their tables too). PostgreSQL's pages are its server's to check (data checksums).
+fn check_pages(x: &mut dyn Exec, postgres: bool, full: bool, report: &mut CheckReport) -> Result<(), DbError> {
+    if postgres {
+        return Ok(());
+    }
+    let (sql, column) = if full {
+        ("PRAGMA integrity_check(20)", "integrity_check")
+    } else {
+        ("PRAGMA quick_check(20)", "quick_check")
+    };
+    let rows = match x.rows(sql, &[], &[(column, Kind::T)]) {
+        Ok(r) => r,
+        Err(e) => {
+            report.problems.push(damaged(&e.to_string()));
+            return Ok(());
+        }
+    };
+    let lines: Vec<String> = rows.iter().map(|r| r.string(column)).collect::<Result<_, DbError>>()?;
+    if lines.len() != 1 || lines[0] != "ok" {
+        report.problems.push(damaged(&lines.join("; ").replace('\n', "; ")));
+    }
+    Ok(())
+}
+
+fn damaged(what: &str) -> Problem {
+    Problem {
+        table: "sqlite file".into(),
+        row_id: None,
+        link: None,
+        what: format!("the database file is damaged ({what}): restore it from a backup"),
+    }
+}
+
 fn check_triggers(x: &mut dyn Exec, postgres: bool, report: &mut CheckReport) -> Result<(), DbError> {
     let expected = expected_triggers(postgres);
     report.triggers_expected = expected.len();
@@ -696,8 +733,16 @@ fn check_tails(x: &mut dyn Exec, report: &mut CheckReport) -> Result<(), DbError
 /// whatever the size of the store: triggers present, no row past the chain's end or without an
 /// id, and the last [`QUICK_LINKS`] links, without gaps, against their rows. A row changed,
 /// deleted or inserted deeper in the store is found by [`full_check`] only.
-pub fn quick_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, DbError> {
+/// `pages`: SQLite's page check first ([`check_pages`]; once per opening for writing, not again
+/// inside each write).
+pub fn quick_check(x: &mut dyn Exec, postgres: bool, pages: bool) -> Result<CheckReport, DbError> {
     let mut report = CheckReport { quick: true, ..CheckReport::default() };
+    if pages {
+        check_pages(x, postgres, false, &mut report)?;
+    }
+    if !report.problems.is_empty() {
+        return Ok(report); // a damaged file: its rows cannot be trusted to be read
+    }
     check_triggers(x, postgres, &mut report)?;
     check_tails(x, &mut report)?;
     let (n, h) = head(x)?;
@@ -751,6 +796,10 @@ pub fn quick_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, DbEr
 /// outside the store), and every stored report file's bytes against its SHA-256 and size.
 pub fn full_check(x: &mut dyn Exec, postgres: bool) -> Result<CheckReport, DbError> {
     let mut report = CheckReport::default();
+    check_pages(x, postgres, true, &mut report)?;
+    if !report.problems.is_empty() {
+        return Ok(report); // a damaged file: its rows cannot be trusted to be read
+    }
     check_triggers(x, postgres, &mut report)?;
     // Every row's digest by (table, id), read in pages; report files re-hashed on the way.
     let mut digests: HashMap<(&'static str, i64), [u8; 32]> = HashMap::new();

@@ -177,8 +177,15 @@ fn set_wal(c: &rusqlite::Connection, budget: Duration) -> Result<(), DbError> {
 
 impl StoreError {
     /// True for errors of the user's data or store (exit code 2), false for failures (exit code 1).
+    /// A damaged SQLite file (SQLite's "malformed" and "not a database") is the store's fault,
+    /// not a failure of this run: exit code 2, as for any unusable store (issue 53).
     pub fn is_bad_input(&self) -> bool {
-        !matches!(self, StoreError::Database { .. })
+        match self {
+            StoreError::Database { message, .. } => {
+                message.contains("database disk image is malformed") || message.contains("file is not a database")
+            }
+            _ => true,
+        }
     }
 }
 
@@ -626,7 +633,7 @@ impl Store {
             if postgres {
                 x.exec("SELECT pg_advisory_xact_lock(7291836)", &[]).map_err(&dberr)?;
             }
-            let quick = chain::quick_check(x, postgres).map_err(&dberr)?;
+            let quick = chain::quick_check(x, postgres, false).map_err(&dberr)?;
             if let Some(first) = quick.problems.first() {
                 let more = match quick.problems.len() - 1 {
                     0 => String::new(),
@@ -1090,14 +1097,15 @@ impl Store {
         })
     }
 
-    /// The quick check run before every write ([`chain::quick_check`]): the triggers, row counts
+    /// The quick check run before every write ([`chain::quick_check`]; SQLite's page check too,
+    /// which the check inside each write leaves out): the triggers, row counts
     /// against link counts and the last links. `gyrolab eval --store` runs it before the report
     /// folder is written.
     pub fn quick_check(&mut self) -> StoreResult<CheckReport> {
         let postgres = self.is_postgres();
         let store = self.name.clone();
         self.transaction(|x| {
-            chain::quick_check(x, postgres)
+            chain::quick_check(x, postgres, true)
                 .map_err(|m| StoreError::Database { store: store.clone(), message: m.to_string() })
         })
     }

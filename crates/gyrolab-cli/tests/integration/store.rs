@@ -907,3 +907,70 @@ fn store_grant_gives_a_postgres_role_select_and_insert_and_refuses_an_sqlite_fil
         }
     }
 }
+
+#[test]
+fn a_store_file_damaged_past_its_header_is_refused_and_nothing_written() {
+    // Issue 53: "A corrupt SQLite file (4 KiB of flipped bytes) accepts new evaluations (only its
+    // 16-byte header is checked)". Every page is now read by SQLite's quick check before a write.
+    let dir = tempfile::tempdir().unwrap();
+    let db = dir.path().join("s.db");
+    for i in 0..4 {
+        eval(&plan(dir.path(), &format!("C{i}"), "L"), &dir.path().join(format!("r{i}")), Some(db.to_str().unwrap()));
+    }
+    let bytes = std::fs::read(&db).unwrap();
+    let pages = bytes.len() / 4096;
+    assert!(pages >= 8, "{pages} pages");
+    // 4 KiB of flipped bytes at the second page, the middle and the last page but one.
+    for page in [1, pages / 2, pages - 2] {
+        let mut b = bytes.clone();
+        b[page * 4096..(page + 1) * 4096].iter_mut().enumerate().for_each(|(i, x)| *x ^= 1 + (i % 255) as u8);
+        let damaged = dir.path().join(format!("damaged-{page}.db"));
+        std::fs::write(&damaged, &b).unwrap();
+        let out = dir.path().join(format!("out-{page}"));
+        let started = std::time::Instant::now();
+        let o = gyrolab()
+            .args(["eval", plan(dir.path(), "C9", "L").to_str().unwrap(), "--out", out.to_str().unwrap(), "-q"])
+            .args(["--store", damaged.to_str().unwrap()])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "page {page}: {err}");
+        assert!(err.contains("damaged") || err.contains("malformed"), "page {page}: {err}");
+        assert!(!out.exists(), "page {page}: nothing written");
+        eprintln!("page {page}: refused in {:?}", started.elapsed());
+        // store check says so: exit 3 (named) or 2 (not even openable), never 0.
+        let c = gyrolab().args(["store", "check", "--store", damaged.to_str().unwrap()]).output().unwrap();
+        assert!(matches!(c.status.code(), Some(2) | Some(3)), "page {page}: {:?}", c.status);
+        assert_eq!(std::fs::read(&damaged).unwrap(), b, "page {page}: the damaged file left as it was");
+    }
+}
+
+#[test]
+fn two_revisions_of_one_evaluation_at_once_one_lands_the_other_is_refused_clearly() {
+    // Issue 53: "Two concurrent store revise of one evaluation on PostgreSQL give a raw
+    // duplicate key error, exit 1." Both processes hold their transaction open 300 ms
+    // (GYROLAB_STORE_TEST_PAUSE_MS), so the second meets the first's revision inside its lock.
+    for b in backends("concurrent_revise") {
+        let dir = tempfile::tempdir().unwrap();
+        eval(&plan(dir.path(), "R1", "L"), &dir.path().join("r"), Some(&b.location));
+        let children: Vec<_> = ["LOT-A", "LOT-B"]
+            .iter()
+            .map(|lot| {
+                let mut c = gyrolab_process();
+                c.env("GYROLAB_STORE_TEST_PAUSE_MS", "300");
+                c.args(["store", "revise", "1", "--kind", "correction", "--by", "QA", "--reason", "lot", "--lot", lot]);
+                c.args(["--store", &b.location]);
+                c.stdout(std::process::Stdio::piped()).stderr(std::process::Stdio::piped()).spawn().unwrap()
+            })
+            .collect();
+        let outs: Vec<_> = children.into_iter().map(|c| c.wait_with_output().unwrap()).collect();
+        let codes: Vec<Option<i32>> = outs.iter().map(|o| o.status.code()).collect();
+        let errs: Vec<String> = outs.iter().map(|o| String::from_utf8_lossy(&o.stderr).into_owned()).collect();
+        assert!(codes.contains(&Some(0)) && codes.contains(&Some(2)), "{}: {codes:?} {errs:?}", b.name);
+        let refused = &errs[codes.iter().position(|c| *c == Some(2)).unwrap()];
+        assert!(refused.contains("already superseded by 2"), "{}: {refused}", b.name);
+        assert!(!refused.contains("duplicate key") && !refused.contains("UNIQUE"), "{}: {refused}", b.name);
+        let ids = history_ids(&b.location, "R1");
+        assert_eq!(ids.keys().copied().collect::<Vec<_>>(), [1, 2], "{}: one revision landed", b.name);
+    }
+}
