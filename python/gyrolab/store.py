@@ -75,14 +75,114 @@ class Store:
     def __repr__(self) -> str:
         return f"Store({_masked(self.location)!r})"
 
-    def add(self, report_folder: PathLike, plan: Optional[PathLike] = None) -> int:
+    def add(
+        self,
+        report_folder: PathLike,
+        plan: Optional[PathLike] = None,
+        user: Optional[str] = None,
+        password: Optional[str] = None,
+    ) -> int:
         """Stores a finished report folder (``gyrolab eval --out``; its plan: ``plan``, else the
-        one its results.json names, with every input hashed) as a new evaluation; the store is
-        created when missing. Returns the evaluation id."""
+        one its results.json names, with every input hashed and kept) as a new evaluation; the
+        store is created when missing. A store with accounts needs the account that stores it:
+        ``user`` and ``password`` (default: the ``GYROLAB_USER`` and ``GYROLAB_PASSWORD``
+        environment variables, as for the command line). Returns the evaluation id."""
+        user, password = _account(user, password)
         eid, _name = _gyrolab.store_add(
-            self.location, os.fspath(report_folder), None if plan is None else os.fspath(plan)
+            self.location, os.fspath(report_folder), None if plan is None else os.fspath(plan), user, password
         )
         return int(eid)
+
+    def check(self) -> Dict[str, Any]:
+        """Re-verifies the store (``gyrolab store check --json``): the SQLite file's pages, the
+        protecting triggers, every hash-chain link against its row, every stored report file and
+        raw record against its SHA-256. ``problems`` is empty when the store is whole; ``head``
+        is the chain head to keep elsewhere."""
+        return json.loads(_gyrolab.store_check(self.location))
+
+    def accounts(self) -> List[Dict[str, Any]]:
+        """Every account (``gyrolab store user list --json``): name, display name, role,
+        disabled, created (the database's time) and by whom."""
+        return list(json.loads(_gyrolab.store_accounts(self.location)))
+
+    def add_user(
+        self,
+        name: str,
+        role: str,
+        new_password: str,
+        display_name: Optional[str] = None,
+        user: Optional[str] = None,
+        password: Optional[str] = None,
+    ) -> str:
+        """Adds an account (``gyrolab store user add``; role ``viewer``, ``operator``,
+        ``approver`` or ``admin``; the password hashed with Argon2id). The store's first account
+        is an admin, added by no one; every later one by the admin ``user`` with ``password``
+        (default: ``GYROLAB_USER``, ``GYROLAB_PASSWORD``). Returns the line saying so."""
+        user, password = _account(user, password)
+        return str(_gyrolab.store_add_user(self.location, name, role, new_password, display_name, user, password))
+
+    def issue(
+        self,
+        id: int,
+        signing_key: PathLike,
+        meaning: str = "approved",
+        report_number: Optional[str] = None,
+        user: Optional[str] = None,
+        password: Optional[str] = None,
+    ) -> Dict[str, Any]:
+        """Issues evaluation ``id`` (``gyrolab store issue``): an approver (``user`` with
+        ``password``; default ``GYROLAB_USER``, ``GYROLAB_PASSWORD``) who did not store it signs
+        its manifest with the lab's private key file ``signing_key``; the store gives the report
+        number (or ``report_number``) and the issue date from its clock. ``meaning``:
+        ``approved`` or ``reviewed``. Returns the issued report (number, date, signer, key,
+        chain head, status)."""
+        user, password = _account(user, password, needed="issuing needs an approver's account")
+        return json.loads(
+            _gyrolab.store_issue(self.location, int(id), user, password, os.fspath(signing_key), meaning, report_number)
+        )
+
+    def amend(
+        self,
+        id: int,
+        reason: str,
+        signing_key: PathLike,
+        meaning: str = "approved",
+        user: Optional[str] = None,
+        password: Optional[str] = None,
+    ) -> Dict[str, Any]:
+        """Issues the correction ``id`` of an issued evaluation as an amendment (``gyrolab store
+        amend``, ISO/IEC 17025 7.8.8): "Amendment N to report R" with ``reason``; the report it
+        replaces stays retrievable, marked superseded. As :meth:`issue` otherwise."""
+        user, password = _account(user, password, needed="amending needs an approver's account")
+        return json.loads(
+            _gyrolab.store_issue(self.location, int(id), user, password, os.fspath(signing_key), meaning, None, reason)
+        )
+
+    def reevaluate(
+        self,
+        id: int,
+        out: PathLike,
+        reason: str,
+        by: Optional[str] = None,
+        user: Optional[str] = None,
+        password: Optional[str] = None,
+    ) -> Dict[str, Any]:
+        """Evaluates the current evaluation ``id`` again under this gyrolab (``gyrolab store
+        reevaluate --json``): its plan and inputs where they are when unchanged, else the raw
+        records the store keeps, into the report folder ``out``, stored as a revision (by the
+        account ``user``, or ``by`` in a store without accounts) for ``reason``. Returns the
+        revision's id and every figure whose value or verdict changed."""
+        user, password = _account(user, password)
+        return json.loads(
+            _gyrolab.store_reevaluate(self.location, int(id), os.fspath(out), reason, by, user, password)
+        )
+
+    def inputs(self, id: int, out: PathLike) -> Tuple[str, List[str]]:
+        """Writes the plan and raw records of evaluation ``id`` into the new folder ``out``, as
+        they stood relative to the plan, each checked against its SHA-256 (``gyrolab store report
+        ID --inputs``). Returns the plan's path and the records' paths."""
+        plan, files = _gyrolab.store_inputs(self.location, int(id), os.fspath(out))
+        return str(plan), [str(f) for f in files]
 
     def history(self, serial: str, figure: Optional[str] = None) -> Any:
         """Every figure of every evaluation (all revisions) of ``serial``, oldest first: one row
@@ -138,6 +238,22 @@ class Store:
     def _name(self) -> str:
         return _masked(self.location)
 
+
+
+def _account(
+    user: Optional[str], password: Optional[str], needed: Optional[str] = None
+) -> Tuple[Optional[str], Optional[str]]:
+    """The account of a write: ``user`` and ``password``, else ``GYROLAB_USER`` and
+    ``GYROLAB_PASSWORD``; none at all for a store without accounts (unless ``needed`` says why
+    one is)."""
+    user = user if user is not None else (os.environ.get("GYROLAB_USER") or None)
+    if user is not None and password is None:
+        password = os.environ.get("GYROLAB_PASSWORD")
+    if user is not None and password is None:
+        raise Error(f"user {user!r} needs its password: password=... or GYROLAB_PASSWORD")
+    if user is None and needed is not None:
+        raise Error(f"{needed}: user=... and password=... (or GYROLAB_USER and GYROLAB_PASSWORD)")
+    return user, password
 
 
 def _masked(location: str) -> str:

@@ -927,5 +927,11 @@ fn _gyrolab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(store::store_add, m)?)?;
     m.add_function(wrap_pyfunction!(store::store_masked, m)?)?;
     m.add_function(wrap_pyfunction!(store::store_report, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_check, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_accounts, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_add_user, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_issue, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_reevaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(store::store_inputs, m)?)?;
     Ok(())
 }

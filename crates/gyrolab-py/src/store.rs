@@ -129,22 +129,31 @@ pub fn store_figures(py: Python<'_>, location: Option<String>, lot: Option<Strin
 /// store show --json`.
 #[pyfunction]
 pub fn store_evaluation(py: Python<'_>, location: Option<String>, id: i64) -> PyResult<String> {
-    let e = with_store(py, location, false, |s| s.evaluation(id))?;
-    serde_json::to_string(&e).map_err(crate::json_err)
+    // The JSON of `gyrolab store show --json`: the evaluation, its issue and its audit trail.
+    let (e, issued, events) =
+        with_store(py, location, false, |s| Ok((s.evaluation(id)?, s.issue_of(id)?, s.audit_events(Some(id))?)))?;
+    let v = tables::evaluation_json(&e, issued.as_ref(), &events).map_err(crate::json_err)?;
+    serde_json::to_string(&v).map_err(crate::json_err)
 }
 
 /// Stores a finished report folder (its plan: `plan`, else the one its results.json names), the
 /// store created when missing: (evaluation id, store name with the password masked).
+/// `user` and `password`: the account that stores it (a store with accounts needs one).
 #[pyfunction]
-#[pyo3(signature = (location, folder, plan=None))]
+#[pyo3(signature = (location, folder, plan=None, user=None, password=None))]
 pub fn store_add(
     py: Python<'_>,
     location: Option<String>,
     folder: PathBuf,
     plan: Option<PathBuf>,
+    user: Option<String>,
+    password: Option<String>,
 ) -> PyResult<(i64, String)> {
+    let credentials = credentials(user, password)?;
+    let credentials = credentials.as_ref().map(|(u, p)| (u.as_str(), p.as_str()));
     // A folder stored already gives the evaluation that holds it (adding is idempotent).
-    match py.detach(|| gyrolab_store::add_report_folder(&folder, plan.as_deref(), location.as_deref())) {
+    match py.detach(|| gyrolab_store::add_report_folder_as(&folder, plan.as_deref(), location.as_deref(), credentials))
+    {
         Err(gyrolab_store::StoreError::AlreadyStored { store, id }) => Ok((id, store)),
         other => other.map_err(store_err),
     }
@@ -162,4 +171,155 @@ pub fn store_masked(location: &str) -> String {
 #[pyfunction]
 pub fn store_report(py: Python<'_>, location: Option<String>, id: i64, out: PathBuf) -> PyResult<Vec<PathBuf>> {
     with_store(py, location, false, |s| s.write_report(id, &out))
+}
+
+/// An account's name and password, both or neither.
+fn credentials(user: Option<String>, password: Option<String>) -> PyResult<Option<(String, String)>> {
+    match (user, password) {
+        (Some(u), Some(p)) => Ok(Some((u, p))),
+        (None, None) => Ok(None),
+        (Some(u), None) => Err(crate::error(format!("user {u:?} needs its password (password=...)"))),
+        (None, Some(_)) => Err(crate::error("a password needs its user (user=...)")),
+    }
+}
+
+/// Opens the store for writing (its quick check first) and authenticates `user` (no account
+/// when none is given, which a store with accounts refuses at the write).
+fn as_actor(
+    store: &mut Store,
+    user: Option<String>,
+    password: Option<String>,
+) -> Result<gyrolab_store::Actor, StoreError> {
+    match (user, password) {
+        (Some(u), Some(p)) => store.authenticate(&u, &p),
+        _ => Ok(gyrolab_store::Actor::unauthenticated()),
+    }
+}
+
+/// Like [`with_store`], the store opened for writing (its quick check first).
+fn with_store_writing<T: Send>(
+    py: Python<'_>,
+    location: Option<String>,
+    create: bool,
+    write: impl FnOnce(&mut Store) -> Result<T, StoreError> + Send,
+) -> PyResult<T> {
+    py.detach(|| {
+        let mut store = Store::open_for_writing(&resolve_location(location.as_deref()), create)?;
+        write(&mut store)
+    })
+    .map_err(store_err)
+}
+
+/// `gyrolab store check --json`: the full check's report as JSON (`problems` empty when whole).
+#[pyfunction]
+pub fn store_check(py: Python<'_>, location: Option<String>) -> PyResult<String> {
+    let r = with_store(py, location, false, |s| s.check())?;
+    serde_json::to_string(&r).map_err(|e| crate::error(e.to_string()))
+}
+
+/// `gyrolab store user list --json`: every account as JSON.
+#[pyfunction]
+pub fn store_accounts(py: Python<'_>, location: Option<String>) -> PyResult<String> {
+    let a = with_store(py, location, false, |s| s.accounts())?;
+    serde_json::to_string(&a).map_err(|e| crate::error(e.to_string()))
+}
+
+/// `gyrolab store user add`: the account `name` with `role` and `new_password`, added by the
+/// admin `user` (the store's first account: an admin, by no one); the line saying so.
+#[pyfunction]
+#[pyo3(signature = (location, name, role, new_password, display_name=None, user=None, password=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn store_add_user(
+    py: Python<'_>,
+    location: Option<String>,
+    name: String,
+    role: String,
+    new_password: String,
+    display_name: Option<String>,
+    user: Option<String>,
+    password: Option<String>,
+) -> PyResult<String> {
+    let role = gyrolab_store::Role::parse(&role)
+        .ok_or_else(|| crate::error(format!("role {role:?}: expected viewer, operator, approver or admin")))?;
+    credentials(user.clone(), password.clone())?;
+    with_store_writing(py, location, true, |s| {
+        let actor = as_actor(s, user, password)?;
+        let display = display_name.as_deref().unwrap_or(&name);
+        tables::add_account(s, &actor, &name, display, role, &new_password)
+    })
+}
+
+/// `gyrolab store issue` (`amend_reason` None) or `store amend`: evaluation `id` issued by the
+/// approver `user` with the lab's private key file `signing_key`; the issued report as JSON.
+#[pyfunction]
+#[pyo3(signature = (location, id, user, password, signing_key, meaning, report_number=None, amend_reason=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn store_issue(
+    py: Python<'_>,
+    location: Option<String>,
+    id: i64,
+    user: String,
+    password: String,
+    signing_key: PathBuf,
+    meaning: String,
+    report_number: Option<String>,
+    amend_reason: Option<String>,
+) -> PyResult<String> {
+    let meaning = match meaning.as_str() {
+        "approved" => gyrolab_store::issue::Meaning::Approved,
+        "reviewed" => gyrolab_store::issue::Meaning::Reviewed,
+        other => return Err(crate::error(format!("meaning {other:?}: expected approved or reviewed"))),
+    };
+    let key = gyrolab_store::sign::read_signing_key(&signing_key).map_err(crate::error)?;
+    let r = with_store_writing(py, location, false, |s| {
+        let actor = s.authenticate(&user, &password)?;
+        let req = gyrolab_lab::issue::Issue {
+            evaluation: id,
+            meaning,
+            key: &key,
+            report_number: report_number.as_deref(),
+            amend_reason: amend_reason.as_deref(),
+        };
+        gyrolab_lab::issue::issue(s, &actor, &req)
+    })?;
+    serde_json::to_string(&r).map_err(|e| crate::error(e.to_string()))
+}
+
+/// `gyrolab store reevaluate --json`: evaluation `id` evaluated again under this build (from its
+/// files where unchanged, else the store's raw records) into `out`, stored as a revision by the
+/// account `user` (or `by` in a store without accounts) for `reason`; the changes as JSON.
+#[pyfunction]
+#[pyo3(signature = (location, id, out, reason, by=None, user=None, password=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn store_reevaluate(
+    py: Python<'_>,
+    location: Option<String>,
+    id: i64,
+    out: PathBuf,
+    reason: String,
+    by: Option<String>,
+    user: Option<String>,
+    password: Option<String>,
+) -> PyResult<String> {
+    credentials(user.clone(), password.clone())?;
+    let r = with_store_writing(py, location, false, |s| {
+        let actor = as_actor(s, user, password)?;
+        let who = tables::revision_author(&actor, by.as_deref())
+            .map_err(|m| StoreError::Refused { store: s.name().to_string(), message: m })?;
+        gyrolab_lab::reevaluate::reevaluate_as(s, id, &who, &reason, &out, &actor)
+    })?;
+    serde_json::to_string(&r).map_err(|e| crate::error(e.to_string()))
+}
+
+/// `gyrolab store report ID --inputs`: the plan and raw records of evaluation `id` written into
+/// the new folder `out`, laid out as they stood relative to the plan: (the plan, the records).
+#[pyfunction]
+pub fn store_inputs(
+    py: Python<'_>,
+    location: Option<String>,
+    id: i64,
+    out: PathBuf,
+) -> PyResult<(PathBuf, Vec<PathBuf>)> {
+    let r = with_store(py, location, false, |s| gyrolab_lab::raw_records::restore_inputs(s, id, &out))?;
+    Ok((r.plan, r.inputs.into_iter().map(|(_, p)| p).collect()))
 }
