@@ -44,7 +44,7 @@ pub fn store_report_folder(
     plan: &Path,
     inputs: Option<Vec<FileRecord>>,
 ) -> StoreResult<(i64, String)> {
-    let record = from_report_folder_with(out, Some(plan), inputs, true)?;
+    let record = from_report_folder_with(out, Some(plan), inputs, true, &[])?;
     let (mut s, actor) = match prepared {
         Some(s) => s,
         None => (Store::open_for_writing(location, true)?, Actor::unauthenticated()),

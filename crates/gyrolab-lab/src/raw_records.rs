@@ -3,6 +3,7 @@
 //! audit (`gyrolab store inputs ID --out DIR`) or a re-evaluation reproduces the report without
 //! the lab's original folders.
 
+use gyrolab_io::test_plan::TestPlan;
 use gyrolab_store::query::write_input_content;
 use gyrolab_store::{Store, StoreError, StoreResult};
 use std::path::{Component, Path, PathBuf};
@@ -15,6 +16,20 @@ pub struct RestoredInputs {
     /// Each input: its path relative to the plan's folder (as results.json names it) and where
     /// it was written.
     pub inputs: Vec<(String, PathBuf)>,
+    /// The inputs the plan names by an absolute path, which cannot sit where the plan names
+    /// them: (the path the plan names, where it was written, under `_absolute/`).
+    pub moved: Vec<(PathBuf, PathBuf)>,
+}
+
+impl RestoredInputs {
+    /// The restored plan, parsed, reading the inputs it names by absolute path from where they
+    /// were written ([`gyrolab_io::test_plan::parse_plan_reading_moved`]; the report still names
+    /// them as the plan does).
+    pub fn plan(&self) -> Result<TestPlan, gyrolab_io::DataError> {
+        let text =
+            gyrolab_io::text::read_text_file(&self.plan, gyrolab_io::text::MAX_CONFIG_BYTES, "a test plan (TOML)")?;
+        gyrolab_io::test_plan::parse_plan_reading_moved(&self.plan, &text, &self.moved)
+    }
 }
 
 /// One input as the evaluation's results.json names it: its path relative to the plan's folder
@@ -57,8 +72,9 @@ fn levels_up(file: &str) -> Result<usize, String> {
 /// Writes the plan and every input of evaluation `id` from the store into `dir` (which must not
 /// exist: it is written whole, by a rename of a staged folder beside it, or not at all), laid
 /// out as they stood relative to the plan. Inputs reaching above the plan's folder (`../x.csv`)
-/// put the plan in as many nested `_` folders. Refused, naming the input, when the store keeps
-/// no copy of one (larger than 256 MiB, or stored before schema version 6).
+/// put the plan in as many nested `_` folders; inputs named by an absolute path go under
+/// `_absolute/` ([`RestoredInputs::plan`] reads them from there). Refused, naming the input,
+/// when the store keeps no copy of one (larger than 256 MiB, or stored before schema version 6).
 pub fn restore_inputs(store: &mut Store, id: i64, dir: &Path) -> StoreResult<RestoredInputs> {
     if std::fs::symlink_metadata(dir).is_ok() {
         return Err(StoreError::Input {
@@ -81,6 +97,7 @@ pub fn restore_inputs(store: &mut Store, id: i64, dir: &Path) -> StoreResult<Res
     Ok(RestoredInputs {
         plan: moved(&restored.plan),
         inputs: restored.inputs.iter().map(|(f, p)| (f.clone(), moved(p))).collect(),
+        moved: restored.moved.iter().map(|(f, p)| (f.clone(), moved(p))).collect(),
     })
 }
 
@@ -96,7 +113,14 @@ pub fn restored_text(store: &mut Store, id: i64, dir: &Path) -> StoreResult<Stri
     for (_, p) in &r.inputs {
         s.push_str(&format!("  {}\n", p.display()));
     }
-    s.push_str(&format!("evaluate them again with: gyrolab eval {} --out DIR\n", r.plan.display()));
+    match r.moved.len() {
+        0 => s.push_str(&format!("evaluate them again with: gyrolab eval {} --out DIR\n", r.plan.display())),
+        n => s.push_str(&format!(
+            "the plan names {n} of them by an absolute path: they are under {}, and gyrolab store reevaluate \
+             reads them from the store\n",
+            dir.join("_absolute").display()
+        )),
+    }
     Ok(s)
 }
 
@@ -109,7 +133,7 @@ pub fn restore_into(store: &mut Store, id: i64, root: &Path) -> StoreResult<Rest
     let refuse = |m: String| StoreError::Refused { store: store_name.clone(), message: m };
     let inputs = named_inputs(&rec.results_json).map_err(|m| refuse(format!("evaluation {id}: {m}")))?;
     let mut up = 0;
-    for (file, _) in &inputs {
+    for (file, _) in inputs.iter().filter(|(f, _)| !Path::new(f).is_absolute()) {
         up = up.max(levels_up(file).map_err(|m| refuse(format!("evaluation {id}: {m}")))?);
     }
     let mut plan_dir = root.to_path_buf();
@@ -123,10 +147,20 @@ pub fn restore_into(store: &mut Store, id: i64, root: &Path) -> StoreResult<Rest
     let plan = plan_dir.join(plan_name);
     std::fs::write(&plan, rec.plan_text.as_bytes()).map_err(|e| io(&plan, e))?;
     let mut written = Vec::new();
+    let mut moved = Vec::new();
     for (file, sha) in inputs {
         // Lexically inside `root`: `levels_up` allowed `..` only before the first name, and
-        // the plan sits that many folders down.
-        let path = plan_dir.join(&file);
+        // the plan sits that many folders down. An absolute path goes under `_absolute/`
+        // (its root and prefix left out).
+        let path = match Path::new(&file).is_absolute() {
+            true => {
+                let mut p = root.join("_absolute");
+                p.extend(Path::new(&file).components().filter(|c| matches!(c, Component::Normal(_))));
+                moved.push((PathBuf::from(&file), p.clone()));
+                p
+            }
+            false => plan_dir.join(&file),
+        };
         let path: PathBuf = path.components().fold(PathBuf::new(), |mut p, c| {
             match c {
                 Component::ParentDir => {
@@ -149,7 +183,7 @@ pub fn restore_into(store: &mut Store, id: i64, root: &Path) -> StoreResult<Rest
         }
         written.push((file, path));
     }
-    Ok(RestoredInputs { plan, inputs: written })
+    Ok(RestoredInputs { plan, inputs: written, moved })
 }
 
 #[cfg(test)]
@@ -162,7 +196,6 @@ mod tests {
         assert_eq!(levels_up("data/x.csv"), Ok(0));
         assert_eq!(levels_up("../data/x.csv"), Ok(1));
         assert_eq!(levels_up("../../x.csv"), Ok(2));
-        assert!(levels_up("/lab/x.csv").is_err());
         assert!(levels_up("data/../../x.csv").is_err(), "up after a name could leave the folder");
         assert!(levels_up("..").is_err());
     }

@@ -553,10 +553,14 @@ pub fn revision_author(actor: &Actor, given: Option<&str>) -> Result<String, Str
 /// Stores the revision `r` (a correction or an approval) with `changes` as `actor`: the line
 /// saying so, and the draft note when it supersedes an issued evaluation.
 pub fn revise(store: &mut Store, r: &Revision, changes: &Changes, actor: &Actor) -> StoreResult<String> {
-    let id = store.revise_as(r, changes, None, actor)?;
+    let (record, how) = match r.kind {
+        gyrolab_store::RevisionKind::Correction => crate::reevaluate::corrected(store, r.supersedes, changes)?,
+        _ => (None, String::new()),
+    };
+    let id = store.revise_as(r, changes, record.as_ref(), actor)?;
     let note = draft_note(store, r.supersedes, id)?;
     Ok(format!(
-        "stored {} of evaluation {} as evaluation {id} in {}\n{note}",
+        "stored {} of evaluation {} as evaluation {id} in {}\n{how}{note}",
         r.kind.as_str(),
         r.supersedes,
         store.name()

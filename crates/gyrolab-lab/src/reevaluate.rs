@@ -36,6 +36,23 @@ fn in_place(rec: &EvaluationRecord, id: i64) -> Result<(), String> {
     Ok(())
 }
 
+/// Where a re-evaluation reads the plan and its inputs.
+enum Restored {
+    /// The plan file where it was, its inputs as it names them.
+    InPlace(PathBuf),
+    /// The store's copies, laid out in a temporary folder.
+    Store(crate::raw_records::RestoredInputs),
+}
+
+impl Restored {
+    fn plan_file(&self) -> &Path {
+        match self {
+            Restored::InPlace(p) => p,
+            Restored::Store(r) => &r.plan,
+        }
+    }
+}
+
 /// The outcome of a re-evaluation.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Reevaluation {
@@ -85,7 +102,7 @@ pub fn reevaluate_as(
     let in_place = in_place(rec, id);
     let staged;
     let (eval_plan, inputs_from_store) = match in_place {
-        Ok(()) => (plan_path.clone(), None),
+        Ok(()) => (Restored::InPlace(plan_path.clone()), None),
         Err(why) => {
             staged =
                 tempfile::Builder::new().prefix("gyrolab-reevaluate-").tempdir().map_err(|e| StoreError::Input {
@@ -98,11 +115,14 @@ pub fn reevaluate_as(
                 }
                 e => e,
             })?;
-            (restored.plan, Some(rec.inputs.clone()))
+            (Restored::Store(restored), Some(rec.inputs.clone()))
         }
     };
-    let plan = read_test_plan(&eval_plan)
-        .map_err(|e| StoreError::Input { path: rec.plan_path.clone(), message: e.to_string() })?;
+    let plan = match &eval_plan {
+        Restored::InPlace(p) => read_test_plan(p).map_err(|e| e.to_string()),
+        Restored::Store(r) => r.plan().map_err(|e| e.to_string()),
+    }
+    .map_err(|message| StoreError::Input { path: rec.plan_path.clone(), message })?;
     let folder = evaluate_test_plan(&plan, &rec.plan_path, &gyrolab_eval::Silent)
         .map_err(|e| StoreError::Input { path: rec.plan_path.clone(), message: e.to_string() })?;
     let files: Vec<(&str, &[u8])> = folder.outputs.iter().map(|o| (o.name.as_str(), o.bytes.as_slice())).collect();
@@ -112,7 +132,11 @@ pub fn reevaluate_as(
     let mut new = match inputs_from_store {
         // The raw records are the store's already: hashed again here, not packed twice.
         Some(stored) => {
-            let mut new = from_report_folder_with(out, Some(&eval_plan), Some(stored), false)?;
+            let moved = match &eval_plan {
+                Restored::Store(r) => r.moved.as_slice(),
+                Restored::InPlace(_) => &[],
+            };
+            let mut new = from_report_folder_with(out, Some(eval_plan.plan_file()), Some(stored), false, moved)?;
             new.plan_path = rec.plan_path.clone();
             new
         }
@@ -138,4 +162,72 @@ pub fn reevaluate_as(
         verdict_after: new.verdict.clone(),
         changes: diff_figures(&rec.figures, &new.figures),
     })
+}
+
+/// The record of a correction of evaluation `id` with `changes` (issue 53: "a corrected serial
+/// still shows the old serial in the stored report"): its report drawn again with the corrected
+/// device and test fields, from the plan and raw records the store keeps, when this build gives
+/// exactly the stored figures (values, verdicts, bounds); else `None` and the report files are
+/// those of the revision corrected (said in the returned line). Changes of the approver alone
+/// keep the files (the sign-off is the issue's).
+pub fn corrected(store: &mut Store, id: i64, changes: &Changes) -> StoreResult<(Option<EvaluationRecord>, String)> {
+    let header = changes.serial.is_some()
+        || changes.model.is_some()
+        || changes.lot.is_some()
+        || changes.operator.is_some()
+        || changes.test_date.is_some();
+    if !header {
+        return Ok((None, String::new()));
+    }
+    let old = store.evaluation(id)?.record;
+    let kept = |why: String| -> StoreResult<(Option<EvaluationRecord>, String)> {
+        Ok((None, format!("the report files are those of evaluation {id}, its body unchanged: {why}\n")))
+    };
+    let staged = tempfile::Builder::new().prefix("gyrolab-correct-").tempdir().map_err(|e| StoreError::Input {
+        path: std::env::temp_dir().display().to_string(),
+        message: format!("cannot write: {e}"),
+    })?;
+    let restored = match crate::raw_records::restore_into(store, id, staged.path()) {
+        Ok(r) => r,
+        Err(StoreError::Refused { message, .. }) => return kept(message),
+        Err(e) => return Err(e),
+    };
+    let mut plan =
+        restored.plan().map_err(|e| StoreError::Input { path: old.plan_path.clone(), message: e.to_string() })?;
+    if let Some(v) = &changes.serial {
+        plan.device.serial = v.clone();
+    }
+    if let Some(v) = &changes.model {
+        plan.device.model = v.clone();
+    }
+    if let Some(v) = &changes.lot {
+        plan.device.lot = Some(v.clone());
+    }
+    if let Some(v) = &changes.operator {
+        plan.test.operator = Some(v.clone());
+    }
+    if let Some(v) = &changes.test_date {
+        plan.test.date = Some(v.clone());
+    }
+    let folder = match evaluate_test_plan(&plan, &old.plan_path, &gyrolab_eval::Silent) {
+        Ok(f) => f,
+        Err(e) => return kept(format!("it does not evaluate under this build ({e})")),
+    };
+    let out = staged.path().join("report");
+    let files: Vec<(&str, &[u8])> = folder.outputs.iter().map(|o| (o.name.as_str(), o.bytes.as_slice())).collect();
+    gyrolab_io::atomic::write_folder(&out, &files, &[])
+        .map_err(|e| StoreError::Input { path: e.path.display().to_string(), message: e.to_string() })?;
+    let mut new =
+        from_report_folder_with(&out, Some(&restored.plan), Some(old.inputs.clone()), false, &restored.moved)?;
+    if new.figures != old.figures {
+        return kept(format!(
+            "this build (gyrolab {}) gives other figures than gyrolab {} did; re-evaluate it to change them",
+            new.software_version, old.software_version
+        ));
+    }
+    new.plan_path = old.plan_path.clone();
+    Ok((
+        Some(new),
+        format!("its report drawn again with the corrected fields (the figures of evaluation {id}, unchanged)\n"),
+    ))
 }

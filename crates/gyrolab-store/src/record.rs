@@ -393,7 +393,7 @@ pub fn absolute(path: &Path) -> PathBuf {
 /// Reads the record of a finished report folder. `plan`: the plan file (default: the
 /// `plan_file` results.json names, as written, relative to the current folder).
 pub fn from_report_folder(dir: &Path, plan: Option<&Path>) -> StoreResult<EvaluationRecord> {
-    from_report_folder_with(dir, plan, None, true)
+    from_report_folder_with(dir, plan, None, true, &[])
 }
 
 /// SHA-256 and size of every input file the plan at `plan_path` names, in plan order.
@@ -468,12 +468,15 @@ fn read_manifest(dir: &Path) -> StoreResult<Option<gyrolab_io::provenance::Manif
 /// [`from_report_folder`] with the inputs' hashes already made by [`hash_plan_inputs`] of the
 /// same plan (`gyrolab eval --store` makes them on a second thread while it evaluates); `None`:
 /// hashed here. `pack`: the inputs' bytes read into [`FileRecord::packed`] ([`pack_inputs`]);
-/// false for a re-evaluation of raw records the store keeps already.
+/// false for a re-evaluation of raw records the store keeps already. `moved`: inputs the plan
+/// names read from elsewhere (the store's copies; see
+/// [`gyrolab_io::test_plan::parse_plan_reading_moved`]).
 pub fn from_report_folder_with(
     dir: &Path,
     plan: Option<&Path>,
     inputs: Option<Vec<FileRecord>>,
     pack: bool,
+    moved: &[(PathBuf, PathBuf)],
 ) -> StoreResult<EvaluationRecord> {
     let results_path = dir.join("results.json");
     let results_json = read_text(&results_path)?;
@@ -498,7 +501,8 @@ pub fn from_report_folder_with(
     // Kept as an absolute path, so that `store reevaluate` finds it from any folder (issue 53).
     let plan_path = absolute(&plan_path);
     let plan_text = read_text(&plan_path)?;
-    let parsed = read_test_plan(&plan_path)
+    // The text read once: parsed as it was read (never the file again).
+    let parsed = gyrolab_io::test_plan::parse_plan_reading_moved(&plan_path, &plan_text, moved)
         .map_err(|e| StoreError::Input { path: plan_path.display().to_string(), message: e.to_string() })?;
     let mut inputs = match inputs {
         Some(i) => i,

@@ -278,6 +278,8 @@ fn accounts_issue_verify_and_amend_from_the_command_line() {
             None,
         );
         let id4 = fixed.split_whitespace().nth(7).unwrap().to_string();
+        // Its report drawn again with the corrected serial (issue 53: the body showed the old one).
+        assert!(fixed.contains("drawn again with the corrected fields"), "{}: {fixed}", b.name);
         let (code, _, err) = r.run(&args(&issue(&id4)), appr, None);
         assert_eq!(code, 2, "{}: {err}", b.name);
         assert!(err.contains("amendment"), "{}: {err}", b.name);
@@ -289,6 +291,10 @@ fn accounts_issue_verify_and_amend_from_the_command_line() {
         assert_eq!(a["amendment"]["replaces_report"], number.as_str());
         assert_eq!(a["amendment"]["title"], format!("Amendment 1 to report {number}").as_str());
         assert!(a["amendment"]["changes"].to_string().contains("SN-1 -> SN-1B"), "{a}");
+        assert_eq!(json(&amended.join("results.json"))["device"]["serial"], "SN-1B", "{}", b.name);
+        let html = std::fs::read_to_string(amended.join("report.html")).unwrap();
+        assert!(html.contains("SN-1B") && !html.contains(">SN-1<"), "{}: the body names the corrected serial", b.name);
+        let summary = |d: &std::path::Path| std::fs::read_to_string(d.join("summary.csv")).unwrap();
         let new_number = a["report_number"].as_str().unwrap().to_string();
         assert_ne!(new_number, number);
         assert_eq!(verify(&mut r, &amended, true).0, 0);
@@ -301,6 +307,7 @@ fn accounts_issue_verify_and_amend_from_the_command_line() {
             (Some("superseded"), Some(new_number.as_str()))
         );
         assert_eq!(verify(&mut r, &old, true).0, 0, "{}", b.name);
+        assert_eq!(summary(&old), summary(&amended), "{}: the figures of the corrected report unchanged", b.name);
         let show = r.ok(&["store", "show", &id1], None, None);
         assert!(show.contains(&format!("SUPERSEDED by report {new_number}")), "{}: {show}", b.name);
         let history = r.ok(&["store", "history", "SN-1", "--csv"], None, None);

@@ -974,3 +974,42 @@ fn two_revisions_of_one_evaluation_at_once_one_lands_the_other_is_refused_clearl
         assert_eq!(ids.keys().copied().collect::<Vec<_>>(), [1, 2], "{}: one revision landed", b.name);
     }
 }
+
+#[test]
+fn inputs_named_by_absolute_paths_are_reevaluated_from_the_store_and_still_named_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("data");
+    std::fs::create_dir_all(&data).unwrap();
+    for axis in ["x", "y", "z"] {
+        let name = format!("paper_rate_table_{axis}.csv");
+        std::fs::copy(repo().join("data/paper").join(&name), data.join(&name)).unwrap();
+    }
+    let text = std::fs::read_to_string(repo().join("examples/paper_plan.toml")).unwrap();
+    // The plan in a folder of its own: its inputs are outside it, named absolutely.
+    std::fs::create_dir_all(dir.path().join("plans")).unwrap();
+    let plan = dir.path().join("plans/plan.toml");
+    std::fs::write(&plan, text.replace("../data/paper/", &format!("{}/", data.display()))).unwrap();
+    let db = dir.path().join("lab.db");
+    eval(&plan, &dir.path().join("r"), Some(db.to_str().unwrap()));
+    let audit = dir.path().join("audit");
+    gyrolab()
+        .args(["store", "report", "1", "--inputs", "--out", audit.to_str().unwrap(), "--store", db.to_str().unwrap()])
+        .assert()
+        .success()
+        .stdout(predicates::str::contains("by an absolute path"));
+    std::fs::remove_dir_all(&data).unwrap();
+    let re = dir.path().join("re");
+    let out = gyrolab()
+        .args(["store", "reevaluate", "1", "--out", re.to_str().unwrap(), "--by", "CI", "--reason", "audit", "--json"])
+        .args(["--store", db.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(r["changes"].as_array().unwrap().len(), 0, "{r}");
+    let results: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(re.join("results.json")).unwrap()).unwrap();
+    let named: Vec<&str> =
+        results["integrity"]["inputs"].as_array().unwrap().iter().map(|i| i["file"].as_str().unwrap()).collect();
+    assert_eq!(named, ["x", "y", "z"].map(|a| format!("{}/paper_rate_table_{a}.csv", data.display())), "{named:?}");
+}

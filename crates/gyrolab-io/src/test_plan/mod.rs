@@ -476,6 +476,9 @@ pub struct TestPlan {
     pub warmup: Vec<WarmupPlan>,
     /// g-sensitivity records (`[g_sensitivity.<axis>]`) in device axis order.
     pub g_sensitivity: Vec<GSensitivityAxisPlan>,
+    /// Inputs read from elsewhere than the plan names ([`parse_plan_reading_moved`]): (where
+    /// they are read, as the plan names them). Empty for a plan as parsed.
+    pub moved_inputs: Vec<(PathBuf, PathBuf)>,
 }
 
 impl TestPlan {
@@ -483,46 +486,59 @@ impl TestPlan {
     /// repeats (the files a report's integrity record hashes).
     pub fn input_files(&self) -> Vec<PathBuf> {
         let mut out: Vec<PathBuf> = Vec::new();
-        let mut add = |p: &PathBuf| {
+        // One traversal of the plan's inputs ([`TestPlan::visit_inputs`]), on a copy.
+        let mut copy = TestPlan { text: String::new(), ..self.clone() };
+        copy.visit_inputs(&mut |p| {
             if !out.iter().any(|q| q == p) {
                 out.push(p.clone());
             }
-        };
-        if let Some(c) = &self.options.calibration {
-            add(c);
-        }
-        for r in &self.rate {
-            add(&r.file);
-            if let Some(s) = &r.segmentation.segments {
-                add(s);
-            }
-        }
-        if let Some(t) = &self.triad {
-            t.files.iter().for_each(&mut add);
-            if let Some(s) = &t.segmentation.segments {
-                add(s);
-            }
-        }
-        for s in &self.static_tests {
-            s.files.iter().for_each(&mut add);
-            if let Some(a) = &s.allan_file {
-                add(a);
-            }
-        }
-        for t in &self.temperature {
-            for p in &t.points {
-                p.rate_file.iter().chain(&p.static_file).for_each(&mut add);
-            }
-        }
-        self.threshold.iter().chain(&self.resolution).for_each(|s| add(&s.file));
-        for p in &self.power_ups {
-            p.rate_files.iter().chain(&p.static_files).for_each(|(f, _)| add(f));
-        }
-        self.warmup.iter().for_each(|w| add(&w.file));
-        for g in &self.g_sensitivity {
-            g.records.iter().for_each(|r| add(&r.file));
-        }
+        });
         out
+    }
+
+    /// Calls `f` on every input path of the plan, in plan order (repeats included): the one
+    /// list of the fields that name a record file.
+    fn visit_inputs(&mut self, f: &mut dyn FnMut(&mut PathBuf)) {
+        if let Some(c) = &mut self.options.calibration {
+            f(c);
+        }
+        for r in &mut self.rate {
+            f(&mut r.file);
+            if let Some(s) = &mut r.segmentation.segments {
+                f(s);
+            }
+        }
+        if let Some(t) = &mut self.triad {
+            t.files.iter_mut().for_each(&mut *f);
+            if let Some(s) = &mut t.segmentation.segments {
+                f(s);
+            }
+        }
+        for s in &mut self.static_tests {
+            s.files.iter_mut().for_each(&mut *f);
+            if let Some(a) = &mut s.allan_file {
+                f(a);
+            }
+        }
+        for t in &mut self.temperature {
+            for p in &mut t.points {
+                p.rate_file.iter_mut().chain(&mut p.static_file).for_each(&mut *f);
+            }
+        }
+        self.threshold.iter_mut().chain(&mut self.resolution).for_each(|s| f(&mut s.file));
+        for p in &mut self.power_ups {
+            p.rate_files.iter_mut().chain(&mut p.static_files).for_each(|(file, _)| f(file));
+        }
+        self.warmup.iter_mut().for_each(|w| f(&mut w.file));
+        for g in &mut self.g_sensitivity {
+            g.records.iter_mut().for_each(|r| f(&mut r.file));
+        }
+    }
+
+    /// The name of input `path` as the plan names it: the path it was read in place of (a plan
+    /// parsed by [`parse_plan_reading_moved`]), else `path`.
+    pub fn named_input<'a>(&'a self, path: &'a Path) -> &'a Path {
+        self.moved_inputs.iter().find(|(now, _)| now == path).map_or(path, |(_, was)| was.as_path())
     }
 }
 
@@ -536,7 +552,16 @@ pub fn read_plan(path: &Path) -> Result<TestPlan, DataError> {
 /// Parses and checks a plan's text (as [`read_plan`]; `path` names the file in errors and
 /// resolves its relative paths).
 pub fn parse_plan(path: &Path, text: &str) -> Result<TestPlan, DataError> {
-    let plan = parse_plan_with(path, text, &|n| gyrolab::figures::known_figure(n).is_some())?;
+    parse_plan_reading_moved(path, text, &[])
+}
+
+/// [`parse_plan`], each input the plan names at a path of `moved` (as the plan resolves it)
+/// read from the path paired with it: a re-evaluation of records kept elsewhere (the records
+/// store's copies of inputs named by an absolute path). The report still names them as the plan
+/// does ([`TestPlan::named_input`]).
+pub fn parse_plan_reading_moved(path: &Path, text: &str, moved: &[(PathBuf, PathBuf)]) -> Result<TestPlan, DataError> {
+    let mut plan = parse_plan_with(path, text, &|n| gyrolab::figures::known_figure(n).is_some(), moved)?;
+    plan.moved_inputs = moved.iter().map(|(was, now)| (now.clone(), was.clone())).collect();
     for l in &plan.limits {
         if let Some(why) = gyrolab::figures::limit_refusal(&l.figure) {
             return Err(DataError::new(path, format!("limits.{}: {why}", l.figure)).at_line(l.line));
@@ -549,6 +574,8 @@ pub(crate) struct Ctx<'a> {
     pub(crate) path: &'a Path,
     pub(crate) text: &'a str,
     pub(crate) base: PathBuf,
+    /// Inputs read from elsewhere: (as the plan resolves it, where it is read).
+    pub(crate) moved: &'a [(PathBuf, PathBuf)],
 }
 
 impl Ctx<'_> {
@@ -559,6 +586,9 @@ impl Ctx<'_> {
 
     pub(crate) fn existing_file(&self, key: &str, value: &Spanned<String>) -> Result<PathBuf, DataError> {
         let p = self.base.join(value.get_ref());
+        if let Some((_, now)) = self.moved.iter().find(|(was, _)| *was == p) {
+            return Ok(now.clone());
+        }
         if p.is_file() {
             Ok(p)
         } else {
@@ -635,7 +665,12 @@ impl Ctx<'_> {
 }
 
 /// Parses and checks plan text; `path` names it in errors and its folder anchors relative paths.
-fn parse_plan_with(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool) -> Result<TestPlan, DataError> {
+fn parse_plan_with(
+    path: &Path,
+    text: &str,
+    known_figure: &dyn Fn(&str) -> bool,
+    moved: &[(PathBuf, PathBuf)],
+) -> Result<TestPlan, DataError> {
     let raw: RawPlan = toml::from_str(text).map_err(|e| {
         let mut d = DataError::new(path, format!("not a valid test plan: {}", crate::text::short_message(e.message())));
         if let Some(span) = e.span() {
@@ -648,7 +683,7 @@ fn parse_plan_with(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool)
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let cx = Ctx { path, text, base };
+    let cx = Ctx { path, text, base, moved };
 
     let axes = raw.device.axes.get_ref().clone();
     if axes.is_empty() {
@@ -1109,6 +1144,7 @@ fn parse_plan_with(path: &Path, text: &str, known_figure: &dyn Fn(&str) -> bool)
         power_ups,
         warmup,
         g_sensitivity,
+        moved_inputs: Vec::new(),
     })
 }
 

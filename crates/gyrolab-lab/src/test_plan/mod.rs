@@ -322,7 +322,9 @@ fn evaluate_marked(plan: &TestPlan, plan_file: &str, progress: &dyn Progress) ->
                 "the input changed (replaced, written or removed) while the plan was evaluated: its figures and its hash could be of different bytes; evaluate again once it is settled",
             )));
         }
-        let file = f.strip_prefix(plan_dir).unwrap_or(&f).display().to_string();
+        // As the plan names it (a re-evaluation reads the store's copies from elsewhere).
+        let named = plan.named_input(&f);
+        let file = named.strip_prefix(plan_dir).unwrap_or(named).display().to_string();
         inputs_json.push(InputJson { file, sha256, size_bytes });
     }
     parts.files.push((PLAN_COPY.into(), plan_bytes));
