@@ -230,11 +230,10 @@ pub fn lot_statistics(values: &[f64], lsl: Option<f64>, usl: Option<f64>, confid
     let (pp, ppk) = indices(mean, usable(sd), lsl, usl, n, confidence);
     let mut warnings = Vec::new();
     let mut refused = Vec::new();
-    if n < 2 {
+    if n < 2 && limits {
+        refused.push("n = 1: no standard deviation, so no Cp, Cpk, Pp or Ppk".to_string());
+    } else if n < 2 {
         warnings.push("n = 1: no standard deviation".to_string());
-        if limits {
-            refused.push("n = 1: no standard deviation, so no Cp, Cpk, Pp or Ppk".to_string());
-        }
     } else if limits {
         let degenerate = |name: &str, what: &str, s: Option<f64>| {
             s.filter(|s| negligible_spread(*s, scale)).map(|s| {
