@@ -518,7 +518,7 @@ fn series_notes(s: &FigureSeries) -> Vec<String> {
     }
     if let Some(x) = lowers.iter().copied().reduce(f64::min) {
         notes.push(format!(
-            "{} give{} only a lower bound (each at least {}{unit}, the smallest bound): kept out of the statistics",
+            "{} give{} only a lower bound (each above {}{unit}, the smallest bound): kept out of the statistics",
             devices(lowers.len()),
             if lowers.len() == 1 { "s" } else { "" },
             gyrolab::format::short(x, 6)
@@ -576,7 +576,7 @@ pub struct LotFigure {
     pub largest_upper_bound: Option<f64>,
     /// Devices that give only a lower bound.
     pub n_lower_bounds: usize,
-    /// The smallest lower bound (each of those devices is at least it).
+    /// The smallest lower bound (each of those devices is above it).
     pub smallest_lower_bound: Option<f64>,
     /// Devices NOT EVALUATED on this figure: stored without a usable value, with the verdict NOT
     /// EVALUATED, or (`n_missing`) without the figure in their current evaluation.
