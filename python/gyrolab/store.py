@@ -202,27 +202,42 @@ class Store:
         return svg
 
     def lot(self, lot: str, confidence: float = 0.95) -> Any:
-        """Statistics of each figure over the current evaluations of ``lot`` (each device once):
-        ``n``, ``mean``, ``sd``, ``min``, ``max``, the limits, ``yield``, Cp, Cpk, Pp, Ppk with
-        their ``confidence`` intervals (``_lo``, ``_hi``), ``outliers`` and ``simulated``."""
+        """Statistics of each figure over the current evaluations of ``lot`` (each device once),
+        from the values only: ``n`` (devices with a value) of ``n_devices`` (every device of the
+        lot), ``n_bounds`` (devices giving only an upper or lower bound, never averaged),
+        ``n_not_evaluated`` (no value, the verdict NOT EVALUATED, or the figure missing),
+        ``mean``, ``sd``, ``min``, ``max``, the limits, ``yield`` (conforming devices /
+        ``n_devices``), ``yield_evaluated`` (values inside the limits / ``n``), Cp, Cpk, Pp, Ppk
+        with their ``confidence`` intervals (``_lo``, ``_hi``; refused for a degenerate spread),
+        ``outliers``, ``simulated`` and ``notes`` (bounds, devices not evaluated, fewer than 25
+        values, indices refused; joined by "; ")."""
         return _frame(_gyrolab.store_lot(self.location, lot, float(confidence)), f"lot {lot}", self._name())
 
     def compare(self, lot1: str, lot2: str) -> Any:
-        """Two lots per figure: both means, their ``difference``, Welch's t-test (``welch_t``,
-        ``dof``, ``p_means``) and the F-test of the spreads (``sd_ratio``, ``F``,
-        ``p_spreads``)."""
+        """Two lots per figure, from the values only: ``n1``, ``n2`` (values) of
+        ``n_devices1``, ``n_devices2``, both means, their ``difference``, Welch's t-test
+        (``welch_t``, ``dof``, ``p_means``), the F-test of the spreads (``sd_ratio``, ``F``,
+        ``p_spreads``) and ``notes`` (bounds, devices not evaluated, why there is no test)."""
         return _frame(_gyrolab.store_compare(self.location, lot1, lot2), f"compare {lot1} {lot2}", self._name())
 
     def control_chart(self, axis: str, figure: str, lot: Optional[str] = None) -> Any:
-        """Control charts of one figure of one axis: one row per point of the individuals and
-        moving-range charts (over ``lot``, or every device) and of the X-bar and S charts over
-        lots, with ``center``, ``lcl``, ``ucl`` and the Nelson rules each point breaks."""
-        return _frame(_gyrolab.store_chart(self.location, axis, figure, lot), f"chart {axis} {figure}", self._name())
+        """Control charts of one figure of one axis, from the values only: one row per point of
+        the individuals and moving-range charts (over ``lot``, or every device) and of the X-bar
+        and S charts over lots, with ``center``, ``lcl``, ``ucl`` and the Nelson rules each point
+        breaks. ``attrs["notes"]`` lists the devices left out (bounds, not evaluated) and why a
+        chart is missing (the command line prints them on standard error)."""
+        table, notes = _gyrolab.store_chart(self.location, axis, figure, lot)
+        df = _frame(table, f"chart {axis} {figure}", self._name())
+        df.attrs["notes"] = list(notes)
+        return df
 
     def figures(self, lot: Optional[str] = None) -> Any:
         """The current figures of every device of ``lot`` (every device: None), one row per
         device and figure: ``axis``, ``figure``, ``unit``, ``serial``, ``evaluation``,
-        ``value``, ``limit_min``, ``limit_max``, ``series_simulated``."""
+        ``value`` (values only), ``limit_min``, ``limit_max``, ``series_simulated``, ``basis``
+        (``value``, ``upper_bound``, ``lower_bound``, or the stored basis of a device not
+        evaluated), ``bound`` (the number of a bound) and ``verdict`` (of a bound or a device
+        not evaluated)."""
         return _frame(_gyrolab.store_figures(self.location, lot), f"figures {lot or '(all)'}", self._name())
 
     def evaluation(self, id: int) -> Dict[str, Any]:

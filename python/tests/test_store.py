@@ -115,7 +115,68 @@ def test_lot_statistics_equal_numpy_and_aiag_formulas(filled):
     assert row["Pp"] == pytest.approx((hi - lo) / (6 * sd), rel=1e-9)
     assert row["Ppk"] == pytest.approx(min(hi - mean, mean - lo) / (3 * sd), rel=1e-9)
     assert row["yield"] == pytest.approx(np.mean((values >= lo) & (values <= hi)), rel=1e-12)
+    assert row["yield_evaluated"] == row["yield"], "every device gives a value"
+    assert (row["n_devices"], row["n_bounds"], row["n_not_evaluated"]) == (3, 0, 0)
+    assert "capability from n = 3 values, fewer than 25" in row["notes"]
     assert lot.attrs["query"] == f"lot {LOT}"
+
+
+NE_LOT = "PY-LOT-NE"
+
+
+@pytest.fixture(scope="module", params=["sqlite", "postgres"])
+def with_not_evaluated(request, root, tmp_path_factory):
+    """A lot of four devices; the fourth's plan decides nonlinearity by the guarded rule, which
+    needs an expanded uncertainty nonlinearity does not have: NOT EVALUATED with a value."""
+    work = tmp_path_factory.mktemp(f"store-ne-{request.param}")
+    location = str(work / "lab.db") if request.param == "sqlite" else _postgres_url()
+    store = Store(location)
+    folders = {}
+    for serial, scale in [("NE-1", 1.0), ("NE-2", 1.002), ("NE-3", 0.997), ("NE-4", 1.001)]:
+        plan = _write_device(root, work, serial, scale)
+        text = plan.read_text().replace(f'lot = "{LOT}"', f'lot = "{NE_LOT}"')
+        if serial == "NE-4":
+            text = text.replace("nonlinearity_pct = { max = 0.1 }",
+                                'nonlinearity_pct = { max = 0.1, rule = "guarded_acceptance" }')
+        plan.write_text(text)
+        out = work / f"report-{serial}"
+        gyrolab.evaluate_plan(plan, out)
+        store.add(out)
+        folders[serial] = out
+    return store, folders
+
+
+def test_lot_counts_a_device_not_evaluated_and_keeps_its_value_out(with_not_evaluated, cli):
+    store, folders = with_not_evaluated
+    h = store.history("NE-4", figure="nonlinearity_pct")
+    assert h["verdict"].tolist() == ["NOT EVALUATED"], "the set-up: NE-4's nonlinearity is not evaluated"
+    lot = store.lot(NE_LOT)
+    nl = lot[lot["figure"] == "nonlinearity_pct"].iloc[0]
+    values = np.array([_value(folders[s], "nonlinearity_pct") for s in ["NE-1", "NE-2", "NE-3"]])
+    assert (nl["n"], nl["n_devices"], nl["n_bounds"], nl["n_not_evaluated"]) == (3, 4, 0, 1)
+    assert nl["mean"] == pytest.approx(values.mean(), rel=1e-12), "NE-4's value is kept out"
+    # The yield counts NE-4 as not conforming: 3 of 4 devices, 3 of 3 values.
+    assert nl["yield"] == pytest.approx(np.sum(values <= 0.1) / 4, rel=1e-12)
+    assert nl["yield_evaluated"] == pytest.approx(np.mean(values <= 0.1), rel=1e-12)
+    assert "1 device NOT EVALUATED (no value, or the verdict NOT EVALUATED): NE-4" in nl["notes"]
+    # Ppk from the three values only (upper limit 0.1), with the few-values warning.
+    assert nl["Ppk"] == pytest.approx((0.1 - values.mean()) / (3 * values.std(ddof=1)), rel=1e-9)
+    assert "capability from n = 3 values, fewer than 25" in nl["notes"]
+    # The scale factor: four values of four devices, Ppk by the AIAG formula, the warning.
+    sf = lot[lot["figure"] == "scale_factor"].iloc[0]
+    k = np.array([_value(folders[s], "scale_factor") for s in ["NE-1", "NE-2", "NE-3", "NE-4"]])
+    lo, hi = LIMITS
+    assert (sf["n"], sf["n_devices"], sf["n_not_evaluated"]) == (4, 4, 0)
+    assert sf["Ppk"] == pytest.approx(min(hi - k.mean(), k.mean() - lo) / (3 * k.std(ddof=1)), rel=1e-9)
+    assert "capability from n = 4 values, fewer than 25" in sf["notes"]
+    # figures(): NE-4's nonlinearity has no value, its verdict says why.
+    f = store.figures(NE_LOT)
+    row = f[(f["serial"] == "NE-4") & (f["figure"] == "nonlinearity_pct")].iloc[0]
+    assert np.isnan(row["value"]) and row["basis"] == "value" and row["verdict"] == "NOT EVALUATED"
+    # The same table as the command line's CSV, notes included.
+    _same_table(lot, _cli_csv(cli, store, "lot", NE_LOT))
+    chart = store.control_chart("x", "nonlinearity_pct", lot=NE_LOT)
+    assert any("NE-4" in n for n in chart.attrs["notes"]), chart.attrs["notes"]
 
 
 def _cli_csv(cli, store, *args):

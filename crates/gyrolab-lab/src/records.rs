@@ -85,14 +85,20 @@ fn index_cols(i: Option<gyrolab::process_capability::Index>) -> [Cell; 3] {
     }
 }
 
-/// Lot statistics: one row per (axis, figure) with n, mean, sd, range, limits, yield, the four
-/// capability indices with their confidence intervals, outliers and the SIMULATED mark.
+/// Lot statistics: one row per (axis, figure) with n (the values counted), n_devices (every
+/// device of the lot), n_bounds and n_not_evaluated, mean, sd, range, limits, yield (over every
+/// device) and yield_evaluated (over the values), the four capability indices with their
+/// confidence intervals, outliers, the SIMULATED mark and the notes (bounds, devices not
+/// evaluated, few values, indices refused), joined by "; ".
 pub fn lot_table(rows: &[query::LotFigure]) -> Table {
     let (head, kinds) = columns(&[
         ("axis", T),
         ("figure", T),
         ("unit", T),
         ("n", C),
+        ("n_devices", C),
+        ("n_bounds", C),
+        ("n_not_evaluated", C),
         ("mean", N),
         ("sd", N),
         ("min", N),
@@ -100,6 +106,7 @@ pub fn lot_table(rows: &[query::LotFigure]) -> Table {
         ("limit_min", N),
         ("limit_max", N),
         ("yield", N),
+        ("yield_evaluated", N),
         ("Cp", N),
         ("Cp_lo", N),
         ("Cp_hi", N),
@@ -114,37 +121,72 @@ pub fn lot_table(rows: &[query::LotFigure]) -> Table {
         ("Ppk_hi", N),
         ("outliers", T),
         ("simulated", T),
+        ("notes", T),
     ]);
     let body = rows
         .iter()
         .map(|r| {
-            let s = &r.statistics;
+            let s = r.statistics.as_ref();
             let mut v = vec![
                 text(&r.axis),
                 text(&r.figure),
                 text(&r.unit),
-                Cell::Count(s.n as i64),
-                num(Some(s.mean)),
-                num(s.sd),
-                num(Some(s.min)),
-                num(Some(s.max)),
+                Cell::Count(r.n_evaluated as i64),
+                Cell::Count(r.n_devices as i64),
+                Cell::Count(r.n_bounds as i64),
+                Cell::Count(r.n_not_evaluated as i64),
+                num(s.map(|s| s.mean)),
+                num(s.and_then(|s| s.sd)),
+                num(s.map(|s| s.min)),
+                num(s.map(|s| s.max)),
                 num(r.limit_min),
                 num(r.limit_max),
-                num(s.yield_fraction),
+                num(r.yield_devices),
+                num(s.and_then(|s| s.yield_fraction)),
             ];
-            for i in [s.cp, s.cpk, s.pp, s.ppk] {
+            for i in s.map_or([None; 4], |s| [s.cp, s.cpk, s.pp, s.ppk]) {
                 v.extend(index_cols(i));
             }
             v.push(text(&r.outlier_serials.join(" ")));
             v.push(text(if r.simulated { "SIMULATED" } else { "" }));
+            v.push(text(&r.warnings.join("; ")));
             v
         })
         .collect();
     Table { columns: head, kinds, rows: body }
 }
 
-/// Two lots compared: one row per (axis, figure) with both means, their difference, Welch's t-test
-/// and the F-test of the spreads.
+/// Lot statistics as text (`gyrolab store lot`): the table of [`lot_table`] without its notes
+/// column, then each figure's notes on lines of their own under `notes:` (what the numbers
+/// leave out or cannot carry: bounds, devices not evaluated, few values, indices refused).
+pub fn lot_text(rows: &[query::LotFigure]) -> String {
+    let mut table = lot_table(rows);
+    table.columns.pop();
+    table.kinds.pop();
+    for r in &mut table.rows {
+        r.pop();
+    }
+    let mut out = to_text(&table);
+    if rows.iter().any(|r| !r.warnings.is_empty()) {
+        out.push_str("notes:\n");
+        for r in rows {
+            for w in &r.warnings {
+                out.push_str(&format!("  {} {}: {w}\n", r.axis, r.figure));
+            }
+        }
+    }
+    out.push_str(
+        "n: devices with a value (the statistics' n); n_devices: every device of the lot (its latest current \
+         evaluation); yield: conforming devices / n_devices (not evaluated = not conforming); yield_evaluated: \
+         values inside the limits / n\n",
+    );
+    out
+}
+
+/// Two lots compared: one row per (axis, figure) with the values counted (n1, n2) of the
+/// devices (n_devices1, n_devices2), both means, their difference, Welch's t-test and the
+/// F-test of the spreads, from the values only, and the notes (bounds, devices not evaluated,
+/// why there is no test).
 pub fn compare_table(rows: &[query::LotComparison]) -> Table {
     let (head, kinds) = columns(&[
         ("axis", T),
@@ -152,6 +194,8 @@ pub fn compare_table(rows: &[query::LotComparison]) -> Table {
         ("unit", T),
         ("n1", C),
         ("n2", C),
+        ("n_devices1", C),
+        ("n_devices2", C),
         ("mean1", N),
         ("mean2", N),
         ("difference", N),
@@ -161,6 +205,7 @@ pub fn compare_table(rows: &[query::LotComparison]) -> Table {
         ("sd_ratio", N),
         ("F", N),
         ("p_spreads", N),
+        ("notes", T),
     ]);
     let body = rows
         .iter()
@@ -172,15 +217,18 @@ pub fn compare_table(rows: &[query::LotComparison]) -> Table {
                 text(&r.unit),
                 Cell::Count(r.n1 as i64),
                 Cell::Count(r.n2 as i64),
-                num(Some(r.mean1)),
-                num(Some(r.mean2)),
-                num(Some(r.mean1 - r.mean2)),
+                Cell::Count(r.n_devices1 as i64),
+                Cell::Count(r.n_devices2 as i64),
+                num(r.mean1),
+                num(r.mean2),
+                num(r.mean1.zip(r.mean2).map(|(a, b)| a - b)),
                 num(t.map(|t| t.t)),
                 num(t.map(|t| t.t_dof)),
                 num(t.map(|t| t.t_p_value)),
                 num(t.map(|t| t.sd_ratio)),
                 num(t.map(|t| t.f)),
                 num(t.map(|t| t.f_p_value)),
+                text(&r.notes.join("; ")),
             ]
         })
         .collect();
@@ -263,9 +311,12 @@ pub fn diff_table(rows: &[query::FigureChange]) -> Table {
 }
 
 /// The current figures of a lot's devices (every lot: `lot_series(store, None)`), long form: one
-/// row per device and (axis, figure), in test order within each figure, with the limits of the
-/// latest evaluation; `series_simulated` is SIMULATED when any value of that figure in the lot
-/// comes from SIMULATED records.
+/// row per device and (axis, figure), in test order within each figure (values, then bounds,
+/// then devices not evaluated), with the limits of the latest evaluation; `series_simulated` is
+/// SIMULATED when any row of that figure in the lot comes from SIMULATED records. `value` holds
+/// values only: a bound is in `bound` (its `basis` upper_bound or lower_bound), a device not
+/// evaluated has neither; `verdict` is the stored verdict of a bound or of a device not
+/// evaluated (empty for values).
 pub fn figures_table(series: &[query::FigureSeries]) -> Table {
     let (head, kinds) = columns(&[
         ("axis", T),
@@ -277,24 +328,47 @@ pub fn figures_table(series: &[query::FigureSeries]) -> Table {
         ("limit_min", N),
         ("limit_max", N),
         ("series_simulated", T),
+        ("basis", T),
+        ("bound", N),
+        ("verdict", T),
     ]);
     let mut body = Vec::new();
     for s in series {
+        let row =
+            |serial: &str, id: i64, value: Option<f64>, basis: &str, bound: Option<f64>, verdict: Option<&str>| {
+                vec![
+                    text(&s.axis),
+                    text(&s.figure),
+                    text(&s.unit),
+                    text(serial),
+                    Cell::Count(id),
+                    num(value),
+                    num(s.limit_min),
+                    num(s.limit_max),
+                    text(if s.simulated { "SIMULATED" } else { "" }),
+                    text(basis),
+                    num(bound),
+                    Cell::text(verdict),
+                ]
+            };
         for (serial, id, value) in &s.values {
-            body.push(vec![
-                text(&s.axis),
-                text(&s.figure),
-                text(&s.unit),
-                text(serial),
-                Cell::Count(*id),
-                num(Some(*value)),
-                num(s.limit_min),
-                num(s.limit_max),
-                text(if s.simulated { "SIMULATED" } else { "" }),
-            ]);
+            body.push(row(serial, *id, Some(*value), "value", None, None));
+        }
+        for b in &s.bounds {
+            body.push(row(&b.serial, b.evaluation, None, &b.basis, b.value, b.verdict.as_deref()));
+        }
+        for r in &s.not_evaluated {
+            body.push(row(&r.serial, r.evaluation, None, &r.basis, None, r.verdict.as_deref()));
         }
     }
     Table { columns: head, kinds, rows: body }
+}
+
+/// The notes of control charts: the devices left out (bounds, not evaluated) and why a chart is
+/// missing; the command line prints them on standard error beside the table, Python in the
+/// frame's `attrs["notes"]`.
+pub fn chart_notes(c: &query::ControlCharts) -> Vec<String> {
+    c.notes.clone()
 }
 
 /// The history of a serial (every figure of every evaluation, all revisions, oldest first), only

@@ -84,7 +84,8 @@ pub fn store_history_svg(
     tables::history_svg(&serial, &rows).map_err(|e| crate::error(e.to_string()))
 }
 
-/// Lot statistics per figure (capability intervals at `confidence`).
+/// Lot statistics per figure (capability intervals at `confidence`): values, bounds and devices
+/// not evaluated counted apart, the notes in the `notes` column.
 #[pyfunction]
 #[pyo3(signature = (location, lot, confidence))]
 pub fn store_lot(py: Python<'_>, location: Option<String>, lot: String, confidence: f64) -> PyResult<PyTable<'_>> {
@@ -102,7 +103,8 @@ pub fn store_compare(py: Python<'_>, location: Option<String>, lot1: String, lot
     table_out(py, tables::compare_table(&rows))
 }
 
-/// Control charts of one figure of one axis (individuals over `lot`, or every device).
+/// Control charts of one figure of one axis (individuals over `lot`, or every device), and
+/// their notes (the devices left out: bounds, not evaluated; why a chart is missing).
 #[pyfunction]
 #[pyo3(signature = (location, axis, figure, lot=None))]
 pub fn store_chart(
@@ -111,9 +113,9 @@ pub fn store_chart(
     axis: String,
     figure: String,
     lot: Option<String>,
-) -> PyResult<PyTable<'_>> {
+) -> PyResult<(PyTable<'_>, Vec<String>)> {
     let charts = with_store(py, location, false, |s| query::control_charts(s, lot.as_deref(), &axis, &figure))?;
-    table_out(py, tables::chart_table(&charts))
+    Ok((table_out(py, tables::chart_table(&charts))?, tables::chart_notes(&charts)))
 }
 
 /// The current figures of a lot's devices (every device: `lot` None), one row per device and

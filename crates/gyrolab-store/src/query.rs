@@ -6,6 +6,9 @@
 //! Which values count: the *current* revision of an evaluation is the one no other revision
 //! supersedes; for lot statistics and charts each device (serial) counts once, with its latest
 //! current evaluation (highest id), in test order (test date, else evaluation time, then id).
+//! Only values enter means, spreads, indices, tests and charts ([`classify`]): a figure stored
+//! as a bound is counted apart, and a device whose figure has no value, or the verdict NOT
+//! EVALUATED, or (in a lot) no such figure at all, is counted as not evaluated (issue 53).
 
 use crate::db::{first_int, Columns, DbError, Kind, Row, Val};
 use crate::record::{EvaluationRecord, FigureRecord, FileRecord};
@@ -285,7 +288,49 @@ pub fn history(store: &mut Store, serial: &str) -> StoreResult<Vec<HistoryRow>> 
         .map_err(|e| store.row_error(e))
 }
 
-/// The values of one figure of one axis over a lot's devices, in test order.
+/// The verdict of a figure that was not evaluated (`gyrolab::limits`).
+pub const NOT_EVALUATED: &str = "NOT EVALUATED";
+
+/// What one device's current evaluation gives for a figure, as stored.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DeviceReading {
+    /// Serial.
+    pub serial: String,
+    /// Evaluation id.
+    pub evaluation: i64,
+    /// The stored basis: `value`, `upper_bound`, `lower_bound`, `absent`...
+    pub basis: String,
+    /// The stored number: the value, or the bound (`None`: none stored).
+    pub value: Option<f64>,
+    /// The stored verdict (`None`: no limit).
+    pub verdict: Option<String>,
+}
+
+/// What a stored figure row counts as in lot statistics.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reading {
+    /// A value: basis `value`, a finite number, a verdict other than NOT EVALUATED. Only these
+    /// enter means, standard deviations, indices, comparisons and charts.
+    Value,
+    /// Only a bound: basis `upper_bound` or `lower_bound` with a finite number (whatever its
+    /// verdict). Counted, never averaged.
+    Bound,
+    /// Not evaluated: no finite number, another basis (`absent`), or a value whose verdict is
+    /// NOT EVALUATED (the evaluation itself declined to use it).
+    NotEvaluated,
+}
+
+/// The class of a stored figure row (see [`Reading`]).
+pub fn classify(basis: &str, value: Option<f64>, verdict: Option<&str>) -> Reading {
+    match (basis, value.filter(|v| v.is_finite())) {
+        ("value", Some(_)) if verdict != Some(NOT_EVALUATED) => Reading::Value,
+        ("upper_bound" | "lower_bound", Some(_)) => Reading::Bound,
+        _ => Reading::NotEvaluated,
+    }
+}
+
+/// One figure of one axis over a lot's devices, in test order: the values, the bounds, the
+/// devices not evaluated and (lot queries) the devices whose current evaluation lacks the figure.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FigureSeries {
     /// Axis.
@@ -298,22 +343,37 @@ pub struct FigureSeries {
     pub limit_min: Option<f64>,
     /// Upper limit (of the latest evaluation).
     pub limit_max: Option<f64>,
-    /// (serial, evaluation id, value) in test order.
+    /// (serial, evaluation id, value) in test order: the values only ([`Reading::Value`]).
     pub values: Vec<(String, i64, f64)>,
-    /// Any value from SIMULATED records.
+    /// Any row of this figure from SIMULATED records.
     pub simulated: bool,
+    /// Devices that give only a bound ([`Reading::Bound`]), in test order.
+    pub bounds: Vec<DeviceReading>,
+    /// Devices whose figure is stored but not evaluated ([`Reading::NotEvaluated`]), in test order.
+    pub not_evaluated: Vec<DeviceReading>,
+    /// Serials of the lot's devices whose current evaluation has no such figure while others
+    /// have it, in test order (empty for the every-lot series).
+    pub missing: Vec<String>,
+    /// Devices counted: every device of the lot (each once) for a lot; the devices with this
+    /// figure for the every-lot series.
+    pub n_devices: usize,
 }
 
-/// Values (serial, id, test order key, value), limits and id of the latest evaluation, simulated;
-/// texts borrowed from the query's rows (no copy per row).
-type Group<'a> = (Vec<(&'a str, i64, &'a str, f64)>, Option<f64>, Option<f64>, i64, bool);
+/// One figure row of a chosen evaluation: serial, id, test order key, class, basis, number, verdict.
+type SeriesRow<'a> = (&'a str, i64, &'a str, Reading, &'a str, Option<f64>, Option<&'a str>);
+
+/// Rows, limits and id of the latest evaluation, simulated; texts borrowed from the query's rows
+/// (no copy per row).
+type Group<'a> = (Vec<SeriesRow<'a>>, Option<f64>, Option<f64>, i64, bool);
 
 /// One series per (axis, figure, unit) of the current evaluations in `lot` (all lots: `None`),
-/// each device once (its latest current evaluation).
+/// each device once (its latest current evaluation): values, bounds and devices not evaluated
+/// apart.
 pub fn lot_series(store: &mut Store, lot: Option<&str>) -> StoreResult<Vec<FigureSeries>> {
     // Two queries: the lot's current evaluations (one row each), then their figures (only the
     // columns that change per figure). Figures of evaluations not chosen by the first query
-    // (superseded ones, or ones stored in between) are passed over.
+    // (superseded ones, or ones stored in between) are passed over. Every figure row is read
+    // (values, bounds, rows without a value) and classified here (`classify`).
     const EVAL_LOT: &str =
         "SELECT e.id AS id, e.serial AS serial, COALESCE(e.test_date, e.evaluated_at) AS tested FROM evaluation e \
          WHERE e.lot = $1 AND NOT EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id)";
@@ -322,12 +382,12 @@ pub fn lot_series(store: &mut Store, lot: Option<&str>) -> StoreResult<Vec<Figur
          WHERE NOT EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id)";
     const FIG_LOT: &str =
         "SELECT f.evaluation_id AS evaluation_id, f.axis AS axis, f.figure AS figure, f.unit AS unit, f.value AS value, \
-         f.limit_min AS limit_min, f.limit_max AS limit_max, f.simulated AS simulated \
-         FROM figure f JOIN evaluation e ON e.id = f.evaluation_id WHERE e.lot = $1 AND f.value IS NOT NULL";
+         f.basis AS basis, f.verdict AS verdict, f.limit_min AS limit_min, f.limit_max AS limit_max, f.simulated AS simulated \
+         FROM figure f JOIN evaluation e ON e.id = f.evaluation_id WHERE e.lot = $1";
     const FIG_ALL: &str =
         "SELECT f.evaluation_id AS evaluation_id, f.axis AS axis, f.figure AS figure, f.unit AS unit, f.value AS value, \
-         f.limit_min AS limit_min, f.limit_max AS limit_max, f.simulated AS simulated \
-         FROM figure f WHERE f.value IS NOT NULL";
+         f.basis AS basis, f.verdict AS verdict, f.limit_min AS limit_min, f.limit_max AS limit_max, f.simulated AS simulated \
+         FROM figure f";
     let eval_kinds: Columns<'_> = &[("id", Kind::I), ("serial", Kind::T), ("tested", Kind::T)];
     let fig_kinds: Columns<'_> = &[
         ("evaluation_id", Kind::I),
@@ -335,6 +395,8 @@ pub fn lot_series(store: &mut Store, lot: Option<&str>) -> StoreResult<Vec<Figur
         ("figure", Kind::T),
         ("unit", Kind::T),
         ("value", Kind::F),
+        ("basis", Kind::T),
+        ("verdict", Kind::T),
         ("limit_min", Kind::F),
         ("limit_max", Kind::F),
         ("simulated", Kind::I),
@@ -344,12 +406,13 @@ pub fn lot_series(store: &mut Store, lot: Option<&str>) -> StoreResult<Vec<Figur
         Some(_) => (store.rows(EVAL_LOT, &lot_param, eval_kinds)?, store.rows(FIG_LOT, &lot_param, fig_kinds)?),
         None => (store.rows(EVAL_ALL, &[], eval_kinds)?, store.rows(FIG_ALL, &[], fig_kinds)?),
     };
-    let groups = group_series(&evals, &rows).map_err(|e| store.row_error(e))?;
+    let groups = group_series(&evals, &rows, lot.is_some()).map_err(|e| store.row_error(e))?;
     Ok(groups)
 }
 
-/// The series of [`lot_series`] from its two queries' rows.
-fn group_series(evals: &[Row], rows: &[Row]) -> Result<Vec<FigureSeries>, DbError> {
+/// The series of [`lot_series`] from its two queries' rows; `whole_lot`: every chosen device
+/// counts in each figure (a device without the figure is `missing`).
+fn group_series(evals: &[Row], rows: &[Row], whole_lot: bool) -> Result<Vec<FigureSeries>, DbError> {
     // The latest current evaluation per serial: id -> (serial, test order key).
     let mut latest: HashMap<&str, (i64, &str)> = HashMap::with_capacity(evals.len());
     for r in evals {
@@ -366,7 +429,7 @@ fn group_series(evals: &[Row], rows: &[Row]) -> Result<Vec<FigureSeries>, DbErro
     for r in rows {
         let id = r.int("evaluation_id")?;
         let Some(&(serial, date)) = chosen.get(&id) else { continue };
-        let Some(v) = r.float("value")? else { continue };
+        let (value, basis, verdict) = (r.float("value")?, r.text("basis")?.unwrap_or_default(), r.text("verdict")?);
         let key = (
             r.text("axis")?.unwrap_or_default(),
             r.text("figure")?.unwrap_or_default(),
@@ -377,7 +440,7 @@ fn group_series(evals: &[Row], rows: &[Row]) -> Result<Vec<FigureSeries>, DbErro
             groups.len() - 1
         });
         let g = &mut groups[i].1;
-        g.0.push((serial, id, date, v));
+        g.0.push((serial, id, date, classify(basis, value, verdict), basis, value, verdict));
         if id > g.3 {
             g.1 = r.float("limit_min")?;
             g.2 = r.float("limit_max")?;
@@ -386,24 +449,102 @@ fn group_series(evals: &[Row], rows: &[Row]) -> Result<Vec<FigureSeries>, DbErro
         g.4 |= r.int("simulated")? != 0;
     }
     groups.sort_by(|a, b| a.0.cmp(&b.0));
+    let mut devices: Vec<(&str, i64, &str)> = chosen.iter().map(|(id, (s, d))| (*s, *id, *d)).collect();
+    devices.sort_by(|a, b| a.2.cmp(b.2).then(a.1.cmp(&b.1)));
     Ok(groups
         .into_iter()
         .map(|((axis, figure, unit), (mut v, lo, hi, _, sim))| {
             v.sort_by(|a, b| a.2.cmp(b.2).then(a.1.cmp(&b.1)));
+            let reading = |r: &SeriesRow| DeviceReading {
+                serial: r.0.to_string(),
+                evaluation: r.1,
+                basis: r.4.to_string(),
+                value: r.5,
+                verdict: r.6.map(str::to_string),
+            };
+            let missing: Vec<String> = if whole_lot {
+                devices.iter().filter(|d| !v.iter().any(|r| r.1 == d.1)).map(|d| d.0.to_string()).collect()
+            } else {
+                Vec::new()
+            };
             FigureSeries {
                 axis: axis.to_string(),
                 figure: figure.to_string(),
                 unit: unit.to_string(),
                 limit_min: lo,
                 limit_max: hi,
-                values: v.into_iter().map(|(s, id, _, x)| (s.to_string(), id, x)).collect(),
+                values: v
+                    .iter()
+                    .filter(|r| r.3 == Reading::Value)
+                    .filter_map(|r| r.5.map(|x| (r.0.to_string(), r.1, x)))
+                    .collect(),
                 simulated: sim,
+                bounds: v.iter().filter(|r| r.3 == Reading::Bound).map(reading).collect(),
+                not_evaluated: v.iter().filter(|r| r.3 == Reading::NotEvaluated).map(reading).collect(),
+                n_devices: v.len() + missing.len(),
+                missing,
             }
         })
         .collect())
 }
 
-/// The statistics of one figure over a lot.
+/// Serials as a note lists them: at most ten, then how many more.
+fn serial_list<'a>(serials: impl Iterator<Item = &'a str>) -> String {
+    let all: Vec<&str> = serials.collect();
+    let mut s = all.iter().take(10).copied().collect::<Vec<_>>().join(", ");
+    if all.len() > 10 {
+        s.push_str(&format!(" and {} more", all.len() - 10));
+    }
+    s
+}
+
+/// "1 device" / "3 devices".
+fn devices(n: usize) -> String {
+    format!("{n} device{}", if n == 1 { "" } else { "s" })
+}
+
+/// The notes of a series' bounds and devices not evaluated (empty when every device gives a value).
+fn series_notes(s: &FigureSeries) -> Vec<String> {
+    let mut notes = Vec::new();
+    let unit = if s.unit.is_empty() { String::new() } else { format!(" {}", s.unit) };
+    let uppers: Vec<f64> = s.bounds.iter().filter(|b| b.basis == "upper_bound").filter_map(|b| b.value).collect();
+    let lowers: Vec<f64> = s.bounds.iter().filter(|b| b.basis == "lower_bound").filter_map(|b| b.value).collect();
+    if let Some(x) = uppers.iter().copied().reduce(f64::max) {
+        notes.push(format!(
+            "{} give{} only an upper bound (each at most {}{unit}, the largest bound): kept out of the statistics",
+            devices(uppers.len()),
+            if uppers.len() == 1 { "s" } else { "" },
+            gyrolab::format::short(x, 6)
+        ));
+    }
+    if let Some(x) = lowers.iter().copied().reduce(f64::min) {
+        notes.push(format!(
+            "{} give{} only a lower bound (each above {}{unit}, the smallest bound): kept out of the statistics",
+            devices(lowers.len()),
+            if lowers.len() == 1 { "s" } else { "" },
+            gyrolab::format::short(x, 6)
+        ));
+    }
+    if !s.not_evaluated.is_empty() {
+        notes.push(format!(
+            "{} NOT EVALUATED (no value, or the verdict NOT EVALUATED): {}",
+            devices(s.not_evaluated.len()),
+            serial_list(s.not_evaluated.iter().map(|r| r.serial.as_str()))
+        ));
+    }
+    if !s.missing.is_empty() {
+        notes.push(format!(
+            "{} without this figure in {} current evaluation, counted as NOT EVALUATED: {}",
+            devices(s.missing.len()),
+            if s.missing.len() == 1 { "its" } else { "their" },
+            serial_list(s.missing.iter().map(String::as_str))
+        ));
+    }
+    notes
+}
+
+/// The statistics of one figure over a lot: the values' statistics, and every device of the lot
+/// counted (values, bounds, not evaluated) with the yield over all of them.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LotFigure {
     /// Axis.
@@ -416,15 +557,51 @@ pub struct LotFigure {
     pub limit_min: Option<f64>,
     /// Upper limit.
     pub limit_max: Option<f64>,
-    /// Statistics (capability intervals: chi-squared for Cp/Pp, Bissell for Cpk/Ppk).
-    pub statistics: LotStatistics,
+    /// Statistics of the values only (capability intervals: chi-squared for Cp/Pp, Bissell for
+    /// Cpk/Ppk); `None` when no device gives a value (`warnings` says why).
+    pub statistics: Option<LotStatistics>,
     /// Serial numbers of the outliers (Tukey's fences).
     pub outlier_serials: Vec<String>,
-    /// Any value from SIMULATED records.
+    /// Any row of this figure from SIMULATED records.
     pub simulated: bool,
+    /// Devices of the lot, each once (its latest current evaluation): n_evaluated + n_bounds +
+    /// n_not_evaluated.
+    pub n_devices: usize,
+    /// Devices that give a value (the statistics' n).
+    pub n_evaluated: usize,
+    /// Devices that give only a bound (upper or lower), kept out of the statistics.
+    pub n_bounds: usize,
+    /// Devices that give only an upper bound.
+    pub n_upper_bounds: usize,
+    /// The largest upper bound (each of those devices is at most it).
+    pub largest_upper_bound: Option<f64>,
+    /// Devices that give only a lower bound.
+    pub n_lower_bounds: usize,
+    /// The smallest lower bound (each of those devices is above it).
+    pub smallest_lower_bound: Option<f64>,
+    /// Devices NOT EVALUATED on this figure: stored without a usable value, with the verdict NOT
+    /// EVALUATED, or (`n_missing`) without the figure in their current evaluation.
+    pub n_not_evaluated: usize,
+    /// Of the devices not evaluated, those whose current evaluation lacks the figure.
+    pub n_missing: usize,
+    /// Serials of the devices that give only a bound, in test order.
+    pub bound_serials: Vec<String>,
+    /// Serials of the devices not evaluated (missing ones included), in test order.
+    pub not_evaluated_serials: Vec<String>,
+    /// Devices that conform to the limits: a value inside them (inclusive), or a bound that
+    /// decides (an upper bound at most the upper limit without a lower limit, a lower bound at
+    /// least the lower limit without an upper limit); `None` without limits.
+    pub conforming_devices: Option<usize>,
+    /// conforming_devices / n_devices: the lot's yield, a device not evaluated counting as not
+    /// conforming (`statistics.yield_fraction` is the yield among the values only).
+    pub yield_devices: Option<f64>,
+    /// Notes: bounds, devices not evaluated, then the statistics' warnings (few values, n < 2,
+    /// indices refused).
+    pub warnings: Vec<String>,
 }
 
-/// Lot statistics of every figure of `lot` at `confidence` (e.g. 0.95).
+/// Lot statistics of every figure of `lot` at `confidence` (e.g. 0.95): every figure any
+/// device of the lot has, with every device of the lot counted (values, bounds, not evaluated).
 pub fn lot(store: &mut Store, lot: &str, confidence: f64) -> StoreResult<Vec<LotFigure>> {
     let series = lot_series(store, Some(lot))?;
     if series.is_empty() {
@@ -433,27 +610,58 @@ pub fn lot(store: &mut Store, lot: &str, confidence: f64) -> StoreResult<Vec<Lot
             message: format!("no figures stored for lot {lot:?}"),
         });
     }
-    Ok(series
-        .into_iter()
-        .filter_map(|s| {
-            let values: Vec<f64> = s.values.iter().map(|v| v.2).collect();
-            let statistics = lot_statistics(&values, s.limit_min, s.limit_max, confidence)?;
-            let outlier_serials = statistics.outliers.iter().map(|i| s.values[*i].0.clone()).collect();
-            Some(LotFigure {
-                axis: s.axis,
-                figure: s.figure,
-                unit: s.unit,
-                limit_min: s.limit_min,
-                limit_max: s.limit_max,
-                statistics,
-                outlier_serials,
-                simulated: s.simulated,
-            })
-        })
-        .collect())
+    Ok(series.into_iter().map(|s| lot_figure(s, confidence)).collect())
 }
 
-/// The comparison of one figure between two lots.
+/// The lot statistics of one series.
+fn lot_figure(s: FigureSeries, confidence: f64) -> LotFigure {
+    let values: Vec<f64> = s.values.iter().map(|v| v.2).collect();
+    let statistics = lot_statistics(&values, s.limit_min, s.limit_max, confidence);
+    let outlier_serials =
+        statistics.as_ref().map_or_else(Vec::new, |st| st.outliers.iter().map(|i| s.values[*i].0.clone()).collect());
+    let upper = |b: &&DeviceReading| b.basis == "upper_bound";
+    let uppers: Vec<f64> = s.bounds.iter().filter(upper).filter_map(|b| b.value).collect();
+    let lowers: Vec<f64> = s.bounds.iter().filter(|b| !upper(b)).filter_map(|b| b.value).collect();
+    let (lo, hi) = (s.limit_min, s.limit_max);
+    let conforming = (lo.is_some() || hi.is_some()).then(|| {
+        values.iter().filter(|v| lo.is_none_or(|l| **v >= l) && hi.is_none_or(|u| **v <= u)).count()
+            + uppers.iter().filter(|b| lo.is_none() && hi.is_some_and(|u| **b <= u)).count()
+            + lowers.iter().filter(|b| hi.is_none() && lo.is_some_and(|l| **b >= l)).count()
+    });
+    let mut warnings = series_notes(&s);
+    match &statistics {
+        Some(st) => warnings.extend(st.warnings.iter().cloned()),
+        None => warnings.push("no device gives a value: no statistics".into()),
+    }
+    let mut not_evaluated: Vec<String> = s.not_evaluated.iter().map(|r| r.serial.clone()).collect();
+    not_evaluated.extend(s.missing.iter().cloned());
+    LotFigure {
+        n_evaluated: values.len(),
+        n_bounds: s.bounds.len(),
+        n_upper_bounds: uppers.len(),
+        largest_upper_bound: uppers.iter().copied().reduce(f64::max),
+        n_lower_bounds: lowers.len(),
+        smallest_lower_bound: lowers.iter().copied().reduce(f64::min),
+        n_not_evaluated: not_evaluated.len(),
+        n_missing: s.missing.len(),
+        bound_serials: s.bounds.iter().map(|b| b.serial.clone()).collect(),
+        not_evaluated_serials: not_evaluated,
+        conforming_devices: conforming,
+        yield_devices: conforming.filter(|_| s.n_devices > 0).map(|c| c as f64 / s.n_devices as f64),
+        n_devices: s.n_devices,
+        warnings,
+        axis: s.axis,
+        figure: s.figure,
+        unit: s.unit,
+        limit_min: s.limit_min,
+        limit_max: s.limit_max,
+        statistics,
+        outlier_serials,
+        simulated: s.simulated,
+    }
+}
+
+/// The comparison of one figure between two lots, from the values only.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LotComparison {
     /// Axis.
@@ -462,19 +670,34 @@ pub struct LotComparison {
     pub figure: String,
     /// Unit.
     pub unit: String,
-    /// Devices in the first lot.
+    /// Values in the first lot (devices that give a value).
     pub n1: usize,
-    /// Devices in the second lot.
+    /// Values in the second lot.
     pub n2: usize,
-    /// Mean of the first lot.
-    pub mean1: f64,
-    /// Mean of the second lot.
-    pub mean2: f64,
-    /// Welch's t-test and the F-test (`None`: a lot has fewer than two values or no spread).
+    /// Mean of the first lot's values (`None`: no value).
+    pub mean1: Option<f64>,
+    /// Mean of the second lot's values.
+    pub mean2: Option<f64>,
+    /// Welch's t-test and the F-test (`None`: a lot has fewer than two values, or no spread or a
+    /// degenerate one).
     pub test: Option<TwoSampleComparison>,
+    /// Devices of the first lot (values, bounds and not evaluated).
+    pub n_devices1: usize,
+    /// Devices of the second lot.
+    pub n_devices2: usize,
+    /// Devices of the first lot that give only a bound.
+    pub n_bounds1: usize,
+    /// Devices of the second lot that give only a bound.
+    pub n_bounds2: usize,
+    /// Devices of the first lot not evaluated (missing ones included).
+    pub n_not_evaluated1: usize,
+    /// Devices of the second lot not evaluated.
+    pub n_not_evaluated2: usize,
+    /// Notes: each lot's bounds and devices not evaluated (`lot A: ...`), and why there is no test.
+    pub notes: Vec<String>,
 }
 
-/// Every figure present in both lots, compared.
+/// Every figure present in both lots, compared on the values only.
 pub fn compare(store: &mut Store, lot1: &str, lot2: &str) -> StoreResult<Vec<LotComparison>> {
     let a = lot_series(store, Some(lot1))?;
     let b = lot_series(store, Some(lot2))?;
@@ -486,26 +709,44 @@ pub fn compare(store: &mut Store, lot1: &str, lot2: &str) -> StoreResult<Vec<Lot
             });
         }
     }
+    let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
     Ok(a.iter()
         .filter_map(|x| {
             let y = b.iter().find(|y| y.axis == x.axis && y.figure == x.figure && y.unit == x.unit)?;
             let xv: Vec<f64> = x.values.iter().map(|v| v.2).collect();
             let yv: Vec<f64> = y.values.iter().map(|v| v.2).collect();
+            let test = compare_samples(&xv, &yv);
+            let mut notes: Vec<String> = series_notes(x).into_iter().map(|n| format!("lot {lot1}: {n}")).collect();
+            notes.extend(series_notes(y).into_iter().map(|n| format!("lot {lot2}: {n}")));
+            if test.is_none() {
+                notes.push(if xv.len() < 2 || yv.len() < 2 {
+                    "no test: a lot has fewer than two values".into()
+                } else {
+                    "no test: a lot's values have no spread (zero or degenerate)".into()
+                });
+            }
             Some(LotComparison {
                 axis: x.axis.clone(),
                 figure: x.figure.clone(),
                 unit: x.unit.clone(),
                 n1: xv.len(),
                 n2: yv.len(),
-                mean1: xv.iter().sum::<f64>() / xv.len() as f64,
-                mean2: yv.iter().sum::<f64>() / yv.len() as f64,
-                test: compare_samples(&xv, &yv),
+                mean1: mean(&xv),
+                mean2: mean(&yv),
+                test,
+                n_devices1: x.n_devices,
+                n_devices2: y.n_devices,
+                n_bounds1: x.bounds.len(),
+                n_bounds2: y.bounds.len(),
+                n_not_evaluated1: x.not_evaluated.len() + x.missing.len(),
+                n_not_evaluated2: y.not_evaluated.len() + y.missing.len(),
+                notes,
             })
         })
         .collect())
 }
 
-/// Control charts of one figure of one axis.
+/// Control charts of one figure of one axis, from the values only.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ControlCharts {
     /// Axis.
@@ -526,9 +767,20 @@ pub struct ControlCharts {
     pub xbar: Option<Chart>,
     /// S chart over lots.
     pub s: Option<Chart>,
+    /// Devices of the individuals chart's series (the lot's, or every device with the figure).
+    pub n_devices: usize,
+    /// Of them, devices that give only a bound (no point).
+    pub n_bounds: usize,
+    /// Of them, devices not evaluated (no point; missing ones included).
+    pub n_not_evaluated: usize,
+    /// Devices of the X-bar/S lots left out: bounds or not evaluated.
+    pub n_left_out_of_lots: usize,
+    /// Notes: the bounds and devices not evaluated left out, and why a chart is missing.
+    pub notes: Vec<String>,
 }
 
-/// I-MR charts over the devices of `lot` (all lots: `None`) and X-bar/S over every lot.
+/// I-MR charts over the devices of `lot` (all lots: `None`) and X-bar/S over every lot, from the
+/// values only (each device once, its latest current evaluation).
 pub fn control_charts(store: &mut Store, lot: Option<&str>, axis: &str, figure: &str) -> StoreResult<ControlCharts> {
     let series = lot_series(store, lot)?;
     let Some(s) = series.into_iter().find(|s| s.axis == axis && s.figure == figure) else {
@@ -542,25 +794,37 @@ pub fn control_charts(store: &mut Store, lot: Option<&str>, axis: &str, figure: 
     };
     let values: Vec<f64> = s.values.iter().map(|v| v.2).collect();
     let im = individuals_moving_range(&values);
-    // X-bar/S: every lot, devices grouped by their lot.
+    // X-bar/S: every lot, devices grouped by their lot; each serial's latest current
+    // evaluation (highest id), then only its value counts.
     let rows = store.rows(
-        "SELECT e.id AS id, e.serial AS serial, e.lot AS lot, f.value AS value FROM evaluation e JOIN figure f ON f.evaluation_id = e.id \
-         WHERE e.lot IS NOT NULL AND f.axis = $1 AND f.figure = $2 AND f.value IS NOT NULL \
+        "SELECT e.id AS id, e.serial AS serial, e.lot AS lot, f.value AS value, f.basis AS basis, f.verdict AS verdict \
+         FROM evaluation e JOIN figure f ON f.evaluation_id = e.id \
+         WHERE e.lot IS NOT NULL AND f.axis = $1 AND f.figure = $2 \
          AND NOT EXISTS (SELECT 1 FROM evaluation s WHERE s.supersedes = e.id) ORDER BY e.id",
         &[Val::T(Some(axis.to_string())), Val::T(Some(figure.to_string()))],
-        &[("id", Kind::I), ("serial", Kind::T), ("lot", Kind::T), ("value", Kind::F)],
+        &[
+            ("id", Kind::I),
+            ("serial", Kind::T),
+            ("lot", Kind::T),
+            ("value", Kind::F),
+            ("basis", Kind::T),
+            ("verdict", Kind::T),
+        ],
     )?;
-    let mut per_serial: BTreeMap<String, (String, f64, i64)> = BTreeMap::new();
+    let mut per_serial: BTreeMap<String, (String, Option<f64>, i64)> = BTreeMap::new();
     for r in rows {
-        let read =
-            || -> Result<_, DbError> { Ok((r.float("value")?, r.string("serial")?, r.string("lot")?, r.int("id")?)) };
+        let read = || -> Result<_, DbError> {
+            let (value, basis, verdict) = (r.float("value")?, r.string("basis")?, r.text("verdict")?);
+            let v = value.filter(|_| classify(&basis, value, verdict) == Reading::Value);
+            Ok((v, r.string("serial")?, r.string("lot")?, r.int("id")?))
+        };
         let (value, serial, lot, id) = read().map_err(|e| store.row_error(e))?;
-        if let Some(v) = value {
-            per_serial.insert(serial, (lot, v, id));
-        }
+        per_serial.insert(serial, (lot, value, id));
     }
+    let left_out = per_serial.values().filter(|v| v.1.is_none()).count();
     let mut lots: BTreeMap<String, (i64, Vec<f64>)> = BTreeMap::new();
     for (lot, v, id) in per_serial.into_values() {
+        let Some(v) = v else { continue };
         let e = lots.entry(lot).or_insert((i64::MAX, Vec::new()));
         e.0 = e.0.min(id);
         e.1.push(v);
@@ -569,7 +833,26 @@ pub fn control_charts(store: &mut Store, lot: Option<&str>, axis: &str, figure: 
     ordered.sort_by_key(|(_, g)| g.0);
     let groups: Vec<Vec<f64>> = ordered.iter().map(|(_, g)| g.1.clone()).collect();
     let xs = xbar_s(&groups);
+    let mut notes: Vec<String> = series_notes(&s).into_iter().map(|n| format!("{n}: no point")).collect();
+    if im.is_none() {
+        notes.push(if values.len() < 2 {
+            "no individuals chart: fewer than two values".into()
+        } else {
+            "no individuals chart: the values have no spread (zero or degenerate)".into()
+        });
+    }
+    if left_out > 0 {
+        notes.push(format!(
+            "X-bar/S: {} of the lots give no value (bounds or NOT EVALUATED): left out",
+            devices(left_out)
+        ));
+    }
     Ok(ControlCharts {
+        n_devices: s.n_devices,
+        n_bounds: s.bounds.len(),
+        n_not_evaluated: s.not_evaluated.len() + s.missing.len(),
+        n_left_out_of_lots: left_out,
+        notes,
         axis: s.axis,
         figure: s.figure,
         unit: s.unit,

@@ -119,15 +119,18 @@ pub fn nelson_violations(points: &[f64], center: f64, sigma: &[f64]) -> Vec<Viol
 }
 
 /// Individuals and moving-range charts of `values` in test order; `None` for fewer than two
-/// values or no variation.
+/// values or no variation (MR-bar zero or degenerate: at most
+/// [`crate::process_capability::NEGLIGIBLE_SPREAD`] of the largest absolute value, values equal
+/// to within rounding, whose limits would flag rounding noise).
 pub fn individuals_moving_range(values: &[f64]) -> Option<(Chart, Chart)> {
+    use crate::process_capability::{negligible_spread, spread_scale};
     if values.len() < 2 {
         return None;
     }
     let center = values.iter().sum::<f64>() / values.len() as f64;
     let mr: Vec<f64> = values.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
     let mr_bar = mr.iter().sum::<f64>() / mr.len() as f64;
-    if mr_bar <= 0.0 || !mr_bar.is_finite() {
+    if negligible_spread(mr_bar, spread_scale(values, None, None)) {
         return None;
     }
     let sigma = mr_bar / crate::process_capability::D2_MOVING_RANGE;
@@ -159,7 +162,8 @@ pub fn individuals_moving_range(values: &[f64]) -> Option<(Chart, Chart)> {
 
 /// X-bar and S charts over subgroups (each at least two values): sigma = mean of s_i / c4(n_i),
 /// centre = grand mean of all values; limits per subgroup. `None` when a subgroup has fewer than
-/// two values or there is no variation.
+/// two values or there is no variation (sigma zero or degenerate, as for
+/// [`individuals_moving_range`]).
 pub fn xbar_s(subgroups: &[Vec<f64>]) -> Option<(Chart, Chart)> {
     if subgroups.is_empty() || subgroups.iter().any(|g| g.len() < 2) {
         return None;
@@ -174,7 +178,8 @@ pub fn xbar_s(subgroups: &[Vec<f64>]) -> Option<(Chart, Chart)> {
     let total: usize = stats.iter().map(|s| s.0).sum();
     let center = stats.iter().map(|(n, m, _)| *n as f64 * m).sum::<f64>() / total as f64;
     let sigma = stats.iter().map(|(n, _, s)| s / c4(*n)).sum::<f64>() / stats.len() as f64;
-    if sigma <= 0.0 || !sigma.is_finite() {
+    let scale = subgroups.iter().map(|g| crate::process_capability::spread_scale(g, None, None)).fold(0.0, f64::max);
+    if crate::process_capability::negligible_spread(sigma, scale) {
         return None;
     }
     let xs: Vec<f64> = stats.iter().map(|s| s.1).collect();
@@ -274,5 +279,9 @@ mod tests {
         assert_relative_eq!(x.ucl[0], 3.0 + 3.0 * sigma / 2f64.sqrt(), max_relative = 1e-12);
         assert_relative_eq!(s.points[0], 2f64.sqrt(), max_relative = 1e-12);
         assert!(xbar_s(&[vec![1.0]]).is_none());
+        // Equal to within rounding: no chart of rounding noise.
+        let e = f64::EPSILON;
+        assert!(xbar_s(&[vec![1.0, 1.0 + e], vec![1.0, 1.0]]).is_none());
+        assert!(individuals_moving_range(&[1.0, 1.0 + e, 1.0]).is_none());
     }
 }

@@ -10,11 +10,45 @@
 //! Applied Statistics 39 (1990) 331-340 (normal approximation of the interval of Cpk);
 //! J. W. Tukey, *Exploratory Data Analysis* (1977) (fences at 1.5 interquartile ranges), with
 //! quartiles by linear interpolation (Hyndman & Fan type 7, numpy's default).
+//!
+//! Two guards keep the indices honest (issue 53). A *degenerate spread* gives no index: a sigma
+//! at most [`NEGLIGIBLE_SPREAD`] (1e-9) times the magnitude of the data and limits
+//! ([`spread_scale`]) is rounding, not variation (values equal to within floating-point
+//! rounding gave Ppk = 1.96e15 from s = 8.5e-18), so Cp/Cpk or Pp/Ppk are `None` with the reason
+//! in [`LotStatistics::indices_refused`]. *Few values* are said: indices from fewer than
+//! [`MIN_VALUES_FOR_CAPABILITY`] (25) values carry a warning (the AIAG SPC manual, 2nd ed., ch. II,
+//! asks for 25 or more subgroups, with individuals 25 values, before capability is judged;
+//! ISO 22514-2 likewise asks for a long enough study), and n < 2 says there is no standard
+//! deviation.
 
 use statrs::distribution::{ChiSquared, ContinuousCDF, Normal};
 
 /// d2 of moving ranges of two consecutive values (AIAG SPC manual, appendix E).
 pub const D2_MOVING_RANGE: f64 = 1.128;
+
+/// Fewest values from which capability indices are given without a warning: 25 (AIAG SPC
+/// manual, 2nd ed., ch. II: 25 or more subgroups before a process is judged; individual values
+/// are subgroups of one; ISO 22514-2 asks for a long enough study likewise).
+pub const MIN_VALUES_FOR_CAPABILITY: usize = 25;
+
+/// A sigma at most this fraction of [`spread_scale`] is degenerate (rounding, not variation):
+/// 1e-9, a million times the relative rounding of a double (2.2e-16) and far below any spread a
+/// test figure resolves (no gyro test figure is measured to nine significant digits).
+pub const NEGLIGIBLE_SPREAD: f64 = 1e-9;
+
+/// The magnitude a spread is judged against: the largest absolute value among the values and
+/// the limits (so at least half the tolerance width when both limits exist). 0 for no values
+/// and no limits.
+pub fn spread_scale(values: &[f64], lsl: Option<f64>, usl: Option<f64>) -> f64 {
+    values.iter().chain(lsl.iter()).chain(usl.iter()).map(|v| v.abs()).filter(|v| v.is_finite()).fold(0.0, f64::max)
+}
+
+/// True when `sigma` is no spread at all for data of magnitude `scale`: not finite, zero, or at
+/// most [`NEGLIGIBLE_SPREAD`] x `scale` (values equal to within rounding). With `scale` 0 (every
+/// value and limit zero) only a positive sigma counts.
+pub fn negligible_spread(sigma: f64, scale: f64) -> bool {
+    !sigma.is_finite() || sigma <= 0.0 || sigma <= NEGLIGIBLE_SPREAD * scale
+}
 
 /// A two-sided confidence interval.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -63,6 +97,13 @@ pub struct LotStatistics {
     pub confidence: f64,
     /// Indices (into the input) of the values outside Tukey's fences (1.5 IQR beyond the quartiles).
     pub outliers: Vec<usize>,
+    /// Why capability indices are missing although a limit exists: n < 2 (no standard
+    /// deviation) or a degenerate spread ([`negligible_spread`]); `None` when every index the
+    /// limits allow is given, or without limits.
+    pub indices_refused: Option<String>,
+    /// What a reader must know before using these numbers: indices from fewer than
+    /// [`MIN_VALUES_FOR_CAPABILITY`] values, n < 2 (no standard deviation), indices refused.
+    pub warnings: Vec<String>,
 }
 
 /// Sample mean and standard deviation (divisor n - 1; `None` for n < 2).
@@ -163,7 +204,10 @@ fn indices(
 }
 
 /// Lot statistics of `values` (in test order: the moving ranges follow it) against the limits
-/// `lsl` (lower) and `usl` (upper); `None` for no values or a non-finite value.
+/// `lsl` (lower) and `usl` (upper); `None` for no values or a non-finite value. Capability
+/// indices are refused (`None`, the reason in `indices_refused`) for n < 2 and for a degenerate
+/// spread ([`negligible_spread`] against [`spread_scale`]); indices from fewer than
+/// [`MIN_VALUES_FOR_CAPABILITY`] values carry a warning.
 pub fn lot_statistics(values: &[f64], lsl: Option<f64>, usl: Option<f64>, confidence: f64) -> Option<LotStatistics> {
     if values.is_empty() || values.iter().any(|v| !v.is_finite()) {
         return None;
@@ -173,14 +217,45 @@ pub fn lot_statistics(values: &[f64], lsl: Option<f64>, usl: Option<f64>, confid
     let sigma_within = sigma_from_moving_range(values);
     let min = values.iter().copied().fold(f64::INFINITY, f64::min);
     let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let yield_fraction = if lsl.is_none() && usl.is_none() {
+    let limits = lsl.is_some() || usl.is_some();
+    let yield_fraction = if !limits {
         None
     } else {
         let inside = values.iter().filter(|v| lsl.is_none_or(|l| **v >= l) && usl.is_none_or(|u| **v <= u)).count();
         Some(inside as f64 / n as f64)
     };
-    let (cp, cpk) = indices(mean, sigma_within, lsl, usl, n, confidence);
-    let (pp, ppk) = indices(mean, sd, lsl, usl, n, confidence);
+    let scale = spread_scale(values, lsl, usl);
+    let usable = |s: Option<f64>| s.filter(|s| !negligible_spread(*s, scale));
+    let (cp, cpk) = indices(mean, usable(sigma_within), lsl, usl, n, confidence);
+    let (pp, ppk) = indices(mean, usable(sd), lsl, usl, n, confidence);
+    let mut warnings = Vec::new();
+    let mut refused = Vec::new();
+    if n < 2 && limits {
+        refused.push("n = 1: no standard deviation, so no Cp, Cpk, Pp or Ppk".to_string());
+    } else if n < 2 {
+        warnings.push("n = 1: no standard deviation".to_string());
+    } else if limits {
+        let degenerate = |name: &str, what: &str, s: Option<f64>| {
+            s.filter(|s| negligible_spread(*s, scale)).map(|s| {
+                format!(
+                    "no {name}: {what} {} is a degenerate spread (at most {NEGLIGIBLE_SPREAD:e} of the data's \
+                     magnitude {}: the values are equal to within rounding)",
+                    crate::format::sig(s, 2),
+                    crate::format::short(scale, 4)
+                )
+            })
+        };
+        refused.extend(degenerate("Cp, Cpk", "sigma within", sigma_within));
+        refused.extend(degenerate("Pp, Ppk", "s", sd));
+    }
+    warnings.extend(refused.iter().cloned());
+    let any_index = cp.is_some() || cpk.is_some() || pp.is_some() || ppk.is_some();
+    if any_index && n < MIN_VALUES_FOR_CAPABILITY {
+        warnings.push(format!(
+            "capability from n = {n} values, fewer than {MIN_VALUES_FOR_CAPABILITY} (AIAG SPC manual, ISO 22514-2): \
+             the indices are rough estimates, see their intervals"
+        ));
+    }
     Some(LotStatistics {
         n,
         mean,
@@ -195,6 +270,8 @@ pub fn lot_statistics(values: &[f64], lsl: Option<f64>, usl: Option<f64>, confid
         ppk,
         confidence,
         outliers: tukey_outliers(values),
+        indices_refused: (!refused.is_empty()).then(|| refused.join("; ")),
+        warnings,
     })
 }
 
@@ -266,9 +343,62 @@ mod tests {
     fn degenerate_lots_give_no_index_rather_than_a_wrong_one() {
         let s = lot_statistics(&[1.0], Some(0.0), Some(2.0), 0.95).unwrap();
         assert!(s.sd.is_none() && s.cp.is_none() && s.ppk.is_none());
+        assert!(s.indices_refused.as_deref().is_some_and(|r| r.contains("n = 1")), "{s:?}");
+        assert!(s.warnings.iter().any(|w| w.contains("no standard deviation")), "{s:?}");
         let s = lot_statistics(&[1.0, 1.0, 1.0], Some(0.0), Some(2.0), 0.95).unwrap();
         assert!(s.cpk.is_none(), "zero spread has no finite capability");
+        assert!(s.indices_refused.as_deref().is_some_and(|r| r.contains("degenerate")), "{s:?}");
         assert!(lot_statistics(&[], None, None, 0.95).is_none());
         assert!(lot_statistics(&[1.0, f64::NAN], None, None, 0.95).is_none());
+        // Without limits nothing is refused, but n = 1 still says there is no sd.
+        let s = lot_statistics(&[1.0], None, None, 0.95).unwrap();
+        assert_eq!((s.indices_refused.as_deref(), s.warnings.len()), (None, 1));
+    }
+
+    #[test]
+    fn the_issues_resolution_case_gives_no_index_from_rounding() {
+        // Issue 53: four values of 0.0125 deg/s equal to within rounding (0, 0, 6 and 10 units in
+        // the last place, 2^-59 each), upper limit 0.0625: s = 8.498e-18 (numpy std ddof=1), and
+        // (USL - mean)/(3 s) = 1.961e15 -- the Ppk the store printed. Refused now, with why.
+        let ulp = 2f64.powi(-59);
+        let v = [0.0125, 0.0125, 0.0125 + 6.0 * ulp, 0.0125 + 10.0 * ulp];
+        let s = lot_statistics(&v, None, Some(0.0625), 0.95).unwrap();
+        let sd = s.sd.unwrap();
+        assert_relative_eq!(sd, 8.498374721940739e-18, max_relative = 1e-6);
+        assert_relative_eq!((0.0625 - s.mean) / (3.0 * sd), 1.961159305394875e15, max_relative = 1e-6);
+        assert!(s.ppk.is_none() && s.cpk.is_none() && s.pp.is_none() && s.cp.is_none(), "{s:?}");
+        let why = s.indices_refused.unwrap();
+        assert!(why.contains("no Pp, Ppk: s 8.5e-18 is a degenerate spread"), "{why}");
+        assert!(why.contains("no Cp, Cpk: sigma within"), "{why}");
+        assert!(s.warnings.iter().all(|w| !w.contains("fewer than 25")), "no index, no few-values warning");
+        // The rule itself: 1e-9 of the magnitude of the values and limits.
+        let scale = spread_scale(&v, None, Some(0.0625));
+        assert_eq!(scale, 0.0625);
+        assert!(negligible_spread(8.5e-18, scale) && negligible_spread(0.0625e-9, scale));
+        assert!(!negligible_spread(0.0625e-9 * 1.01, scale));
+        assert!(negligible_spread(0.0, 0.0) && !negligible_spread(1e-300, 0.0));
+        assert!(negligible_spread(f64::NAN, 1.0) && negligible_spread(f64::INFINITY, 1.0));
+        // Scale-free: the same lot in units 1e12 times smaller is refused alike; a real spread is not.
+        let tiny: Vec<f64> = v.iter().map(|x| x * 1e-12).collect();
+        assert!(lot_statistics(&tiny, None, Some(0.0625e-12), 0.95).unwrap().ppk.is_none());
+        let small: Vec<f64> = V.iter().map(|x| x * 1e-12).collect();
+        let s = lot_statistics(&small, Some(9e-12), Some(11e-12), 0.95).unwrap();
+        assert_relative_eq!(s.pp.unwrap().value, 2.108185106778919, max_relative = 1e-9);
+    }
+
+    #[test]
+    fn indices_from_fewer_than_25_values_carry_a_warning() {
+        let s = lot_statistics(&V, Some(9.0), Some(11.0), 0.95).unwrap();
+        assert!(s.ppk.is_some() && s.indices_refused.is_none());
+        assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+        assert!(s.warnings[0].starts_with("capability from n = 5 values, fewer than 25"), "{:?}", s.warnings);
+        // 24 values warn, 25 do not.
+        let many: Vec<f64> = (0..25).map(|i| 10.0 + 0.01 * ((i * 7 % 11) as f64 - 5.0)).collect();
+        let s24 = lot_statistics(&many[..24], Some(9.0), Some(11.0), 0.95).unwrap();
+        assert!(s24.warnings.iter().any(|w| w.contains("n = 24 values, fewer than 25")), "{:?}", s24.warnings);
+        let s25 = lot_statistics(&many, Some(9.0), Some(11.0), 0.95).unwrap();
+        assert!(s25.ppk.is_some() && s25.warnings.is_empty(), "{:?}", s25.warnings);
+        // No limits, no index: no capability warning either.
+        assert!(lot_statistics(&V, None, None, 0.95).unwrap().warnings.is_empty());
     }
 }

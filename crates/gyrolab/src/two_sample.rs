@@ -31,12 +31,16 @@ pub struct TwoSampleComparison {
 }
 
 /// Welch's t-test and the F-test of two samples; `None` when a sample has fewer than two values
-/// or no spread.
+/// or no spread: a standard deviation that is zero or degenerate (at most
+/// [`crate::process_capability::NEGLIGIBLE_SPREAD`] of the largest absolute value of both
+/// samples: values equal to within rounding, whose t and F would be rounding noise).
 pub fn compare_samples(a: &[f64], b: &[f64]) -> Option<TwoSampleComparison> {
-    let (ma, sa) = crate::process_capability::mean_sd(a);
-    let (mb, sb) = crate::process_capability::mean_sd(b);
+    use crate::process_capability::{mean_sd, negligible_spread, spread_scale};
+    let (ma, sa) = mean_sd(a);
+    let (mb, sb) = mean_sd(b);
     let (sa, sb) = (sa?, sb?);
-    if sa <= 0.0 || sb <= 0.0 {
+    let scale = spread_scale(a, None, None).max(spread_scale(b, None, None));
+    if negligible_spread(sa, scale) || negligible_spread(sb, scale) {
         return None;
     }
     let (na, nb) = (a.len() as f64, b.len() as f64);
@@ -84,6 +88,8 @@ mod tests {
     fn degenerate_samples_are_refused() {
         assert!(compare_samples(&[1.0], &[1.0, 2.0]).is_none());
         assert!(compare_samples(&[1.0, 1.0], &[1.0, 2.0]).is_none());
+        // Equal to within rounding (s = 2.2e-16 of 1.0) is no spread either.
+        assert!(compare_samples(&[1.0, 1.0 + f64::EPSILON], &[1.0, 2.0]).is_none());
         let c = compare_samples(&[1.0, 2.0, 3.0], &[1.0, 2.0, 3.0]).unwrap();
         assert_relative_eq!(c.t_p_value, 1.0, max_relative = 1e-12);
         assert_relative_eq!(c.f_p_value, 1.0, max_relative = 1e-12);

@@ -9,8 +9,8 @@ use crate::output::{print, to_json, write_file};
 use clap::{Args, Subcommand, ValueEnum};
 use gyrolab_lab::issue::Issue;
 use gyrolab_lab::records::{
-    accounts_text, chart_table, check_text, compare_table, evaluation_json, evaluation_text, history_table, lot_table,
-    reevaluation_text, revision_author,
+    accounts_text, chart_notes, chart_table, check_text, compare_table, evaluation_json, evaluation_text,
+    history_table, lot_table, lot_text, reevaluation_text, revision_author,
 };
 use gyrolab_lab::reevaluate;
 use gyrolab_report::table::{to_csv, to_parquet, to_text, Table};
@@ -38,7 +38,8 @@ pub enum StoreCommand {
     Report(ReportArgs),
     /// Every figure of a serial over time and revisions, with limits (`--plot` SVG trend plot).
     History(HistoryArgs),
-    /// Lot statistics per figure: n, mean, sd, min, max, yield, Cp/Cpk, Pp/Ppk with intervals, outliers.
+    /// Lot statistics per figure: n of n_devices, bounds and devices not evaluated counted apart, mean,
+    /// sd, min, max, yield, Cp/Cpk, Pp/Ppk with intervals, outliers, notes.
     Lot(LotArgs),
     /// Compare two lots per figure: Welch's t-test of the means, F-test of the spreads.
     Compare(CompareArgs),
@@ -564,17 +565,20 @@ pub fn run(cmd: &StoreCommand) -> CliResult {
             }
             let mut s = open(&a.location, false)?;
             let rows = query::lot(&mut s, &a.lot, a.confidence)?;
-            emit(&lot_table(&rows), &a.format, || to_json(&rows))
+            emit(&lot_table(&rows), &a.format, || to_json(&rows), Some(lot_text(&rows)))
         }
         StoreCommand::Compare(a) => {
             let mut s = open(&a.location, false)?;
             let rows = query::compare(&mut s, &a.lot1, &a.lot2)?;
-            emit(&compare_table(&rows), &a.format, || to_json(&rows))
+            emit(&compare_table(&rows), &a.format, || to_json(&rows), None)
         }
         StoreCommand::Chart(a) => {
             let mut s = open(&a.location, false)?;
             let c = query::control_charts(&mut s, a.lot.as_deref(), &a.axis, &a.figure)?;
-            emit(&chart_table(&c), &a.format, || to_json(&c))
+            if !a.format.json {
+                chart_notes(&c).iter().for_each(|n| eprintln!("note: {n}"));
+            }
+            emit(&chart_table(&c), &a.format, || to_json(&c), None)
         }
         StoreCommand::Revise(a) => {
             let mut s = open_for_writing(&a.location)?;
@@ -634,9 +638,14 @@ fn check(a: &CheckArgs) -> CliResult {
     }
 }
 
-/// Prints a query's table as text, CSV or JSON (`json` makes the JSON), and writes the Parquet
-/// file of `--parquet` first (whole or not at all).
-fn emit(table: &Table, output: &QueryOutput, json: impl FnOnce() -> CliResult<String>) -> CliResult {
+/// Prints a query's table as text (`text`, else the table's), CSV or JSON (`json` makes the
+/// JSON), and writes the Parquet file of `--parquet` first (whole or not at all).
+fn emit(
+    table: &Table,
+    output: &QueryOutput,
+    json: impl FnOnce() -> CliResult<String>,
+    text: Option<String>,
+) -> CliResult {
     if let Some(path) = &output.parquet {
         write_file(path, &to_parquet(table).map_err(|e| CliError::Usage(e.to_string()))?, &[])?;
     }
@@ -645,7 +654,7 @@ fn emit(table: &Table, output: &QueryOutput, json: impl FnOnce() -> CliResult<St
     } else if output.csv {
         print(&to_csv(table))
     } else {
-        print(&to_text(table))
+        print(&text.unwrap_or_else(|| to_text(table)))
     }
 }
 
@@ -658,5 +667,5 @@ fn history(a: &HistoryArgs) -> CliResult {
             .ok_or_else(|| CliError::Usage(format!("serial {:?}: no values to plot", a.serial)))?;
         write_file(path, svg.as_bytes(), &[])?;
     }
-    emit(&history_table(&rows), &a.format, || to_json(&rows))
+    emit(&history_table(&rows), &a.format, || to_json(&rows), None)
 }

@@ -138,7 +138,22 @@ fn eval_store_then_queries_revisions_and_reevaluation() {
             .unwrap();
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         let csv = String::from_utf8(out.stdout).unwrap();
-        assert!(csv.starts_with("axis,figure,unit,n,mean,sd,min,max,limit_min,limit_max,yield,Cp,"), "{csv}");
+        assert!(
+            csv.starts_with(
+                "axis,figure,unit,n,n_devices,n_bounds,n_not_evaluated,mean,sd,min,max,limit_min,limit_max,yield,\
+                 yield_evaluated,Cp,"
+            ),
+            "{csv}"
+        );
+        assert!(csv.lines().next().unwrap().ends_with(",outliers,simulated,notes"), "{csv}");
+        // Three devices: every index carries the few-values warning (n = 3 < 25).
+        assert_eq!(sf["n_devices"], 3, "{}", b.name);
+        let warned = sf["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w.as_str().unwrap().starts_with("capability from n = 3 values, fewer than 25"));
+        assert!(warned || sf["statistics"]["ppk"].is_null(), "{}: {sf}", b.name);
         assert_eq!(csv.lines().count(), lot.as_array().unwrap().len() + 1);
         assert_eq!(&std::fs::read(&pq).unwrap()[..4], b"PAR1");
         let text =
@@ -908,6 +923,43 @@ fn store_grant_gives_a_postgres_role_select_and_insert_and_refuses_an_sqlite_fil
     }
 }
 
+/// Lot Q of the store's own test (issue 53), stored through the store crate: D1-D5 values of
+/// bias_dph 9.8, 10.1, 10.0, 9.9, 10.2 and D6 NOT EVALUATED (limits 9 .. 11); resolution_dps
+/// upper bounds 0.0125, 0.02 on D1, D2, a value 0.03 on D3 and no row on D4-D6 (upper limit 0.0625).
+fn store_lot_q(location: &str) {
+    use gyrolab_store::record::FigureRecord;
+    let row = |key: &str, unit: &str, value: Option<f64>, basis: &str, lo: Option<f64>, hi: f64, verdict: &str| {
+        FigureRecord {
+            axis: "x".into(),
+            figure: key.into(),
+            value,
+            unit: unit.into(),
+            basis: basis.into(),
+            expanded_uncertainty: None,
+            coverage_factor: None,
+            limit_min: lo,
+            limit_max: Some(hi),
+            verdict: Some(verdict.into()),
+            simulated: false,
+        }
+    };
+    let mut s = gyrolab_store::Store::open(location, true).unwrap();
+    let bias = [Some(9.8), Some(10.1), Some(10.0), Some(9.9), Some(10.2), None];
+    for (i, v) in bias.into_iter().enumerate() {
+        let mut r = store_backends::record(&format!("D{}", i + 1), Some("Q"), &[]);
+        r.test_date = Some(format!("2026-11-{:02}", i + 1));
+        let verdict = if v.is_some() { "PASS" } else { "NOT EVALUATED" };
+        r.figures.push(row("bias_dph", "deg/h", v, "value", Some(9.0), 11.0, verdict));
+        match i {
+            0 => r.figures.push(row("resolution_dps", "deg/s", Some(0.0125), "upper_bound", None, 0.0625, "PASS")),
+            1 => r.figures.push(row("resolution_dps", "deg/s", Some(0.02), "upper_bound", None, 0.0625, "PASS")),
+            2 => r.figures.push(row("resolution_dps", "deg/s", Some(0.03), "value", None, 0.0625, "PASS")),
+            _ => {}
+        }
+        s.add(&r).unwrap();
+    }
+}
+
 #[test]
 fn a_store_file_damaged_past_its_header_is_refused_and_nothing_written() {
     // Issue 53: "A corrupt SQLite file (4 KiB of flipped bytes) accepts new evaluations (only its
@@ -1012,4 +1064,79 @@ fn inputs_named_by_absolute_paths_are_reevaluated_from_the_store_and_still_named
     let named: Vec<&str> =
         results["integrity"]["inputs"].as_array().unwrap().iter().map(|i| i["file"].as_str().unwrap()).collect();
     assert_eq!(named, ["x", "y", "z"].map(|a| format!("{}/paper_rate_table_{a}.csv", data.display())), "{named:?}");
+}
+
+#[test]
+fn store_lot_shows_devices_bounds_not_evaluated_and_the_few_values_warning() {
+    for b in backends("lot_output") {
+        let loc = b.location.as_str();
+        store_lot_q(loc);
+        // JSON: the counts, the yield over every device, the notes.
+        let lot = json_of(&["store", "lot", "Q"], loc);
+        let rows = lot.as_array().unwrap();
+        let by = |k: &str| rows.iter().find(|r| r["figure"] == k).unwrap().clone();
+        let bias = by("bias_dph");
+        assert_eq!(
+            (&bias["n_devices"], &bias["n_evaluated"], &bias["n_bounds"], &bias["n_not_evaluated"]),
+            (&serde_json::json!(6), &serde_json::json!(5), &serde_json::json!(0), &serde_json::json!(1)),
+            "{}: {bias}",
+            b.name
+        );
+        assert_eq!(bias["statistics"]["n"], 5);
+        assert_eq!(bias["statistics"]["yield_fraction"], 1.0, "among the values");
+        assert_eq!(bias["yield_devices"].as_f64(), Some(5.0 / 6.0), "over every device");
+        let notes: Vec<&str> = bias["warnings"].as_array().unwrap().iter().map(|w| w.as_str().unwrap()).collect();
+        assert!(notes.iter().any(|w| w.starts_with("capability from n = 5 values, fewer than 25")), "{notes:?}");
+        assert!(notes.contains(&"1 device NOT EVALUATED (no value, or the verdict NOT EVALUATED): D6"), "{notes:?}");
+        let res = by("resolution_dps");
+        assert_eq!(
+            (res["n_devices"].as_i64(), res["n_bounds"].as_i64(), res["n_missing"].as_i64()),
+            (Some(6), Some(2), Some(3))
+        );
+        assert_eq!(res["statistics"]["mean"], 0.03, "{}: the bounds are not averaged", b.name);
+        assert_eq!(res["largest_upper_bound"], 0.02);
+        assert!(res["statistics"]["ppk"].is_null() && res["statistics"]["sd"].is_null());
+
+        // CSV: the count columns and the notes, one row per figure.
+        let out = gyrolab().args(["store", "lot", "Q", "--csv", "--store", loc]).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let csv = String::from_utf8(out.stdout).unwrap();
+        let head: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+        let line = csv.lines().find(|l| l.starts_with("x,bias_dph,")).unwrap();
+        let col = |k: &str| head.iter().position(|h| *h == k).unwrap();
+        let f: Vec<&str> = line.splitn(head.len(), ',').collect();
+        assert_eq!((f[col("n")], f[col("n_devices")], f[col("n_not_evaluated")]), ("5", "6", "1"), "{csv}");
+        assert_eq!(f[col("yield")].parse::<f64>().unwrap(), 5.0 / 6.0, "{csv}");
+        assert_eq!(f[col("yield_evaluated")], "1", "{csv}");
+        let notes = line.rsplit_once(",\"").map(|(_, n)| n).unwrap_or_default();
+        assert!(notes.contains("fewer than 25") && notes.contains("D6"), "{csv}");
+        let res = csv.lines().find(|l| l.starts_with("x,resolution_dps,")).unwrap();
+        assert!(res.contains("2 devices give only an upper bound (each at most 0.02 deg/s"), "{csv}");
+
+        // Text: the table without the notes column, then the notes and what n and yield mean.
+        let out = gyrolab().args(["store", "lot", "Q", "--store", loc]).output().unwrap();
+        let text = String::from_utf8(out.stdout).unwrap();
+        let header = text.lines().next().unwrap();
+        assert!(
+            header.contains("n_devices") && header.contains("n_not_evaluated") && !header.contains("notes"),
+            "{text}"
+        );
+        assert!(text.contains("\nnotes:\n"), "{text}");
+        assert!(text.contains("  x bias_dph: capability from n = 5 values, fewer than 25"), "{text}");
+        assert!(text.contains("  x resolution_dps: 3 devices without this figure"), "{text}");
+        assert!(text.contains("yield: conforming devices / n_devices"), "{text}");
+
+        // A chart says on standard error what it leaves out; its JSON has the counts.
+        let out = gyrolab()
+            .args(["store", "chart", "--axis", "x", "--figure", "bias_dph", "--lot", "Q"])
+            .args(["--store", loc])
+            .output()
+            .unwrap();
+        assert!(out.status.success());
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert!(err.contains("note: 1 device NOT EVALUATED") && err.contains("no point"), "{err}");
+        let chart = json_of(&["store", "chart", "--axis", "x", "--figure", "bias_dph", "--lot", "Q"], loc);
+        assert_eq!((chart["n_devices"].as_i64(), chart["n_not_evaluated"].as_i64()), (Some(6), Some(1)));
+        assert_eq!(chart["serials"].as_array().unwrap().len(), 5);
+    }
 }

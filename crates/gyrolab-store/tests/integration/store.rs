@@ -8,6 +8,7 @@ use crate::common;
 
 use approx::assert_relative_eq;
 use common::{backends, make_version_1_store, mark_newer_schema, pg_url, record};
+use gyrolab_store::record::FigureRecord;
 use gyrolab_store::{query, Changes, Revision, RevisionKind, Store, StoreError};
 
 fn count(store: &mut Store) -> usize {
@@ -104,7 +105,7 @@ fn revisions_supersede_and_never_change_the_record() {
         assert!(s.revise(&anon, &Changes::default(), None).unwrap_err().to_string().contains("--by"));
         // Only the current revision counts in the lot: the wrong lot is empty now.
         assert!(matches!(query::lot(&mut s, "L-wrong", 0.95), Err(StoreError::NotFound { .. })));
-        assert_eq!(query::lot(&mut s, "L1", 0.95).unwrap()[0].statistics.n, 1);
+        assert_eq!(query::lot(&mut s, "L1", 0.95).unwrap()[0].statistics.as_ref().unwrap().n, 1);
     }
 }
 
@@ -166,8 +167,9 @@ fn lot_statistics_equal_the_hand_calculation() {
         s.add(&record("OTHER", Some("L2"), &[("x", "bias_dph", 100.0)])).unwrap();
         let lot = query::lot(&mut s, "L1", 0.95).unwrap();
         assert_eq!(lot.len(), 1, "{}", b.name);
-        let st = &lot[0].statistics;
+        let st = lot[0].statistics.as_ref().unwrap();
         assert_eq!(st.n, 5);
+        assert_eq!((lot[0].n_devices, lot[0].n_bounds, lot[0].n_not_evaluated), (5, 0, 0));
         assert_relative_eq!(st.mean, 10.0, max_relative = 1e-12);
         assert_relative_eq!(st.sd.unwrap(), 0.158113883008419, max_relative = 1e-12);
         assert_relative_eq!(st.cp.unwrap().value, 1.88, max_relative = 1e-12);
@@ -178,6 +180,257 @@ fn lot_statistics_equal_the_hand_calculation() {
         let ppk = st.ppk.unwrap();
         let half = 1.959963984540054 * (1.0 / 45.0 + ppk.value * ppk.value / 8.0).sqrt();
         assert_relative_eq!(ppk.interval.unwrap().lower, ppk.value - half, max_relative = 1e-9);
+    }
+}
+
+/// A figure row as a test sets it: `value` (or the bound), `basis`, limits and verdict.
+fn figure_row(
+    key: &str,
+    unit: &str,
+    value: Option<f64>,
+    basis: &str,
+    limits: (Option<f64>, Option<f64>),
+    verdict: Option<&str>,
+) -> FigureRecord {
+    FigureRecord {
+        axis: "x".into(),
+        figure: key.into(),
+        value,
+        unit: unit.into(),
+        basis: basis.into(),
+        expanded_uncertainty: None,
+        coverage_factor: None,
+        limit_min: limits.0,
+        limit_max: limits.1,
+        verdict: verdict.map(str::to_string),
+        simulated: false,
+    }
+}
+
+/// The devices of lot Q (issue 53), in test order D1 .. D7, each with its figure rows:
+/// - bias_dph (deg/h, limits 9 .. 11): values 9.8, 10.1, 10.0, 9.9, 10.2 (D1-D5), D6 a value 10.0
+///   whose verdict is NOT EVALUATED, D7 10.0;
+/// - resolution_dps (deg/s, upper limit 0.0625): upper bounds 0.0125, 0.0125, 0.02 (D1-D3), a
+///   value 0.03 (D4), an upper bound 0.1 (D5), no value NOT EVALUATED (D6), no row (D7);
+/// - scale_factor (mV/(deg/s), upper limit 0.0625): the issue's degenerate values 0.0125 + 0,
+///   0, 6 and 10 units in the last place (2^-59) on D1-D4, no row on D5-D7.
+fn lot_q(s: &mut Store) {
+    let ulp = 2f64.powi(-59);
+    let bias = [Some(9.8), Some(10.1), Some(10.0), Some(9.9), Some(10.2), Some(10.0), Some(10.0)];
+    let resolution: [Option<(f64, &str)>; 7] = [
+        Some((0.0125, "upper_bound")),
+        Some((0.0125, "upper_bound")),
+        Some((0.02, "upper_bound")),
+        Some((0.03, "value")),
+        Some((0.1, "upper_bound")),
+        None,
+        None,
+    ];
+    let k = [0.0, 0.0, 6.0, 10.0];
+    for i in 0..7 {
+        let mut r = common::record(&format!("D{}", i + 1), Some("Q"), &[]);
+        r.test_date = Some(format!("2026-11-{:02}", i + 1));
+        let nev = i == 5;
+        r.figures.push(figure_row(
+            "bias_dph",
+            "deg/h",
+            bias[i],
+            "value",
+            (Some(9.0), Some(11.0)),
+            Some(if nev { "NOT EVALUATED" } else { "PASS" }),
+        ));
+        let usl = (None, Some(0.0625));
+        match (i, resolution[i]) {
+            (_, Some((v, basis))) => r.figures.push(figure_row(
+                "resolution_dps",
+                "deg/s",
+                Some(v),
+                basis,
+                usl,
+                Some(if v <= 0.0625 { "PASS" } else { "FAIL" }),
+            )),
+            (5, None) => {
+                r.figures.push(figure_row("resolution_dps", "deg/s", None, "value", usl, Some("NOT EVALUATED")))
+            }
+            _ => {}
+        }
+        if i < 4 {
+            r.figures.push(figure_row(
+                "scale_factor",
+                "mV/(deg/s)",
+                Some(0.0125 + k[i] * ulp),
+                "value",
+                usl,
+                Some("PASS"),
+            ));
+        }
+        s.add(&r).unwrap();
+    }
+}
+
+#[test]
+fn lot_statistics_keep_bounds_apart_and_count_devices_not_evaluated() {
+    for b in backends("lot_honest") {
+        let mut s = Store::open(&b.location, true).unwrap();
+        lot_q(&mut s);
+        let lot = query::lot(&mut s, "Q", 0.95).unwrap();
+        let by = |k: &str| lot.iter().find(|f| f.figure == k).unwrap_or_else(|| panic!("{k}: {lot:?}")).clone();
+        assert_eq!(lot.len(), 3, "{}", b.name);
+
+        // bias_dph: D6's value is NOT EVALUATED, so the values are 9.8 10.1 10.0 9.9 10.2 10.0
+        // (n = 6): mean 60/6 = 10; squares .04 .01 0 .01 .04 0 = .10, s = sqrt(.1/5) = 0.1414213562;
+        // moving ranges .3 .1 .1 .3 .2 -> .2, sigma within .2/1.128, Cp = 2/(6 .2/1.128) = 1.88;
+        // Pp = Ppk = 2/(6 s) = 2.3570226040. Yield: 6 inside of 7 devices; 6 of 6 values.
+        let f = by("bias_dph");
+        let st = f.statistics.as_ref().unwrap();
+        assert_eq!((f.n_devices, f.n_evaluated, f.n_bounds, f.n_not_evaluated, f.n_missing), (7, 6, 0, 1, 0));
+        assert_eq!(st.n, 6);
+        assert_eq!(f.not_evaluated_serials, vec!["D6"]);
+        assert_relative_eq!(st.mean, 10.0, max_relative = 1e-12);
+        assert_relative_eq!(st.sd.unwrap(), 0.1414213562373095, max_relative = 1e-12);
+        assert_relative_eq!(st.sigma_within.unwrap(), 0.2 / 1.128, max_relative = 1e-12);
+        assert_relative_eq!(st.cp.unwrap().value, 1.88, max_relative = 1e-12);
+        assert_relative_eq!(st.pp.unwrap().value, 2.357022603955158, max_relative = 1e-12);
+        assert_relative_eq!(st.ppk.unwrap().value, 2.357022603955158, max_relative = 1e-12);
+        assert_eq!(f.conforming_devices, Some(6));
+        assert_relative_eq!(f.yield_devices.unwrap(), 6.0 / 7.0, max_relative = 1e-15);
+        assert_eq!(st.yield_fraction, Some(1.0));
+        assert!(f.warnings.iter().any(|w| w.starts_with("1 device NOT EVALUATED") && w.ends_with(": D6")), "{f:?}");
+        assert!(
+            f.warnings.iter().any(|w| w.starts_with("capability from n = 6 values, fewer than 25")),
+            "{}: {:?}",
+            b.name,
+            f.warnings
+        );
+
+        // resolution_dps: four upper bounds (0.0125, 0.0125, 0.02, 0.1) kept out, one value
+        // (0.03: n = 1, no sd, no index), D6 NOT EVALUATED and D7 without the figure. Yield over
+        // the 7 devices: the value 0.03 and the bounds 0.0125, 0.0125, 0.02 are at most 0.0625;
+        // the bound 0.1 decides nothing, D6 and D7 are not evaluated: 4/7.
+        let f = by("resolution_dps");
+        let st = f.statistics.as_ref().unwrap();
+        assert_eq!((f.n_devices, f.n_evaluated, f.n_bounds, f.n_not_evaluated, f.n_missing), (7, 1, 4, 2, 1));
+        assert_eq!((f.n_upper_bounds, f.largest_upper_bound, f.n_lower_bounds), (4, Some(0.1), 0));
+        assert_eq!((st.n, st.mean, st.sd), (1, 0.03, None), "bounds are never averaged");
+        assert!(st.ppk.is_none() && st.indices_refused.as_deref().is_some_and(|r| r.contains("n = 1")));
+        assert_eq!(f.bound_serials, vec!["D1", "D2", "D3", "D5"]);
+        assert_eq!(f.not_evaluated_serials, vec!["D6", "D7"]);
+        assert_eq!(f.conforming_devices, Some(4));
+        assert_relative_eq!(f.yield_devices.unwrap(), 4.0 / 7.0, max_relative = 1e-15);
+        let notes = f.warnings.join("\n");
+        assert!(
+            notes.contains("4 devices give only an upper bound (each at most 0.1 deg/s, the largest bound)"),
+            "{notes}"
+        );
+        assert!(
+            notes.contains("1 device without this figure in its current evaluation, counted as NOT EVALUATED: D7"),
+            "{notes}"
+        );
+        assert!(notes.contains("n = 1: no standard deviation"), "{notes}");
+
+        // scale_factor: the issue's case, s = 8.498e-18 from values equal to within rounding:
+        // (USL - mean)/(3 s) would be 1.96e15; refused, with the reason. D5-D7 lack the figure.
+        let f = by("scale_factor");
+        let st = f.statistics.as_ref().unwrap();
+        assert_eq!((f.n_devices, f.n_evaluated, f.n_not_evaluated, f.n_missing), (7, 4, 3, 3));
+        assert_relative_eq!(st.sd.unwrap(), 8.498374721940739e-18, max_relative = 1e-6);
+        assert!(st.cp.is_none() && st.cpk.is_none() && st.pp.is_none() && st.ppk.is_none(), "{st:?}");
+        assert!(st.indices_refused.as_deref().unwrap().contains("degenerate spread"), "{st:?}");
+        assert!(f.warnings.iter().all(|w| !w.contains("fewer than 25")), "no index, no few-values warning");
+        assert_relative_eq!(f.yield_devices.unwrap(), 4.0 / 7.0, max_relative = 1e-15);
+    }
+}
+
+#[test]
+fn the_issues_resolution_upper_bounds_give_no_statistics() {
+    // Issue 53: every device's resolution an upper bound of 0.0125 deg/s (equal to within
+    // rounding) was averaged into s = 8.5e-18 and Ppk = 1.96e15. Now: no statistics, the bounds
+    // counted and named, and the yield from the bounds (each at most the limit 0.0625: 4/4).
+    for b in backends("lot_resolution") {
+        let mut s = Store::open(&b.location, true).unwrap();
+        let ulp = 2f64.powi(-59);
+        for (i, k) in [0.0, 0.0, 6.0, 10.0].iter().enumerate() {
+            let mut r = common::record(&format!("R{i}"), Some("R"), &[]);
+            r.figures.push(figure_row(
+                "resolution_dps",
+                "deg/s",
+                Some(0.0125 + k * ulp),
+                "upper_bound",
+                (None, Some(0.0625)),
+                Some("PASS"),
+            ));
+            s.add(&r).unwrap();
+        }
+        let lot = query::lot(&mut s, "R", 0.95).unwrap();
+        assert_eq!(lot.len(), 1, "{}: the figure is a row, not dropped", b.name);
+        let f = &lot[0];
+        assert!(f.statistics.is_none(), "{}: {f:?}", b.name);
+        assert_eq!((f.n_devices, f.n_evaluated, f.n_bounds, f.n_not_evaluated), (4, 0, 4, 0));
+        assert_eq!(f.largest_upper_bound, Some(0.0125 + 10.0 * ulp));
+        assert_eq!(f.yield_devices, Some(1.0));
+        assert!(f.warnings.iter().any(|w| w == "no device gives a value: no statistics"), "{:?}", f.warnings);
+        assert!(
+            f.warnings[0].starts_with("4 devices give only an upper bound (each at most 0.0125 deg/s"),
+            "{:?}",
+            f.warnings
+        );
+    }
+}
+
+#[test]
+fn no_few_values_warning_from_25_devices() {
+    for b in backends("lot_25") {
+        let mut s = Store::open(&b.location, true).unwrap();
+        let values: Vec<f64> = (0..25).map(|i| 10.0 + 0.01 * ((i * 7 % 11) as f64 - 5.0)).collect();
+        for (i, v) in values.iter().enumerate() {
+            let lot = if i < 24 { "BIG" } else { "BIG-late" };
+            s.add(&common::record(&format!("B{i:02}"), Some(lot), &[("x", "bias_dph", *v)])).unwrap();
+        }
+        let f = &query::lot(&mut s, "BIG", 0.95).unwrap()[0];
+        assert_eq!(f.n_evaluated, 24);
+        assert!(f.warnings.iter().any(|w| w.contains("n = 24 values, fewer than 25")), "{}: {:?}", b.name, f.warnings);
+        // The 25th device joins the lot by a correction: 25 values, no warning.
+        let id = query::history(&mut s, "B24").unwrap()[0].evaluation;
+        let corr = Revision { supersedes: id, kind: RevisionKind::Correction, by: "QA".into(), reason: "lot".into() };
+        s.revise(&corr, &Changes { lot: Some("BIG".into()), ..Default::default() }, None).unwrap();
+        let f = &query::lot(&mut s, "BIG", 0.95).unwrap()[0];
+        assert_eq!((f.n_evaluated, f.n_devices), (25, 25));
+        assert!(f.statistics.as_ref().unwrap().ppk.is_some());
+        assert!(f.warnings.is_empty(), "{}: {:?}", b.name, f.warnings);
+    }
+}
+
+#[test]
+fn comparison_and_charts_use_values_only_and_count_the_rest() {
+    for b in backends("lot_compare_honest") {
+        let mut s = Store::open(&b.location, true).unwrap();
+        lot_q(&mut s);
+        for (i, v) in [10.4, 10.6, 10.5].iter().enumerate() {
+            s.add(&common::record(&format!("P{i}"), Some("P"), &[("x", "bias_dph", *v)])).unwrap();
+        }
+        let c = query::compare(&mut s, "Q", "P").unwrap();
+        assert_eq!(c.len(), 1, "{}: only bias_dph is in both lots", b.name);
+        let r = &c[0];
+        assert_eq!((r.n1, r.n_devices1, r.n_not_evaluated1, r.n2, r.n_devices2), (6, 7, 1, 3, 3));
+        assert_eq!((r.mean1, r.mean2), (Some(10.0), Some(10.5)));
+        assert!(r.test.is_some());
+        assert!(r.notes.iter().any(|n| n.starts_with("lot Q: 1 device NOT EVALUATED")), "{:?}", r.notes);
+        // Charts: the individuals chart has the six values of Q (D6 left out).
+        let ch = query::control_charts(&mut s, Some("Q"), "x", "bias_dph").unwrap();
+        assert_eq!(ch.serials, vec!["D1", "D2", "D3", "D4", "D5", "D7"], "{}", b.name);
+        assert_eq!((ch.n_devices, ch.n_not_evaluated), (7, 1));
+        assert!(ch.notes.iter().any(|n| n.contains("NOT EVALUATED") && n.ends_with("no point")), "{:?}", ch.notes);
+        // X-bar/S: lots Q (6 values) and P (3), D6 left out.
+        assert_eq!(ch.lots, vec!["Q", "P"]);
+        assert_eq!(ch.n_left_out_of_lots, 1);
+        // The resolution chart has one value only: no chart, and the bounds counted.
+        let ch = query::control_charts(&mut s, Some("Q"), "x", "resolution_dps").unwrap();
+        assert!(ch.individuals.is_none());
+        assert_eq!((ch.serials.len(), ch.n_bounds, ch.n_not_evaluated), (1, 4, 2));
+        // The degenerate scale factors give no chart of rounding noise.
+        let ch = query::control_charts(&mut s, Some("Q"), "x", "scale_factor").unwrap();
+        assert!(ch.individuals.is_none(), "{ch:?}");
+        assert!(ch.notes.iter().any(|n| n.contains("no spread (zero or degenerate)")), "{:?}", ch.notes);
     }
 }
 
@@ -249,7 +502,7 @@ fn concurrent_writers_all_land() {
         threads.into_iter().for_each(|t| t.join().unwrap());
         let mut s = Store::open(&b.location, false).unwrap();
         let lot = query::lot(&mut s, "C", 0.95).unwrap();
-        assert_eq!(lot.iter().map(|f| f.statistics.n).collect::<Vec<_>>(), vec![50, 50], "{}", b.name);
+        assert_eq!(lot.iter().map(|f| f.n_evaluated).collect::<Vec<_>>(), vec![50, 50], "{}", b.name);
     }
 }
 
@@ -433,6 +686,6 @@ fn a_version_1_store_is_migrated_on_first_use_and_keeps_its_records() {
         let files = query::report_files(&mut s, id).unwrap();
         assert_eq!(files, vec![("results.json".to_string(), b"{}".to_vec())], "{}", b.name);
         let lot = query::lot(&mut s, "L", 0.95).unwrap();
-        assert_eq!(lot[0].statistics.n, 2, "{}", b.name);
+        assert_eq!(lot[0].n_evaluated, 2, "{}", b.name);
     }
 }
