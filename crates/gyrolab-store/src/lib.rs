@@ -1069,7 +1069,7 @@ impl Store {
                     e => dberr(e),
                 })
             };
-            statement(x, "SELECT format('GRANT USAGE ON SCHEMA %I TO %I', current_schema(), $1::text) AS sql", &[r.clone()])?;
+            statement(x, "SELECT format('GRANT USAGE ON SCHEMA %I TO %I', current_schema(), $1::text) AS sql", std::slice::from_ref(&r))?;
             for t in &tables {
                 let t = Val::T(Some(t.to_string()));
                 statement(
@@ -1079,8 +1079,8 @@ impl Store {
                 )?;
                 statement(x, "SELECT format('GRANT SELECT, INSERT ON %I TO %I', $1::text, $2::text) AS sql", &[t, r.clone()])?;
             }
-            statement(x, "SELECT format('REVOKE ALL ON gyrolab_schema FROM %I', $1::text) AS sql", &[r.clone()])?;
-            statement(x, "SELECT format('GRANT SELECT ON gyrolab_schema TO %I', $1::text) AS sql", &[r.clone()])?;
+            statement(x, "SELECT format('REVOKE ALL ON gyrolab_schema FROM %I', $1::text) AS sql", std::slice::from_ref(&r))?;
+            statement(x, "SELECT format('GRANT SELECT ON gyrolab_schema TO %I', $1::text) AS sql", std::slice::from_ref(&r))?;
             Ok(tables.iter().map(|t| t.to_string()).collect())
         })
     }
