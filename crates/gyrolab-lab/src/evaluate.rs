@@ -2,8 +2,8 @@
 //! authenticated before anything is written (while the plan is evaluated, on another thread), then
 //! the written report folder stored as a new evaluation.
 
-use gyrolab_store::record::{from_report_folder_with, FileRecord};
-use gyrolab_store::{Actor, Store, StoreError, StoreResult};
+use gyrolab_store::record::{from_report_folder_with, EvaluationRecord, FileRecord};
+use gyrolab_store::{Actor, Changes, Revision, RevisionKind, Store, StoreError, StoreResult};
 use std::path::Path;
 
 /// Opens the store at `location` for writing and authenticates `credentials` (name, password):
@@ -34,23 +34,91 @@ pub fn prepare_store(location: &str, credentials: Option<&(String, String)>) -> 
     }
 }
 
+/// What `eval --store` stored: the evaluation's id and the line saying where (and, for the
+/// same plan and inputs evaluated again, that it is a re-evaluation of the current one).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stored {
+    /// The evaluation's id.
+    pub id: i64,
+    /// The current evaluation of the same serial, plan and inputs it supersedes, if any.
+    pub revision_of: Option<i64>,
+    /// The store's name (its password masked).
+    pub store: String,
+    /// The line saying so.
+    pub line: String,
+}
+
 /// Stores the report folder `out` of `plan` (its inputs' hashes made while it was evaluated, or
-/// `None`) in the store `prepared` by [`prepare_store`], else in a new store at `location`:
-/// (evaluation id, store name).
+/// `None`) in the store `prepared` by [`prepare_store`], else in a new store at `location`.
+/// The same plan (its SHA-256) and inputs (paths and SHA-256) of a serial evaluated again, while
+/// an evaluation of them is current, is stored as that evaluation's re-evaluation (a revision,
+/// said so), not as a second current original (issue 53).
 pub fn store_report_folder(
     location: &str,
     prepared: Option<(Store, Actor)>,
     out: &Path,
     plan: &Path,
     inputs: Option<Vec<FileRecord>>,
-) -> StoreResult<(i64, String)> {
+) -> StoreResult<Stored> {
     let record = from_report_folder_with(out, Some(plan), inputs, true, &[])?;
     let (mut s, actor) = match prepared {
         Some(s) => s,
         None => (Store::open_for_writing(location, true)?, Actor::unauthenticated()),
     };
-    let id = s.add_as(&record, &actor)?;
-    Ok((id, s.name().to_string()))
+    store_record(&mut s, &actor, &record)
+}
+
+/// Stores one finished report folder (`gyrolab store add`, Python's `Store.add`) in the store at
+/// `location` (see [`gyrolab_store::resolve_location`]), created when missing, as the account
+/// `credentials` (name, password) authenticates, or without an account (which a store that has
+/// accounts refuses). The same folder added again (the same results.json of the same serial,
+/// still current) adds nothing ([`StoreError::AlreadyStored`]; issue 53: re-adding a folder
+/// made a second current original); another folder of the same plan and inputs is stored as a
+/// re-evaluation of the current one, said so ([`store_report_folder`]).
+pub fn add_report_folder(
+    dir: &Path,
+    plan: Option<&Path>,
+    location: Option<&str>,
+    credentials: Option<(&str, &str)>,
+) -> StoreResult<Stored> {
+    let record = gyrolab_store::record::from_report_folder(dir, plan)?;
+    let mut store = Store::open_for_writing(&gyrolab_store::resolve_location(location), true)?;
+    let actor = match credentials {
+        Some((user, password)) => store.authenticate(user, password)?,
+        None => Actor::unauthenticated(),
+    };
+    if let Some(id) = store.current_with_results(&record.serial, &record.results_json)? {
+        return Err(StoreError::AlreadyStored { store: store.name().to_string(), id });
+    }
+    store_record(&mut store, &actor, &record)
+}
+
+/// Stores `record` as a new original, or as the re-evaluation of the current evaluation of the
+/// same serial, plan and inputs (said so in the line).
+fn store_record(s: &mut Store, actor: &Actor, record: &EvaluationRecord) -> StoreResult<Stored> {
+    let same = s.current_of_same_inputs(record)?;
+    let id = match same {
+        None => s.add_as(record, actor)?,
+        Some(old) => {
+            let revision = Revision {
+                supersedes: old,
+                kind: RevisionKind::Reevaluation,
+                by: actor.label(),
+                reason: "the same plan and inputs evaluated again (gyrolab eval --store)".into(),
+            };
+            s.revise_as(&revision, &Changes::default(), Some(record), actor)?
+        }
+    };
+    let line = match same {
+        None => format!("Stored as evaluation {id} in {}", s.name()),
+        Some(old) => format!(
+            "Stored as evaluation {id} in {}: a re-evaluation of evaluation {old}, the current one of the same serial, \
+             plan and inputs (it supersedes it; both are kept: gyrolab store history {})",
+            s.name(),
+            record.serial
+        ),
+    };
+    Ok(Stored { id, revision_of: same, line, store: s.name().to_string() })
 }
 
 /// Whether an SQLite store can be created at `location` (a path): its folder exists and takes a

@@ -570,8 +570,13 @@ pub fn add_folders(
 ) -> StoreResult<String> {
     let mut out = String::new();
     for d in dirs {
-        match gyrolab_store::add_report_folder_as(d, plan, location, credentials) {
-            Ok((id, name)) => out.push_str(&format!("stored {} as evaluation {id} in {name}\n", d.display())),
+        match crate::evaluate::add_report_folder(d, plan, location, credentials) {
+            Ok(stored) => match stored.revision_of {
+                None => {
+                    out.push_str(&format!("stored {} as evaluation {} in {}\n", d.display(), stored.id, stored.store))
+                }
+                Some(_) => out.push_str(&format!("{}: {}\n", d.display(), stored.line)),
+            },
             Err(gyrolab_store::StoreError::AlreadyStored { store, id }) => out.push_str(&format!(
                 "{} is stored already as evaluation {id} in {store} (the same results.json): nothing added\n",
                 d.display()

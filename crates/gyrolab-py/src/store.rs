@@ -154,8 +154,10 @@ pub fn store_add(
     let credentials = credentials(user, password)?;
     let credentials = credentials.as_ref().map(|(u, p)| (u.as_str(), p.as_str()));
     // A folder stored already gives the evaluation that holds it (adding is idempotent).
-    match py.detach(|| gyrolab_store::add_report_folder_as(&folder, plan.as_deref(), location.as_deref(), credentials))
-    {
+    match py.detach(|| {
+        gyrolab_lab::evaluate::add_report_folder(&folder, plan.as_deref(), location.as_deref(), credentials)
+            .map(|s| (s.id, s.line))
+    }) {
         Err(gyrolab_store::StoreError::AlreadyStored { store, id }) => Ok((id, store)),
         other => other.map_err(store_err),
     }

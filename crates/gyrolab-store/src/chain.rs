@@ -733,7 +733,7 @@ fn check_tails(x: &mut dyn Exec, report: &mut CheckReport) -> Result<(), DbError
 /// whatever the size of the store: triggers present, no row past the chain's end or without an
 /// id, and the last [`QUICK_LINKS`] links, without gaps, against their rows. A row changed,
 /// deleted or inserted deeper in the store is found by [`full_check`] only.
-/// `pages`: SQLite's page check first ([`check_pages`]; once per opening for writing, not again
+/// `pages`: SQLite's page check first (`check_pages`; once per opening for writing, not again
 /// inside each write).
 pub fn quick_check(x: &mut dyn Exec, postgres: bool, pages: bool) -> Result<CheckReport, DbError> {
     let mut report = CheckReport { quick: true, ..CheckReport::default() };

@@ -598,6 +598,51 @@ impl Store {
         })
     }
 
+    /// The current evaluation of `record`'s serial made from the same plan (its SHA-256) and the
+    /// same inputs (each path and SHA-256), if one is stored: running the same `eval --store`
+    /// again is then its re-evaluation, not a second current original.
+    pub fn current_of_same_inputs(&mut self, record: &EvaluationRecord) -> StoreResult<Option<i64>> {
+        // A record the store refuses (a NUL in a text) is refused as storing it would be.
+        if let Err(m) = record.check() {
+            return Err(StoreError::Refused { store: self.name.clone(), message: m });
+        }
+        let store = self.name.clone();
+        let dberr = |m: DbError| StoreError::Database { store: store.clone(), message: m.to_string() };
+        let mut want: Vec<(String, String)> =
+            record.inputs.iter().map(|f| (f.path.clone(), f.sha256.clone())).collect();
+        want.sort();
+        self.transaction(|x| {
+            let ids = x
+                .rows(
+                    "SELECT id FROM evaluation WHERE serial = $1 AND plan_sha256 = $2 \
+                     AND NOT EXISTS (SELECT 1 FROM evaluation later WHERE later.supersedes = evaluation.id) ORDER BY id",
+                    &[Val::T(Some(record.serial.clone())), Val::T(Some(record.plan_sha256.clone()))],
+                    &[("id", Kind::I)],
+                )
+                .map_err(&dberr)?;
+            for r in ids {
+                let id = r.int("id").map_err(&dberr)?;
+                let files = x
+                    .rows(
+                        "SELECT path, sha256 FROM input_file WHERE evaluation_id = $1",
+                        &[Val::I(id)],
+                        &[("path", Kind::T), ("sha256", Kind::T)],
+                    )
+                    .map_err(&dberr)?;
+                let mut have: Vec<(String, String)> = files
+                    .iter()
+                    .map(|f| Ok((f.string("path")?, f.string("sha256")?)))
+                    .collect::<Result<_, DbError>>()
+                    .map_err(&dberr)?;
+                have.sort();
+                if have == want {
+                    return Ok(Some(id));
+                }
+            }
+            Ok(None)
+        })
+    }
+
     /// Whether the store has any account (then every write needs one).
     pub fn has_accounts(&mut self) -> StoreResult<bool> {
         let store = self.name.clone();
@@ -1129,37 +1174,6 @@ impl Store {
     pub fn evaluation(&mut self, id: i64) -> StoreResult<query::StoredEvaluation> {
         query::evaluation(self, id)
     }
-}
-
-/// Stores one finished report folder in the store at `location` (see [`resolve_location`]; the
-/// default is `gyrolab.db` in the current folder), created when missing: the evaluation's id and the
-/// store's name (password masked). Shared by `gyrolab store add` and `gyrolab eval --store`.
-pub fn add_report_folder(dir: &Path, plan: Option<&Path>, location: Option<&str>) -> StoreResult<(i64, String)> {
-    add_report_folder_as(dir, plan, location, None)
-}
-
-/// [`add_report_folder`] as the account `credentials` (name, password) authenticates, or
-/// without an account (`None`: a store that has accounts refuses it).
-pub fn add_report_folder_as(
-    dir: &Path,
-    plan: Option<&Path>,
-    location: Option<&str>,
-    credentials: Option<(&str, &str)>,
-) -> StoreResult<(i64, String)> {
-    let rec = record::from_report_folder(dir, plan)?;
-    let mut store = Store::open_for_writing(&resolve_location(location), true)?;
-    let actor = match credentials {
-        Some((user, password)) => store.authenticate(user, password)?,
-        None => Actor::unauthenticated(),
-    };
-    // The same folder added again (the same results.json of the same serial, still current) is
-    // the evaluation already stored: nothing is added (issue 53: re-adding a folder made a
-    // second current original).
-    if let Some(id) = store.current_with_results(&rec.serial, &rec.results_json)? {
-        return Err(StoreError::AlreadyStored { store: store.name().to_string(), id });
-    }
-    let id = store.add_as(&rec, &actor)?;
-    Ok((id, store.name().to_string()))
 }
 
 /// Recorded as the creator of a store's first account (made without authentication).

@@ -83,9 +83,9 @@ pub fn run(args: &EvalArgs) -> CliResult {
             Some(hashed) => Some(hashed?),
             None => None,
         };
-        let (id, name) = store_report_folder(l, store, &args.out, &args.plan, inputs)?;
-        if !args.quiet {
-            eprintln!("Stored as evaluation {id} in {name}");
+        let stored = store_report_folder(l, store, &args.out, &args.plan, inputs)?;
+        if !args.quiet || stored.revision_of.is_some() {
+            eprintln!("{}", stored.line);
         }
     }
     result

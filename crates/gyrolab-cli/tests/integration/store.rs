@@ -1140,3 +1140,46 @@ fn store_lot_shows_devices_bounds_not_evaluated_and_the_few_values_warning() {
         assert_eq!(chart["serials"].as_array().unwrap().len(), 5);
     }
 }
+
+#[test]
+fn the_same_eval_store_run_twice_is_stored_as_a_reevaluation_and_said_so() {
+    // Issue 53: "running the same eval --store twice stores a second current evaluation without a
+    // word". The second run supersedes the first (kind reevaluation) and says so, even with -q.
+    let dir = tempfile::tempdir().unwrap();
+    let p = plan(dir.path(), "T1", "L");
+    let db = dir.path().join("s.db");
+    eval(&p, &dir.path().join("r1"), Some(db.to_str().unwrap()));
+    let o = gyrolab()
+        .args(["eval", p.to_str().unwrap(), "--out", dir.path().join("r2").to_str().unwrap(), "-q"])
+        .args(["--store", db.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(3));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("a re-evaluation of evaluation 1"), "{err}");
+    let rows = json_of(&["store", "history", "T1"], db.to_str().unwrap());
+    let current: BTreeSet<i64> = rows
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|r| r["current"] == true)
+        .map(|r| r["evaluation"].as_i64().unwrap())
+        .collect();
+    assert_eq!(current.into_iter().collect::<Vec<_>>(), [2], "one current evaluation");
+    let e = json_of(&["store", "show", "2"], db.to_str().unwrap());
+    assert_eq!(e["revision_kind"], "reevaluation", "{e}");
+    // Another plan of the same serial (a comment apart: another SHA-256) is a new original.
+    let p2 = plan_with(dir.path(), "T1b.toml", "T1", "L", "A. Operator", "# another plan\n");
+    eval(&p2, &dir.path().join("r3"), Some(db.to_str().unwrap()));
+    let e = json_of(&["store", "show", "3"], db.to_str().unwrap());
+    assert_eq!((e["revision_kind"].as_str(), e["supersedes"].as_i64()), (Some("original"), None), "{e}");
+    // store add of another folder of the first plan (evaluated again without --store): the
+    // re-evaluation of evaluation 2, said so.
+    std::thread::sleep(std::time::Duration::from_millis(1100)); // another `created` second
+    eval(&p, &dir.path().join("r4"), None);
+    gyrolab()
+        .args(["store", "add", dir.path().join("r4").to_str().unwrap(), "--store", db.to_str().unwrap()])
+        .assert()
+        .success()
+        .stdout(predicates::str::contains("a re-evaluation of evaluation 2"));
+}

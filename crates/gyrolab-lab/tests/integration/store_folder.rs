@@ -5,10 +5,11 @@
 //! re-evaluated from the store's copy, and refused when the store keeps none.
 
 use crate::store_common::backends;
+use gyrolab_lab::evaluate::add_report_folder;
 use gyrolab_lab::raw_records::restore_inputs;
 use gyrolab_lab::reevaluate::reevaluate;
 use gyrolab_store::record::{from_report_folder, hash_file};
-use gyrolab_store::{add_report_folder, Store, StoreError};
+use gyrolab_store::{Store, StoreError};
 use std::path::{Path, PathBuf};
 
 fn repo() -> PathBuf {
@@ -83,10 +84,10 @@ fn a_report_folder_is_kept_whole_and_reevaluated_with_a_diff() {
     }
 
     // The one path shared with `eval --store`: a store named explicitly.
-    let (id, name) =
-        add_report_folder(&out, Some(&plan), Some(dir.path().join("shared.db").to_str().unwrap())).unwrap();
-    assert_eq!(id, 1);
-    assert!(name.ends_with("shared.db"));
+    let stored =
+        add_report_folder(&out, Some(&plan), Some(dir.path().join("shared.db").to_str().unwrap()), None).unwrap();
+    assert_eq!(stored.id, 1);
+    assert!(stored.line.contains("shared.db"), "{}", stored.line);
 
     // The raw records are kept: laid out again from the store alone, byte for byte, beside
     // their plan (issue 53).
