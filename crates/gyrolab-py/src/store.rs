@@ -28,11 +28,28 @@ fn with_store<T: Send>(
     create: bool,
     query: impl FnOnce(&mut Store) -> Result<T, StoreError> + Send,
 ) -> PyResult<T> {
-    py.detach(|| {
-        let mut store = Store::open(&resolve_location(location.as_deref()), create)?;
-        query(&mut store)
-    })
-    .map_err(store_err)
+    opened(py, Store::open, location, create, query)
+}
+
+/// Like [`with_store`], the store opened for writing (its quick check first).
+fn with_store_writing<T: Send>(
+    py: Python<'_>,
+    location: Option<String>,
+    create: bool,
+    write: impl FnOnce(&mut Store) -> Result<T, StoreError> + Send,
+) -> PyResult<T> {
+    opened(py, Store::open_for_writing, location, create, write)
+}
+
+/// The store at `location` opened by `open`, `f` run on it with the interpreter released.
+fn opened<T: Send>(
+    py: Python<'_>,
+    open: fn(&str, bool) -> Result<Store, StoreError>,
+    location: Option<String>,
+    create: bool,
+    f: impl FnOnce(&mut Store) -> Result<T, StoreError> + Send,
+) -> PyResult<T> {
+    py.detach(|| f(&mut open(&resolve_location(location.as_deref()), create)?)).map_err(store_err)
 }
 
 /// A table as Python lists, one per column.
@@ -198,20 +215,6 @@ fn as_actor(
         (Some(u), Some(p)) => store.authenticate(&u, &p),
         _ => Ok(gyrolab_store::Actor::unauthenticated()),
     }
-}
-
-/// Like [`with_store`], the store opened for writing (its quick check first).
-fn with_store_writing<T: Send>(
-    py: Python<'_>,
-    location: Option<String>,
-    create: bool,
-    write: impl FnOnce(&mut Store) -> Result<T, StoreError> + Send,
-) -> PyResult<T> {
-    py.detach(|| {
-        let mut store = Store::open_for_writing(&resolve_location(location.as_deref()), create)?;
-        write(&mut store)
-    })
-    .map_err(store_err)
 }
 
 /// `gyrolab store check --json`: the full check's report as JSON (`problems` empty when whole).

@@ -843,6 +843,14 @@ fn a_long_serial_is_stored_on_both_back_ends() {
     }
 }
 
+/// The paper's three rate-table records copied into `data` (which exists).
+fn copy_paper_records(data: &Path) {
+    for axis in ["x", "y", "z"] {
+        let name = format!("paper_rate_table_{axis}.csv");
+        std::fs::copy(repo().join("data/paper").join(&name), data.join(&name)).unwrap();
+    }
+}
+
 #[test]
 fn the_raw_records_are_kept_and_a_report_is_reproduced_from_the_store_alone() {
     // Issue 53: "Raw records are hashed, not kept"; "paths are stored relative to the working
@@ -851,10 +859,7 @@ fn the_raw_records_are_kept_and_a_report_is_reproduced_from_the_store_alone() {
     let lab = dir.path().join("lab");
     let data = lab.join("data");
     std::fs::create_dir_all(&data).unwrap();
-    for axis in ["x", "y", "z"] {
-        let name = format!("paper_rate_table_{axis}.csv");
-        std::fs::copy(repo().join("data/paper").join(&name), data.join(&name)).unwrap();
-    }
+    copy_paper_records(&data);
     let plans = lab.join("plans");
     std::fs::create_dir_all(&plans).unwrap();
     let text = std::fs::read_to_string(repo().join("examples/paper_plan.toml")).unwrap();
@@ -1032,10 +1037,7 @@ fn inputs_named_by_absolute_paths_are_reevaluated_from_the_store_and_still_named
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("data");
     std::fs::create_dir_all(&data).unwrap();
-    for axis in ["x", "y", "z"] {
-        let name = format!("paper_rate_table_{axis}.csv");
-        std::fs::copy(repo().join("data/paper").join(&name), data.join(&name)).unwrap();
-    }
+    copy_paper_records(&data);
     let text = std::fs::read_to_string(repo().join("examples/paper_plan.toml")).unwrap();
     // The plan in a folder of its own: its inputs are outside it, named absolutely.
     std::fs::create_dir_all(dir.path().join("plans")).unwrap();
