@@ -45,7 +45,7 @@ fn staging_prefix() -> String {
     format!(".gyrolab-{}-", std::process::id())
 }
 
-/// Removes the staged files a killed run left in `dir` (`.gyrolab-<pid>-*.tmp` whose process
+/// Removes the staged files and folders a killed run left in `dir` (`.gyrolab-<pid>-*.tmp` whose process
 /// no longer exists; never another live process's, never the `.gyrolab-old-*` copies a
 /// replacement keeps, which may be the only copy of a file a run was replacing when killed).
 /// Returns the files removed. Errors are ignored: cleaning is a courtesy, never a failure.
@@ -60,7 +60,13 @@ pub fn clean_leftovers(dir: &Path) -> Vec<PathBuf> {
         if pid == std::process::id() || process_alive(pid) {
             continue;
         }
-        if entry.file_type().is_ok_and(|t| t.is_file()) && std::fs::remove_file(entry.path()).is_ok() {
+        // A staged file, or a staged folder (a folder written whole, then renamed into place).
+        let gone = match entry.file_type() {
+            Ok(t) if t.is_file() => std::fs::remove_file(entry.path()).is_ok(),
+            Ok(t) if t.is_dir() => std::fs::remove_dir_all(entry.path()).is_ok(),
+            _ => false,
+        };
+        if gone {
             removed.push(entry.path());
         }
     }
@@ -516,6 +522,10 @@ mod tests {
         for n in &names {
             std::fs::write(dir.path().join(n), b"x").unwrap();
         }
+        // A staged folder of the dead run (`store report --inputs`), with a file in it.
+        let staged_dir = dir.path().join(format!(".gyrolab-{dead}-inputs-Q1.tmp"));
+        std::fs::create_dir_all(staged_dir.join("data")).unwrap();
+        std::fs::write(staged_dir.join("data/x.csv"), b"1,2\n").unwrap();
         write_outputs(vec![OutputFile::bytes(dir.path().join("out.csv"), b"a,b\n".to_vec())], &[]).unwrap();
         let mut left: Vec<String> = std::fs::read_dir(dir.path())
             .unwrap()

@@ -83,8 +83,12 @@ pub fn restore_inputs(store: &mut Store, id: i64, dir: &Path) -> StoreResult<Res
         });
     }
     let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    // Staged as `.gyrolab-<pid>-inputs-*.tmp`, so that the next run removes what a killed one
+    // left (gyrolab_io::atomic::clean_leftovers).
+    gyrolab_io::atomic::clean_leftovers(parent);
     let staged = tempfile::Builder::new()
-        .prefix(".gyrolab-inputs-")
+        .prefix(&format!(".gyrolab-{}-inputs-", std::process::id()))
+        .suffix(".tmp")
         .tempdir_in(parent)
         .map_err(|e| StoreError::Input { path: parent.display().to_string(), message: format!("cannot write: {e}") })?;
     let restored = restore_into(store, id, staged.path())?;
