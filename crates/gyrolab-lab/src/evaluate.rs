@@ -3,6 +3,7 @@
 //! the written report folder stored as a new evaluation.
 
 use gyrolab_store::record::{from_report_folder_with, EvaluationRecord, FileRecord};
+use rayon::prelude::*;
 use gyrolab_store::{Actor, Changes, Revision, RevisionKind, Store, StoreError, StoreResult};
 use std::path::Path;
 
@@ -60,12 +61,12 @@ pub fn store_report_folder(
     plan: &Path,
     inputs: Option<Vec<FileRecord>>,
 ) -> StoreResult<Stored> {
-    let record = from_report_folder_with(out, Some(plan), inputs, true, &[])?;
+    let mut record = from_report_folder_with(out, Some(plan), inputs, false, &[])?;
     let (mut s, actor) = match prepared {
         Some(s) => s,
         None => (Store::open_for_writing(location, true)?, Actor::unauthenticated()),
     };
-    store_record(&mut s, &actor, &record)
+    store_record(&mut s, &actor, &mut record)
 }
 
 /// Stores one finished report folder (`gyrolab store add`, Python's `Store.add`) in the store at
@@ -81,7 +82,7 @@ pub fn add_report_folder(
     location: Option<&str>,
     credentials: Option<(&str, &str)>,
 ) -> StoreResult<Stored> {
-    let record = gyrolab_store::record::from_report_folder(dir, plan)?;
+    let mut record = from_report_folder_with(dir, plan, None, false, &[])?;
     let mut store = Store::open_for_writing(&gyrolab_store::resolve_location(location), true)?;
     let actor = match credentials {
         Some((user, password)) => store.authenticate(user, password)?,
@@ -90,12 +91,21 @@ pub fn add_report_folder(
     if let Some(id) = store.current_with_results(&record.serial, &record.results_json)? {
         return Err(StoreError::AlreadyStored { store: store.name().to_string(), id });
     }
-    store_record(&mut store, &actor, &record)
+    store_record(&mut store, &actor, &mut record)
 }
 
 /// Stores `record` as a new original, or as the re-evaluation of the current evaluation of the
 /// same serial, plan and inputs (said so in the line).
-fn store_record(s: &mut Store, actor: &Actor, record: &EvaluationRecord) -> StoreResult<Stored> {
+fn store_record(s: &mut Store, actor: &Actor, record: &mut EvaluationRecord) -> StoreResult<Stored> {
+    // The raw records the store does not hold yet, read, checked against the hashes of the
+    // bytes evaluated and compressed, on every core: the others are kept already (by SHA-256).
+    let kept = s.kept_contents(&record.inputs.iter().map(|f| f.sha256.clone()).collect::<Vec<_>>())?;
+    record
+        .inputs
+        .par_iter_mut()
+        .filter(|f| !kept.contains(&f.sha256))
+        .try_for_each(|f| gyrolab_store::record::pack_inputs(std::slice::from_mut(f)))?;
+    let record = &*record;
     let same = s.current_of_same_inputs(record)?;
     let id = match same {
         None => s.add_as(record, actor)?,

@@ -598,6 +598,23 @@ impl Store {
         })
     }
 
+    /// Which of the raw records `sha256s` the store keeps already (schema 6, `input_content`):
+    /// those need not be read and compressed again.
+    pub fn kept_contents(&mut self, sha256s: &[String]) -> StoreResult<std::collections::HashSet<String>> {
+        let mut kept = std::collections::HashSet::new();
+        for sha in sha256s {
+            let rows = self.rows(
+                "SELECT id FROM input_content WHERE sha256 = $1",
+                &[Val::T(Some(sha.clone()))],
+                &[("id", Kind::I)],
+            )?;
+            if !rows.is_empty() {
+                kept.insert(sha.clone());
+            }
+        }
+        Ok(kept)
+    }
+
     /// The current evaluation of `record`'s serial made from the same plan (its SHA-256) and the
     /// same inputs (each path and SHA-256), if one is stored: running the same `eval --store`
     /// again is then its re-evaluation, not a second current original.
