@@ -3,8 +3,8 @@
 //! the written report folder stored as a new evaluation.
 
 use gyrolab_store::record::{from_report_folder_with, EvaluationRecord, FileRecord};
-use rayon::prelude::*;
 use gyrolab_store::{Actor, Changes, Revision, RevisionKind, Store, StoreError, StoreResult};
+use rayon::prelude::*;
 use std::path::Path;
 
 /// Opens the store at `location` for writing and authenticates `credentials` (name, password):
