@@ -36,21 +36,45 @@ fn in_place(rec: &EvaluationRecord, id: i64) -> Result<(), String> {
     Ok(())
 }
 
+/// A temporary folder named `prefix`..., removed when dropped.
+fn staging(prefix: &str) -> StoreResult<tempfile::TempDir> {
+    tempfile::Builder::new().prefix(prefix).tempdir().map_err(|e| StoreError::Input {
+        path: std::env::temp_dir().display().to_string(),
+        message: format!("cannot write: {e}"),
+    })
+}
+
+/// Writes the report `folder` to `out`, all or none, never over one of its inputs.
+fn write_report(folder: &crate::report_folder::ReportFolder, out: &Path) -> StoreResult<()> {
+    let files: Vec<(&str, &[u8])> = folder.outputs.iter().map(|o| (o.name.as_str(), o.bytes.as_slice())).collect();
+    let inputs: Vec<&Path> = folder.inputs.iter().map(PathBuf::as_path).collect();
+    gyrolab_io::atomic::write_folder(out, &files, &inputs)
+        .map(drop)
+        .map_err(|e| StoreError::Input { path: e.path.display().to_string(), message: e.to_string() })
+}
+
+/// The report `folder` of the plan and raw records `restored` from the store, written to `out`
+/// and read back as the record of a revision: its inputs those stored (`inputs`, not packed
+/// again), its plan path the original `plan_path`.
+fn written_record(
+    folder: &crate::report_folder::ReportFolder,
+    out: &Path,
+    restored: &crate::raw_records::RestoredInputs,
+    inputs: Vec<gyrolab_store::record::FileRecord>,
+    plan_path: &str,
+) -> StoreResult<EvaluationRecord> {
+    write_report(folder, out)?;
+    let mut new = from_report_folder_with(out, Some(&restored.plan), Some(inputs), false, &restored.moved)?;
+    new.plan_path = plan_path.to_string();
+    Ok(new)
+}
+
 /// Where a re-evaluation reads the plan and its inputs.
 enum Restored {
     /// The plan file where it was, its inputs as it names them.
     InPlace(PathBuf),
     /// The store's copies, laid out in a temporary folder.
     Store(crate::raw_records::RestoredInputs),
-}
-
-impl Restored {
-    fn plan_file(&self) -> &Path {
-        match self {
-            Restored::InPlace(p) => p,
-            Restored::Store(r) => &r.plan,
-        }
-    }
 }
 
 /// The outcome of a re-evaluation.
@@ -104,11 +128,7 @@ pub fn reevaluate_as(
     let (eval_plan, inputs_from_store) = match in_place {
         Ok(()) => (Restored::InPlace(plan_path.clone()), None),
         Err(why) => {
-            staged =
-                tempfile::Builder::new().prefix("gyrolab-reevaluate-").tempdir().map_err(|e| StoreError::Input {
-                    path: std::env::temp_dir().display().to_string(),
-                    message: format!("cannot write: {e}"),
-                })?;
+            staged = staging("gyrolab-reevaluate-")?;
             let restored = crate::raw_records::restore_into(store, id, staged.path()).map_err(|e| match e {
                 StoreError::Refused { store, message } => {
                     StoreError::Refused { store, message: format!("{why}; and from the store: {message}") }
@@ -125,22 +145,13 @@ pub fn reevaluate_as(
     .map_err(|message| StoreError::Input { path: rec.plan_path.clone(), message })?;
     let folder = evaluate_test_plan(&plan, &rec.plan_path, &gyrolab_eval::Silent)
         .map_err(|e| StoreError::Input { path: rec.plan_path.clone(), message: e.to_string() })?;
-    let files: Vec<(&str, &[u8])> = folder.outputs.iter().map(|o| (o.name.as_str(), o.bytes.as_slice())).collect();
-    let inputs: Vec<&Path> = folder.inputs.iter().map(PathBuf::as_path).collect();
-    gyrolab_io::atomic::write_folder(out, &files, &inputs)
-        .map_err(|e| StoreError::Input { path: e.path.display().to_string(), message: e.to_string() })?;
-    let mut new = match inputs_from_store {
-        // The raw records are the store's already: hashed again here, not packed twice.
-        Some(stored) => {
-            let moved = match &eval_plan {
-                Restored::Store(r) => r.moved.as_slice(),
-                Restored::InPlace(_) => &[],
-            };
-            let mut new = from_report_folder_with(out, Some(eval_plan.plan_file()), Some(stored), false, moved)?;
-            new.plan_path = rec.plan_path.clone();
-            new
+    let mut new = match (&eval_plan, inputs_from_store) {
+        // The raw records are the store's already: not packed twice.
+        (Restored::Store(r), Some(stored)) => written_record(&folder, out, r, stored, &rec.plan_path)?,
+        _ => {
+            write_report(&folder, out)?;
+            from_report_folder(out, Some(&plan_path))?
         }
-        None => from_report_folder(out, Some(&plan_path))?,
     };
     // The facts recorded about the device stay those of the revision superseded (corrections
     // included); the figures are the new ones.
@@ -183,10 +194,7 @@ pub fn corrected(store: &mut Store, id: i64, changes: &Changes) -> StoreResult<(
     let kept = |why: String| -> StoreResult<(Option<EvaluationRecord>, String)> {
         Ok((None, format!("the report files are those of evaluation {id}, its body unchanged: {why}\n")))
     };
-    let staged = tempfile::Builder::new().prefix("gyrolab-correct-").tempdir().map_err(|e| StoreError::Input {
-        path: std::env::temp_dir().display().to_string(),
-        message: format!("cannot write: {e}"),
-    })?;
+    let staged = staging("gyrolab-correct-")?;
     let restored = match crate::raw_records::restore_into(store, id, staged.path()) {
         Ok(r) => r,
         Err(StoreError::Refused { message, .. }) => return kept(message),
@@ -213,19 +221,13 @@ pub fn corrected(store: &mut Store, id: i64, changes: &Changes) -> StoreResult<(
         Ok(f) => f,
         Err(e) => return kept(format!("it does not evaluate under this build ({e})")),
     };
-    let out = staged.path().join("report");
-    let files: Vec<(&str, &[u8])> = folder.outputs.iter().map(|o| (o.name.as_str(), o.bytes.as_slice())).collect();
-    gyrolab_io::atomic::write_folder(&out, &files, &[])
-        .map_err(|e| StoreError::Input { path: e.path.display().to_string(), message: e.to_string() })?;
-    let mut new =
-        from_report_folder_with(&out, Some(&restored.plan), Some(old.inputs.clone()), false, &restored.moved)?;
+    let new = written_record(&folder, &staged.path().join("report"), &restored, old.inputs.clone(), &old.plan_path)?;
     if new.figures != old.figures {
         return kept(format!(
             "this build (gyrolab {}) gives other figures than gyrolab {} did; re-evaluate it to change them",
             new.software_version, old.software_version
         ));
     }
-    new.plan_path = old.plan_path.clone();
     Ok((
         Some(new),
         format!("its report drawn again with the corrected fields (the figures of evaluation {id}, unchanged)\n"),
