@@ -9,8 +9,11 @@ use gyrolab::dropout::{DropoutTally, DropoutVerdict};
 use gyrolab::static_test::{bias_repeatability, StaticTestConfig, StaticTestResult};
 use gyrolab::units::OutputUnit;
 use gyrolab::validate;
-use gyrolab_io::series::{evaluate_static_file, ReaderQuality, SeriesOptions, SeriesSummary};
+use gyrolab_io::series::{ReaderQuality, SeriesOptions, SeriesSummary};
 use std::path::{Path, PathBuf};
+
+mod streamed;
+pub use streamed::{evaluate_static_data, evaluate_static_file, window_means_file};
 
 /// Static tests, one file per test.
 ///
@@ -351,7 +354,7 @@ pub fn evaluate_record(
     tally.push_block(&data.channels.iter().map(|c| &c[..]).collect::<Vec<_>>());
     let verdict = tally.verdict();
     with_reference(&path, reference, config, |config_for| {
-        gyrolab_io::series::evaluate_static_data(&mut data, verdict, config_for)
+        evaluate_static_data(&mut data, verdict, config_for)
     })
 }
 

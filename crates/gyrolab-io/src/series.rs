@@ -8,7 +8,9 @@
 //! Layout: optional UTF-8 BOM; `#` comment lines and blank lines anywhere; one header row whose
 //! names carry unit suffixes (`time_s`, `temp_c`, `output_v`, `gyro_x_mv`, `rate_dps`,
 //! `rate_rad_s`, `counts_lsb`); then one row of numbers per sample. The delimiter is sniffed
-//! from the header (comma, else tab, else semicolon, else runs of whitespace).
+//! from the header ([`Delimiter::sniff`]: tab, semicolons between decimal-comma numbers, comma,
+//! semicolon, else runs of whitespace). Where the delimiter is not the comma, numbers written
+//! with a decimal comma (`0,25`) are read as with a point, by every path (issue 55).
 //! Bad input is never repaired: every problem is a [`DataError`] with line and column, except
 //! NaN and empty cells in tolerant mode, which are passed on as NaN and listed in
 //! [`ReaderQuality`].
@@ -16,7 +18,7 @@
 use crate::error::DataError;
 use gyrolab::dropout::{DropoutKind, DropoutMarker, DropoutVerdict};
 use gyrolab::sampling::CompactStamps;
-use gyrolab::static_test::{OutlierScan, SampleBlock, StaticTestAccumulator, StaticTestConfig, StaticTestResult};
+use gyrolab::static_test::SampleBlock;
 use gyrolab::units::{is_celsius, parse_column_name, OutputUnit, Quantity, RateUnit, TimeUnit};
 use serde::{Deserialize, Serialize};
 use std::fs::File;
@@ -263,6 +265,11 @@ pub struct SeriesHeader {
     /// What a row's number counts: text lines, or messages and rows of a binary file.
     #[serde(default)]
     pub rows: RowKind,
+    /// Whether the first data row writes its numbers with a decimal comma (`0,25`), as a
+    /// European spreadsheet exports a `;`- or tab-separated file. Decimal commas are read in
+    /// every file whose delimiter is not the comma, as the text-table reader of `rate` reads them.
+    #[serde(default)]
+    pub decimal_comma: bool,
 }
 
 /// What the number of a row ([`LineMap`], [`DataError::line`]) counts.
@@ -479,6 +486,38 @@ impl<'a> SeriesBlock<'a> {
 
 const SKIP: u32 = SKIP_COLUMN;
 
+/// Writes the decimal commas of a row's numbers as points (`0,25` as `0.25`) when the
+/// delimiter is not the comma; whether there was one.
+fn with_decimal_points(delim: Delimiter, fields: &mut [String]) -> bool {
+    let mut found = false;
+    if delim != Delimiter::Comma {
+        for f in fields.iter_mut() {
+            if crate::text::is_decimal_comma_number(f.trim()) {
+                *f = f.replace(',', ".");
+                found = true;
+            }
+        }
+    }
+    found
+}
+
+/// Parses the number at the start of `bytes` written with a decimal comma (`-0,25`, `1,5e-3`):
+/// the field (up to a delimiter, blank or line end) is copied with its comma as a point and
+/// parsed; the length counts the original bytes. `None` when the field holds no number or is
+/// longer than any number is written.
+fn parse_decimal_comma(bytes: &[u8], delim: u8, ws: bool) -> Option<(f64, usize)> {
+    let mut copy = [0u8; 64];
+    let mut len = 0;
+    while len < bytes.len() && !is_field_end(bytes[len], delim, ws) && bytes[len] != b' ' {
+        if len == copy.len() {
+            return None;
+        }
+        copy[len] = if bytes[len] == b',' { b'.' } else { bytes[len] };
+        len += 1;
+    }
+    fast_float2::parse_partial::<f64, _>(&copy[..len]).ok()
+}
+
 /// Whether a header field is a number (then the line is data, not a header).
 fn is_number_text(f: &str) -> bool {
     let t = f.trim();
@@ -643,6 +682,7 @@ impl<R: Read> SeriesReader<R> {
                 headerless: false,
                 skipped: Vec::new(),
                 rows: RowKind::Line,
+                decimal_comma: false,
             },
             tolerant: options.tolerant,
             dropouts: dropout_marker(options.zero_rows_missing, options.repeated_rows_missing),
@@ -717,8 +757,10 @@ impl<R: Read> SeriesReader<R> {
             break (String::from_utf8_lossy(line).trim().to_string(), start);
         };
         let delim = options.delimiter.unwrap_or_else(|| Delimiter::sniff(&header_text));
-        let fields = delim.split(&header_text);
+        let mut fields = delim.split(&header_text);
+        let decimal_comma = with_decimal_points(delim, &mut fields);
         if fields.iter().all(|f| is_number_text(f)) {
+            r.header.decimal_comma = decimal_comma;
             // No header row: hand the line back to the data parser.
             let data_line = r.line_no;
             r.pos = data_start;
@@ -780,7 +822,9 @@ impl<R: Read> SeriesReader<R> {
             let end = memchr::memchr(b'\n', &self.buf[p..self.complete]).map_or(self.complete, |i| p + i);
             let line = &self.buf[p..end];
             if !is_blank_or_comment(line) {
-                return Ok(Some(delim.split(String::from_utf8_lossy(line).trim())));
+                let mut fields = delim.split(String::from_utf8_lossy(line).trim());
+                self.header.decimal_comma = with_decimal_points(delim, &mut fields);
+                return Ok(Some(fields));
             }
             p = end + 1;
         }
@@ -1228,7 +1272,8 @@ impl<R: Read> SeriesReader<R> {
         let ncols = self.targets.len();
         // With whitespace, the fast path takes rows with exactly one space between fields (runs of
         // spaces, tabs and leading spaces go to the general path, which reads them the same).
-        let fast = self.fast_rows;
+        let fast = self.fast_rows && !self.header.decimal_comma;
+        let decimal_comma = delim != b',';
         let mut refused_at = usize::MAX;
         // Rows the fast path refused in a row, and rows to leave to the general path before
         // trying it again (files whose numbers it never takes, such as `%e` exponents, would
@@ -1291,10 +1336,20 @@ impl<R: Read> SeriesReader<R> {
                         p += 1;
                     }
                 } else {
-                    let parsed = match plain_decimal(&bytes[p..end]) {
+                    let mut parsed = match plain_decimal(&bytes[p..end]) {
                         Some(hit) => Ok(hit),
                         None => fast_float2::parse_partial::<f64, _>(&bytes[p..end]),
                     };
+                    if decimal_comma {
+                        // `0,25` stops the parse at its comma: read it again as `0.25`.
+                        if let Ok((_, n)) = parsed {
+                            if bytes[p + n] == b',' && bytes.get(p + n + 1).is_some_and(u8::is_ascii_digit) {
+                                if let Some(hit) = parse_decimal_comma(&bytes[p..end], delim, ws) {
+                                    parsed = Ok(hit);
+                                }
+                            }
+                        }
+                    }
                     let value = match parsed {
                         Ok((v, n)) => {
                             p += n;
@@ -1748,172 +1803,6 @@ pub fn collect_series<R: Read>(mut r: SeriesReader<R>) -> Result<SeriesData, Dat
     }
     let quality = r.quality.clone();
     Ok(SeriesData { header, lines, time, time_compact, temperature, table_rate, channels, quality })
-}
-
-/// Each channel's static-test options: `config_for`'s, with the channel's name, unit and the
-/// header's sample rate when none is set.
-fn channel_configs(
-    header: &SeriesHeader,
-    config_for: &mut impl FnMut(&ChannelInfo) -> StaticTestConfig,
-) -> Vec<StaticTestConfig> {
-    header
-        .channels
-        .iter()
-        .map(|c| {
-            let mut cfg = config_for(c);
-            cfg.channel = c.name.clone();
-            cfg.output_unit = c.unit;
-            if cfg.sample_rate_hz.is_none() {
-                cfg.sample_rate_hz = header.sample_rate_hz;
-            }
-            cfg
-        })
-        .collect()
-}
-
-/// Evaluates the static (bias) test of every channel of a file, streaming it twice (figures,
-/// then outliers); `config_for` gives each channel's options (scale factor, null, latitude ...).
-pub fn evaluate_static_file(
-    path: impl AsRef<Path>,
-    options: &SeriesOptions,
-    mut config_for: impl FnMut(&ChannelInfo) -> StaticTestConfig,
-) -> Result<(Vec<StaticTestResult>, SeriesSummary), DataError> {
-    let path = path.as_ref();
-    let mut r = SeriesReader::open(path, options)?;
-    let header = r.header.clone();
-    let configs = channel_configs(&header, &mut config_for);
-    let wrap = |ch: &str, e: gyrolab::static_test::StaticTestError| {
-        DataError::new(path, format!("channel '{}': {e}", crate::text::excerpt(ch)))
-    };
-    let mut accs = Vec::with_capacity(configs.len());
-    for cfg in &configs {
-        accs.push(StaticTestAccumulator::new(cfg.clone()).map_err(|e| wrap(&cfg.channel, e))?);
-    }
-    while let Some(b) = r.next_block()? {
-        for (k, acc) in accs.iter_mut().enumerate() {
-            acc.push(&b.samples(k)).map_err(|e| wrap(&configs[k].channel, e))?;
-        }
-    }
-    let summary = SeriesSummary { header: header.clone(), rows: r.rows, quality: r.quality.clone() };
-    let mut firsts = Vec::with_capacity(accs.len());
-    let mut scans = Vec::with_capacity(accs.len());
-    for (acc, cfg) in accs.into_iter().zip(&configs) {
-        let first = acc.finish().map_err(|e| wrap(&cfg.channel, e))?;
-        scans.push(OutlierScan::new(&first, cfg).map_err(|e| wrap(&cfg.channel, e))?);
-        firsts.push(first);
-    }
-    // The second pass can only find outliers where the first pass's extremes allow them.
-    if firsts.iter().all(|f| !f.outlier_scan_needed) {
-        let results = firsts.into_iter().zip(&configs).map(|(f, cfg)| f.with_no_outliers(cfg)).collect();
-        return Ok((results, summary));
-    }
-    let mut r = SeriesReader::open(path, options)?;
-    while let Some(b) = r.next_block()? {
-        for (k, scan) in scans.iter_mut().enumerate() {
-            scan.push(&b.samples(k)).map_err(|e| wrap(&configs[k].channel, e))?;
-        }
-    }
-    let mut results = Vec::with_capacity(scans.len());
-    for ((scan, first), cfg) in scans.into_iter().zip(firsts).zip(&configs) {
-        results.push(scan.finish(first).map_err(|e| wrap(&cfg.channel, e))?);
-    }
-    Ok((results, summary))
-}
-
-/// Evaluates the static (bias) test of every channel of a record held in memory (a Parquet
-/// table, a recording's topic) as [`evaluate_static_file`] does for a file; the dropout rows of
-/// the kinds `dropouts` names (all zero, repeated; [`gyrolab::dropout`]) are left out as missing
-/// (counted in the summary's quality).
-pub fn evaluate_static_data(
-    data: &mut SeriesData,
-    dropouts: DropoutVerdict,
-    mut config_for: impl FnMut(&ChannelInfo) -> StaticTestConfig,
-) -> Result<(Vec<StaticTestResult>, SeriesSummary), DataError> {
-    let header = data.header.clone();
-    let path = header.file.clone();
-    let nch = data.channels.len();
-    if dropouts.any() && nch > 0 {
-        let mut rows = Vec::new();
-        let refs: Vec<&[f64]> = data.channels.iter().map(|c| &c[..]).collect();
-        DropoutMarker::new(dropouts).mark_block(&refs, |i, kind| rows.push((i, kind)));
-        for (i, kind) in rows {
-            data.channels.iter_mut().for_each(|c| c[i] = f64::NAN);
-            data.quality.count_dropout(kind, data.lines.get(i).unwrap_or(0));
-        }
-    }
-    let configs = channel_configs(&header, &mut config_for);
-    let wrap = |ch: &str, e: gyrolab::static_test::StaticTestError| {
-        DataError::new(&path, format!("channel '{}': {e}", crate::text::excerpt(ch)))
-    };
-    let lines = data.lines.to_vec();
-    let block = SeriesBlock {
-        first_line: lines.first().copied().unwrap_or(0),
-        lines: &lines,
-        time: data.time.as_deref(),
-        temp: data.temperature.as_deref(),
-        table_rate: data.table_rate.as_deref(),
-        channels: &data.channels,
-    };
-    let mut results = Vec::with_capacity(configs.len());
-    for (k, cfg) in configs.iter().enumerate() {
-        let mut acc = StaticTestAccumulator::new(cfg.clone()).map_err(|e| wrap(&cfg.channel, e))?;
-        acc.push(&block.samples(k)).map_err(|e| wrap(&cfg.channel, e))?;
-        let first = acc.finish().map_err(|e| wrap(&cfg.channel, e))?;
-        if !first.outlier_scan_needed {
-            results.push(first.with_no_outliers(cfg));
-            continue;
-        }
-        let mut scan = OutlierScan::new(&first, cfg).map_err(|e| wrap(&cfg.channel, e))?;
-        scan.push(&block.samples(k)).map_err(|e| wrap(&cfg.channel, e))?;
-        results.push(scan.finish(first).map_err(|e| wrap(&cfg.channel, e))?);
-    }
-    let summary = SeriesSummary { header, rows: lines.len() as u64, quality: data.quality.clone() };
-    Ok((results, summary))
-}
-
-/// Means of consecutive `window_s`-second windows of one output channel (index into the
-/// header's channels) and the temperature, streaming the file once (memory per window, not
-/// per sample). The sample rate is the options' one, else the mean interval of the time column.
-pub fn window_means_file(
-    path: impl AsRef<Path>,
-    options: &SeriesOptions,
-    channel: usize,
-    window_s: f64,
-) -> Result<Vec<gyrolab::window_means::WindowMean>, DataError> {
-    let path = path.as_ref();
-    let mut r = SeriesReader::open(path, options)?;
-    let fs = match options.sample_rate_hz {
-        Some(f) => f,
-        None => {
-            // The time column's mean interval, from a first pass over the time stamps.
-            let (mut first, mut last, mut n) = (None, 0.0, 0u64);
-            read_series(path, options, |_, b| {
-                if let Some(t) = b.time {
-                    if first.is_none() {
-                        first = t.first().copied();
-                    }
-                    if let Some(&l) = t.last() {
-                        last = l;
-                    }
-                    n += t.len() as u64;
-                }
-                Ok(())
-            })?;
-            match first {
-                Some(f0) if n > 1 && last > f0 => (n - 1) as f64 / (last - f0),
-                _ => return Err(DataError::new(path, "cannot tell the sample rate: give it (sample_rate_hz)")),
-            }
-        }
-    };
-    let mut acc = gyrolab::window_means::WindowMeanAccumulator::new(window_s, fs)
-        .ok_or_else(|| DataError::new(path, format!("window of {window_s} s at {fs} Hz: expected positive numbers")))?;
-    while let Some(b) = r.next_block()? {
-        let Some(out) = b.channels.get(channel) else {
-            return Err(DataError::new(path, format!("no output channel number {}", channel + 1)));
-        };
-        acc.push(out, b.temp);
-    }
-    Ok(acc.finish())
 }
 
 /// Named numeric columns already in memory (a Parquet table, the messages of a recording's

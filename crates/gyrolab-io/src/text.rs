@@ -176,10 +176,17 @@ impl Delimiter {
         }
     }
 
-    /// Guesses the separator from a header line: tab, then comma, then semicolon, else whitespace.
+    /// Guesses the separator from a header line: tab; then semicolon where the commas are decimal
+    /// commas (`0,01;0,25`); then comma, then semicolon, else whitespace.
     pub fn sniff(header: &str) -> Delimiter {
         if header.contains('\t') {
             Delimiter::Tab
+        } else if header.contains(';')
+            && header.split(';').all(|f| !f.contains(',') || is_decimal_comma_number(f.trim().trim_matches('"')))
+        {
+            // `0,01;0,2515`: semicolons between numbers written with decimal commas (a European
+            // spreadsheet's export without a header row).
+            Delimiter::Semicolon
         } else if header.contains(',') {
             Delimiter::Comma
         } else if header.contains(';') {
@@ -317,7 +324,7 @@ pub fn parse_text_table(file: &Path, text: &str) -> Result<TextTable, DataError>
 }
 
 /// Whether a field is a number written with a decimal comma (`-0,25`, `1,5e-3`).
-fn is_decimal_comma_number(f: &str) -> bool {
+pub(crate) fn is_decimal_comma_number(f: &str) -> bool {
     let t = f.strip_prefix(['+', '-']).unwrap_or(f);
     let Some((a, b)) = t.split_once(',') else { return false };
     let (frac, exp) = match b.split_once(['e', 'E']) {

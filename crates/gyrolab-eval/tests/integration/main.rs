@@ -7,5 +7,6 @@ mod clock;
 mod common;
 mod rate;
 mod raw_log;
+mod static_file;
 mod static_test;
 mod triad;

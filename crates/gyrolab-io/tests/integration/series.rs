@@ -1,7 +1,6 @@
 //! The time-series reader: good layouts, every bad input (with line and column), block and chunk
 //! boundaries, and the static test of a file.
 
-use gyrolab::static_test::{Position, StaticTestConfig};
 use gyrolab::units::OutputUnit;
 use gyrolab_io::series::*;
 use gyrolab_io::DataError;
@@ -143,79 +142,6 @@ fn header_errors() {
     assert!(e.message.contains("no time column"), "{e}");
     let e = err("time_s,temp_c\n0,1\n", &SeriesOptions::default());
     assert!(e.message.contains("no output channel"), "{e}");
-}
-
-fn write_temp(text: &str) -> (tempfile::TempDir, std::path::PathBuf) {
-    let dir = tempfile::tempdir().unwrap();
-    let p = dir.path().join("rec.csv");
-    std::fs::write(&p, text).unwrap();
-    (dir, p)
-}
-
-#[test]
-fn static_test_of_a_file_reports_gaps_and_unsorted_time_with_lines() {
-    // 1 Hz; line 2 is the header, sample i on line 3 + i. Gap before sample 5 (t 4 -> 7),
-    // t repeats at sample 8, decreases at sample 9.
-    let times = [0.0, 1.0, 2.0, 3.0, 4.0, 7.0, 8.0, 9.0, 9.0, 8.5, 10.0, 11.0];
-    let mut text = String::from("# rec\ntime_s,output_v\n");
-    for (i, t) in times.iter().enumerate() {
-        text.push_str(&format!("{t},{}\n", 2.5 + 0.001 * (i % 3) as f64));
-    }
-    let (_d, p) = write_temp(&text);
-    let (res, summary) = evaluate_static_file(&p, &SeriesOptions::default(), |_| StaticTestConfig {
-        sample_rate_hz: Some(1.0),
-        ..StaticTestConfig::default()
-    })
-    .unwrap();
-    assert_eq!(summary.rows, 12);
-    let q = &res[0].quality;
-    let pos = |s: u64| Position { sample: s, line: Some(3 + s) };
-    // Sample 10 follows 8.5 by 1.5 s: not above 1.5 x 1 s, so not a gap.
-    assert_eq!(q.time_gaps.first, vec![pos(5)]);
-    assert_eq!(q.repeated_time.first, vec![pos(8)]);
-    assert_eq!(q.decreasing_time.first, vec![pos(9)]);
-    // Short record: 12 samples fit 1 window of 10 s, none of 100 s: both skipped with reasons.
-    let skipped: Vec<f64> = res[0].bias_stability_skipped.iter().map(|s| s.smoothing_s).collect();
-    assert_eq!(skipped, vec![10.0, 100.0]);
-    assert!(res[0].bias_stability_skipped[0].reason.contains("1 whole windows"));
-    assert_eq!(res[0].channel, "output_v");
-}
-
-#[test]
-fn tolerant_missing_cells_reach_the_static_test_with_lines() {
-    let (_d, p) = write_temp("time_s,output_v,gyro_y_v\n0,1,1\n1,nan,2\n2,3,\n3,4,4\n");
-    let (res, summary) = evaluate_static_file(&p, &tolerant(), |_| StaticTestConfig::default()).unwrap();
-    assert_eq!(summary.quality.missing_cells, 2);
-    assert_eq!(res[0].quality.missing.first, vec![Position { sample: 1, line: Some(3) }]);
-    assert_eq!(res[1].quality.missing.first, vec![Position { sample: 2, line: Some(4) }]);
-    assert_eq!(res[0].valid_samples, 3);
-    assert!((res[0].mean_output - 8.0 / 3.0).abs() < 1e-15);
-}
-
-#[test]
-fn chunk_and_block_sizes_do_not_change_static_results() {
-    let mut text = String::from("time_s,temp_c,output_v\n");
-    for i in 0..3000 {
-        let x = 2.5 + 1e-3 * (((i * 7919) % 101) as f64 / 101.0 - 0.5) + 1e-7 * i as f64;
-        text.push_str(&format!("{:.2},{:.3},{x:.9}\n", i as f64 * 0.1, 20.0 + i as f64 * 0.001));
-    }
-    let (_d, p) = write_temp(&text);
-    let base = evaluate_static_file(&p, &SeriesOptions::default(), |_| StaticTestConfig::default()).unwrap().0;
-    for (chunk, rows) in [(16, 1), (64, 7), (1000, 333), (5000, 4096)] {
-        let o = SeriesOptions { chunk_bytes: chunk, block_rows: rows, ..SeriesOptions::default() };
-        let r = evaluate_static_file(&p, &o, |_| StaticTestConfig::default()).unwrap().0;
-        let (a, b) = (&base[0], &r[0]);
-        assert_eq!(a.samples, b.samples);
-        assert!((a.mean_output - b.mean_output).abs() < 1e-14);
-        assert_eq!(a.bias_stability.len(), b.bias_stability.len());
-        for (x, y) in a.bias_stability.iter().zip(&b.bias_stability) {
-            assert_eq!(x.smoothing_s, y.smoothing_s);
-            assert!((y.output - x.output).abs() < 1e-12 * x.output.abs(), "{} s", x.smoothing_s);
-        }
-        assert!((a.drift_output_per_h.unwrap() - b.drift_output_per_h.unwrap()).abs() < 1e-10);
-        let (ta, tb) = (a.temperature.as_ref().unwrap(), b.temperature.as_ref().unwrap());
-        assert!((ta.slope_output_per_c - tb.slope_output_per_c).abs() < 1e-9 * ta.slope_output_per_c.abs());
-    }
 }
 
 proptest! {
@@ -678,4 +604,58 @@ fn batches_of_several_sizes_equal_the_sequential_reader_and_locate_errors() {
             assert!(b.next_batch().unwrap().is_none(), "spent after the error");
         }
     }
+}
+
+/// `;`- and tab-separated files with decimal commas (issue 55), as a European spreadsheet
+/// exports them, read as the same file with points by the sequential reader, the parallel
+/// batches and the parallel ranges; a headerless one too; a field with two commas is located.
+#[test]
+fn decimal_commas_are_read_by_every_path_of_the_series_reader() {
+    let mut dotted = String::from("time_s,gyro_x_dps,temp_c\n");
+    let mut semicolon = String::from("time_s;gyro_x_dps;temp_c\n");
+    let mut tabbed = String::from("time_s\tgyro_x_dps\ttemp_c\n");
+    let mut headerless = String::new();
+    for i in 0..5_000 {
+        // The first row holds integers only: the commas come later.
+        let (t, w, c) = (i as f64 * 0.01, if i == 0 { 1.0 } else { 0.25 + (i % 13) as f64 * 1.5e-3 }, 21.0 + (i % 7) as f64 * 0.1);
+        dotted.push_str(&format!("{t},{w},{c}\n"));
+        let dc = |x: f64| format!("{x}").replace('.', ",");
+        semicolon.push_str(&format!("{};{};{}\n", dc(t), dc(w), dc(c)));
+        tabbed.push_str(&format!("{}\t{}\t{}\n", dc(t), dc(w), dc(c)));
+        if i > 0 {
+            headerless.push_str(&format!("{};{}\n", dc(t), dc(w)));
+        }
+    }
+    let plain = read_str(&dotted, &SeriesOptions::default()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in [("semicolon", &semicolon), ("tab", &tabbed)] {
+        let seq = read_str(text, &SeriesOptions::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let path = dir.path().join(format!("{name}.csv"));
+        std::fs::write(&path, text).unwrap();
+        let opts = SeriesOptions { chunk_bytes: 4096, ..SeriesOptions::default() };
+        let batches = SeriesReader::from_reader("t.csv", text.as_bytes(), &opts)
+            .and_then(|r| collect_series_in_parallel(r, 2, 1000))
+            .unwrap();
+        let ranges = read_series_in_ranges(&path, &opts, 3, 4096).unwrap();
+        for (how, d) in [("sequential", &seq), ("batches", &batches), ("ranges", &ranges)] {
+            assert_eq!(d.channels, plain.channels, "{name} {how}");
+            assert_eq!(d.time, plain.time, "{name} {how}");
+            assert_eq!(d.temperature, plain.temperature, "{name} {how}");
+            assert_eq!(d.lines, plain.lines, "{name} {how}");
+        }
+    }
+    // A first data row with decimal commas: said in the header.
+    let later = semicolon.replacen("0;1;21\n", "", 1);
+    assert!(read_str(&later, &SeriesOptions::default()).unwrap().header.decimal_comma);
+    assert!(!plain.header.decimal_comma);
+    // Without a header row: the decimal commas are numbers, not column names.
+    let d = read_str(&headerless, &SeriesOptions { sample_rate_hz: Some(100.0), ..SeriesOptions::default() }).unwrap();
+    assert!(d.header.headerless && d.header.decimal_comma);
+    assert_eq!(d.channels[0].len(), 4_999);
+    assert_eq!((d.channels[0][0], d.channels[1][0]), (0.01, 0.2515));
+    // Two commas in a number: located; in a comma-separated file a comma stays a delimiter.
+    let e = err("time_s;gyro_x_dps\n0,01;0,25\n0,02;0,2,5\n", &SeriesOptions::default());
+    assert_eq!(at(&e), (Some(3), Some(2)), "{e}");
+    let e = err("time_s,gyro_x_dps\n0.01,0,25\n", &SeriesOptions::default());
+    assert_eq!(e.line, Some(2), "{e}");
 }

@@ -1,10 +1,11 @@
 //! Measures the time-series reader: writes a synthetic `time_s,output_v` file (10 M lines by
 //! default, or the count given as the first argument) into a temporary folder, then reads it back
 //! (parse only) and runs the static test on it (parse + figures + outlier pass), reporting MB/s
-//! and rows/s per second of CPU time of the reading thread (wall time where that is unavailable). Run with `cargo run --release -p gyrolab-io --example series_speed [-- LINES]`.
+//! and rows/s per second of CPU time of the reading thread (wall time where that is unavailable). Run with `cargo run --release -p gyrolab-eval --example series_speed [-- LINES]`.
 
 use gyrolab::static_test::StaticTestConfig;
-use gyrolab_io::series::{evaluate_static_file, read_series, SeriesOptions};
+use gyrolab_eval::static_test::evaluate_static_file;
+use gyrolab_io::series::{read_series, SeriesOptions};
 use std::io::Write;
 use std::time::Instant;
 
