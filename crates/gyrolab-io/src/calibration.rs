@@ -200,16 +200,28 @@ pub fn parse_calibration(path: &Path, text: &str) -> Result<CalibrationFile, Dat
         d
     })?;
     if cal.format != CALIBRATION_FORMAT {
-        return Err(DataError::new(
+        let d = DataError::new(
             path,
-            format!("format '{}' is not supported: expected '{CALIBRATION_FORMAT}'", cal.format),
-        ));
+            format!(
+                "format: '{}' is not supported: expected '{CALIBRATION_FORMAT}'",
+                crate::text::excerpt(&cal.format)
+            ),
+        );
+        return Err(match value_line(text, &[TomlStep::Key("format")]) {
+            Some(l) => d.at_line(l),
+            None => d,
+        });
     }
     for (i, a) in cal.axes.iter().enumerate() {
         let axis = crate::text::excerpt(&a.name);
         let at = |table: &str, key: &str, msg: String| {
             let d = DataError::new(path, format!("axis '{axis}', {key}: {msg}"));
-            match key_line(text, table, i, key) {
+            let mut place = vec![TomlStep::Key("axis"), TomlStep::Index(i)];
+            if let Some(sub) = table.strip_prefix("[axis.").and_then(|t| t.strip_suffix(']')) {
+                place.push(TomlStep::Key(sub));
+            }
+            place.push(TomlStep::Key(key));
+            match value_line(text, &place) {
                 Some(l) => d.at_line(l),
                 None => d,
             }
@@ -232,6 +244,16 @@ pub fn parse_calibration(path: &Path, text: &str) -> Result<CalibrationFile, Dat
                     ),
                 ));
             }
+        }
+        if a.rate_min_dps >= a.rate_max_dps {
+            return Err(at(
+                "[[axis]]",
+                "rate_max_dps",
+                format!(
+                    "{} is not above rate_min_dps = {}: expected the calibrated range as rate_min_dps < rate_max_dps",
+                    a.rate_max_dps, a.rate_min_dps
+                ),
+            ));
         }
         if a.scale_factor.abs() < MIN_SCALE_FACTOR {
             return Err(at(
@@ -322,7 +344,7 @@ pub fn parse_calibration(path: &Path, text: &str) -> Result<CalibrationFile, Dat
         }
     }
     if let Some(t) = &cal.triad {
-        let line = |key: &str| key_line(text, "[triad]", 0, key);
+        let line = |key: &str| value_line(text, &[TomlStep::Key("triad"), TomlStep::Key(key)]);
         let with_line = |d: DataError, l: Option<u64>| match l {
             Some(l) => d.at_line(l),
             None => d,
@@ -365,29 +387,31 @@ pub const MIN_SCALE_FACTOR: f64 = 1e-100;
 /// Highest polynomial order in a calibration file.
 pub const MAX_POLYNOMIAL_ORDER: usize = 9;
 
-/// The 1-based line of `key` in the `index`-th table headed `table` (`[[axis]]`, `[triad]`,
-/// `[axis.polynomial]`) of TOML text, when written as `key = ...` on a line of its own.
-pub fn key_line(text: &str, table: &str, index: usize, key: &str) -> Option<u64> {
-    let mut seen: Option<usize> = None;
-    let mut inside = false;
-    for (n, raw) in text.lines().enumerate() {
-        let t = raw.trim();
-        if t.starts_with('[') {
-            inside = t.split('#').next().map(str::trim) == Some(table);
-            if inside {
-                seen = Some(seen.map_or(0, |s| s + 1));
-            }
-            continue;
-        }
-        if inside && seen == Some(index) {
-            if let Some(rest) = t.strip_prefix(key) {
-                if rest.trim_start().starts_with('=') {
-                    return Some(n as u64 + 1);
-                }
-            }
-        }
+/// One step of a path into a TOML document: a key, or a 0-based index into an array (of
+/// tables).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TomlStep<'a> {
+    /// A key of a table (a `[table]`, an inline table or a dotted key alike).
+    Key(&'a str),
+    /// An element of an array or of an array of tables (`[[axis]]`).
+    Index(usize),
+}
+
+/// The 1-based line on which the value at `place` is written, from a parse that keeps where
+/// each value stands (toml_edit): `key = value` lines, inline tables, dotted keys and the
+/// sub-tables of an array of tables (`[axis.polynomial]` of the third `[[axis]]`) alike. A table
+/// is placed at its header. `None` when the text does not write that value.
+pub fn value_line(text: &str, place: &[TomlStep<'_>]) -> Option<u64> {
+    let doc = toml_edit::ImDocument::parse(text).ok()?;
+    let mut item = doc.as_item();
+    for step in place {
+        item = match *step {
+            TomlStep::Key(k) => item.get(k)?,
+            TomlStep::Index(i) => item.get(i)?,
+        };
     }
-    None
+    let span = item.span()?;
+    Some(line_col(text, span.start).0)
 }
 
 /// 1-based line and column of a byte offset.
@@ -508,5 +532,56 @@ mod tests {
         let text = good.replace("coefficients = [", "coefficients = [1e300, ");
         let e = parse_calibration(p, &text).unwrap_err();
         assert_eq!(e.line, Some(line_of(&text, "coefficients")), "{e}");
+    }
+
+    /// The malformed-input campaign's calibration cases (issue 55), each located to the line of
+    /// its key: a wrong format, an inverted range, NaN coefficients, an order that does not match
+    /// the coefficients, in the second of two axes (whose polynomial table follows a first axis
+    /// without one written as a table), in an inline table, and in [triad].
+    #[test]
+    fn every_calibration_error_names_its_line_and_key() {
+        let p = Path::new("cal.toml");
+        let mut two = sample();
+        let mut y = two.axes[0].clone();
+        y.name = "y".into();
+        y.polynomial = PolynomialModel { order: 2, coefficients: vec![2.5, 0.0075, 1e-8] };
+        two.axes.push(y);
+        let good = two.to_toml().unwrap();
+        // The line of the n-th (0-based) line starting with `key`.
+        let nth = |text: &str, key: &str, n: usize| {
+            text.lines().enumerate().filter(|(_, l)| l.trim_start().starts_with(key)).nth(n).unwrap().0 as u64 + 1
+        };
+        let second = |text: &str, from: &str, to: &str| {
+            let at = text.match_indices(from).nth(1).unwrap().0;
+            format!("{}{to}{}", &text[..at], &text[at + from.len()..])
+        };
+        let cases: Vec<(String, &str, usize, &str)> = vec![
+            (good.replace("format = \"gyrolab-calibration-1\"", "format = \"gyrolab-calibration-9\""), "format", 0, "format"),
+            (second(&good, "rate_min_dps = -300.0", "rate_min_dps = 400.0"), "rate_max_dps", 1, "rate_min_dps < rate_max_dps"),
+            (second(&good, "0.0075,", "nan,"), "coefficients", 1, "finite"),
+            (good.replace("order = 2", "order = 3"), "coefficients", 1, "needs 4 coefficients"),
+            (good.replace("order = 1", "order = 4"), "coefficients", 0, "needs 5 coefficients"),
+        ];
+        assert!(good.contains("format = \"gyrolab-calibration-1\""), "{good}");
+        for (text, key, n, says) in &cases {
+            let e = parse_calibration(p, text).unwrap_err();
+            assert_eq!(e.line, Some(nth(text, key, *n)), "{key}: {e}\n{text}");
+            assert!(e.message.contains(says) && e.message.contains(key), "{e}");
+        }
+        // An inline polynomial table: its line.
+        let inline = "format = \"gyrolab-calibration-1\"\ngenerator = \"hand\"\ncreated = \"2026\"\n\n[[axis]]\nname = \"x\"\nsource_file = \"x.csv\"\noutput_unit = \"V\"\nscale_factor = 0.0075\nzero_offset = 2.5\nrest_reference = 2.5\nrate_min_dps = -300.0\nrate_max_dps = 300.0\npolynomial = { order = 1, coefficients = [2.5, nan] }\n";
+        let e = parse_calibration(p, inline).unwrap_err();
+        assert_eq!(e.line, Some(14), "{e}");
+        // [triad]: a NaN bias and a negative rate limit, each at its line.
+        let mut c = sample();
+        c.triad = Some(triad());
+        let text = c.to_toml().unwrap();
+        for (from, to, key) in [("bias = [", "bias = [nan, ", "bias"), ("rate_limit_dps = 300.0", "rate_limit_dps = -1.0", "rate_limit_dps")] {
+            let bad = text.replace(from, to);
+            let e = parse_calibration(p, &bad).unwrap_err();
+            let triad_at = bad.find("[triad]").unwrap();
+            let line = bad[..triad_at].matches('\n').count() + bad[triad_at..].lines().position(|l| l.starts_with(key)).unwrap() + 1;
+            assert_eq!(e.line, Some(line as u64), "{e}\n{bad}");
+        }
     }
 }

@@ -390,4 +390,22 @@ fn bad_raw_logs_exit_2_naming_file_and_line() {
         cmd.arg("--triad").arg(format!("{a}={}", p.display()));
     }
     assert_exit2(&mut cmd, &["turn_z.csv", "both senses"]);
+
+    // The malformed-input campaign's triad case (issue 55): a time stamp of the y log that goes
+    // back, located at its line of that file.
+    let (z, _) = triad_log(d, 2, &raw_log_setpoints(&TRIAD_RATES, 1, true, true), 3);
+    let text = std::fs::read_to_string(&y).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let header = lines.iter().position(|l| l.starts_with("time_s")).unwrap();
+    let bad = header + 301;
+    let mut fields: Vec<String> = lines[bad].split(',').map(String::from).collect();
+    fields[0] = "0.5".into();
+    lines[bad] = fields.join(",");
+    let back = write(d, "back_y.csv", &(lines.join("\n") + "\n"));
+    let mut cmd = gyrolab();
+    cmd.arg("rate");
+    for (a, p) in [("x", &x), ("y", &back), ("z", &z)] {
+        cmd.arg("--triad").arg(format!("{a}={}", p.display()));
+    }
+    assert_exit2(&mut cmd, &[&format!("back_y.csv:{}:", bad + 1), "time"]);
 }

@@ -476,15 +476,41 @@ pub fn parse_sim_config(path: &std::path::Path, text: &str) -> Result<gyrolab::s
     ];
     for (section, r) in checks {
         let Err(e) = r else { continue };
-        let mut d = crate::DataError::new(path, format!("[{section}] {e}"));
-        if let gyrolab::sim::SimError::OutOfRange { parameter, .. } = &e {
-            let (table, key) = match parameter.rsplit_once('.') {
-                Some((sub, key)) => (format!("[{section}.{sub}]"), key),
-                None => (format!("[{section}]"), *parameter),
-            };
-            if let Some(l) = crate::calibration::key_line(text, &table, 0, key) {
-                d = d.at_line(l);
+        use crate::calibration::{value_line, TomlStep};
+        let place_of = |parameter: &'static str| {
+            let mut place = vec![TomlStep::Key(section)];
+            for k in parameter.split('.') {
+                place.push(TomlStep::Key(k));
+                // `temperature.steps.at_s`: the step at fault, then its key.
+                if let (Some(i), "steps") = (e.step(), k) {
+                    place.push(TomlStep::Index(i));
+                }
             }
+            place
+        };
+        let parameters = e.parameters();
+        // The first key at fault the file writes; else the table's line, and the value said to
+        // be a preset's or the default.
+        let written = parameters.iter().find_map(|p| value_line(text, &place_of(p)));
+        let mut d = match written {
+            Some(_) => crate::DataError::new(path, format!("[{section}] {e}")),
+            None => {
+                let (table, key) = match parameters[0].rsplit_once('.') {
+                    Some((sub, key)) => (format!("[{section}.{sub}]"), key),
+                    None => (format!("[{section}]"), parameters[0]),
+                };
+                crate::DataError::new(
+                    path,
+                    format!("[{section}] {e} (`{key}` is not written in {table}: the value is the preset's or the default)"),
+                )
+            }
+        };
+        let table_line = || {
+            let place = place_of(parameters[0]);
+            (1..place.len()).rev().find_map(|n| value_line(text, &place[..n]))
+        };
+        if let Some(l) = written.or_else(table_line) {
+            d = d.at_line(l);
         }
         return Err(d);
     }
@@ -735,5 +761,45 @@ mod time_column_tests {
         assert!(CountedTime::new(200_000.0, 10, Some(7)).is_none());
         assert!(CountedTime::new(0.5, 10, Some(7)).is_none());
         assert!(CountedTime::new(100.0, 10, None).is_none());
+    }
+
+    /// The malformed-input campaign's simulator set-ups (issue 55), each located to the line of
+    /// the key at fault: rails that do not enclose the null, an inverted flicker range, a
+    /// temperature step going back in time (the step's own line, in an array of tables and in an
+    /// inline array), a repeated rate; a value the file does not write is said to be so.
+    #[test]
+    fn every_simulator_set_up_error_names_its_line_and_key() {
+        let p = std::path::Path::new("sim.toml");
+        let head = "seed = 3\n\n[sensor]\narw_deg_rt_h = 0.5\n";
+        let cases: Vec<(String, u64, &str)> = vec![
+            (format!("{head}null = 2.5\noutput_rail_low = 3.0\noutput_rail_high = 5.0\n"), 6, "output_rail_low"),
+            (format!("{head}flicker_tau_min_s = 100.0\nflicker_tau_max_s = 10.0\n"), 6, "flicker_tau_max_s"),
+            (
+                format!(
+                    "{head}\n[static_record]\nduration_s = 60\n\n[static_record.temperature]\nkind = \"steps\"\nstart_c = 20.0\n\n\
+                     [[static_record.temperature.steps]]\nat_s = 10.0\ntemp_c = 30.0\n\n\
+                     [[static_record.temperature.steps]]\nat_s = 5.0\ntemp_c = 40.0\n"
+                ),
+                18,
+                "step 2",
+            ),
+            (
+                format!(
+                    "{head}\n[static_record.temperature]\nkind = \"steps\"\nstart_c = 20.0\nsteps = [\n  {{ at_s = 10.0, temp_c = 30.0 }},\n  {{ at_s = 20.0, temp_c = nan }},\n]\n"
+                ),
+                11,
+                "temp_c",
+            ),
+            (format!("{head}\n[rate_table]\nruns = 2\nrates_dps = [-10.0, 10.0, 10.0]\n"), 8, "rates_dps"),
+        ];
+        for (text, line, says) in &cases {
+            let e = parse_sim_config(p, text).unwrap_err();
+            assert_eq!(e.line, Some(*line), "{e}\n{text}");
+            assert!(e.message.contains(says), "{e}");
+        }
+        // A preset's value the file does not write: said so, at its table's line.
+        let text = "seed = 3\npreset = \"adxrs646\"\n\n[sensor]\noutput_rail_high = -100.0\n";
+        let e = parse_sim_config(p, text).unwrap_err();
+        assert_eq!(e.line, Some(5), "{e}");
     }
 }

@@ -48,6 +48,36 @@ pub enum SimError {
         /// The repeated rate, deg/s.
         rate_dps: f64,
     },
+    /// A step of a temperature profile is out of range.
+    #[error("step {} of `temperature.steps`: {error}", index + 1)]
+    InStep {
+        /// 0-based index of the step.
+        index: usize,
+        /// What is wrong with it.
+        error: Box<SimError>,
+    },
+}
+
+impl SimError {
+    /// The configuration keys at fault (`flicker_tau_max_s`; `output_rail_low`,
+    /// `output_rail_high` and `null` for rails; `rates_dps`), which a reader of the file locates
+    /// to the line of the first it writes.
+    pub fn parameters(&self) -> Vec<&'static str> {
+        match self {
+            SimError::OutOfRange { parameter, .. } => vec![parameter],
+            SimError::RailsMustEncloseNull { .. } => vec!["output_rail_low", "output_rail_high", "null"],
+            SimError::TooFewRates { .. } | SimError::DuplicateRate { .. } => vec!["rates_dps"],
+            SimError::InStep { error, .. } => error.parameters(),
+        }
+    }
+
+    /// The 0-based index of the temperature step at fault, for an error in one.
+    pub fn step(&self) -> Option<usize> {
+        match self {
+            SimError::InStep { index, .. } => Some(*index),
+            _ => None,
+        }
+    }
 }
 
 fn check(parameter: &'static str, value: f64, ok: bool, valid: &str) -> Result<(), SimError> {
@@ -503,14 +533,16 @@ impl TemperatureProfile {
             TemperatureProfile::Steps { start_c, steps } => {
                 finite("temperature.start_c", *start_c)?;
                 let mut last = f64::NEG_INFINITY;
-                for s in steps {
+                for (index, s) in steps.iter().enumerate() {
+                    let in_step = |e| SimError::InStep { index, error: Box::new(e) };
                     check(
                         "temperature.steps.at_s",
                         s.at_s,
                         s.at_s >= 0.0 && s.at_s > last,
                         "finite, >= 0 and increasing",
-                    )?;
-                    finite("temperature.steps.temp_c", s.temp_c)?;
+                    )
+                    .map_err(in_step)?;
+                    finite("temperature.steps.temp_c", s.temp_c).map_err(in_step)?;
                     last = s.at_s;
                 }
                 Ok(())
