@@ -172,8 +172,8 @@ fn weight_percent(w: f64) -> String {
 
 /// A channel's white-noise and random-walk terms by one estimator, in the curve's coefficient
 /// units (deg/sqrt(s), deg/s/sqrt(s) for a gyro in deg/s; m/s/sqrt(s), m/s^2/sqrt(s) for an
-/// accelerometer) with their sources (intervals written in SI units, `to_si` the factor).
-fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Option<(f64, String, String)>; 2] {
+/// accelerometer) with their sources (intervals written in SI units, `to_si` the conversion: deg to rad as the Kalibr writer converts, to the last bit).
+fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: fn(f64) -> f64) -> [Option<(f64, String, String)>; 2] {
     let name = match &a.topic {
         Some(t) => format!("{} {} ({})", a.file, t, a.channel),
         None => format!("{} ({})", a.file, a.channel),
@@ -227,7 +227,7 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
                 .map(|p| match p.correlation_time {
                     Some(t) => format!(
                         "gauss_markov(sigma {} {}, T {} s)",
-                        real_text(p.value * to_si),
+                        real_text(to_si(p.value)),
                         if a.quantity == Quantity::Acceleration { "m/s^2" } else { "rad/s" },
                         real_text(t.value_s)
                     ),
@@ -238,8 +238,8 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
                 format!(
                     "{} % two-sided interval [{}, {}] {unit} (asymptotic sandwich covariance with the scales' covariance under the fitted model, averaged over the candidate models by their criterion weights, a candidate dropped where a simpler one nested in it has a criterion as small; coverage in simulation: docs/METHODS.md 3.1)",
                     percent(g.confidence),
-                    real_text(x.lower * to_si),
-                    real_text(x.upper * to_si),
+                    real_text(to_si(x.lower)),
+                    real_text(to_si(x.upper)),
                 )
             };
             let accel = a.quantity == Quantity::Acceleration;
@@ -286,7 +286,7 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
                             format!(
                                 "GMWM: left out by the chosen model ({model}); one-sided {} % upper bound {} {unit} given that it is there (nominal: in simulation such bounds held the truth less often), from the intervals averaged over the candidate models holding it, which weigh {} % (docs/METHODS.md 3.1); {name}",
                                 percent(1.0 - (1.0 - g.confidence) / 2.0),
-                                real_text(b.upper * to_si),
+                                real_text(to_si(b.upper)),
                                 weight_percent(b.model_weight),
                             ),
                         )
@@ -307,7 +307,7 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
                     format!(
                         "GMWM: {} plus {rule} bounding {extra} Gauss-Markov process(es) of the model (on or above its Allan variance at every tau, all sampled at the record's rate: the tighter of white noise sigma^2 tau0 (1 + phi) / (1 - phi), about 2 sigma^2 T, and random walk 2 sigma^2 / T over the curve's taus; docs/METHODS.md 3.1), model {model}; {name}",
                         match own {
-                            Some(x) => format!("the estimate {} {unit}", real_text(x.value * to_si)),
+                            Some(x) => format!("the estimate {} {unit}", real_text(to_si(x.value))),
                             None => "no term of its own".to_string(),
                         }
                     ),
@@ -337,8 +337,8 @@ fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: f64) -> [Opti
 /// (in calibrated units).
 pub fn channel_filter_terms(a: &ChannelAnalysis) -> Option<ChannelFilterTerms> {
     let (accelerometer, to_si) = match a.quantity {
-        Quantity::AngularRate => (false, units::deg_to_rad(1.0)),
-        Quantity::Acceleration => (true, 1.0),
+        Quantity::AngularRate => (false, units::deg_to_rad as fn(f64) -> f64),
+        Quantity::Acceleration => (true, std::convert::identity as fn(f64) -> f64),
         _ => return None,
     };
     let terms = |estimator: Estimator| -> [Option<TermEstimate>; 2] {
@@ -347,7 +347,7 @@ pub fn channel_filter_terms(a: &ChannelAnalysis) -> Option<ChannelFilterTerms> {
         let mut out: [Option<TermEstimate>; 2] = Default::default();
         for (i, x) in t.into_iter().enumerate() {
             out[i] = x.map(|(value, basis, detail)| TermEstimate {
-                value: value * to_si,
+                value: to_si(value),
                 basis,
                 detail,
                 overbound_factor: factors.and_then(|f| if i == 0 { f.white } else { f.random_walk }),
@@ -372,7 +372,7 @@ pub fn channel_filter_terms(a: &ChannelAnalysis) -> Option<ChannelFilterTerms> {
                 Some(format!(
                     "{}: the GMWM model holds {what} = {} {}) that no stack takes; the exported values do not model it (with --overbound they are raised until the model lies on or above the curve's upper confidence bounds at the curve's taus)",
                     a.channel,
-                    real_text(p.value * to_si),
+                    real_text(to_si(p.value)),
                     if accelerometer { accel_unit } else { gyro_unit }
                 ))
             })

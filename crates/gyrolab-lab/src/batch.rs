@@ -502,6 +502,11 @@ pub fn result_row(j: &AllanJson, file: &Path, sha256: &str, simulated: Option<&s
     let basis = |readings: &[gyrolab_report::allan::ReadingJson], term: &str| {
         opt_text(readings.iter().find(|r| r.term == term).map(|r| r.basis))
     };
+    // A term with a basis column: its value, or its upper bound (the basis beside it says
+    // which), as the text prints `< 9.17`; empty only when absent.
+    let reading = |readings: &[gyrolab_report::allan::ReadingJson], term: &str| {
+        num(readings.iter().find(|r| r.term == term).and_then(|r| r.value))
+    };
     let quantity = serde_json::to_value(j.quantity).ok().and_then(|v| v.as_str().map(String::from));
     let min = j.dev.iter().zip(&j.taus_s).filter(|(d, _)| d.is_finite()).min_by(|a, b| a.0.total_cmp(b.0));
     let noise = j.noise.as_ref();
@@ -526,13 +531,13 @@ pub fn result_row(j: &AllanJson, file: &Path, sha256: &str, simulated: Option<&s
         Cell::Number(j.samples as f64 * j.tau0_s),
         num(min.map(|m| *m.0)),
         num(min.map(|m| *m.1)),
-        gyro(|n| n.arw_deg_rt_h),
+        reading(readings, "arw"),
         if noise.is_some() { basis(readings, "arw") } else { Cell::Empty },
-        gyro(|n| n.bias_instability_dph),
+        reading(readings, "bias_instability"),
         if noise.is_some() { basis(readings, "bias_instability") } else { Cell::Empty },
         gyro(|n| n.allan_minimum_dph),
         gyro(|n| n.allan_minimum_tau_s),
-        gyro(|n| n.rrw_deg_h_rt_h),
+        reading(readings, "rrw"),
         if noise.is_some() { basis(readings, "rrw") } else { Cell::Empty },
         gyro(|n| n.quantization_deg),
         gyro(|n| n.rate_ramp_dph_per_h),
@@ -540,11 +545,11 @@ pub fn result_row(j: &AllanJson, file: &Path, sha256: &str, simulated: Option<&s
         num(fit.and_then(|f| f.bias_instability_dph)),
         num(fit.and_then(|f| f.rrw_deg_h_rt_h)),
         opt_text(fit_quality.as_deref()),
-        acc(|n| n.vrw_m_s_rt_h),
+        reading(accel_readings, "vrw"),
         if accel.is_some() { basis(accel_readings, "vrw") } else { Cell::Empty },
         acc(|n| n.bias_instability_ug),
         acc(|n| n.allan_minimum_ug),
-        acc(|n| n.accel_random_walk_m_s2_rt_h),
+        reading(accel_readings, "accel_random_walk"),
         if accel.is_some() { basis(accel_readings, "accel_random_walk") } else { Cell::Empty },
         opt_text(j.noise_note.as_deref()),
     ])

@@ -1077,9 +1077,18 @@ pub fn record_length_text(plan: &gyrolab::record_length::RecordLength, precision
         NoiseTerm::BiasInstability => "bias instability (flicker rate noise, alpha = -1)",
         NoiseTerm::AngleRandomWalk => "angle random walk (white rate noise, alpha = 0)",
     };
+    let flat = plan.flat_run_record_s.map_or(String::new(), |f| {
+        format!(
+            "The slope lines read it on a flat run of octave points from {:.4} s to {:.4} s, within a quarter of the record:\n\
+             at least {f:.0} s whatever the precision (`gyrolab allan` calls a shorter record too short by the same rule).\n",
+            plan.request.tau_s,
+            (1u64 << gyrolab::noise::FLAT_MIN_SEGMENTS) as f64 * plan.request.tau_s
+        )
+    });
     format!(
         "To measure {term} from the overlapping Allan deviation at tau = {:.4} s (m = {}, {} Hz)\n\
          within +-{} % at {} % confidence, record at least {} samples: {:.0} s = {:.2} h.\n\
+         {flat}\
          Such a record gives {:.1} equivalent degrees of freedom and an interval of {:.3} to {:.3} times the value.\n\
          (EDF by Greenhall & Riley 2004; chi-squared bounds, NIST SP 1065 section 5.3.)\n",
         plan.request.tau_s,

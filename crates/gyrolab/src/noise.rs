@@ -17,6 +17,7 @@
 //! = N in rad/s/sqrt(Hz), gyroscope_random_walk = K in rad/s^2/sqrt(Hz).
 
 use crate::allan::{AllanCurve, AllanPoint, DeviationKind};
+use statrs::distribution::ContinuousCDF;
 use crate::units;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -497,29 +498,33 @@ struct Pt {
     hi: f64,
     /// Half-width of the interval of ln(deviation).
     h: f64,
+    /// Standard deviation of ln(deviation): h over the normal quantile of the curve's
+    /// confidence when the interval is the curve's, else h (z = 1).
+    sd: f64,
 }
 
 /// The point's interval: its confidence bounds; else dev exp(-+ z / sqrt(2 edf)) with the EDF
 /// (z = 1); else the EDF of `terms / m` independent terms (at least 1).
-fn interval(p: &AllanPoint) -> Pt {
+fn interval(p: &AllanPoint, z: f64) -> Pt {
     if let (Some(lo), Some(hi)) = (p.lower, p.upper) {
         if lo > 0.0 && hi >= lo && hi.is_finite() {
-            return Pt { tau: p.tau_s, dev: p.deviation, lo, hi, h: 0.5 * (hi / lo).ln() };
+            let h = 0.5 * (hi / lo).ln();
+            return Pt { tau: p.tau_s, dev: p.deviation, lo, hi, h, sd: h / z };
         }
     }
     let edf = p.edf.filter(|e| *e > 0.0).unwrap_or_else(|| (p.terms as f64 / p.m.max(1) as f64).max(1.0));
     let h = 1.0 / (2.0 * edf).sqrt();
-    Pt { tau: p.tau_s, dev: p.deviation, lo: p.deviation * (-h).exp(), hi: p.deviation * h.exp(), h }
+    Pt { tau: p.tau_s, dev: p.deviation, lo: p.deviation * (-h).exp(), hi: p.deviation * h.exp(), h, sd: h }
 }
 
 /// Points at least an octave apart (the first point, then each next point at >= 2 x the last
 /// kept tau): octave and decade lists are kept whole, denser lists thinned, so that every
 /// segment spans at least a factor 2 in tau.
-fn octave_points(pts: &[AllanPoint]) -> Vec<Pt> {
+fn octave_points(pts: &[AllanPoint], z: f64) -> Vec<Pt> {
     let mut out: Vec<Pt> = Vec::new();
     for p in pts {
         if out.last().is_none_or(|l| p.tau_s >= 2.0 * l.tau * (1.0 - 1e-9)) {
-            out.push(interval(p));
+            out.push(interval(p, z));
         }
     }
     out
@@ -574,6 +579,103 @@ fn bound_at(pts: &[Pt], at: usize, reason: Unresolved, g: impl Fn(f64, f64) -> f
     }
 }
 
+/// Level of the goodness-of-fit test by which a simpler explanation of a region of the curve is
+/// kept (a flat run without flicker, a rise without a random walk): 90 %.
+pub const ALTERNATIVE_TEST_LEVEL: f64 = 0.9;
+
+/// Whether one term of shape `g` (with the curve's other terms `others`, variance at each point)
+/// explains a region of the curve: the least-squares coefficient c >= 0 of
+/// sum ((ln sigma_i^2 - ln(others_i + c g(tau_i))) / s_i)^2, with s_i = 2 h_i / z the standard
+/// deviation of ln sigma_i^2 (h_i the half-width of ln sigma at the curve's confidence, z its
+/// normal quantile; `Pt::sd` is h_i / z), leaves a sum at or below the chi-square quantile at
+/// [`ALTERNATIVE_TEST_LEVEL`] with n - 1 degrees of freedom (one coefficient fitted). Neighbouring
+/// overlapping estimates are positively correlated, which makes the test lenient: it keeps the
+/// simpler explanation more often than its level says, as an honest reading must.
+fn one_term_explains(region: &[Pt], others: &dyn Fn(&Pt) -> f64, g: impl Fn(f64) -> f64) -> bool {
+    if region.len() < 2 {
+        return true;
+    }
+    let limit = crate::allan::chi_squared_quantile(ALTERNATIVE_TEST_LEVEL, (region.len() - 1) as f64);
+    limit.is_some_and(|q| one_term_misfit(region, others, g) <= q)
+}
+
+/// The least sum of squares of [`one_term_explains`]: how far the best curve `others + c g`
+/// (c >= 0) lies from the region's points, in their standard deviations.
+fn one_term_misfit(region: &[Pt], others: &dyn Fn(&Pt) -> f64, g: impl Fn(f64) -> f64) -> f64 {
+    let sum = |c: f64| -> f64 {
+        region
+            .iter()
+            .map(|p| {
+                let model = (others(p) + c * g(p.tau)).max(f64::MIN_POSITIVE);
+                let sd = (2.0 * p.sd).max(1e-12);
+                ((p.dev * p.dev).ln() - model.ln()).powi(2) / (sd * sd)
+            })
+            .sum()
+    };
+    // c on a log grid from the smallest to the largest one point alone asks, and 0; then golden
+    // section around the best grid value.
+    let scale: Vec<f64> = region.iter().map(|p| p.dev * p.dev / g(p.tau)).filter(|v| v.is_finite() && *v > 0.0).collect();
+    let (lo, hi) = scale.iter().fold((f64::INFINITY, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
+    let mut best = (sum(0.0), 0.0);
+    if lo.is_finite() && hi > 0.0 {
+        let (l0, l1) = ((lo * 1e-3).ln(), (hi * 10.0).ln());
+        let steps = 80;
+        let mut at = 0;
+        for i in 0..=steps {
+            let c = (l0 + (l1 - l0) * i as f64 / steps as f64).exp();
+            let v = sum(c);
+            if v < best.0 {
+                best = (v, c);
+                at = i;
+            }
+        }
+        if best.1 > 0.0 {
+            let grid = |i: usize| l0 + (l1 - l0) * i.min(steps) as f64 / steps as f64;
+            let (mut a, mut b) = (grid(at.saturating_sub(1)), grid(at + 1));
+            let r = (5f64.sqrt() - 1.0) / 2.0;
+            for _ in 0..40 {
+                let (x1, x2) = (b - r * (b - a), a + r * (b - a));
+                if sum(x1.exp()) < sum(x2.exp()) {
+                    b = x2;
+                } else {
+                    a = x1;
+                }
+            }
+            let v = sum((0.5 * (a + b)).exp());
+            if v < best.0 {
+                best = (v, (0.5 * (a + b)).exp());
+            }
+        }
+    }
+    best.0
+}
+
+/// Whether the points of a flat run are explained without a flicker floor: whether one curve
+/// N^2/tau + K^2 tau/3 (white noise N and a rate random walk K >= 0), or one curve N^2/tau +
+/// R^2 tau^2/2 (a rate ramp R >= 0), fits them ([`one_term_explains`]). Then the run is the
+/// rounded bottom of the white noise meeting a random walk or a ramp, which a record too short or
+/// too noisy to show its curvature makes look flat, and bias instability is not resolved there
+/// (issue 55; docs/METHODS.md section 3, "Terms reported only where the record shows them").
+fn explained_without_flicker(run: &[Pt], n: f64) -> bool {
+    let white = |p: &Pt| n * n / p.tau;
+    one_term_explains(run, &white, |tau| tau) || one_term_explains(run, &white, |tau| tau * tau)
+}
+
+/// Where a flat (flicker) region of level `flat_level` (deg/s) begins beside white noise `n`
+/// (deg/sqrt(s)): the tau at which the white-noise line n / sqrt(tau) has fallen to half the flat
+/// level, (2 n / flat_level)^2 s. The slope lines' reading of bias instability and
+/// `gyrolab plan static` place B there alike (issue 55: one rule for both).
+pub fn flat_start_tau_s(n: f64, flat_level: f64) -> f64 {
+    (2.0 * n / flat_level).powi(2)
+}
+
+/// The shortest record in which the slope lines can read a flat run beginning at `tau_start_s`:
+/// its [`FLAT_MIN_SEGMENTS`] + 1 octave points reach 2^FLAT_MIN_SEGMENTS x tau_start, and octave
+/// taus reach a quarter of the record, so 4 x 2^FLAT_MIN_SEGMENTS x tau_start (32 tau_start).
+pub fn flat_run_record_s(tau_start_s: f64) -> f64 {
+    4.0 * (1u64 << FLAT_MIN_SEGMENTS) as f64 * tau_start_s
+}
+
 /// Minimum number of consecutive octave segments of slope 0 that make a flat (bias-instability)
 /// region.
 pub const FLAT_MIN_SEGMENTS: usize = 3;
@@ -590,7 +692,15 @@ pub fn slope_line_terms(curve: &AllanCurve) -> Result<SlopeLineResult, NoiseErro
     if all.len() < 2 {
         return Err(NoiseError::TooFewPoints { needed: 2, found: all.len() });
     }
-    let pts = octave_points(&all);
+    // The normal quantile of the curve's two-sided confidence: its bounds' half-width in
+    // ln(deviation) over z is the standard deviation the alternatives' tests use.
+    let z = curve
+        .confidence
+        .filter(|c| *c > 0.0 && *c < 1.0)
+        .and_then(|c| statrs::distribution::Normal::new(0.0, 1.0).ok().map(|n| n.inverse_cdf(0.5 + c / 2.0)))
+        .filter(|z| z.is_finite() && *z > 0.0)
+        .unwrap_or(1.0);
+    let pts = octave_points(&all, z);
     let seg: Vec<(f64, f64)> = pts.windows(2).map(|w| segment(&w[0], &w[1])).collect();
     let last = pts.len() - 1;
     let i_min = pts.iter().enumerate().min_by(|a, b| a.1.dev.total_cmp(&b.1.dev)).map_or(0, |(i, _)| i);
@@ -671,6 +781,7 @@ pub fn slope_line_terms(curve: &AllanCurve) -> Result<SlopeLineResult, NoiseErro
     let flat = runs(&seg, 0.0, FLAT_MIN_SEGMENTS)
         .into_iter()
         .filter(|r| (r.0..=r.1 + 1).filter(|&i| above_n(i)).count() >= 2)
+        .filter(|r| !explained_without_flicker(&pts[r.0..=r.1 + 1], n_val.unwrap_or(0.0)))
         .map(|r| {
             let at = (r.0..=r.1 + 1).min_by(|&a, &b| pts[a].dev.total_cmp(&pts[b].dev)).unwrap_or(r.0);
             let total: f64 = (r.0..=r.1 + 1).map(weight).sum();
@@ -745,7 +856,17 @@ pub fn slope_line_terms(curve: &AllanCurve) -> Result<SlopeLineResult, NoiseErro
         let dl = (b.tau / a.tau).ln();
         let slope = (eb / ea).ln() / dl;
         let w = (a.h * a.h + b.h * b.h).sqrt() / dl;
-        if (slope - 0.5).abs() <= SLOPE_TOLERANCE + w {
+        // Not resolved as K when, beside the other resolved terms, the rise right of the minimum
+        // (or of the flat run) is explained as well by a flat floor (flicker; only where no flat
+        // run is resolved: a resolved one has its level measured, and the rise after it is
+        // compared with that level at its upper bound above), or by a ramp that fits it better
+        // than a random walk does (a ramp not resolved as R).
+        let region = &pts[start..=last];
+        let ramp = |tau: f64| tau * tau;
+        let explained = (flat.is_none() && one_term_explains(region, &others, |_| 1.0))
+            || (one_term_explains(region, &others, ramp)
+                && one_term_misfit(region, &others, ramp) < one_term_misfit(region, &others, |tau| tau));
+        if (slope - 0.5).abs() <= SLOPE_TOLERANCE + w && !explained {
             let (mut sw, mut swl) = (0.0, 0.0);
             let mut best = (f64::INFINITY, ia);
             for &(i, e) in &excess {
@@ -777,7 +898,19 @@ pub fn slope_line_terms(curve: &AllanCurve) -> Result<SlopeLineResult, NoiseErro
             )
         }
         _ => {
-            let reason = if beyond { too_short } else { Unresolved::NoSupportedRegion };
+            // The curve has not turned: the record a flat run would need, from where the white
+            // noise line falls to half the curve's minimum (the rule `gyrolab plan static` plans
+            // by), the minimum taken at its upper bound so that the length stays a lower limit
+            // (the flat level is at most the minimum). A record already as long shows no flat
+            // run: the reason is then that, not its length.
+            let record_s = curve.n_rate as f64 * curve.tau0_s;
+            let needed = n_val.map(|n| flat_run_record_s(flat_start_tau_s(n, pts[i_min].hi)));
+            let reason = match needed {
+                _ if !beyond => Unresolved::NoSupportedRegion,
+                Some(need) if need <= record_s => Unresolved::NoSupportedRegion,
+                Some(need) => Unresolved::RecordTooShort { needed_record_s: need },
+                None => too_short,
+            };
             let m = bound_at(&pts, i_min, reason, |hi, _| hi);
             (m, m.scaled(1.0 / BIAS_INSTABILITY_FACTOR))
         }

@@ -111,8 +111,18 @@ fn results_equal_those_of_single_allan_runs() {
         assert_eq!(num(row, "tau0_s"), j["tau0_s"].as_f64());
         let dev_min = j["dev"].as_array().unwrap().iter().filter_map(|v| v.as_f64()).fold(f64::INFINITY, f64::min);
         assert!(same(num(row, "dev_min"), Some(dev_min)));
-        for key in ["arw_deg_rt_h", "bias_instability_dph", "allan_minimum_dph", "rrw_deg_h_rt_h", "quantization_deg"] {
+        for key in ["allan_minimum_dph", "quantization_deg"] {
             assert!(same(num(row, key), j["noise"][key].as_f64()), "{key} of {}", r.display());
+        }
+        // A term with a basis: the reading's value or upper bound (issue 55: a bound is never a
+        // blank cell), and its basis.
+        for (key, term) in [("arw_deg_rt_h", "arw"), ("bias_instability_dph", "bias_instability"), ("rrw_deg_h_rt_h", "rrw")] {
+            let reading = j["noise"]["readings"].as_array().unwrap().iter().find(|x| x["term"] == term).unwrap();
+            assert!(same(num(row, key), reading["value"].as_f64()), "{key} of {}", r.display());
+            assert_eq!(row[&format!("{term}_basis")], reading["basis"].as_str().unwrap());
+            if reading["basis"] != "absent" {
+                assert!(num(row, key).is_some(), "{key} of {}: a bound is written", r.display());
+            }
         }
         assert!(same(num(row, "fit_arw_deg_rt_h"), j["noise"]["fit"]["arw_deg_rt_h"].as_f64()));
         assert!(num(row, "arw_deg_rt_h").is_some(), "ARW resolved on 300 s at 50 Hz");
