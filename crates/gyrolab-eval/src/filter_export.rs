@@ -173,7 +173,11 @@ fn weight_percent(w: f64) -> String {
 /// A channel's white-noise and random-walk terms by one estimator, in the curve's coefficient
 /// units (deg/sqrt(s), deg/s/sqrt(s) for a gyro in deg/s; m/s/sqrt(s), m/s^2/sqrt(s) for an
 /// accelerometer) with their sources (intervals written in SI units, `to_si` the conversion: deg to rad as the Kalibr writer converts, to the last bit).
-fn channel_terms(a: &ChannelAnalysis, estimator: Estimator, to_si: fn(f64) -> f64) -> [Option<(f64, String, String)>; 2] {
+fn channel_terms(
+    a: &ChannelAnalysis,
+    estimator: Estimator,
+    to_si: fn(f64) -> f64,
+) -> [Option<(f64, String, String)>; 2] {
     let name = match &a.topic {
         Some(t) => format!("{} {} ({})", a.file, t, a.channel),
         None => format!("{} ({})", a.file, a.channel),

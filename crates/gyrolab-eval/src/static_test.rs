@@ -353,9 +353,7 @@ pub fn evaluate_record(
     let mut tally = DropoutTally::new(data.channels.len());
     tally.push_block(&data.channels.iter().map(|c| &c[..]).collect::<Vec<_>>());
     let verdict = tally.verdict();
-    with_reference(&path, reference, config, |config_for| {
-        evaluate_static_data(&mut data, verdict, config_for)
-    })
+    with_reference(&path, reference, config, |config_for| evaluate_static_data(&mut data, verdict, config_for))
 }
 
 /// The stillness check ([`gyrolab::stillness`]) of a static record's first selected channel,

@@ -556,8 +556,18 @@ mod tests {
             format!("{}{to}{}", &text[..at], &text[at + from.len()..])
         };
         let cases: Vec<(String, &str, usize, &str)> = vec![
-            (good.replace("format = \"gyrolab-calibration-1\"", "format = \"gyrolab-calibration-9\""), "format", 0, "format"),
-            (second(&good, "rate_min_dps = -300.0", "rate_min_dps = 400.0"), "rate_max_dps", 1, "rate_min_dps < rate_max_dps"),
+            (
+                good.replace("format = \"gyrolab-calibration-1\"", "format = \"gyrolab-calibration-9\""),
+                "format",
+                0,
+                "format",
+            ),
+            (
+                second(&good, "rate_min_dps = -300.0", "rate_min_dps = 400.0"),
+                "rate_max_dps",
+                1,
+                "rate_min_dps < rate_max_dps",
+            ),
             (second(&good, "0.0075,", "nan,"), "coefficients", 1, "finite"),
             (good.replace("order = 2", "order = 3"), "coefficients", 1, "needs 4 coefficients"),
             (good.replace("order = 1", "order = 4"), "coefficients", 0, "needs 5 coefficients"),
@@ -576,11 +586,16 @@ mod tests {
         let mut c = sample();
         c.triad = Some(triad());
         let text = c.to_toml().unwrap();
-        for (from, to, key) in [("bias = [", "bias = [nan, ", "bias"), ("rate_limit_dps = 300.0", "rate_limit_dps = -1.0", "rate_limit_dps")] {
+        for (from, to, key) in [
+            ("bias = [", "bias = [nan, ", "bias"),
+            ("rate_limit_dps = 300.0", "rate_limit_dps = -1.0", "rate_limit_dps"),
+        ] {
             let bad = text.replace(from, to);
             let e = parse_calibration(p, &bad).unwrap_err();
             let triad_at = bad.find("[triad]").unwrap();
-            let line = bad[..triad_at].matches('\n').count() + bad[triad_at..].lines().position(|l| l.starts_with(key)).unwrap() + 1;
+            let line = bad[..triad_at].matches('\n').count()
+                + bad[triad_at..].lines().position(|l| l.starts_with(key)).unwrap()
+                + 1;
             assert_eq!(e.line, Some(line as u64), "{e}\n{bad}");
         }
     }

@@ -77,7 +77,8 @@ fn record(case: &Case, hours: f64, seed: u64) -> Option<Vec<f64>> {
 /// B (deg/s) and K (deg/s/sqrt(s)) as the slope lines and the GMWM read them from one record.
 fn read(case: &Case, hours: f64, seed: u64) -> Option<[Said; 2]> {
     let samples = record(case, hours, seed)?;
-    let opts = AllanOptions { kind: DeviationKind::Oadev, taus: TauList::Octave, confidence: Some(0.683), max_factor: None };
+    let opts =
+        AllanOptions { kind: DeviationKind::Oadev, taus: TauList::Octave, confidence: Some(0.683), max_factor: None };
     let curve = deviation_from_rate(samples, 1.0 / RATE_HZ, &opts).ok()?;
     let slope = slope_line_terms(&curve).ok()?;
     let g = gmwm(&curve, 0.683).ok();

@@ -17,10 +17,10 @@
 //! = N in rad/s/sqrt(Hz), gyroscope_random_walk = K in rad/s^2/sqrt(Hz).
 
 use crate::allan::{AllanCurve, AllanPoint, DeviationKind};
-use statrs::distribution::ContinuousCDF;
 use crate::units;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
+use statrs::distribution::ContinuousCDF;
 use thiserror::Error;
 
 /// sqrt(2 ln 2 / pi) = 0.6643: the flat-region Allan deviation per unit bias instability.
@@ -614,7 +614,8 @@ fn one_term_misfit(region: &[Pt], others: &dyn Fn(&Pt) -> f64, g: impl Fn(f64) -
     };
     // c on a log grid from the smallest to the largest one point alone asks, and 0; then golden
     // section around the best grid value.
-    let scale: Vec<f64> = region.iter().map(|p| p.dev * p.dev / g(p.tau)).filter(|v| v.is_finite() && *v > 0.0).collect();
+    let scale: Vec<f64> =
+        region.iter().map(|p| p.dev * p.dev / g(p.tau)).filter(|v| v.is_finite() && *v > 0.0).collect();
     let (lo, hi) = scale.iter().fold((f64::INFINITY, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
     let mut best = (sum(0.0), 0.0);
     if lo.is_finite() && hi > 0.0 {

@@ -142,7 +142,7 @@ pub fn static_record_length(req: &RecordLengthRequest) -> Result<RecordLength, R
     // Stable32's stop limit for OADEV: m <= N / 4; for bias instability, the flat run the slope
     // lines read (its last point at 2^FLAT_MIN_SEGMENTS m, within the same limit).
     let mut lo = match req.term {
-        NoiseTerm::BiasInstability => 4 * (m as u64) << FLAT_MIN_SEGMENTS,
+        NoiseTerm::BiasInstability => (4 * m as u64) << FLAT_MIN_SEGMENTS,
         NoiseTerm::AngleRandomWalk => 4 * m as u64,
     };
     if good(lo) {
@@ -300,7 +300,10 @@ mod tests {
                 match b {
                     Reading::UpperBound { reason: Unresolved::RecordTooShort { needed_record_s }, .. } => {
                         assert!(duration < flat, "seed {seed}: {duration} s called too short");
-                        assert!((0.25..2.0).contains(&(needed_record_s / flat)), "seed {seed}: {needed_record_s} vs {flat}");
+                        assert!(
+                            (0.25..2.0).contains(&(needed_record_s / flat)),
+                            "seed {seed}: {needed_record_s} vs {flat}"
+                        );
                         too_short += 1;
                     }
                     other => assert!(duration >= flat || other.value().is_none(), "seed {seed}: {other:?}"),

@@ -116,7 +116,9 @@ fn results_equal_those_of_single_allan_runs() {
         }
         // A term with a basis: the reading's value or upper bound (issue 55: a bound is never a
         // blank cell), and its basis.
-        for (key, term) in [("arw_deg_rt_h", "arw"), ("bias_instability_dph", "bias_instability"), ("rrw_deg_h_rt_h", "rrw")] {
+        for (key, term) in
+            [("arw_deg_rt_h", "arw"), ("bias_instability_dph", "bias_instability"), ("rrw_deg_h_rt_h", "rrw")]
+        {
             let reading = j["noise"]["readings"].as_array().unwrap().iter().find(|x| x["term"] == term).unwrap();
             assert!(same(num(row, key), reading["value"].as_f64()), "{key} of {}", r.display());
             assert_eq!(row[&format!("{term}_basis")], reading["basis"].as_str().unwrap());

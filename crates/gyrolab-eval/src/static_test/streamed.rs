@@ -7,7 +7,9 @@
 
 use gyrolab::dropout::{DropoutMarker, DropoutVerdict};
 use gyrolab::static_test::{OutlierScan, StaticTestAccumulator, StaticTestConfig, StaticTestResult};
-use gyrolab_io::series::{read_series, ChannelInfo, SeriesBlock, SeriesData, SeriesHeader, SeriesOptions, SeriesReader, SeriesSummary};
+use gyrolab_io::series::{
+    read_series, ChannelInfo, SeriesBlock, SeriesData, SeriesHeader, SeriesOptions, SeriesReader, SeriesSummary,
+};
 use gyrolab_io::DataError;
 use std::path::Path;
 

@@ -501,7 +501,9 @@ pub fn parse_sim_config(path: &std::path::Path, text: &str) -> Result<gyrolab::s
                 };
                 crate::DataError::new(
                     path,
-                    format!("[{section}] {e} (`{key}` is not written in {table}: the value is the preset's or the default)"),
+                    format!(
+                        "[{section}] {e} (`{key}` is not written in {table}: the value is the preset's or the default)"
+                    ),
                 )
             }
         };

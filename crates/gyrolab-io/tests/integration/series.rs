@@ -617,7 +617,8 @@ fn decimal_commas_are_read_by_every_path_of_the_series_reader() {
     let mut headerless = String::new();
     for i in 0..5_000 {
         // The first row holds integers only: the commas come later.
-        let (t, w, c) = (i as f64 * 0.01, if i == 0 { 1.0 } else { 0.25 + (i % 13) as f64 * 1.5e-3 }, 21.0 + (i % 7) as f64 * 0.1);
+        let (t, w, c) =
+            (i as f64 * 0.01, if i == 0 { 1.0 } else { 0.25 + (i % 13) as f64 * 1.5e-3 }, 21.0 + (i % 7) as f64 * 0.1);
         dotted.push_str(&format!("{t},{w},{c}\n"));
         let dc = |x: f64| format!("{x}").replace('.', ",");
         semicolon.push_str(&format!("{};{};{}\n", dc(t), dc(w), dc(c)));
