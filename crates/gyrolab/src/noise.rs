@@ -903,8 +903,10 @@ pub fn slope_line_terms(curve: &AllanCurve) -> Result<SlopeLineResult, NoiseErro
             // noise line falls to half the curve's minimum (the rule `gyrolab plan static` plans
             // by), the minimum taken at its upper bound so that the length stays a lower limit
             // (the flat level is at most the minimum). A record already as long shows no flat
-            // run: the reason is then that, not its length.
-            let record_s = curve.n_rate as f64 * curve.tau0_s;
+            // run: the reason is then that, not its length. The record counts as far as the
+            // curve's taus reach (octave taus reach between an eighth and a quarter of it; a tau
+            // list cut short by the caller reaches less).
+            let record_s = (curve.n_rate as f64 * curve.tau0_s).min(8.0 * pts[last].tau);
             let needed = n_val.map(|n| flat_run_record_s(flat_start_tau_s(n, pts[i_min].hi)));
             let reason = match needed {
                 _ if !beyond => Unresolved::NoSupportedRegion,
